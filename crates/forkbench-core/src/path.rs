@@ -1,0 +1,120 @@
+//! Dense path samples (s, x, y, heading, curvature) and the metrics every planner reports.
+
+use serde::{Deserialize, Serialize};
+
+use crate::pose::Pose2;
+use crate::units::wrap_angle;
+use crate::vehicle::ForkliftSpec;
+
+/// One sample along a planned path.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PathSample {
+    pub s_m: f64,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_rad: f64,
+    pub curvature_per_m: f64,
+}
+
+impl PathSample {
+    pub fn pose(&self) -> Pose2 {
+        Pose2::new(self.x_m, self.y_m, self.heading_rad)
+    }
+}
+
+/// A forward path as dense samples ordered by arc length.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Path {
+    pub samples: Vec<PathSample>,
+}
+
+/// Summary figures of a path against the pose it was meant to reach.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PathMetrics {
+    pub length_m: f64,
+    pub max_abs_curvature_per_m: f64,
+    /// Equivalent steering angle arctan(L |κ|max) for the given truck.
+    pub max_steer_rad: f64,
+    /// Largest curvature change between neighbouring samples (continuity check).
+    pub max_curvature_jump_per_m: f64,
+    /// Largest spacing between neighbouring samples.
+    pub max_sample_spacing_m: f64,
+    pub start_position_error_m: f64,
+    pub start_heading_error_rad: f64,
+    pub endpoint_position_error_m: f64,
+    pub endpoint_heading_error_rad: f64,
+}
+
+impl Path {
+    pub fn length_m(&self) -> f64 {
+        self.samples.last().map_or(0.0, |p| p.s_m)
+    }
+
+    pub fn is_finite(&self) -> bool {
+        self.samples.iter().all(|p| {
+            p.s_m.is_finite()
+                && p.x_m.is_finite()
+                && p.y_m.is_finite()
+                && p.heading_rad.is_finite()
+                && p.curvature_per_m.is_finite()
+        })
+    }
+
+    /// Measures the path against the start and goal poses it was planned for.
+    pub fn metrics(&self, start: &Pose2, goal: &Pose2, truck: &ForkliftSpec) -> PathMetrics {
+        let first = self.samples.first().map_or(*start, PathSample::pose);
+        let last = self.samples.last().map_or(*start, PathSample::pose);
+        let max_k = self
+            .samples
+            .iter()
+            .map(|p| p.curvature_per_m.abs())
+            .fold(0.0, f64::max);
+        let (mut jump, mut spacing) = (0.0_f64, 0.0_f64);
+        for w in self.samples.windows(2) {
+            jump = jump.max((w[1].curvature_per_m - w[0].curvature_per_m).abs());
+            spacing = spacing.max((w[1].x_m - w[0].x_m).hypot(w[1].y_m - w[0].y_m));
+        }
+        PathMetrics {
+            length_m: self.length_m(),
+            max_abs_curvature_per_m: max_k,
+            max_steer_rad: truck.steer_for_curvature(max_k),
+            max_curvature_jump_per_m: jump,
+            max_sample_spacing_m: spacing,
+            start_position_error_m: first.distance_to(start),
+            start_heading_error_rad: wrap_angle(first.heading_rad - start.heading_rad).abs(),
+            endpoint_position_error_m: last.distance_to(goal),
+            endpoint_heading_error_rad: wrap_angle(last.heading_rad - goal.heading_rad).abs(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metrics_of_a_straight_line() {
+        let samples = (0..=100)
+            .map(|i| {
+                let s = i as f64 * 0.01;
+                PathSample {
+                    s_m: s,
+                    x_m: s,
+                    y_m: 0.0,
+                    heading_rad: 0.0,
+                    curvature_per_m: 0.0,
+                }
+            })
+            .collect();
+        let path = Path { samples };
+        let m = path.metrics(
+            &Pose2::new(0.0, 0.0, 0.0),
+            &Pose2::new(1.0, 0.1, 0.0),
+            &ForkliftSpec::default(),
+        );
+        assert!((m.length_m - 1.0).abs() < 1e-12);
+        assert_eq!(m.max_abs_curvature_per_m, 0.0);
+        assert!((m.endpoint_position_error_m - 0.1).abs() < 1e-12);
+        assert!((m.max_sample_spacing_m - 0.01).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,163 @@
+//! The forklift specification (Hangcha A30 defaults, SPEC section 0) and its derived limits.
+
+use serde::{Deserialize, Serialize};
+
+/// Geometry and limits of a rear-steered counterbalance forklift.
+///
+/// The kinematic origin is the centre of the front (drive) axle; the path reference
+/// point for picking is the fork root.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ForkliftSpec {
+    /// Distance between front (drive) and rear (steer) axles.
+    pub wheelbase_m: f64,
+    /// Largest equivalent steering angle of the rear wheel.
+    pub max_steer_rad: f64,
+    /// Chassis length (simulation body).
+    pub body_length_m: f64,
+    /// Chassis width (simulation body).
+    pub body_width_m: f64,
+    /// Mass of the loaded-free truck.
+    pub mass_kg: f64,
+    pub fork_length_m: f64,
+    pub fork_width_m: f64,
+    /// Centre-to-centre spacing of the two forks.
+    pub fork_spacing_m: f64,
+    /// Longitudinal distance from the front axle forward to the fork root.
+    pub fork_root_ahead_of_front_axle_m: f64,
+    /// Largest speed while picking.
+    pub max_speed_mps: f64,
+    /// Rate limit of the steering actuator.
+    pub max_steer_rate_radps: f64,
+}
+
+impl Default for ForkliftSpec {
+    // 1.0471 rad is the paper's printed α_max (not π/3); κ_max = 1.063 m⁻¹ follows from it.
+    #[allow(clippy::approx_constant)]
+    fn default() -> Self {
+        Self {
+            wheelbase_m: 1.629,
+            max_steer_rad: 1.0471,
+            body_length_m: 2.45,
+            body_width_m: 1.2,
+            mass_kg: 4850.0,
+            fork_length_m: 1.6,
+            fork_width_m: 0.15,
+            fork_spacing_m: 0.6,
+            fork_root_ahead_of_front_axle_m: 0.45,
+            max_speed_mps: 0.8,
+            max_steer_rate_radps: 0.8,
+        }
+    }
+}
+
+/// A forklift spec value that cannot describe a real truck.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("forklift spec field `{field}` = {value}: {reason}")]
+pub struct SpecError {
+    pub field: &'static str,
+    pub value: f64,
+    pub reason: &'static str,
+}
+
+impl ForkliftSpec {
+    /// Largest path curvature the truck can follow: tan(α_max) / L.
+    pub fn max_curvature_per_m(&self) -> f64 {
+        self.max_steer_rad.tan() / self.wheelbase_m
+    }
+
+    /// Smallest turning radius of the front-axle reference point: 1 / κ_max.
+    pub fn min_turn_radius_m(&self) -> f64 {
+        1.0 / self.max_curvature_per_m()
+    }
+
+    /// Equivalent steering angle that yields the given path curvature: arctan(L κ).
+    pub fn steer_for_curvature(&self, curvature_per_m: f64) -> f64 {
+        (self.wheelbase_m * curvature_per_m).atan()
+    }
+
+    /// Rejects values no truck can have, naming the field.
+    pub fn validate(&self) -> Result<(), SpecError> {
+        let positive = [
+            ("wheelbase_m", self.wheelbase_m),
+            ("body_length_m", self.body_length_m),
+            ("body_width_m", self.body_width_m),
+            ("mass_kg", self.mass_kg),
+            ("fork_length_m", self.fork_length_m),
+            ("fork_width_m", self.fork_width_m),
+            ("fork_spacing_m", self.fork_spacing_m),
+            ("max_speed_mps", self.max_speed_mps),
+            ("max_steer_rate_radps", self.max_steer_rate_radps),
+        ];
+        for (field, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(SpecError {
+                    field,
+                    value,
+                    reason: "must be a positive finite number",
+                });
+            }
+        }
+        if !(self.max_steer_rad > 0.0 && self.max_steer_rad < std::f64::consts::FRAC_PI_2) {
+            return Err(SpecError {
+                field: "max_steer_rad",
+                value: self.max_steer_rad,
+                reason: "must lie strictly between 0 and π/2",
+            });
+        }
+        if !self.fork_root_ahead_of_front_axle_m.is_finite() {
+            return Err(SpecError {
+                field: "fork_root_ahead_of_front_axle_m",
+                value: self.fork_root_ahead_of_front_axle_m,
+                reason: "must be finite",
+            });
+        }
+        if self.fork_spacing_m + self.fork_width_m > self.body_width_m * 1.5 {
+            return Err(SpecError {
+                field: "fork_spacing_m",
+                value: self.fork_spacing_m,
+                reason: "forks spread far wider than the truck",
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a30_limits_match_spec_section_0() {
+        let spec = ForkliftSpec::default();
+        assert!((spec.max_curvature_per_m() - 1.063).abs() < 1e-3);
+        assert!((spec.min_turn_radius_m() - 0.9407).abs() < 1e-3);
+        assert!(spec.validate().is_ok());
+    }
+
+    #[test]
+    fn toml_overrides_and_rejects_unknown_fields() {
+        let spec: ForkliftSpec = toml::from_str("wheelbase_m = 2.0").expect("valid toml");
+        assert_eq!(spec.wheelbase_m, 2.0);
+        assert_eq!(spec.max_speed_mps, 0.8);
+        assert!(toml::from_str::<ForkliftSpec>("wheelbase = 2.0").is_err());
+    }
+
+    #[test]
+    fn validate_names_the_field() {
+        let spec = ForkliftSpec {
+            wheelbase_m: -1.0,
+            ..ForkliftSpec::default()
+        };
+        let err = spec.validate().expect_err("negative wheelbase");
+        assert_eq!(err.field, "wheelbase_m");
+        let spec = ForkliftSpec {
+            max_steer_rad: 2.0,
+            ..ForkliftSpec::default()
+        };
+        assert_eq!(
+            spec.validate().expect_err("too much steer").field,
+            "max_steer_rad"
+        );
+    }
+}

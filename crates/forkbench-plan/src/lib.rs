@@ -1,0 +1,199 @@
+//! Pallet-pick path planners: cubic B-spline (Lü et al. 2019) and quartic polynomial spiral (Shen et al. 2022).
+
+pub mod bspline;
+pub mod numeric;
+pub mod reproduce;
+pub mod spiral;
+
+use forkbench_core::{ForkliftSpec, Path, Pose2};
+use serde::{Deserialize, Serialize};
+
+pub use bspline::{BsplineConfig, BsplinePlan};
+pub use spiral::{SpiralConfig, SpiralParams, SpiralPlan};
+
+/// Which local planner to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PlannerKind {
+    Bspline,
+    Spiral,
+}
+
+impl PlannerKind {
+    pub const ALL: [PlannerKind; 2] = [PlannerKind::Bspline, PlannerKind::Spiral];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            PlannerKind::Bspline => "bspline",
+            PlannerKind::Spiral => "spiral",
+        }
+    }
+}
+
+impl std::fmt::Display for PlannerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for PlannerKind {
+    type Err = PlanError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "bspline" => Ok(PlannerKind::Bspline),
+            "spiral" => Ok(PlannerKind::Spiral),
+            other => Err(PlanError::InvalidInput {
+                what: "planner",
+                reason: format!("unknown planner {other:?} (expected bspline or spiral)"),
+            }),
+        }
+    }
+}
+
+/// What to plan: a forward path of the fork root from `start` to `goal`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanRequest {
+    pub start: Pose2,
+    pub goal: Pose2,
+    /// Path curvature at the start (from the current steering angle); the B-spline
+    /// always starts at zero curvature and ignores it.
+    pub start_curvature_per_m: f64,
+    pub truck: ForkliftSpec,
+}
+
+impl PlanRequest {
+    pub fn new(start: Pose2, goal: Pose2) -> Self {
+        Self {
+            start,
+            goal,
+            start_curvature_per_m: 0.0,
+            truck: ForkliftSpec::default(),
+        }
+    }
+
+    /// Checks what every planner needs: finite poses, a valid truck, distinct start and goal.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        if !self.start.is_finite() {
+            return Err(PlanError::InvalidInput {
+                what: "start",
+                reason: "pose has a non-finite component".into(),
+            });
+        }
+        if !self.goal.is_finite() {
+            return Err(PlanError::InvalidInput {
+                what: "goal",
+                reason: "pose has a non-finite component".into(),
+            });
+        }
+        if !self.start_curvature_per_m.is_finite() {
+            return Err(PlanError::InvalidInput {
+                what: "start_curvature_per_m",
+                reason: "must be finite".into(),
+            });
+        }
+        self.truck.validate().map_err(|e| PlanError::InvalidInput {
+            what: "truck",
+            reason: e.to_string(),
+        })?;
+        let limit = self.truck.max_curvature_per_m();
+        if self.start_curvature_per_m.abs() > limit {
+            return Err(PlanError::StartCurvature {
+                curvature_per_m: self.start_curvature_per_m,
+                limit_per_m: limit,
+            });
+        }
+        let d = self.start.distance_to(&self.goal);
+        if d < MIN_GOAL_DISTANCE_M {
+            return Err(PlanError::GoalTooClose {
+                distance_m: d,
+                min_m: MIN_GOAL_DISTANCE_M,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Below this start–goal distance no forward pick path is meaningful.
+pub const MIN_GOAL_DISTANCE_M: f64 = 0.05;
+
+/// Why a plan could not be made. Every variant names the limit that failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    #[error("invalid {what}: {reason}")]
+    InvalidInput { what: &'static str, reason: String },
+    #[error("goal is {distance_m:.3} m from the start; a pick path needs at least {min_m} m")]
+    GoalTooClose { distance_m: f64, min_m: f64 },
+    #[error(
+        "start curvature {curvature_per_m:.4} m⁻¹ exceeds κ_max {limit_per_m:.4} m⁻¹ of the truck"
+    )]
+    StartCurvature {
+        curvature_per_m: f64,
+        limit_per_m: f64,
+    },
+    #[error(
+        "{planner} path needs max |κ| {needed_per_m:.4} m⁻¹ > κ_max {limit_per_m:.4} m⁻¹ \
+         (steering {needed_steer_rad:.4} rad > α_max {limit_steer_rad:.4} rad)"
+    )]
+    CurvatureLimit {
+        planner: PlannerKind,
+        needed_per_m: f64,
+        limit_per_m: f64,
+        needed_steer_rad: f64,
+        limit_steer_rad: f64,
+    },
+    #[error("{planner} cannot reach the goal: {reason}")]
+    Unreachable {
+        planner: PlannerKind,
+        reason: String,
+    },
+}
+
+impl PlanError {
+    pub(crate) fn curvature(planner: PlannerKind, needed_per_m: f64, truck: &ForkliftSpec) -> Self {
+        PlanError::CurvatureLimit {
+            planner,
+            needed_per_m,
+            limit_per_m: truck.max_curvature_per_m(),
+            needed_steer_rad: truck.steer_for_curvature(needed_per_m),
+            limit_steer_rad: truck.max_steer_rad,
+        }
+    }
+}
+
+/// Planner-specific parameters of a finished plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PlanParams {
+    Bspline {
+        l1_m: f64,
+        l2_m: f64,
+        control_points_m: [[f64; 2]; 6],
+    },
+    Spiral(SpiralParams),
+}
+
+/// A planned path with the planner's parameters and objective value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    pub planner: PlannerKind,
+    pub params: PlanParams,
+    /// The planner's own objective: max |κ| (m⁻¹) for bspline, normalised ∫½κ² for spiral.
+    pub cost: f64,
+    pub path: Path,
+}
+
+/// Settings of both planners (each keeps its own defaults).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlannerConfig {
+    pub bspline: BsplineConfig,
+    pub spiral: SpiralConfig,
+}
+
+/// Plans with the chosen planner.
+pub fn plan(kind: PlannerKind, req: &PlanRequest, cfg: &PlannerConfig) -> Result<Plan, PlanError> {
+    match kind {
+        PlannerKind::Bspline => bspline::plan(req, &cfg.bspline).map(BsplinePlan::into_plan),
+        PlannerKind::Spiral => spiral::plan(req, &cfg.spiral).map(SpiralPlan::into_plan),
+    }
+}
