@@ -1,1 +1,168 @@
-fn main() {}
+//! `forkbench`: the command-line front end (parse, call the libraries, print).
+
+mod plan_cmd;
+mod plot;
+mod reproduce_cmd;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use clap::{Parser, Subcommand, ValueEnum};
+use forkbench_core::{ForkliftSpec, Pose2};
+use forkbench_plan::PlannerKind;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "forkbench",
+    version,
+    about = "Physics test bench for autonomous forklift pallet picking"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Planner names as the CLI spells them.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum PlannerArg {
+    Bspline,
+    Spiral,
+}
+
+impl From<PlannerArg> for PlannerKind {
+    fn from(p: PlannerArg) -> Self {
+        match p {
+            PlannerArg::Bspline => PlannerKind::Bspline,
+            PlannerArg::Spiral => PlannerKind::Spiral,
+        }
+    }
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Plan one pick path from a start pose to a pallet pose.
+    Plan {
+        planner: PlannerArg,
+        /// Start pose of the fork root: x_m,y_m,heading_deg
+        #[arg(long, value_parser = parse_pose, allow_hyphen_values = true)]
+        start: Pose2,
+        /// Goal pose (pallet pocket centre): x_m,y_m,heading_deg
+        #[arg(long, value_parser = parse_pose, allow_hyphen_values = true)]
+        goal: Pose2,
+        /// Path curvature at the start in m⁻¹ (from the current steering angle; spiral only).
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        start_curvature: f64,
+        /// Forklift spec overrides (TOML with fields of ForkliftSpec).
+        #[arg(long)]
+        truck: Option<PathBuf>,
+        /// Planner settings (TOML with [bspline] and [spiral] tables).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Spiral: search lengths outside the paper's window 1 + θ²/5 ≤ s_f ≤ 2 + θ²/5.
+        #[arg(long)]
+        no_length_window: bool,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+        /// Draw path, curvature and steering to FILE (.svg or .png).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Reproduce a paper's Table 2 side by side with this project's results.
+    Reproduce {
+        planner: PlannerArg,
+        /// Reference table (default: the embedded scenarios/reference/<planner>-table2.toml).
+        #[arg(long)]
+        table: Option<PathBuf>,
+        #[arg(long)]
+        json: bool,
+        /// Draw all paths, curvature and steering to FILE (.svg or .png).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+}
+
+/// Writes command output; a closed pipe (`forkbench … | head`) ends output quietly.
+pub(crate) fn emit(text: &str) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other.context("writing to stdout"),
+    }
+}
+
+fn parse_pose(text: &str) -> Result<Pose2, String> {
+    Pose2::parse_ui(text).map_err(|e| e.to_string())
+}
+
+/// Reads a forklift spec override file, or the A30 defaults.
+fn load_truck(path: Option<&PathBuf>) -> anyhow::Result<ForkliftSpec> {
+    let Some(path) = path else {
+        return Ok(ForkliftSpec::default());
+    };
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let spec: ForkliftSpec =
+        toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    spec.validate()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(spec)
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Plan {
+            planner,
+            start,
+            goal,
+            start_curvature,
+            truck,
+            config,
+            no_length_window,
+            json,
+            plot,
+        } => {
+            let truck = load_truck(truck.as_ref())?;
+            let mut cfg = match &config {
+                Some(p) => {
+                    let text = std::fs::read_to_string(p)
+                        .with_context(|| format!("reading {}", p.display()))?;
+                    toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?
+                }
+                None => forkbench_plan::PlannerConfig::default(),
+            };
+            if no_length_window {
+                cfg.spiral.enforce_length_window = false;
+            }
+            plan_cmd::run(plan_cmd::PlanArgs {
+                planner: planner.into(),
+                start,
+                goal,
+                start_curvature_per_m: start_curvature,
+                truck,
+                cfg,
+                json,
+                plot,
+            })
+        }
+        Command::Reproduce {
+            planner,
+            table,
+            json,
+            plot,
+        } => reproduce_cmd::run(planner.into(), table.as_deref(), json, plot.as_deref()),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -90,11 +90,12 @@ impl SpiralProblem {
         let mirrored = local.y_m < 0.0;
         let sign = if mirrored { -1.0 } else { 1.0 };
         SpiralProblem {
-            a: sign * r * req.start_curvature_per_m,
+            // `+ 0.0` turns the −0.0 of a mirrored zero curvature into +0.0 for printing.
+            a: sign * r * req.start_curvature_per_m + 0.0,
             x_f: local.x_m / r,
             y_f: sign * local.y_m / r,
             theta_f: sign * local.heading_rad,
-            kappa_f: sign * r * goal_curvature_per_m,
+            kappa_f: sign * r * goal_curvature_per_m + 0.0,
             kappa_limit: r * req.truck.max_curvature_per_m(),
             scale_m: r,
             mirrored,
@@ -122,28 +123,47 @@ impl SpiralProblem {
     }
 
     /// End position (x(s_f), y(s_f)) and its Jacobian with respect to (b, c).
+    ///
+    /// Composite 16-point Gauss–Legendre: one panel per ~2 rad of possible turning, so
+    /// spirals that sweep through large angles are integrated as accurately as gentle ones.
     fn endpoint_and_jacobian(&self, b: f64, c: f64, sf: f64) -> ([f64; 2], [[f64; 2]; 2]) {
         let p = self.params(b, c, sf);
         let gl = GaussLegendre::rule16();
-        let half = sf / 2.0;
+        // Bound on the total turning ∫|κ| ds from the coefficients.
+        let turning = sf
+            * (p.a.abs()
+                + p.b.abs() * sf
+                + p.c.abs() * sf * sf
+                + p.d.abs() * sf.powi(3)
+                + p.e.abs() * sf.powi(4));
+        let panels = if turning.is_finite() {
+            (turning / 2.0).ceil().clamp(1.0, 64.0) as usize
+        } else {
+            1
+        };
+        let width = sf / panels as f64;
+        let half = width / 2.0;
         let (mut x, mut y) = (0.0, 0.0);
         let mut jac = [[0.0; 2]; 2];
         let (inv_s2, inv_s3) = (1.0 / (sf * sf), 1.0 / sf.powi(3));
-        for (xi, wi) in gl.nodes.iter().zip(&gl.weights) {
-            let s = half * (1.0 + xi);
-            let w = half * wi;
-            let (sin, cos) = p.heading(s).sin_cos();
-            let (s2, s3) = (s * s, s * s * s);
-            let (s4, s5) = (s2 * s2, s2 * s3);
-            // ∂θ/∂b and ∂θ/∂c through b, c directly and through d(b, c), e(b, c).
-            let dtb = s2 / 2.0 - 1.5 * s4 * inv_s2 + s5 * inv_s3;
-            let dtc = s3 / 3.0 - (2.0 / 3.0) * s4 / sf + s5 * inv_s2 / 3.0;
-            x += w * cos;
-            y += w * sin;
-            jac[0][0] -= w * sin * dtb;
-            jac[0][1] -= w * sin * dtc;
-            jac[1][0] += w * cos * dtb;
-            jac[1][1] += w * cos * dtc;
+        for k in 0..panels {
+            let s0 = width * k as f64;
+            for (xi, wi) in gl.nodes.iter().zip(&gl.weights) {
+                let s = s0 + half * (1.0 + xi);
+                let w = half * wi;
+                let (sin, cos) = p.heading(s).sin_cos();
+                let (s2, s3) = (s * s, s * s * s);
+                let (s4, s5) = (s2 * s2, s2 * s3);
+                // ∂θ/∂b and ∂θ/∂c through b, c directly and through d(b, c), e(b, c).
+                let dtb = s2 / 2.0 - 1.5 * s4 * inv_s2 + s5 * inv_s3;
+                let dtc = s3 / 3.0 - (2.0 / 3.0) * s4 / sf + s5 * inv_s2 / 3.0;
+                x += w * cos;
+                y += w * sin;
+                jac[0][0] -= w * sin * dtb;
+                jac[0][1] -= w * sin * dtc;
+                jac[1][0] += w * cos * dtb;
+                jac[1][1] += w * cos * dtc;
+            }
         }
         ([x, y], jac)
     }
@@ -282,15 +302,39 @@ impl SpiralProblem {
         };
         let mut p = guess;
         let (mut r, mut j, mut norm) = eval(p);
+        let mut kicks = 0;
         for _ in 0..25 {
             if norm < 1e-12 {
                 return Some(p);
             }
             let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
             let scale = j.iter().flatten().map(|v| v * v).sum::<f64>();
-            if det.is_nan() || det.abs() <= 1e-12 * scale {
-                // Singular Jacobian: this guess sits on a fold; another guess will do better.
+            if det.is_nan() {
                 return None;
+            }
+            if det.abs() <= 1e-12 * scale {
+                // Singular Jacobian. Symmetric problems (a = κ_f = θ_f = 0) are singular on
+                // every heading profile symmetric about s_f/2, and the solutions at most
+                // lengths are asymmetric: kick the iterate along the null vector.
+                if kicks == 4 {
+                    return None;
+                }
+                let row = if j[0][0].hypot(j[0][1]) >= j[1][0].hypot(j[1][1]) {
+                    j[0]
+                } else {
+                    j[1]
+                };
+                let len = row[0].hypot(row[1]);
+                let v = if len > 0.0 {
+                    [-row[1] / len, row[0] / len]
+                } else {
+                    [1.0, 0.0]
+                };
+                let eps = 0.1 * (1.0 + p[0].hypot(p[1])) * if kicks % 2 == 0 { 1.0 } else { -1.0 };
+                kicks += 1;
+                p = [p[0] + eps * v[0], p[1] + eps * v[1]];
+                (r, j, norm) = eval(p);
+                continue;
             }
             let step = [
                 -(j[1][1] * r[0] - j[0][1] * r[1]) / det,
@@ -316,6 +360,67 @@ impl SpiralProblem {
     }
 }
 
+impl SpiralProblem {
+    /// Damped minimum-norm Gauss–Newton in (b, c, s_f) with s_f kept in [lo, hi].
+    ///
+    /// Where the fixed-length solve fails, the solution curve is usually at a fold in
+    /// s_f (the shortest length that reaches, e.g. a symmetric lane change); the 2 × 3
+    /// Jacobian keeps full rank there, so letting s_f move finds the fold solution.
+    fn solve_free(&self, guess: [f64; 2], sf0: f64, lo: f64, hi: f64) -> Option<([f64; 2], f64)> {
+        let eval = |q: [f64; 3]| {
+            let (e, j) = self.endpoint_and_jacobian(q[0], q[1], q[2]);
+            let r = [e[0] - self.x_f, e[1] - self.y_f];
+            (r, j, r[0].hypot(r[1]))
+        };
+        let mut q = [guess[0], guess[1], sf0];
+        let (mut r, mut j, mut norm) = eval(q);
+        for _ in 0..40 {
+            if norm < 1e-12 {
+                return Some(([q[0], q[1]], q[2]));
+            }
+            // ∂(x, y)/∂s_f by central difference (d and e depend on s_f rationally).
+            let h = 1e-7 * q[2];
+            let (ep, _) = self.endpoint_and_jacobian(q[0], q[1], q[2] + h);
+            let (em, _) = self.endpoint_and_jacobian(q[0], q[1], q[2] - h);
+            let js = [(ep[0] - em[0]) / (2.0 * h), (ep[1] - em[1]) / (2.0 * h)];
+            let a = [[j[0][0], j[0][1], js[0]], [j[1][0], j[1][1], js[1]]];
+            // δ = −Aᵀ (A Aᵀ)⁻¹ r
+            let m = [
+                [
+                    a[0].iter().map(|v| v * v).sum::<f64>(),
+                    (0..3).map(|k| a[0][k] * a[1][k]).sum::<f64>(),
+                ],
+                [0.0, a[1].iter().map(|v| v * v).sum::<f64>()],
+            ];
+            let m10 = m[0][1];
+            let det = m[0][0] * m[1][1] - m10 * m10;
+            if !(det.is_finite() && det.abs() > 1e-30) {
+                return None;
+            }
+            let y = [
+                (m[1][1] * r[0] - m10 * r[1]) / det,
+                (m[0][0] * r[1] - m10 * r[0]) / det,
+            ];
+            let step: [f64; 3] = std::array::from_fn(|k| -(a[0][k] * y[0] + a[1][k] * y[1]));
+            let mut t = 1.0;
+            loop {
+                let mut n = [q[0] + t * step[0], q[1] + t * step[1], q[2] + t * step[2]];
+                n[2] = n[2].clamp(lo, hi);
+                let (rn, jn, nn) = eval(n);
+                if nn < norm * (1.0 - 1e-4 * t) {
+                    (q, r, j, norm) = (n, rn, jn, nn);
+                    break;
+                }
+                t *= 0.5;
+                if t < 1e-3 {
+                    return None;
+                }
+            }
+        }
+        None
+    }
+}
+
 /// Result of the spiral planner.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpiralPlan {
@@ -324,7 +429,7 @@ pub struct SpiralPlan {
     pub cost: f64,
     pub max_abs_curvature_per_m: f64,
     pub path: Path,
-    /// Newton solves of the endpoint equations the search used.
+    /// Fixed-length Newton solves of the endpoint equations the search used.
     pub newton_solves: usize,
 }
 
@@ -395,7 +500,17 @@ pub fn plan(req: &PlanRequest, cfg: &SpiralConfig) -> Result<SpiralPlan, PlanErr
         let sf = grid_sf(i);
         let mut guesses = vec![prob.fit_bc(sf, &profile), [0.0, 0.0]];
         guesses.extend(warm);
-        let cand = solve(sf, &guesses);
+        let mut cand = solve(sf, &guesses);
+        if cand.is_none() {
+            cand = prob.solve_free(guesses[0], sf, lo, hi).map(|(bc, s)| {
+                (
+                    s,
+                    bc,
+                    prob.cost(bc[0], bc[1], s),
+                    prob.max_abs_curvature(bc[0], bc[1], s),
+                )
+            });
+        }
         warm = cand.map(|c| c.1).or(warm);
         grid[i] = cand;
     }

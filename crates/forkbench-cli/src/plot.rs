@@ -1,0 +1,225 @@
+//! Path figures like the papers' figures 6–8: the path (with control polygon), curvature and steering vs s.
+
+use std::path::Path as FsPath;
+use std::sync::Once;
+
+use anyhow::{Context as _, bail};
+use forkbench_core::{ForkliftSpec, Path};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// One path to draw.
+#[derive(Debug)]
+pub struct Series<'a> {
+    pub label: String,
+    pub path: &'a Path,
+    pub control_polygon: Option<Vec<[f64; 2]>>,
+}
+
+/// The bitmap backend needs a font; the embedded DejaVu Sans avoids a system font lookup.
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The embedded font is a valid TTF; a failure would only lose text, never data.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            dejavu::sans::regular(),
+        );
+    });
+}
+
+/// Draws to FILE; the format follows the extension (.svg or .png).
+pub fn draw_plans(
+    file: &FsPath,
+    title: &str,
+    series: &[Series],
+    truck: &ForkliftSpec,
+) -> anyhow::Result<()> {
+    register_font();
+    let size = (1400, 800);
+    let ext = file
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let result = match ext.as_deref() {
+        Some("svg") => draw(
+            SVGBackend::new(file, size).into_drawing_area(),
+            title,
+            series,
+            truck,
+        ),
+        Some("png") => draw(
+            BitMapBackend::new(file, size).into_drawing_area(),
+            title,
+            series,
+            truck,
+        ),
+        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
+    };
+    result.with_context(|| format!("drawing {}", file.display()))
+}
+
+fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow::anyhow!("{e:?}")
+}
+
+/// One curvature-derived panel: caption, y label, limit line, and κ ↦ plotted value.
+type Panel<'a> = (&'a str, &'a str, f64, Box<dyn Fn(f64) -> f64 + 'a>);
+
+const COLORS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    series: &[Series],
+    truck: &ForkliftSpec,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 24)).map_err(err)?;
+    let (left, right) = root.split_horizontally(700);
+    let right_parts = right.split_evenly((2, 1));
+    let label = |s: &Series| {
+        if series.len() > 1 {
+            s.label.clone()
+        } else {
+            String::new()
+        }
+    };
+
+    // Path in the plane, equal axis scales.
+    let pts = series.iter().flat_map(|s| {
+        s.path
+            .samples
+            .iter()
+            .map(|p| (p.x_m, p.y_m))
+            .chain(s.control_polygon.iter().flatten().map(|p| (p[0], p[1])))
+    });
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in pts {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+    let half = ((x1 - x0).max(y1 - y0) / 2.0 + 0.3).max(0.5);
+    let mut chart = ChartBuilder::on(&left)
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .caption("path (m)", ("sans-serif", 18))
+        .build_cartesian_2d((cx - half)..(cx + half), (cy - half)..(cy + half))
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .draw()
+        .map_err(err)?;
+    for (i, s) in series.iter().enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        let line = chart
+            .draw_series(LineSeries::new(
+                s.path.samples.iter().map(|p| (p.x_m, p.y_m)),
+                color.stroke_width(2),
+            ))
+            .map_err(err)?;
+        if series.len() > 1 {
+            line.label(label(s)).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+            });
+        }
+        if let Some(poly) = &s.control_polygon {
+            chart
+                .draw_series(LineSeries::new(
+                    poly.iter().map(|p| (p[0], p[1])),
+                    color.mix(0.5),
+                ))
+                .map_err(err)?;
+            chart
+                .draw_series(
+                    poly.iter()
+                        .map(|p| Circle::new((p[0], p[1]), 3, color.filled())),
+                )
+                .map_err(err)?;
+        }
+    }
+    if series.len() > 1 {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(err)?;
+    }
+
+    // Curvature and steering against arc length, with the truck's limits.
+    let s_max = series.iter().map(|s| s.path.length_m()).fold(0.1, f64::max);
+    let k_lim = truck.max_curvature_per_m();
+    let panels: [Panel; 2] = [
+        ("curvature vs s", "κ (1/m)", k_lim, Box::new(|k| k)),
+        (
+            "equivalent steering vs s",
+            "α (rad)",
+            truck.max_steer_rad,
+            Box::new(|k| truck.steer_for_curvature(k)),
+        ),
+    ];
+    for (area, (caption, ylabel, limit, map)) in right_parts.iter().zip(panels) {
+        let peak = series
+            .iter()
+            .flat_map(|s| s.path.samples.iter().map(|p| map(p.curvature_per_m).abs()))
+            .fold(0.0, f64::max);
+        let y = (peak * 1.15).max(0.05).min(limit * 1.1);
+        let mut chart = ChartBuilder::on(area)
+            .margin(15)
+            .x_label_area_size(35)
+            .y_label_area_size(55)
+            .caption(caption, ("sans-serif", 18))
+            .build_cartesian_2d(0.0..s_max, -y..y)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("s (m)")
+            .y_desc(ylabel)
+            .draw()
+            .map_err(err)?;
+        for (i, s) in series.iter().enumerate() {
+            let color = COLORS[i % COLORS.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    s.path
+                        .samples
+                        .iter()
+                        .map(|p| (p.s_m, map(p.curvature_per_m))),
+                    color.stroke_width(2),
+                ))
+                .map_err(err)?;
+        }
+        if limit <= y {
+            for l in [limit, -limit] {
+                chart
+                    .draw_series(LineSeries::new([(0.0, l), (s_max, l)], RED.mix(0.6)))
+                    .map_err(err)?;
+            }
+        }
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}

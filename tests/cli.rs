@@ -1,0 +1,273 @@
+//! End-to-end tests of the `forkbench` binary and of the data files under scenarios/ and worlds/.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn forkbench(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_forkbench"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn stdout_json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("forkbench-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+#[test]
+fn plan_bspline_json_has_every_field_and_an_exact_endpoint() {
+    let v = stdout_json(&forkbench(&[
+        "plan",
+        "bspline",
+        "--start",
+        "0,0,90",
+        "--goal",
+        "1.5,6.5,105",
+        "--json",
+    ]));
+    for key in [
+        "planner",
+        "start",
+        "goal",
+        "params",
+        "cost",
+        "max_curvature_per_m",
+        "max_steer_rad",
+        "length_m",
+        "endpoint_error_m",
+        "solve_time_us",
+        "samples",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["planner"], "bspline");
+    assert!(v["params"]["l1_m"].as_f64().expect("l1") >= 1.5);
+    assert!(v["params"]["l2_m"].as_f64().expect("l2") >= 1.5);
+    assert!(v["endpoint_error_m"].as_f64().expect("err") < 1e-9);
+    // Scenario 18 of the paper: max steering 0.5255 rad.
+    assert!((v["max_steer_rad"].as_f64().expect("steer") - 0.5255).abs() < 5e-4);
+    let samples = v["samples"].as_array().expect("samples");
+    let mut prev: Option<(f64, f64, f64)> = None;
+    for s in samples {
+        let (sm, x, y) = (
+            s["s_m"].as_f64().expect("s"),
+            s["x_m"].as_f64().expect("x"),
+            s["y_m"].as_f64().expect("y"),
+        );
+        assert!(s["heading_rad"].is_f64() && s["curvature_per_m"].is_f64());
+        if let Some((ps, px, py)) = prev {
+            assert!(sm > ps && sm - ps <= 0.01 + 1e-9, "arc spacing {}", sm - ps);
+            assert!((x - px).hypot(y - py) <= 0.01 + 1e-9);
+        }
+        prev = Some((sm, x, y));
+    }
+    let last = samples.last().expect("non-empty");
+    assert!((last["x_m"].as_f64().expect("x") - 1.5).abs() < 1e-9);
+    assert!((last["y_m"].as_f64().expect("y") - 6.5).abs() < 1e-9);
+}
+
+#[test]
+fn plan_spiral_json_reports_normalised_params() {
+    let v = stdout_json(&forkbench(&[
+        "plan",
+        "spiral",
+        "--start",
+        "1,2,30",
+        "--goal",
+        "6,-1,-20",
+        "--start-curvature",
+        "-0.2",
+        "--json",
+    ]));
+    assert_eq!(v["planner"], "spiral");
+    for key in ["a", "b", "c", "d", "e", "sf", "scale_m", "mirrored"] {
+        assert!(v["params"].get(key).is_some(), "missing params.{key}");
+    }
+    assert_eq!(v["params"]["mirrored"], true);
+    assert!(v["endpoint_error_m"].as_f64().expect("err") <= 1e-3);
+    assert!(v["cost"].as_f64().expect("cost") > 0.0);
+    let first = &v["samples"][0];
+    assert!((first["curvature_per_m"].as_f64().expect("k0") + 0.2).abs() < 1e-12);
+}
+
+#[test]
+fn infeasible_goal_fails_with_the_limit_named() {
+    let out = forkbench(&["plan", "bspline", "--start", "0,0,0", "--goal", "1,3,0"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("κ_max 1.0630 m⁻¹") && err.contains("needs max |κ|"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn malformed_pose_is_a_usage_error() {
+    let out = forkbench(&["plan", "spiral", "--start", "0,0", "--goal", "6,1,0"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("x_m,y_m,heading_deg"), "{err}");
+    let out = forkbench(&["plan", "spiral", "--start", "0,0,abc", "--goal", "6,1,0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("heading_deg"));
+}
+
+#[test]
+fn reproduce_both_tables_as_json() {
+    let b = stdout_json(&forkbench(&["reproduce", "bspline", "--json"]));
+    let rows = b["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 18);
+    for r in rows {
+        let ours = r["max_curvature_per_m"].as_f64().expect("ours");
+        let paper = r["paper_max_curvature_per_m"].as_f64().expect("paper");
+        assert!(ours <= paper * (1.0 + 1e-9), "{r}");
+    }
+    let s = stdout_json(&forkbench(&["reproduce", "spiral", "--json"]));
+    let rows = s["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 23);
+    for r in rows {
+        assert!(r["endpoint_error_m"].as_f64().expect("err") <= 1e-3, "{r}");
+        assert!(r["paper_cost"].as_f64().expect("paper cost") > 0.0);
+    }
+}
+
+#[test]
+fn reproduce_markdown_has_a_row_per_scenario() {
+    let out = forkbench(&["reproduce", "spiral"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.starts_with("| ") && !l.starts_with("| #"))
+            .count(),
+        23
+    );
+    assert!(
+        text.contains("paper's path ends"),
+        "explains the rows where our cost is higher"
+    );
+}
+
+#[test]
+fn plots_are_written_as_png_and_svg() {
+    let png = tmp("plan.png");
+    let out = forkbench(&[
+        "plan",
+        "bspline",
+        "--start",
+        "0,0,90",
+        "--goal",
+        "1,6.5,95",
+        "--plot",
+        png.to_str().expect("utf8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(&png).expect("png written");
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let svg = tmp("table.svg");
+    let out = forkbench(&["reproduce", "spiral", "--plot", svg.to_str().expect("utf8")]);
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(&svg).expect("svg written");
+    assert!(text.contains("<svg") && text.contains("polyline"));
+    let out = forkbench(&[
+        "plan", "bspline", "--start", "0,0,90", "--goal", "1,6.5,95", "--plot", "x.gif",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
+}
+
+#[test]
+fn bad_table_file_error_names_file_and_line() {
+    let bad = tmp("bad-table.toml");
+    std::fs::write(&bad, "paper = \"x\"\nstart_mm_deg = [0.0, 0.0, 90.0]\npick_distance_mm = 6500.0\n\n[[case]]\nname = \"1\"\nlateral_offset_mm = \"wide\"\n").expect("write");
+    let out = forkbench(&[
+        "reproduce",
+        "bspline",
+        "--table",
+        bad.to_str().expect("utf8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("bad-table.toml")
+            && err.contains("line 7")
+            && err.contains("lateral_offset_mm"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_truck_file_error_names_the_field() {
+    let bad = tmp("truck.toml");
+    std::fs::write(&bad, "wheelbase_m = -1.0\n").expect("write");
+    let out = forkbench(&[
+        "plan",
+        "bspline",
+        "--start",
+        "0,0,90",
+        "--goal",
+        "1,6.5,95",
+        "--truck",
+        bad.to_str().expect("utf8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("truck.toml") && err.contains("wheelbase_m"),
+        "{err}"
+    );
+}
+
+/// Every committed data file parses, so none goes stale.
+#[test]
+fn every_committed_data_file_loads() {
+    let mut seen = 0;
+    for dir in ["scenarios", "scenarios/reference", "worlds"] {
+        let Ok(entries) = std::fs::read_dir(repo_root().join(dir)) else {
+            continue;
+        };
+        for entry in entries {
+            let path = entry.expect("dir entry").path();
+            if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).expect("readable");
+            let name = path.display().to_string();
+            let file = path
+                .file_name()
+                .and_then(|f| f.to_str())
+                .unwrap_or_default();
+            if file.starts_with("bspline-") {
+                forkbench_plan::reproduce::BsplineTable::parse(&text, &name)
+                    .expect("valid B-spline table");
+            } else if file.starts_with("spiral-") {
+                forkbench_plan::reproduce::SpiralTable::parse(&text, &name)
+                    .expect("valid spiral table");
+            } else {
+                panic!("{name}: no loader knows this data file");
+            }
+            seen += 1;
+        }
+    }
+    assert!(seen >= 2, "found {seen} data files");
+}
