@@ -124,20 +124,20 @@ impl SpiralProblem {
 
     /// End position (x(s_f), y(s_f)) and its Jacobian with respect to (b, c).
     ///
-    /// Composite 16-point Gauss–Legendre: one panel per ~2 rad of possible turning, so
+    /// Composite 16-point Gauss–Legendre: one panel per ~10 rad of turning (its error
+    /// scales like (T/32)^32 for a turning T per panel), so
     /// spirals that sweep through large angles are integrated as accurately as gentle ones.
     fn endpoint_and_jacobian(&self, b: f64, c: f64, sf: f64) -> ([f64; 2], [[f64; 2]; 2]) {
         let p = self.params(b, c, sf);
         let gl = GaussLegendre::rule16();
-        // Bound on the total turning ∫|κ| ds from the coefficients.
-        let turning = sf
-            * (p.a.abs()
-                + p.b.abs() * sf
-                + p.c.abs() * sf * sf
-                + p.d.abs() * sf.powi(3)
-                + p.e.abs() * sf.powi(4));
+        // Total turning ≤ s_f · max|κ|, with max|κ| from a coarse polynomial sample (no
+        // trig, so cheap); coefficient bounds are useless here, they cancel heavily.
+        let peak = (0..=16)
+            .map(|i| p.curvature(sf * i as f64 / 16.0).abs())
+            .fold(0.0, f64::max);
+        let turning = 1.25 * sf * peak;
         let panels = if turning.is_finite() {
-            (turning / 2.0).ceil().clamp(1.0, 64.0) as usize
+            (turning / 10.0).ceil().clamp(1.0, 8.0) as usize
         } else {
             1
         };
@@ -500,19 +500,32 @@ pub fn plan(req: &PlanRequest, cfg: &SpiralConfig) -> Result<SpiralPlan, PlanErr
         let sf = grid_sf(i);
         let mut guesses = vec![prob.fit_bc(sf, &profile), [0.0, 0.0]];
         guesses.extend(warm);
-        let mut cand = solve(sf, &guesses);
-        if cand.is_none() {
-            cand = prob.solve_free(guesses[0], sf, lo, hi).map(|(bc, s)| {
-                (
-                    s,
-                    bc,
-                    prob.cost(bc[0], bc[1], s),
-                    prob.max_abs_curvature(bc[0], bc[1], s),
-                )
-            });
-        }
+        let cand = solve(sf, &guesses);
         warm = cand.map(|c| c.1).or(warm);
         grid[i] = cand;
+    }
+    // Where the short end of the window failed, the cheapest spiral may sit at a fold in
+    // s_f (the shortest length that reaches; e.g. a symmetric lane change), where the
+    // fixed-length solve is singular: solve once with s_f free from just below the
+    // shortest solved length (or, if nothing solved, from each grid length in turn).
+    let mut fold: Option<Candidate> = None;
+    if grid[0].is_none() {
+        let first_ok = grid.iter().position(Option::is_some);
+        let tries: Vec<usize> = match first_ok {
+            Some(k) => vec![k.saturating_sub(1)],
+            None => (0..m).collect(),
+        };
+        for i in tries {
+            let sf = grid_sf(i);
+            if let Some((bc, s)) = prob.solve_free(prob.fit_bc(sf, &profile), sf, lo, hi) {
+                let (cost, max_k) = (
+                    prob.cost(bc[0], bc[1], s),
+                    prob.max_abs_curvature(bc[0], bc[1], s),
+                );
+                fold = Some((s, bc, cost, max_k));
+                break;
+            }
+        }
     }
     let limit = prob.kappa_limit;
     let feasible = |c: &Candidate| c.3 <= limit;
@@ -522,10 +535,12 @@ pub fn plan(req: &PlanRequest, cfg: &SpiralConfig) -> Result<SpiralPlan, PlanErr
         .filter_map(|(i, c)| c.filter(feasible).map(|c| (i, c.2)))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(i, _)| i);
-    let Some(best_idx) = best_idx else {
+    let fold = fold.filter(feasible);
+    let Some(best_idx) = best_idx.or(fold.map(|_| usize::MAX)) else {
         let least_k = grid
             .iter()
             .flatten()
+            .chain(fold.iter())
             .map(|c| c.3)
             .fold(f64::INFINITY, f64::min);
         return Err(if least_k.is_finite() {
@@ -539,28 +554,36 @@ pub fn plan(req: &PlanRequest, cfg: &SpiralConfig) -> Result<SpiralPlan, PlanErr
             }
         });
     };
-    let seed = grid[best_idx].map(|c| c.1).unwrap_or([0.0, 0.0]);
-    let (a, b) = (
-        grid_sf(best_idx.saturating_sub(1)),
-        grid_sf((best_idx + 1).min(m - 1)),
-    );
-    let mut best = grid[best_idx];
-    let mut warm = seed;
-    brent_min(
-        |sf| match solve(sf, &[warm]) {
-            Some(c) if feasible(&c) => {
-                warm = c.1;
-                if best.is_none_or(|b| c.2 < b.2) {
-                    best = Some(c);
+    // usize::MAX marks "only the fold solution is feasible": nothing to refine.
+    let mut best = grid.get(best_idx).copied().flatten();
+    if best_idx != usize::MAX {
+        let seed = grid[best_idx].map(|c| c.1).unwrap_or([0.0, 0.0]);
+        let (a, b) = (
+            grid_sf(best_idx.saturating_sub(1)),
+            grid_sf((best_idx + 1).min(m - 1)),
+        );
+        let mut warm = seed;
+        brent_min(
+            |sf| match solve(sf, &[warm]) {
+                Some(c) if feasible(&c) => {
+                    warm = c.1;
+                    if best.is_none_or(|b| c.2 < b.2) {
+                        best = Some(c);
+                    }
+                    c.2
                 }
-                c.2
-            }
-            _ => f64::INFINITY,
-        },
-        a,
-        b,
-        1e-5 * (hi - lo),
-    );
+                _ => f64::INFINITY,
+            },
+            a,
+            b,
+            1e-5 * (hi - lo),
+        );
+    }
+    if let Some(f) = fold
+        && best.is_none_or(|b| f.2 < b.2)
+    {
+        best = Some(f);
+    }
     let Some((sf, [bb, cc], cost, max_k)) = best else {
         unreachable!("best_idx points at a solved grid entry");
     };
