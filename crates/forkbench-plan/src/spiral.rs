@@ -127,17 +127,29 @@ impl SpiralProblem {
     /// Composite 16-point Gauss–Legendre: one panel per ~10 rad of turning (its error
     /// scales like (T/32)^32 for a turning T per panel), so
     /// spirals that sweep through large angles are integrated as accurately as gentle ones.
-    fn endpoint_and_jacobian(&self, b: f64, c: f64, sf: f64) -> ([f64; 2], [[f64; 2]; 2]) {
+    /// With `fine` false a single panel is used: cheap, and accurate enough to steer
+    /// Newton while it is far from the solution.
+    fn endpoint_and_jacobian(
+        &self,
+        b: f64,
+        c: f64,
+        sf: f64,
+        fine: bool,
+    ) -> ([f64; 2], [[f64; 2]; 2]) {
         let p = self.params(b, c, sf);
         let gl = GaussLegendre::rule16();
         // Total turning ≤ s_f · max|κ|, with max|κ| from a coarse polynomial sample (no
         // trig, so cheap); coefficient bounds are useless here, they cancel heavily.
-        let peak = (0..=16)
-            .map(|i| p.curvature(sf * i as f64 / 16.0).abs())
-            .fold(0.0, f64::max);
-        let turning = 1.25 * sf * peak;
-        let panels = if turning.is_finite() {
-            (turning / 10.0).ceil().clamp(1.0, 8.0) as usize
+        let panels = if fine {
+            let peak = (0..=16)
+                .map(|i| p.curvature(sf * i as f64 / 16.0).abs())
+                .fold(0.0, f64::max);
+            let turning = 1.25 * sf * peak;
+            if turning.is_finite() {
+                (turning / 10.0).ceil().clamp(1.0, 8.0) as usize
+            } else {
+                1
+            }
         } else {
             1
         };
@@ -191,7 +203,7 @@ impl SpiralProblem {
 
     /// Scores given (b, c, s_f), e.g. the paper's, with this project's integration.
     pub fn evaluate(&self, b: f64, c: f64, sf: f64) -> SpiralEvaluation {
-        let (end, _) = self.endpoint_and_jacobian(b, c, sf);
+        let (end, _) = self.endpoint_and_jacobian(b, c, sf, true);
         SpiralEvaluation {
             params: self.params(b, c, sf),
             cost: self.cost(b, c, sf),
@@ -295,16 +307,27 @@ impl SpiralProblem {
 
     /// Damped Newton on the endpoint equations for (b, c) at a fixed length.
     fn solve_bc(&self, sf: f64, guess: [f64; 2]) -> Option<[f64; 2]> {
-        let eval = |p: [f64; 2]| {
-            let (e, j) = self.endpoint_and_jacobian(p[0], p[1], sf);
+        let eval = |p: [f64; 2], fine: bool| {
+            let (e, j) = self.endpoint_and_jacobian(p[0], p[1], sf, fine);
             let r = [e[0] - self.x_f, e[1] - self.y_f];
             (r, j, r[0].hypot(r[1]))
         };
         let mut p = guess;
-        let (mut r, mut j, mut norm) = eval(p);
+        let mut fine = false;
+        let (mut r, mut j, mut norm) = eval(p, fine);
         let mut kicks = 0;
-        for _ in 0..25 {
-            if norm < 1e-12 {
+        for iter in 0..30 {
+            // A guess that has not come near the goal after a few steps is on a wrong
+            // branch; the other guesses are cheaper than crawling.
+            if iter >= 8 && norm > 1e-3 {
+                return None;
+            }
+            if !fine && norm < 1e-6 {
+                // Close enough to switch to the accurate rule for the last digits.
+                fine = true;
+                (r, j, norm) = eval(p, fine);
+            }
+            if fine && norm < 1e-12 {
                 return Some(p);
             }
             let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
@@ -333,7 +356,7 @@ impl SpiralProblem {
                 let eps = 0.1 * (1.0 + p[0].hypot(p[1])) * if kicks % 2 == 0 { 1.0 } else { -1.0 };
                 kicks += 1;
                 p = [p[0] + eps * v[0], p[1] + eps * v[1]];
-                (r, j, norm) = eval(p);
+                (r, j, norm) = eval(p, fine);
                 continue;
             }
             let step = [
@@ -343,7 +366,7 @@ impl SpiralProblem {
             let mut t = 1.0;
             loop {
                 let q = [p[0] + t * step[0], p[1] + t * step[1]];
-                let (rq, jq, nq) = eval(q);
+                let (rq, jq, nq) = eval(q, fine);
                 if nq < norm * (1.0 - 1e-4 * t) {
                     (p, r, j, norm) = (q, rq, jq, nq);
                     break;
@@ -351,12 +374,12 @@ impl SpiralProblem {
                 t *= 0.5;
                 // Heavy damping means the guess is on the wrong side of a fold: give up
                 // early rather than crawl.
-                if t < 1.0 / 64.0 {
+                if t < 1.0 / 16.0 {
                     return None;
                 }
             }
         }
-        (norm < 1e-11).then_some(p)
+        (fine && norm < 1e-11).then_some(p)
     }
 }
 
@@ -367,21 +390,26 @@ impl SpiralProblem {
     /// s_f (the shortest length that reaches, e.g. a symmetric lane change); the 2 × 3
     /// Jacobian keeps full rank there, so letting s_f move finds the fold solution.
     fn solve_free(&self, guess: [f64; 2], sf0: f64, lo: f64, hi: f64) -> Option<([f64; 2], f64)> {
-        let eval = |q: [f64; 3]| {
-            let (e, j) = self.endpoint_and_jacobian(q[0], q[1], q[2]);
+        let eval = |q: [f64; 3], fine: bool| {
+            let (e, j) = self.endpoint_and_jacobian(q[0], q[1], q[2], fine);
             let r = [e[0] - self.x_f, e[1] - self.y_f];
             (r, j, r[0].hypot(r[1]))
         };
         let mut q = [guess[0], guess[1], sf0];
-        let (mut r, mut j, mut norm) = eval(q);
+        let mut fine = false;
+        let (mut r, mut j, mut norm) = eval(q, fine);
         for _ in 0..40 {
-            if norm < 1e-12 {
+            if !fine && norm < 1e-6 {
+                fine = true;
+                (r, j, norm) = eval(q, fine);
+            }
+            if fine && norm < 1e-12 {
                 return Some(([q[0], q[1]], q[2]));
             }
             // ∂(x, y)/∂s_f by central difference (d and e depend on s_f rationally).
             let h = 1e-7 * q[2];
-            let (ep, _) = self.endpoint_and_jacobian(q[0], q[1], q[2] + h);
-            let (em, _) = self.endpoint_and_jacobian(q[0], q[1], q[2] - h);
+            let (ep, _) = self.endpoint_and_jacobian(q[0], q[1], q[2] + h, fine);
+            let (em, _) = self.endpoint_and_jacobian(q[0], q[1], q[2] - h, fine);
             let js = [(ep[0] - em[0]) / (2.0 * h), (ep[1] - em[1]) / (2.0 * h)];
             let a = [[j[0][0], j[0][1], js[0]], [j[1][0], j[1][1], js[1]]];
             // δ = −Aᵀ (A Aᵀ)⁻¹ r
@@ -406,7 +434,7 @@ impl SpiralProblem {
             loop {
                 let mut n = [q[0] + t * step[0], q[1] + t * step[1], q[2] + t * step[2]];
                 n[2] = n[2].clamp(lo, hi);
-                let (rn, jn, nn) = eval(n);
+                let (rn, jn, nn) = eval(n, fine);
                 if nn < norm * (1.0 - 1e-4 * t) {
                     (q, r, j, norm) = (n, rn, jn, nn);
                     break;
@@ -668,12 +696,12 @@ mod tests {
             mirrored: false,
         };
         let (b, c, sf) = (2.0, -5.0, 1.1);
-        let (_, j) = prob.endpoint_and_jacobian(b, c, sf);
+        let (_, j) = prob.endpoint_and_jacobian(b, c, sf, true);
         let h = 1e-6;
-        let (pb, _) = prob.endpoint_and_jacobian(b + h, c, sf);
-        let (mb, _) = prob.endpoint_and_jacobian(b - h, c, sf);
-        let (pc, _) = prob.endpoint_and_jacobian(b, c + h, sf);
-        let (mc, _) = prob.endpoint_and_jacobian(b, c - h, sf);
+        let (pb, _) = prob.endpoint_and_jacobian(b + h, c, sf, true);
+        let (mb, _) = prob.endpoint_and_jacobian(b - h, c, sf, true);
+        let (pc, _) = prob.endpoint_and_jacobian(b, c + h, sf, true);
+        let (mc, _) = prob.endpoint_and_jacobian(b, c - h, sf, true);
         for k in 0..2 {
             assert!((j[k][0] - (pb[k] - mb[k]) / (2.0 * h)).abs() < 1e-7);
             assert!((j[k][1] - (pc[k] - mc[k]) / (2.0 * h)).abs() < 1e-7);
