@@ -241,33 +241,109 @@ fn bad_truck_file_error_names_the_field() {
 /// Every committed data file parses, so none goes stale.
 #[test]
 fn every_committed_data_file_loads() {
-    let mut seen = 0;
-    for dir in ["scenarios", "scenarios/reference", "worlds"] {
-        let Ok(entries) = std::fs::read_dir(repo_root().join(dir)) else {
-            continue;
-        };
-        for entry in entries {
-            let path = entry.expect("dir entry").path();
-            if path.extension().and_then(|e| e.to_str()) != Some("toml") {
-                continue;
-            }
-            let text = std::fs::read_to_string(&path).expect("readable");
-            let name = path.display().to_string();
-            let file = path
-                .file_name()
-                .and_then(|f| f.to_str())
-                .unwrap_or_default();
-            if file.starts_with("bspline-") {
-                forkbench_plan::reproduce::BsplineTable::parse(&text, &name)
-                    .expect("valid B-spline table");
-            } else if file.starts_with("spiral-") {
-                forkbench_plan::reproduce::SpiralTable::parse(&text, &name)
-                    .expect("valid spiral table");
-            } else {
-                panic!("{name}: no loader knows this data file");
-            }
-            seen += 1;
+    let toml_files = |dir: &str| -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(repo_root().join(dir))
+            .expect("dir exists")
+            .map(|e| e.expect("entry").path())
+            .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("toml"))
+            .collect();
+        v.sort();
+        v
+    };
+    let (mut tables, mut scenarios, mut worlds) = (0, 0, 0);
+    for path in toml_files("scenarios/reference") {
+        let text = std::fs::read_to_string(&path).expect("readable");
+        let name = path.display().to_string();
+        if path
+            .file_name()
+            .and_then(|f| f.to_str())
+            .is_some_and(|f| f.starts_with("bspline-"))
+        {
+            forkbench_plan::reproduce::BsplineTable::parse(&text, &name)
+                .expect("valid B-spline table");
+        } else {
+            forkbench_plan::reproduce::SpiralTable::parse(&text, &name)
+                .expect("valid spiral table");
         }
+        tables += 1;
     }
-    assert!(seen >= 2, "found {seen} data files");
+    for path in toml_files("scenarios") {
+        let s = forkbench_trial::Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!s.cases.is_empty());
+        scenarios += 1;
+    }
+    for path in toml_files("worlds") {
+        forkbench_trial::World::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        worlds += 1;
+    }
+    assert!(
+        tables >= 2 && scenarios >= 4 && worlds >= 2,
+        "{tables} tables, {scenarios} scenarios, {worlds} worlds"
+    );
+}
+
+#[test]
+fn trial_json_reports_the_outcome_in_si_units() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let v = stdout_json(&forkbench(&[
+        "trial",
+        scn.to_str().expect("utf8"),
+        "--no-noise",
+        "--json",
+    ]));
+    for key in [
+        "success",
+        "failure",
+        "lateral_error_m",
+        "heading_error_rad",
+        "insertion_depth_m",
+        "max_steer_rad",
+        "max_contact_force_n",
+        "pallet_displacement_m",
+        "sim_time_s",
+        "wall_time_ms",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["success"], true);
+    assert!(v["failure"].is_null());
+    assert!(v["insertion_depth_m"].as_f64().expect("depth") > 1.0);
+}
+
+#[test]
+fn failed_pick_exits_3_and_names_the_criterion() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let out = forkbench(&["trial", scn.to_str().expect("utf8"), "--seed", "3"]);
+    // Seed 3 with full pallet-estimate noise and no replanning; whichever way it ends,
+    // the exit status must match the verdict.
+    let text = String::from_utf8_lossy(&out.stdout);
+    if text.contains("SUCCESS") {
+        assert_eq!(out.status.code(), Some(0));
+    } else {
+        assert_eq!(out.status.code(), Some(3), "{text}");
+        assert!(text.contains("FAILED: "), "{text}");
+    }
+    let bad = tmp("bias.toml");
+    std::fs::write(
+        &bad,
+        "name = \"bias\"\nplanner = \"spiral\"\nestimate_bias = { x_m = 0.0, y_m = 0.27, heading_deg = 0.0 }\nstart = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }\npallet = { x_m = 8.5, y_m = 0.5, heading_deg = 0.0 }\n",
+    )
+    .expect("write");
+    let out = forkbench(&["trial", bad.to_str().expect("utf8"), "--no-noise"]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("FAILED: contact_force"));
+}
+
+#[test]
+fn trial_input_errors_are_clear() {
+    let scn = repo_root().join("scenarios/bspline-table2.toml");
+    let out = forkbench(&["trial", scn.to_str().expect("utf8")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("choose one with --case"));
+    let out = forkbench(&["trial", scn.to_str().expect("utf8"), "--case", "42"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no case named \"42\""));
+    let out = forkbench(&["trial", "does-not-exist.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does-not-exist.toml"));
 }

@@ -3,6 +3,7 @@
 mod plan_cmd;
 mod plot;
 mod reproduce_cmd;
+mod trial_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -69,6 +70,30 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Run one pick trial from a scenario file (exit status 3 when the pick fails).
+    Trial {
+        scenario: PathBuf,
+        /// Case of the scenario (required when it has several).
+        #[arg(long)]
+        case: Option<String>,
+        /// Seed of every random draw (default: the scenario's).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Planner (default: the scenario's).
+        #[arg(long)]
+        planner: Option<PlannerArg>,
+        /// Turn off NAV350 and pallet-estimate noise.
+        #[arg(long)]
+        no_noise: bool,
+        /// Scale of the pallet-estimate σ (0: perfect estimate, NAV350 noise kept).
+        #[arg(long)]
+        pallet_noise_scale: Option<f64>,
+        /// Re-estimate the pallet at the configured ranges and replan when it moved.
+        #[arg(long)]
+        replan: bool,
+        #[arg(long)]
+        json: bool,
+    },
     /// Reproduce a paper's Table 2 side by side with this project's results.
     Reproduce {
         planner: PlannerArg,
@@ -111,8 +136,34 @@ fn load_truck(path: Option<&PathBuf>) -> anyhow::Result<ForkliftSpec> {
     Ok(spec)
 }
 
-fn run(cli: Cli) -> anyhow::Result<()> {
+/// What a successful run reports: whether the work itself succeeded (a failed pick).
+enum Done {
+    Ok,
+    PickFailed,
+}
+
+fn run(cli: Cli) -> anyhow::Result<Done> {
     match cli.command {
+        Command::Trial {
+            scenario,
+            case,
+            seed,
+            planner,
+            no_noise,
+            pallet_noise_scale,
+            replan,
+            json,
+        } => {
+            let opts = trial_cmd::options(
+                seed,
+                planner.map(Into::into),
+                no_noise,
+                pallet_noise_scale,
+                replan,
+            )?;
+            let ok = trial_cmd::run(&scenario, case.as_deref(), &opts, json)?;
+            Ok(if ok { Done::Ok } else { Done::PickFailed })
+        }
         Command::Plan {
             planner,
             start,
@@ -146,20 +197,23 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 json,
                 plot,
             })
+            .map(|()| Done::Ok)
         }
         Command::Reproduce {
             planner,
             table,
             json,
             plot,
-        } => reproduce_cmd::run(planner.into(), table.as_deref(), json, plot.as_deref()),
+        } => reproduce_cmd::run(planner.into(), table.as_deref(), json, plot.as_deref())
+            .map(|()| Done::Ok),
     }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Done::Ok) => ExitCode::SUCCESS,
+        Ok(Done::PickFailed) => ExitCode::from(3),
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

@@ -60,6 +60,29 @@ impl Path {
         })
     }
 
+    /// Appends a straight segment of `length_m` along the last sample's heading, with
+    /// samples at most `spacing_m` apart (e.g. the fork insertion after an approach curve).
+    pub fn extend_straight(&mut self, length_m: f64, spacing_m: f64) {
+        let Some(last) = self.samples.last().copied() else {
+            return;
+        };
+        if !(length_m > 0.0 && spacing_m > 0.0) {
+            return;
+        }
+        let n = (length_m / spacing_m).ceil() as usize;
+        let (s, c) = last.heading_rad.sin_cos();
+        for i in 1..=n {
+            let d = length_m * i as f64 / n as f64;
+            self.samples.push(PathSample {
+                s_m: last.s_m + d,
+                x_m: last.x_m + c * d,
+                y_m: last.y_m + s * d,
+                heading_rad: last.heading_rad,
+                curvature_per_m: 0.0,
+            });
+        }
+    }
+
     /// Measures the path against the start and goal poses it was planned for.
     pub fn metrics(&self, start: &Pose2, goal: &Pose2, truck: &ForkliftSpec) -> PathMetrics {
         let first = self.samples.first().map_or(*start, PathSample::pose);
@@ -91,6 +114,24 @@ impl Path {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn extend_straight_appends_along_the_heading() {
+        let mut p = Path {
+            samples: vec![PathSample {
+                s_m: 0.0,
+                x_m: 1.0,
+                y_m: 1.0,
+                heading_rad: std::f64::consts::FRAC_PI_2,
+                curvature_per_m: 0.3,
+            }],
+        };
+        p.extend_straight(0.5, 0.01);
+        let last = p.samples.last().expect("samples");
+        assert_eq!(p.samples.len(), 51);
+        assert!((last.x_m - 1.0).abs() < 1e-12 && (last.y_m - 1.5).abs() < 1e-12);
+        assert!((last.s_m - 0.5).abs() < 1e-12 && last.curvature_per_m == 0.0);
+    }
 
     #[test]
     fn metrics_of_a_straight_line() {

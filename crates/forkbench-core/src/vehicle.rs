@@ -43,7 +43,7 @@ impl Default for ForkliftSpec {
             mass_kg: 4850.0,
             fork_length_m: 1.6,
             fork_width_m: 0.15,
-            fork_spacing_m: 0.6,
+            fork_spacing_m: 0.535,
             fork_root_ahead_of_front_axle_m: 0.45,
             max_speed_mps: 0.8,
             max_steer_rate_radps: 0.8,

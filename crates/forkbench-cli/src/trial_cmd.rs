@@ -1,0 +1,113 @@
+//! `forkbench trial`: one pick trial from a scenario file, printed as text or JSON.
+
+use std::path::Path;
+
+use anyhow::Context as _;
+use forkbench_plan::PlannerKind;
+use forkbench_trial::{Scenario, TrialOptions, run_trial};
+
+pub fn run(
+    file: &Path,
+    case: Option<&str>,
+    opts: &TrialOptions,
+    json: bool,
+) -> anyhow::Result<bool> {
+    let scn = Scenario::load(file)?;
+    let case = match case {
+        Some(name) => scn.case(name)?,
+        None if scn.cases.len() == 1 => &scn.cases[0],
+        None => anyhow::bail!(
+            "{}: has {} cases; choose one with --case (cases: {})",
+            file.display(),
+            scn.cases.len(),
+            scn.cases
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    let out = run_trial(&scn, case, opts);
+    if json {
+        let text = serde_json::to_string(&out).context("serialising the outcome")?;
+        crate::emit(&format!("{text}\n"))?;
+        return Ok(out.success);
+    }
+    let opt = |v: Option<f64>, scale: f64, unit: &str| {
+        v.map_or("never entered".to_owned(), |v| {
+            format!("{:.4} {unit}", v * scale)
+        })
+    };
+    let verdict = match (&out.failure, out.success) {
+        (_, true) => "SUCCESS".to_owned(),
+        (Some(f), false) => format!("FAILED: {}", f.name()),
+        (None, false) => "FAILED".to_owned(),
+    };
+    let mut s = String::new();
+    use std::fmt::Write as _;
+    let _ = writeln!(
+        s,
+        "scenario             {} / case {} / planner {} / seed {}{}",
+        out.scenario,
+        out.case,
+        out.planner,
+        out.seed,
+        if out.noise { "" } else { " / no noise" }
+    );
+    let _ = writeln!(s, "outcome              {verdict}");
+    if let Some(d) = &out.failure_detail {
+        let _ = writeln!(s, "reason               {d}");
+    }
+    let _ = writeln!(
+        s,
+        "lateral error entry  {}",
+        opt(out.lateral_error_m, 1.0, "m")
+    );
+    let _ = writeln!(
+        s,
+        "heading error entry  {}",
+        opt(out.heading_error_rad, 1.0, "rad")
+    );
+    let _ = writeln!(s, "final lateral error  {:.4} m", out.final_lateral_error_m);
+    let _ = writeln!(
+        s,
+        "final heading error  {:.5} rad",
+        out.final_heading_error_rad
+    );
+    let _ = writeln!(s, "insertion depth      {:.3} m", out.insertion_depth_m);
+    let _ = writeln!(s, "max steering         {:.4} rad", out.max_steer_rad);
+    let _ = writeln!(s, "max contact force    {:.1} N", out.max_contact_force_n);
+    let _ = writeln!(
+        s,
+        "pallet displacement  {:.4} m, {:.3}°",
+        out.pallet_displacement_m,
+        out.pallet_rotation_rad.to_degrees()
+    );
+    let _ = writeln!(s, "replans              {}", out.replans);
+    let _ = writeln!(s, "sim time             {:.2} s", out.sim_time_s);
+    let _ = writeln!(s, "wall time            {:.1} ms", out.wall_time_ms);
+    crate::emit(&s)?;
+    Ok(out.success)
+}
+
+/// Planner override from the CLI.
+pub fn options(
+    seed: Option<u64>,
+    planner: Option<PlannerKind>,
+    no_noise: bool,
+    pallet_noise_scale: Option<f64>,
+    replan: bool,
+) -> anyhow::Result<TrialOptions> {
+    if let Some(s) = pallet_noise_scale
+        && !(s.is_finite() && s >= 0.0)
+    {
+        anyhow::bail!("--pallet-noise-scale {s}: must be a finite number ≥ 0");
+    }
+    Ok(TrialOptions {
+        seed,
+        planner,
+        no_noise,
+        pallet_noise_scale,
+        replan: replan.then_some(true),
+    })
+}

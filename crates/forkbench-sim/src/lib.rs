@@ -1,0 +1,482 @@
+//! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers, fixed racks.
+
+mod pallet;
+
+use forkbench_core::{ForkliftSpec, Pose2};
+use rapier2d::prelude::*;
+use serde::{Deserialize, Serialize};
+
+pub use pallet::PalletSpec;
+
+/// Standard gravity, for tyre and floor normal loads (the plane itself has no gravity).
+const G_MPS2: f64 = 9.81;
+
+/// Settings of the physics model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    /// Fixed physics step (100 Hz by default).
+    pub dt_s: f64,
+    /// Tyre–floor friction coefficient: caps the lateral tyre impulse at μ N dt.
+    pub tyre_friction: f64,
+    /// Pallet–floor friction coefficient.
+    pub pallet_floor_friction: f64,
+    /// Largest drive/brake acceleration.
+    pub max_accel_mps2: f64,
+    /// Proportional gain of the speed controller (1/s).
+    pub speed_gain_per_s: f64,
+    /// Friction between forks and pallet wood.
+    pub fork_friction: f64,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        Self {
+            dt_s: 0.01,
+            tyre_friction: 0.8,
+            pallet_floor_friction: 0.4,
+            max_accel_mps2: 1.0,
+            speed_gain_per_s: 4.0,
+            fork_friction: 0.3,
+        }
+    }
+}
+
+/// A fixed rectangle (rack upright, rack bay, wall) in the world frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Obstacle {
+    pub centre: Pose2,
+    pub length_m: f64,
+    pub width_m: f64,
+}
+
+/// Why a world could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    #[error("sim setting `{field}` = {value}: {reason}")]
+    Config {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("pallet spec: {0}")]
+    Pallet(String),
+    #[error("truck spec: {0}")]
+    Truck(#[from] forkbench_core::SpecError),
+}
+
+/// The simulated truck, pallet and obstacles.
+pub struct Sim {
+    world: PhysicsWorld,
+    truck: RigidBodyHandle,
+    forks: [ColliderHandle; 2],
+    chassis: ColliderHandle,
+    pallet: RigidBodyHandle,
+    stringers: Vec<ColliderHandle>,
+    obstacles: Vec<ColliderHandle>,
+    spec: ForkliftSpec,
+    pallet_spec: PalletSpec,
+    cfg: SimConfig,
+    steer_rad: f64,
+    /// Steps taken; time is steps × dt, so it never drifts from float accumulation.
+    steps: u64,
+    truck_mass_kg: f64,
+    truck_inertia: f64,
+    /// Chassis centre (the centre of mass) ahead of the front axle, in the body frame.
+    com_ahead_m: f64,
+    pallet_inertia: f64,
+    last_fork_force_n: f64,
+    last_obstacle_contact: bool,
+}
+
+impl std::fmt::Debug for Sim {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Sim")
+            .field("time_s", &self.time_s())
+            .field("fork_root", &self.fork_root_pose())
+            .field("pallet", &self.pallet_pose())
+            .field("steer_rad", &self.steer_rad)
+            .finish_non_exhaustive()
+    }
+}
+
+fn v2(x: f64, y: f64) -> Vector {
+    Vector::new(x as Real, y as Real)
+}
+
+fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+impl SimConfig {
+    fn validate(&self) -> Result<(), SimError> {
+        let fields = [
+            ("dt_s", self.dt_s),
+            ("tyre_friction", self.tyre_friction),
+            ("pallet_floor_friction", self.pallet_floor_friction),
+            ("max_accel_mps2", self.max_accel_mps2),
+            ("speed_gain_per_s", self.speed_gain_per_s),
+        ];
+        for (field, value) in fields {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(SimError::Config {
+                    field,
+                    value,
+                    reason: "must be a positive finite number",
+                });
+            }
+        }
+        if self.dt_s > 0.02 {
+            return Err(SimError::Config {
+                field: "dt_s",
+                value: self.dt_s,
+                reason: "must be ≤ 0.02 s (50 Hz) for stable tyre impulses",
+            });
+        }
+        if !(self.fork_friction.is_finite() && self.fork_friction >= 0.0) {
+            return Err(SimError::Config {
+                field: "fork_friction",
+                value: self.fork_friction,
+                reason: "must be a finite number ≥ 0",
+            });
+        }
+        Ok(())
+    }
+}
+
+impl Sim {
+    /// Builds the world. `start` is the fork-root pose; `pallet_pose` the pallet's front-face
+    /// centre with heading pointing into the pallet (the direction the forks travel).
+    pub fn new(
+        spec: &ForkliftSpec,
+        start: &Pose2,
+        pallet_spec: &PalletSpec,
+        pallet_pose: &Pose2,
+        obstacles: &[Obstacle],
+        cfg: &SimConfig,
+    ) -> Result<Self, SimError> {
+        spec.validate()?;
+        pallet_spec.validate().map_err(SimError::Pallet)?;
+        cfg.validate()?;
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::ZERO;
+        world.integration_parameters.dt = cfg.dt_s as Real;
+
+        // Truck: body origin at the front (drive) axle centre, +x forward (fork side).
+        let d = spec.fork_root_ahead_of_front_axle_m;
+        let (s, c) = start.heading_rad.sin_cos();
+        let axle = [start.x_m - c * d, start.y_m - s * d];
+        let truck = world.insert_body(
+            RigidBodyBuilder::dynamic()
+                .translation(v2(axle[0], axle[1]))
+                .rotation(start.heading_rad as Real)
+                .can_sleep(false),
+        );
+        // Chassis (with the mast) ends at the fork root; it carries all the mass, so the
+        // inertia is that of a solid 2.45 × 1.2 m body.
+        let chassis_front = d;
+        let chassis_centre = chassis_front - spec.body_length_m / 2.0;
+        let chassis = world.insert_collider(
+            ColliderBuilder::cuboid(
+                (spec.body_length_m / 2.0) as Real,
+                (spec.body_width_m / 2.0) as Real,
+            )
+            .translation(v2(chassis_centre, 0.0))
+            .mass(spec.mass_kg as Real)
+            .friction(0.5),
+            Some(truck),
+        );
+        let fork = |side: f64| {
+            ColliderBuilder::cuboid(
+                (spec.fork_length_m / 2.0) as Real,
+                (spec.fork_width_m / 2.0) as Real,
+            )
+            .translation(v2(
+                d + spec.fork_length_m / 2.0,
+                side * spec.fork_spacing_m / 2.0,
+            ))
+            .density(0.0)
+            .friction(cfg.fork_friction as Real)
+        };
+        let forks = [
+            world.insert_collider(fork(1.0), Some(truck)),
+            world.insert_collider(fork(-1.0), Some(truck)),
+        ];
+        let truck_mass_kg = spec.mass_kg;
+        let truck_inertia =
+            spec.mass_kg * (spec.body_length_m.powi(2) + spec.body_width_m.powi(2)) / 12.0;
+
+        // Pallet: stringers run along its heading from the face to the back.
+        let pallet = world.insert_body(
+            RigidBodyBuilder::dynamic()
+                .translation(v2(pallet_pose.x_m, pallet_pose.y_m))
+                .rotation(pallet_pose.heading_rad as Real)
+                .can_sleep(false),
+        );
+        let sw = pallet_spec.stringer_width_m();
+        let mut stringers = Vec::new();
+        for y in pallet_spec.stringer_offsets_m() {
+            stringers.push(
+                world.insert_collider(
+                    ColliderBuilder::cuboid(
+                        (pallet_spec.depth_m / 2.0) as Real,
+                        (sw / 2.0) as Real,
+                    )
+                    .translation(v2(pallet_spec.depth_m / 2.0, y))
+                    .mass((pallet_spec.mass_kg / 3.0) as Real)
+                    .friction(cfg.fork_friction as Real),
+                    Some(pallet),
+                ),
+            );
+        }
+        let pallet_inertia = pallet_spec.mass_kg
+            * (pallet_spec.depth_m.powi(2) + pallet_spec.width_m.powi(2))
+            / 12.0;
+
+        let obstacles = obstacles
+            .iter()
+            .map(|o| {
+                world.insert_collider(
+                    ColliderBuilder::cuboid((o.length_m / 2.0) as Real, (o.width_m / 2.0) as Real)
+                        .translation(v2(o.centre.x_m, o.centre.y_m))
+                        .rotation(o.centre.heading_rad as Real),
+                    None,
+                )
+            })
+            .collect();
+
+        Ok(Self {
+            world,
+            truck,
+            forks,
+            chassis,
+            pallet,
+            stringers,
+            obstacles,
+            spec: spec.clone(),
+            pallet_spec: pallet_spec.clone(),
+            cfg: cfg.clone(),
+            steer_rad: 0.0,
+            steps: 0,
+            truck_mass_kg,
+            truck_inertia,
+            com_ahead_m: chassis_centre,
+            pallet_inertia,
+            last_fork_force_n: 0.0,
+            last_obstacle_contact: false,
+        })
+    }
+
+    pub fn time_s(&self) -> f64 {
+        self.steps as f64 * self.cfg.dt_s
+    }
+
+    pub fn dt_s(&self) -> f64 {
+        self.cfg.dt_s
+    }
+
+    /// Actual (rate-limited) equivalent steering angle.
+    pub fn steer_rad(&self) -> f64 {
+        self.steer_rad
+    }
+
+    fn body_pose(&self, h: RigidBodyHandle) -> Pose2 {
+        let b = &self.world.bodies[h];
+        let t = b.translation();
+        Pose2::new(t.x as f64, t.y as f64, b.rotation().angle() as f64)
+    }
+
+    /// Front-axle (kinematic origin) pose.
+    pub fn front_axle_pose(&self) -> Pose2 {
+        self.body_pose(self.truck)
+    }
+
+    /// Fork-root (path reference point) pose.
+    pub fn fork_root_pose(&self) -> Pose2 {
+        let a = self.front_axle_pose();
+        a.to_world(&Pose2::new(
+            self.spec.fork_root_ahead_of_front_axle_m,
+            0.0,
+            0.0,
+        ))
+    }
+
+    /// Pallet front-face centre pose (moves if the pallet is pushed).
+    pub fn pallet_pose(&self) -> Pose2 {
+        self.body_pose(self.pallet)
+    }
+
+    pub fn pallet_spec(&self) -> &PalletSpec {
+        &self.pallet_spec
+    }
+
+    /// Longitudinal speed of the front axle (what the drive encoder reads).
+    pub fn speed_mps(&self) -> f64 {
+        let b = &self.world.bodies[self.truck];
+        let a = self.front_axle_pose();
+        let v = b.velocity_at_point(b.translation());
+        v.x as f64 * a.heading_rad.cos() + v.y as f64 * a.heading_rad.sin()
+    }
+
+    /// Lateral (side-slip) speed of the front axle.
+    pub fn lateral_speed_mps(&self) -> f64 {
+        let b = &self.world.bodies[self.truck];
+        let a = self.front_axle_pose();
+        let v = b.velocity_at_point(b.translation());
+        -(v.x as f64) * a.heading_rad.sin() + v.y as f64 * a.heading_rad.cos()
+    }
+
+    pub fn yaw_rate_radps(&self) -> f64 {
+        self.world.bodies[self.truck].angvel() as f64
+    }
+
+    /// Largest fork–pallet contact force in the last step.
+    pub fn fork_contact_force_n(&self) -> f64 {
+        self.last_fork_force_n
+    }
+
+    /// Whether the truck touched a rack or wall in the last step.
+    pub fn obstacle_contact(&self) -> bool {
+        self.last_obstacle_contact
+    }
+
+    /// One fixed step with the commanded speed and steering angle.
+    pub fn step(&mut self, speed_cmd_mps: f64, steer_cmd_rad: f64) {
+        let dt = self.cfg.dt_s;
+        // Rate-limited steering actuator.
+        let max = self.spec.max_steer_rad;
+        let target = if steer_cmd_rad.is_finite() {
+            steer_cmd_rad.clamp(-max, max)
+        } else {
+            self.steer_rad
+        };
+        let rate = self.spec.max_steer_rate_radps * dt;
+        self.steer_rad =
+            (self.steer_rad + (target - self.steer_rad).clamp(-rate, rate)).clamp(-max, max);
+        let speed_cmd = if speed_cmd_mps.is_finite() {
+            speed_cmd_mps
+        } else {
+            0.0
+        };
+
+        self.apply_drive(speed_cmd, dt);
+        self.apply_tyres(dt);
+        self.apply_pallet_floor_friction(dt);
+        self.world.step();
+        self.steps += 1;
+        self.read_contacts(dt);
+    }
+
+    /// Drive/brake force at the front axle from a proportional speed controller.
+    fn apply_drive(&mut self, speed_cmd: f64, dt: f64) {
+        let a = self.front_axle_pose();
+        let v = self.speed_mps();
+        let accel = (self.cfg.speed_gain_per_s * (speed_cmd - v))
+            .clamp(-self.cfg.max_accel_mps2, self.cfg.max_accel_mps2);
+        let j = self.truck_mass_kg * accel * dt;
+        let (s, c) = a.heading_rad.sin_cos();
+        let b = &mut self.world.bodies[self.truck];
+        let p = b.translation();
+        b.apply_impulse_at_point(v2(j * c, j * s), p, true);
+    }
+
+    /// Lateral tyre impulses at the front axle and the steered rear wheel that cancel
+    /// side slip (solved together: they couple through the yaw), each capped at μ N dt.
+    fn apply_tyres(&mut self, dt: f64) {
+        let a = self.front_axle_pose();
+        let (s, c) = a.heading_rad.sin_cos();
+        let l = self.spec.wheelbase_m;
+        let b = &self.world.bodies[self.truck];
+        let com = b.center_of_mass();
+        let com = [com.x as f64, com.y as f64];
+        let lin = b.linvel();
+        let lin = [lin.x as f64, lin.y as f64];
+        let w = b.angvel() as f64;
+        let pf = [a.x_m, a.y_m];
+        let pr = [a.x_m - c * l, a.y_m - s * l];
+        let nf = [-s, c];
+        // Rear wheel points at −α for a left (positive) turn: the ICR lies on the front axle line.
+        let hr = a.heading_rad - self.steer_rad;
+        let nr = [-hr.sin(), hr.cos()];
+        let pts = [(pf, nf), (pr, nr)];
+        let r: Vec<[f64; 2]> = pts
+            .iter()
+            .map(|(p, _)| [p[0] - com[0], p[1] - com[1]])
+            .collect();
+        let u: Vec<f64> = pts
+            .iter()
+            .zip(&r)
+            .map(|((_, n), ri)| {
+                let vp = [lin[0] - w * ri[1], lin[1] + w * ri[0]];
+                vp[0] * n[0] + vp[1] * n[1]
+            })
+            .collect();
+        let (m, i) = (self.truck_mass_kg, self.truck_inertia);
+        let k = |a: usize, bb: usize| {
+            let (na, nb) = (pts[a].1, pts[bb].1);
+            (na[0] * nb[0] + na[1] * nb[1]) / m + cross(r[a], na) * cross(r[bb], nb) / i
+        };
+        let kk = [[k(0, 0), k(0, 1)], [k(1, 0), k(1, 1)]];
+        let det = kk[0][0] * kk[1][1] - kk[0][1] * kk[1][0];
+        if det.abs() < 1e-18 {
+            return;
+        }
+        let lam = [
+            -(kk[1][1] * u[0] - kk[0][1] * u[1]) / det,
+            -(kk[0][0] * u[1] - kk[1][0] * u[0]) / det,
+        ];
+        // Static axle loads from where the centre of mass sits between the axles.
+        let rear_share = (-self.com_ahead_m / l).clamp(0.0, 1.0);
+        let loads = [m * G_MPS2 * (1.0 - rear_share), m * G_MPS2 * rear_share];
+        let b = &mut self.world.bodies[self.truck];
+        for (idx, ((p, n), lam)) in pts.iter().zip(lam).enumerate() {
+            let cap = self.cfg.tyre_friction * loads[idx] * dt;
+            let lam = lam.clamp(-cap, cap);
+            b.apply_impulse_at_point(v2(lam * n[0], lam * n[1]), v2(p[0], p[1]), true);
+        }
+    }
+
+    /// Coulomb floor friction on the pallet, as impulses that never reverse its motion.
+    fn apply_pallet_floor_friction(&mut self, dt: f64) {
+        let mu_g_dt = self.cfg.pallet_floor_friction * G_MPS2 * dt;
+        let m = self.pallet_spec.mass_kg;
+        let i = self.pallet_inertia;
+        let b = &mut self.world.bodies[self.pallet];
+        let v = b.linvel();
+        let speed = (v.x as f64).hypot(v.y as f64);
+        if speed > 0.0 {
+            let dv = speed.min(mu_g_dt);
+            let j = -m * dv / speed;
+            b.apply_impulse(v2(j * v.x as f64, j * v.y as f64), true);
+        }
+        let w = b.angvel() as f64;
+        // Friction torque of a uniformly loaded rectangle ≈ μ m g r̄, r̄ ≈ a third of its size.
+        let r_mean = (self.pallet_spec.depth_m + self.pallet_spec.width_m) / 6.0;
+        let dw = w.abs().min(mu_g_dt * m * r_mean / i);
+        if w != 0.0 {
+            b.apply_torque_impulse((-dw.copysign(w) * i) as Real, true);
+        }
+    }
+
+    fn read_contacts(&mut self, dt: f64) {
+        let np = &self.world.narrow_phase;
+        let mut fork_force = 0.0_f64;
+        for &f in &self.forks {
+            for &s in &self.stringers {
+                if let Some(pair) = np.contact_pair(f, s)
+                    && pair.has_any_active_contact()
+                {
+                    fork_force = fork_force.max(pair.total_impulse_magnitude() as f64 / dt);
+                }
+            }
+        }
+        self.last_fork_force_n = fork_force;
+        let truck_colliders = [self.chassis, self.forks[0], self.forks[1]];
+        self.last_obstacle_contact = truck_colliders.iter().any(|&t| {
+            self.obstacles.iter().any(|&o| {
+                np.contact_pair(t, o)
+                    .is_some_and(|p| p.has_any_active_contact())
+            })
+        });
+    }
+}

@@ -1,0 +1,279 @@
+//! Pure pursuit on the fork-root reference point, with fixed or speed-scaled look-ahead and a slow final approach.
+
+use forkbench_core::units::wrap_angle;
+use forkbench_core::{ForkliftSpec, Path, Pose2};
+use serde::{Deserialize, Serialize};
+
+/// Tracker settings (SI units).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TrackerConfig {
+    /// Fixed look-ahead distance (the B-spline paper's field test: 0.7 m).
+    pub lookahead_m: f64,
+    /// When set, look-ahead = gain · speed (l_d = K v), bounded below by `min_lookahead_m`.
+    pub lookahead_gain_s: Option<f64>,
+    pub min_lookahead_m: f64,
+    /// Cruise speed (≤ the truck's max picking speed).
+    pub cruise_speed_mps: f64,
+    /// Speed for the last `approach_distance_m` before the goal (fork entry).
+    pub approach_speed_mps: f64,
+    pub approach_distance_m: f64,
+    /// Deceleration used to plan the stop at the goal.
+    pub decel_mps2: f64,
+}
+
+impl Default for TrackerConfig {
+    fn default() -> Self {
+        Self {
+            lookahead_m: 0.7,
+            lookahead_gain_s: None,
+            min_lookahead_m: 0.3,
+            cruise_speed_mps: 0.8,
+            approach_speed_mps: 0.3,
+            approach_distance_m: 2.0,
+            decel_mps2: 0.4,
+        }
+    }
+}
+
+impl TrackerConfig {
+    /// The first field that holds an impossible value, with the reason.
+    pub fn invalid_field(&self) -> Option<(&'static str, &'static str)> {
+        let positive = [
+            ("lookahead_m", self.lookahead_m),
+            ("min_lookahead_m", self.min_lookahead_m),
+            ("cruise_speed_mps", self.cruise_speed_mps),
+            ("approach_speed_mps", self.approach_speed_mps),
+            ("decel_mps2", self.decel_mps2),
+        ];
+        for (f, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Some((f, "must be a positive finite number"));
+            }
+        }
+        if !(self.approach_distance_m.is_finite() && self.approach_distance_m >= 0.0) {
+            return Some(("approach_distance_m", "must be a finite number ≥ 0"));
+        }
+        if let Some(k) = self.lookahead_gain_s
+            && !(k.is_finite() && k > 0.0)
+        {
+            return Some(("lookahead_gain_s", "must be a positive finite number"));
+        }
+        None
+    }
+}
+
+/// One control output.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Command {
+    pub speed_mps: f64,
+    /// Equivalent steering angle (positive turns left), already within ±α_max.
+    pub steer_rad: f64,
+    pub lookahead_point: [f64; 2],
+    /// Signed lateral offset of the reference point from the path (left positive).
+    pub cross_track_m: f64,
+    /// Arc length left to the goal.
+    pub remaining_m: f64,
+    /// The goal is reached: stop.
+    pub done: bool,
+}
+
+/// Pure pursuit along one path. Progress along the path only moves forward, so a path
+/// that passes near itself cannot make the tracker jump.
+///
+/// The path is planned for the fork root, but pure pursuit's arc geometry holds for the
+/// point that moves along its own heading: the front (fixed) axle. So the tracker steers
+/// the front axle along the fork-root path shifted back by the root's offset; when the
+/// axle is on its path with the path's heading, the fork root is on the planned path.
+#[derive(Debug, Clone)]
+pub struct PurePursuit {
+    path: Path,
+    cfg: TrackerConfig,
+    idx: usize,
+    root_ahead_m: f64,
+}
+
+impl PurePursuit {
+    /// `root_ahead_m`: how far the tracked (fork-root) point sits ahead of the front axle.
+    pub fn new(root_path: Path, cfg: TrackerConfig, root_ahead_m: f64) -> Self {
+        let mut path = root_path;
+        for p in &mut path.samples {
+            p.x_m -= root_ahead_m * p.heading_rad.cos();
+            p.y_m -= root_ahead_m * p.heading_rad.sin();
+        }
+        Self {
+            path,
+            cfg,
+            idx: 0,
+            root_ahead_m,
+        }
+    }
+
+    /// The front-axle path being tracked.
+    pub fn axle_path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Steering and speed for the (measured or predicted) fork-root pose.
+    pub fn command(&mut self, root: &Pose2, speed_mps: f64, truck: &ForkliftSpec) -> Command {
+        let pose = &root.to_world(&Pose2::new(-self.root_ahead_m, 0.0, 0.0));
+        let n = self.path.samples.len();
+        let Some(last) = self.path.samples.last().copied() else {
+            return Command {
+                speed_mps: 0.0,
+                steer_rad: 0.0,
+                lookahead_point: [pose.x_m, pose.y_m],
+                cross_track_m: 0.0,
+                remaining_m: 0.0,
+                done: true,
+            };
+        };
+        // Closest sample, searched forward from the last progress over a bounded window.
+        let d2 = |i: usize| {
+            let p = &self.path.samples[i];
+            (p.x_m - pose.x_m).powi(2) + (p.y_m - pose.y_m).powi(2)
+        };
+        let window = (self.idx + 400).min(n);
+        let mut best = self.idx;
+        for i in self.idx..window {
+            if d2(i) < d2(best) {
+                best = i;
+            }
+        }
+        self.idx = best;
+        let near = self.path.samples[best];
+        let (sn, cn) = near.heading_rad.sin_cos();
+        let dx = pose.x_m - near.x_m;
+        let dy = pose.y_m - near.y_m;
+        let cross_track_m = -sn * dx + cn * dy;
+        let along = cn * dx + sn * dy;
+        // Distance to go, measured along the goal heading at the end so the stop is exact.
+        let (gs, gc) = last.heading_rad.sin_cos();
+        let to_goal_along_heading = gc * (last.x_m - pose.x_m) + gs * (last.y_m - pose.y_m);
+        let remaining_m = if self.path.length_m() - near.s_m < 0.5 {
+            to_goal_along_heading
+        } else {
+            self.path.length_m() - near.s_m - along
+        };
+
+        let ld = match self.cfg.lookahead_gain_s {
+            Some(k) => (k * speed_mps.abs()).max(self.cfg.min_lookahead_m),
+            None => self.cfg.lookahead_m,
+        };
+        // Look-ahead point: first sample at least ld away; past the end, a point on the
+        // goal heading's extension keeps the forks aligned with the pocket.
+        let mut target = None;
+        for i in best..n {
+            if d2(i) >= ld * ld {
+                target = Some([self.path.samples[i].x_m, self.path.samples[i].y_m]);
+                break;
+            }
+        }
+        let target = target.unwrap_or_else(|| {
+            let ext = ld.max(0.05);
+            // Project onto the extension line at distance ld from the pose.
+            let px = pose.x_m - last.x_m;
+            let py = pose.y_m - last.y_m;
+            let t_along = gc * px + gs * py;
+            let lat = -gs * px + gc * py;
+            let fwd = (ext * ext - lat * lat).max(0.0).sqrt();
+            let t = t_along + fwd;
+            [last.x_m + gc * t, last.y_m + gs * t]
+        });
+        let vx = target[0] - pose.x_m;
+        let vy = target[1] - pose.y_m;
+        let dist = vx.hypot(vy).max(1e-6);
+        let eta = wrap_angle(vy.atan2(vx) - pose.heading_rad);
+        let curvature = 2.0 * eta.sin() / dist;
+        let steer_rad = truck
+            .steer_for_curvature(curvature)
+            .clamp(-truck.max_steer_rad, truck.max_steer_rad);
+
+        let done = remaining_m <= 0.002;
+        let cruise = self.cfg.cruise_speed_mps.min(truck.max_speed_mps);
+        let mut speed = cruise;
+        if remaining_m < self.cfg.approach_distance_m {
+            speed = speed.min(self.cfg.approach_speed_mps);
+        }
+        // Stop at the goal: v ≤ √(2 a d), with a small floor so the last millimetres close.
+        speed = speed.min(
+            (2.0 * self.cfg.decel_mps2 * remaining_m.max(0.0))
+                .sqrt()
+                .max(0.02),
+        );
+        if done {
+            speed = 0.0;
+        }
+        Command {
+            speed_mps: speed,
+            steer_rad,
+            lookahead_point: target,
+            cross_track_m,
+            remaining_m,
+            done,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use forkbench_core::PathSample;
+
+    fn straight(len: f64) -> Path {
+        let n = (len / 0.01) as usize;
+        Path {
+            samples: (0..=n)
+                .map(|i| {
+                    let s = i as f64 * 0.01;
+                    PathSample {
+                        s_m: s,
+                        x_m: s,
+                        y_m: 0.0,
+                        heading_rad: 0.0,
+                        curvature_per_m: 0.0,
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn steers_back_toward_the_path() {
+        let truck = ForkliftSpec::default();
+        let mut pp = PurePursuit::new(straight(5.0), TrackerConfig::default(), 0.0);
+        let left = pp.command(&Pose2::new(1.0, 0.2, 0.0), 0.5, &truck);
+        assert!(left.steer_rad < 0.0, "left of the path must steer right");
+        assert!((left.cross_track_m - 0.2).abs() < 1e-9);
+        let mut pp = PurePursuit::new(straight(5.0), TrackerConfig::default(), 0.0);
+        let right = pp.command(&Pose2::new(1.0, -0.2, 0.0), 0.5, &truck);
+        assert!(right.steer_rad > 0.0);
+    }
+
+    #[test]
+    fn slows_near_the_goal_and_stops_there() {
+        let truck = ForkliftSpec::default();
+        let mut pp = PurePursuit::new(straight(5.0), TrackerConfig::default(), 0.0);
+        let far = pp.command(&Pose2::new(0.5, 0.0, 0.0), 0.8, &truck);
+        assert!((far.speed_mps - 0.8).abs() < 1e-9);
+        let near = pp.command(&Pose2::new(4.0, 0.0, 0.0), 0.3, &truck);
+        assert!(near.speed_mps <= 0.3 + 1e-9);
+        let end = pp.command(&Pose2::new(4.999, 0.0, 0.0), 0.05, &truck);
+        assert!(end.done && end.speed_mps == 0.0);
+    }
+
+    #[test]
+    fn speed_scaled_lookahead_grows_with_speed() {
+        let truck = ForkliftSpec::default();
+        let cfg = TrackerConfig {
+            lookahead_gain_s: Some(1.5),
+            ..TrackerConfig::default()
+        };
+        let mut pp = PurePursuit::new(straight(8.0), cfg.clone(), 0.0);
+        let slow = pp.command(&Pose2::new(1.0, 0.0, 0.0), 0.1, &truck);
+        let mut pp = PurePursuit::new(straight(8.0), cfg, 0.0);
+        let fast = pp.command(&Pose2::new(1.0, 0.0, 0.0), 0.8, &truck);
+        assert!((slow.lookahead_point[0] - 1.3).abs() < 0.02);
+        assert!((fast.lookahead_point[0] - 2.2).abs() < 0.02);
+    }
+}

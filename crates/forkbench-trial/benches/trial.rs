@@ -1,0 +1,38 @@
+//! Wall time of one 6.5 m pick trial (issue target: ≤ 20 ms on one core, ≥ 500× real time).
+
+use std::path::Path;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use forkbench_plan::PlannerKind;
+use forkbench_trial::{Scenario, TrialOptions, run_trial};
+
+fn bench(c: &mut Criterion) {
+    let file = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/field-test.toml"
+    ));
+    let scn = Scenario::load(file).expect("field test loads");
+    let case = &scn.cases[0];
+    let mut g = c.benchmark_group("trial");
+    for planner in PlannerKind::ALL {
+        for (label, no_noise) in [("no_noise", true), ("noise", false)] {
+            let opts = TrialOptions {
+                no_noise,
+                planner: Some(planner),
+                seed: Some(7),
+                ..TrialOptions::default()
+            };
+            g.bench_function(format!("field_test/{planner}/{label}"), |b| {
+                b.iter(|| run_trial(&scn, case, &opts))
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2));
+    targets = bench
+}
+criterion_main!(benches);

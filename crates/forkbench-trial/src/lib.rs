@@ -1,0 +1,36 @@
+//! One pick trial end to end: scenario and world files, noisy estimate → plan → pure pursuit in rapier2d → judged outcome.
+
+pub mod geometry;
+pub mod outcome;
+pub mod scenario;
+pub mod trial;
+
+pub use outcome::{Failure, TrialOutcome};
+pub use scenario::{Case, PoseDeg, Scenario, Tolerances, World};
+pub use trial::{TrialOptions, run_trial};
+
+/// A scenario or world file that cannot be used, with the file and field named.
+#[derive(Debug, thiserror::Error)]
+pub enum TrialError {
+    #[error("{file}: {source}")]
+    Read {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Syntax or type error; toml's message carries line and column.
+    #[error("{file}: {message}")]
+    Parse { file: String, message: String },
+    #[error("{file}: field `{field}`: {reason}")]
+    Invalid {
+        file: String,
+        field: String,
+        reason: String,
+    },
+    #[error("{file}: no case named {case:?} (cases: {known})")]
+    UnknownCase {
+        file: String,
+        case: String,
+        known: String,
+    },
+}

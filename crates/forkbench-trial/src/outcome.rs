@@ -1,0 +1,78 @@
+//! The judged result of one trial, in SI units, serialisable as one JSON object.
+
+use serde::{Deserialize, Serialize};
+
+/// The criteria a pick can fail, in the order they are checked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Failure {
+    /// The planner refused the (estimated) goal.
+    PlanFailed,
+    /// The truck touched a rack or wall.
+    Collision,
+    /// A fork pushed on the pallet harder than the threshold before full depth.
+    ContactForce,
+    /// The pallet moved or turned more than the tolerance.
+    PalletDisplaced,
+    /// Fork root off the pocket centre line when the tips reached the pallet face.
+    LateralError,
+    /// Fork root heading off the pallet axis when the tips reached the pallet face.
+    HeadingError,
+    /// The truck did not stop at the goal within the time limit.
+    Timeout,
+    /// The forks ended short of the required depth (or never entered).
+    InsertionDepth,
+    /// A fork ended outside its pocket.
+    ForkOutsidePocket,
+    /// The trial itself broke (panic or non-finite state).
+    Error,
+}
+
+impl Failure {
+    pub fn name(self) -> &'static str {
+        match self {
+            Failure::PlanFailed => "plan_failed",
+            Failure::Collision => "collision",
+            Failure::ContactForce => "contact_force",
+            Failure::PalletDisplaced => "pallet_displaced",
+            Failure::LateralError => "lateral_error",
+            Failure::HeadingError => "heading_error",
+            Failure::Timeout => "timeout",
+            Failure::InsertionDepth => "insertion_depth",
+            Failure::ForkOutsidePocket => "fork_outside_pocket",
+            Failure::Error => "error",
+        }
+    }
+}
+
+/// Everything a trial reports.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialOutcome {
+    pub scenario: String,
+    pub case: String,
+    pub planner: String,
+    pub seed: u64,
+    pub noise: bool,
+    pub success: bool,
+    /// First failed criterion in check order, if any.
+    pub failure: Option<Failure>,
+    pub failure_detail: Option<String>,
+    /// Fork-root offset from the pocket centre line when the fork tips reached the face.
+    pub lateral_error_m: Option<f64>,
+    pub heading_error_rad: Option<f64>,
+    /// The same errors when the truck stopped.
+    pub final_lateral_error_m: f64,
+    pub final_heading_error_rad: f64,
+    pub insertion_depth_m: f64,
+    pub max_steer_rad: f64,
+    /// Largest fork–pallet contact force before full depth.
+    pub max_contact_force_n: f64,
+    pub pallet_displacement_m: f64,
+    pub pallet_rotation_rad: f64,
+    pub replans: u32,
+    /// New estimates whose replan the planner refused (the old plan was kept).
+    pub replans_failed: u32,
+    pub path_length_m: f64,
+    pub sim_time_s: f64,
+    pub wall_time_ms: f64,
+}

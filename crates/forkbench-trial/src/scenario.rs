@@ -1,0 +1,566 @@
+//! Scenario and world files (TOML, unknown fields rejected), validated into SI-unit cases before any simulation.
+
+use std::path::{Path as FsPath, PathBuf};
+
+use forkbench_core::{ForkliftSpec, Pose2};
+use forkbench_plan::PlannerKind;
+use forkbench_sensors::{Nav350Config, PalletEstimateConfig};
+use forkbench_sim::{Obstacle, PalletSpec, SimConfig};
+use forkbench_track::TrackerConfig;
+use serde::{Deserialize, Serialize};
+
+use crate::TrialError;
+use crate::geometry::Rect;
+
+/// A pose as written in files: metres and degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseDeg {
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_deg: f64,
+}
+
+impl PoseDeg {
+    pub fn to_pose(self) -> Pose2 {
+        Pose2::new(self.x_m, self.y_m, self.heading_deg.to_radians())
+    }
+
+    fn check(&self, file: &str, field: &str) -> Result<(), TrialError> {
+        for (name, v) in [
+            ("x_m", self.x_m),
+            ("y_m", self.y_m),
+            ("heading_deg", self.heading_deg),
+        ] {
+            if !v.is_finite() {
+                return Err(invalid(
+                    file,
+                    &format!("{field}.{name}"),
+                    "must be a finite number",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
+    TrialError::Invalid {
+        file: file.to_owned(),
+        field: field.to_owned(),
+        reason: reason.to_owned(),
+    }
+}
+
+/// A fixed rectangle in a world file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RectFile {
+    #[serde(default)]
+    pub name: String,
+    pub x_m: f64,
+    pub y_m: f64,
+    #[serde(default)]
+    pub heading_deg: f64,
+    pub length_m: f64,
+    pub width_m: f64,
+}
+
+/// A named place a pallet can stand (face centre, heading into the pallet).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PalletSlot {
+    pub name: String,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_deg: f64,
+}
+
+/// A warehouse layout.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct World {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default)]
+    pub rack: Vec<RectFile>,
+    #[serde(default)]
+    pub wall: Vec<RectFile>,
+    #[serde(default)]
+    pub pallet_slot: Vec<PalletSlot>,
+}
+
+fn read(path: &FsPath) -> Result<String, TrialError> {
+    std::fs::read_to_string(path).map_err(|source| TrialError::Read {
+        file: path.display().to_string(),
+        source,
+    })
+}
+
+fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, TrialError> {
+    toml::from_str(text).map_err(|e| TrialError::Parse {
+        file: file.to_owned(),
+        message: e.to_string().trim_end().to_owned(),
+    })
+}
+
+impl World {
+    pub fn load(path: &FsPath) -> Result<Self, TrialError> {
+        let file = path.display().to_string();
+        Self::parse(&read(path)?, &file)
+    }
+
+    pub fn parse(text: &str, file: &str) -> Result<Self, TrialError> {
+        let w: World = parse(text, file)?;
+        for (kind, list) in [("rack", &w.rack), ("wall", &w.wall)] {
+            for (i, r) in list.iter().enumerate() {
+                let f = format!("{kind}[{i}]");
+                PoseDeg {
+                    x_m: r.x_m,
+                    y_m: r.y_m,
+                    heading_deg: r.heading_deg,
+                }
+                .check(file, &f)?;
+                for (name, v) in [("length_m", r.length_m), ("width_m", r.width_m)] {
+                    if !(v.is_finite() && v > 0.0) {
+                        return Err(invalid(
+                            file,
+                            &format!("{f}.{name}"),
+                            "must be a positive finite length",
+                        ));
+                    }
+                }
+            }
+        }
+        for (i, s) in w.pallet_slot.iter().enumerate() {
+            PoseDeg {
+                x_m: s.x_m,
+                y_m: s.y_m,
+                heading_deg: s.heading_deg,
+            }
+            .check(file, &format!("pallet_slot[{i}]"))?;
+        }
+        Ok(w)
+    }
+
+    /// Racks and walls as simulator obstacles.
+    pub fn obstacles(&self) -> Vec<Obstacle> {
+        self.rack
+            .iter()
+            .chain(&self.wall)
+            .map(|r| Obstacle {
+                centre: Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
+                length_m: r.length_m,
+                width_m: r.width_m,
+            })
+            .collect()
+    }
+}
+
+/// Where the pallet stands: a pose, or a slot of the world.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PalletPlacement {
+    Slot { slot: String },
+    Pose(PoseDeg),
+}
+
+/// Which pallet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PalletKind {
+    /// 1.2 × 1.2 m, 0.405 m pockets (the field test).
+    #[serde(rename = "field-1200")]
+    Field1200,
+    /// 1.0 × 1.0 m (the papers' simulations).
+    #[serde(rename = "sim-1000")]
+    Sim1000,
+}
+
+/// Success tolerances of a pick.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Tolerances {
+    /// Fork-root offset from the pocket centre line at entry.
+    pub lateral_m: f64,
+    pub heading_deg: f64,
+    /// Required fork insertion (tips past the pallet face).
+    pub insertion_depth_m: f64,
+    /// Fork–pallet contact force allowed before full depth.
+    pub contact_force_n: f64,
+    pub pallet_displacement_m: f64,
+    pub pallet_rotation_deg: f64,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Self {
+            // 0.15 m forks in 0.405 m pockets leave ±0.1275 m; keep a margin for the
+            // heading error's contribution along the fork.
+            lateral_m: 0.10,
+            heading_deg: 3.0,
+            insertion_depth_m: 1.0,
+            contact_force_n: 200.0,
+            pallet_displacement_m: 0.02,
+            pallet_rotation_deg: 1.0,
+        }
+    }
+}
+
+/// Sensor noise settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseFile {
+    pub enabled: bool,
+    pub nav350: Nav350Config,
+    pub pallet_estimate: PalletEstimateConfig,
+}
+
+impl Default for NoiseFile {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            nav350: Nav350Config::default(),
+            pallet_estimate: PalletEstimateConfig::default(),
+        }
+    }
+}
+
+/// Replanning when a new pallet estimate arrives.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ReplanFile {
+    /// Off reproduces the papers: plan once from the first estimate.
+    pub enabled: bool,
+    pub position_threshold_m: f64,
+    pub heading_threshold_deg: f64,
+}
+
+impl Default for ReplanFile {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            position_threshold_m: 0.02,
+            heading_threshold_deg: 1.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CaseFile {
+    name: String,
+    start: Option<PoseDeg>,
+    pallet: Option<PalletPlacement>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioFile {
+    name: String,
+    #[serde(default)]
+    description: String,
+    /// World file, relative to this scenario file; none is an open floor.
+    world: Option<PathBuf>,
+    planner: PlannerKind,
+    #[serde(default)]
+    seed: u64,
+    #[serde(default = "default_pallet_kind")]
+    pallet_kind: PalletKind,
+    #[serde(default = "default_timeout")]
+    timeout_s: f64,
+    #[serde(default)]
+    truck: ForkliftSpec,
+    #[serde(default)]
+    tracker: TrackerConfig,
+    #[serde(default)]
+    sim: SimConfig,
+    #[serde(default)]
+    noise: NoiseFile,
+    #[serde(default)]
+    replan: ReplanFile,
+    #[serde(default)]
+    tolerances: Tolerances,
+    /// Fixed error of every pallet estimate, in the pallet frame (a miscalibrated camera);
+    /// kept with `--no-noise`, since it is not random.
+    estimate_bias: Option<PoseDeg>,
+    start: Option<PoseDeg>,
+    pallet: Option<PalletPlacement>,
+    #[serde(default)]
+    case: Vec<CaseFile>,
+}
+
+fn default_pallet_kind() -> PalletKind {
+    PalletKind::Field1200
+}
+
+fn default_timeout() -> f64 {
+    120.0
+}
+
+/// A loaded, validated scenario file.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    pub file: String,
+    pub name: String,
+    pub description: String,
+    pub planner: PlannerKind,
+    pub seed: u64,
+    pub pallet: PalletSpec,
+    pub timeout_s: f64,
+    pub truck: ForkliftSpec,
+    pub tracker: TrackerConfig,
+    pub sim: SimConfig,
+    pub noise: NoiseFile,
+    pub replan: ReplanFile,
+    pub tolerances: Tolerances,
+    /// Fixed pallet-estimate error in the pallet frame.
+    pub estimate_bias: Pose2,
+    pub world: World,
+    pub cases: Vec<Case>,
+}
+
+/// One start/pallet geometry of a scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Case {
+    pub name: String,
+    /// Fork-root start pose.
+    pub start: Pose2,
+    /// Pallet front-face centre, heading into the pallet.
+    pub pallet: Pose2,
+}
+
+impl Scenario {
+    pub fn load(path: &FsPath) -> Result<Self, TrialError> {
+        let file = path.display().to_string();
+        let text = read(path)?;
+        let dir = path.parent().unwrap_or(FsPath::new("."));
+        Self::parse(&text, &file, |world| World::load(&dir.join(world)))
+    }
+
+    /// Parses scenario text; `load_world` resolves the `world` path.
+    pub fn parse(
+        text: &str,
+        file: &str,
+        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
+    ) -> Result<Self, TrialError> {
+        let f: ScenarioFile = parse(text, file)?;
+        let world = match &f.world {
+            Some(p) => load_world(p)?,
+            None => World::default(),
+        };
+        f.truck
+            .validate()
+            .map_err(|e| invalid(file, &format!("truck.{}", e.field), e.reason))?;
+        if let Some((field, reason)) = f.tracker.invalid_field() {
+            return Err(invalid(file, &format!("tracker.{field}"), reason));
+        }
+        if let Some((field, reason)) = f.noise.nav350.invalid_field() {
+            return Err(invalid(file, &format!("noise.nav350.{field}"), reason));
+        }
+        if let Some((field, reason)) = f.noise.pallet_estimate.invalid_field() {
+            return Err(invalid(
+                file,
+                &format!("noise.pallet_estimate.{field}"),
+                reason,
+            ));
+        }
+        if !(f.timeout_s.is_finite() && f.timeout_s > 0.0) {
+            return Err(invalid(file, "timeout_s", "must be a positive finite time"));
+        }
+        let t = &f.tolerances;
+        for (name, v) in [
+            ("lateral_m", t.lateral_m),
+            ("heading_deg", t.heading_deg),
+            ("insertion_depth_m", t.insertion_depth_m),
+            ("contact_force_n", t.contact_force_n),
+            ("pallet_displacement_m", t.pallet_displacement_m),
+            ("pallet_rotation_deg", t.pallet_rotation_deg),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(
+                    file,
+                    &format!("tolerances.{name}"),
+                    "must be a positive finite number",
+                ));
+            }
+        }
+        if let Some(b) = &f.estimate_bias {
+            b.check(file, "estimate_bias")?;
+        }
+        let pallet = match f.pallet_kind {
+            PalletKind::Field1200 => PalletSpec::field_1200(),
+            PalletKind::Sim1000 => PalletSpec::sim_1000(),
+        };
+        if t.insertion_depth_m > pallet.depth_m.min(f.truck.fork_length_m) {
+            return Err(invalid(
+                file,
+                "tolerances.insertion_depth_m",
+                "deeper than the pallet or the forks allow",
+            ));
+        }
+        let resolve = |p: &PalletPlacement, field: &str| -> Result<Pose2, TrialError> {
+            match p {
+                PalletPlacement::Pose(pd) => {
+                    pd.check(file, field)?;
+                    Ok(pd.to_pose())
+                }
+                PalletPlacement::Slot { slot } => world
+                    .pallet_slot
+                    .iter()
+                    .find(|s| &s.name == slot)
+                    .map(|s| Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()))
+                    .ok_or_else(|| {
+                        invalid(
+                            file,
+                            &format!("{field}.slot"),
+                            &format!("world has no pallet slot {slot:?}"),
+                        )
+                    }),
+            }
+        };
+        let mut cases = Vec::new();
+        let listed: Vec<CaseFile> = if f.case.is_empty() {
+            vec![CaseFile {
+                name: "default".into(),
+                start: None,
+                pallet: None,
+            }]
+        } else {
+            f.case.clone()
+        };
+        for (i, c) in listed.iter().enumerate() {
+            let field = if f.case.is_empty() {
+                String::new()
+            } else {
+                format!("case[{i}].")
+            };
+            let start = c
+                .start
+                .or(f.start)
+                .ok_or_else(|| invalid(file, &format!("{field}start"), "missing"))?;
+            start.check(file, &format!("{field}start"))?;
+            let placement = c
+                .pallet
+                .as_ref()
+                .or(f.pallet.as_ref())
+                .ok_or_else(|| invalid(file, &format!("{field}pallet"), "missing"))?;
+            let case = Case {
+                name: c.name.clone(),
+                start: start.to_pose(),
+                pallet: resolve(placement, &format!("{field}pallet"))?,
+            };
+            check_layout(&case, &f.truck, &pallet, &world, file, &field)?;
+            if cases.iter().any(|k: &Case| k.name == case.name) {
+                return Err(invalid(
+                    file,
+                    &format!("{field}name"),
+                    "duplicate case name",
+                ));
+            }
+            cases.push(case);
+        }
+        Ok(Scenario {
+            file: file.to_owned(),
+            name: f.name,
+            description: f.description,
+            planner: f.planner,
+            seed: f.seed,
+            pallet,
+            timeout_s: f.timeout_s,
+            truck: f.truck,
+            tracker: f.tracker,
+            sim: f.sim,
+            noise: f.noise,
+            replan: f.replan,
+            tolerances: f.tolerances,
+            estimate_bias: f
+                .estimate_bias
+                .map_or(Pose2::new(0.0, 0.0, 0.0), PoseDeg::to_pose),
+            world,
+            cases,
+        })
+    }
+
+    pub fn case(&self, name: &str) -> Result<&Case, TrialError> {
+        self.cases
+            .iter()
+            .find(|c| c.name == name)
+            .ok_or_else(|| TrialError::UnknownCase {
+                file: self.file.clone(),
+                case: name.to_owned(),
+                known: self
+                    .cases
+                    .iter()
+                    .map(|c| c.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    }
+}
+
+/// Truck footprint at a fork-root pose: chassis ending at the fork root.
+pub fn truck_rect(truck: &ForkliftSpec, root: &Pose2) -> Rect {
+    Rect {
+        centre: root.to_world(&Pose2::new(-truck.body_length_m / 2.0, 0.0, 0.0)),
+        length_m: truck.body_length_m,
+        width_m: truck.body_width_m,
+    }
+}
+
+/// Pallet footprint from its face-centre pose.
+pub fn pallet_rect(pallet: &PalletSpec, face: &Pose2) -> Rect {
+    Rect {
+        centre: face.to_world(&Pose2::new(pallet.depth_m / 2.0, 0.0, 0.0)),
+        length_m: pallet.depth_m,
+        width_m: pallet.width_m,
+    }
+}
+
+fn check_layout(
+    case: &Case,
+    truck: &ForkliftSpec,
+    pallet: &PalletSpec,
+    world: &World,
+    file: &str,
+    field: &str,
+) -> Result<(), TrialError> {
+    let p = pallet_rect(pallet, &case.pallet);
+    let t = truck_rect(truck, &case.start);
+    for (kind, list) in [("rack", &world.rack), ("wall", &world.wall)] {
+        for r in list {
+            let o = Rect {
+                centre: Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
+                length_m: r.length_m,
+                width_m: r.width_m,
+            };
+            let label = if r.name.is_empty() {
+                kind.to_owned()
+            } else {
+                format!("{kind} {:?}", r.name)
+            };
+            if p.overlaps(&o, 1e-3) {
+                return Err(invalid(
+                    file,
+                    &format!("{field}pallet"),
+                    &format!("pallet overlaps {label}"),
+                ));
+            }
+            if t.overlaps(&o, 1e-3) {
+                return Err(invalid(
+                    file,
+                    &format!("{field}start"),
+                    &format!("truck starts inside {label}"),
+                ));
+            }
+        }
+    }
+    if p.overlaps(&t, 1e-3) {
+        return Err(invalid(
+            file,
+            &format!("{field}start"),
+            "truck starts overlapping the pallet",
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,270 @@
+//! Pick trials end to end: the field test's figures, determinism, and every failure criterion.
+
+use std::path::Path;
+
+use forkbench_trial::{Failure, Scenario, TrialError, TrialOptions, World, run_trial};
+
+fn repo() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+fn no_noise() -> TrialOptions {
+    TrialOptions {
+        no_noise: true,
+        ..TrialOptions::default()
+    }
+}
+
+/// A straight 1.2 m-pallet pick on an open floor, plus extra TOML.
+fn straight_pick(extra: &str) -> Scenario {
+    let text = format!(
+        r#"
+name = "straight"
+planner = "bspline"
+start = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}
+pallet = {{ x_m = 8.5, y_m = 0.5, heading_deg = 0.0 }}
+{extra}
+"#
+    );
+    Scenario::parse(&text, "straight.toml", |_| Ok(World::default())).expect("valid scenario")
+}
+
+fn failure_of(scn: &Scenario) -> Option<Failure> {
+    let out = run_trial(scn, &scn.cases[0], &no_noise());
+    out.failure
+}
+
+#[test]
+fn field_test_without_noise_meets_the_papers_figures() {
+    let scn = Scenario::load(&repo().join("scenarios/field-test.toml")).expect("loads");
+    let out = run_trial(&scn, &scn.cases[0], &no_noise());
+    assert!(out.success, "{out:?}");
+    // Paper (Lü et al. 2019): lateral 4.71 cm and heading 9.6e-3 rad at the end.
+    assert!(
+        out.final_lateral_error_m.abs() <= 0.0471,
+        "{}",
+        out.final_lateral_error_m
+    );
+    assert!(
+        out.final_heading_error_rad.abs() <= 9.6e-3,
+        "{}",
+        out.final_heading_error_rad
+    );
+    assert!(out.max_contact_force_n < 1.0 && out.pallet_displacement_m < 1e-3);
+    assert!(out.insertion_depth_m >= 1.0);
+}
+
+#[test]
+fn same_seed_same_outcome_and_seeds_differ() {
+    let scn = Scenario::load(&repo().join("scenarios/field-test.toml")).expect("loads");
+    let run = |seed| {
+        let mut o = run_trial(
+            &scn,
+            &scn.cases[0],
+            &TrialOptions {
+                seed: Some(seed),
+                replan: Some(true),
+                ..TrialOptions::default()
+            },
+        );
+        o.wall_time_ms = 0.0;
+        o
+    };
+    assert_eq!(run(5), run(5));
+    assert_ne!(run(5).final_lateral_error_m, run(6).final_lateral_error_m);
+}
+
+#[test]
+fn a_clean_straight_pick_succeeds() {
+    let out = run_trial(&straight_pick(""), &straight_pick("").cases[0], &no_noise());
+    assert!(out.success, "{out:?}");
+}
+
+#[test]
+fn every_failure_criterion_can_trigger() {
+    let cases: [(&str, Failure); 8] = [
+        // Pallet 1 m beside the start, facing across: no forward path fits.
+        (
+            "[[case]]\nname = \"x\"\npallet = { x_m = 1.0, y_m = 3.0, heading_deg = -90.0 }",
+            Failure::PlanFailed,
+        ),
+        // A camera that sees the pallet 0.27 m to the side: a fork meets a stringer.
+        (
+            "estimate_bias = { x_m = 0.0, y_m = 0.27, heading_deg = 0.0 }",
+            Failure::ContactForce,
+        ),
+        (
+            "estimate_bias = { x_m = 0.0, y_m = 0.27, heading_deg = 0.0 }\n[tolerances]\ncontact_force_n = 1e9",
+            Failure::PalletDisplaced,
+        ),
+        (
+            "estimate_bias = { x_m = 0.0, y_m = 0.06, heading_deg = 0.0 }\n[tolerances]\nlateral_m = 0.03",
+            Failure::LateralError,
+        ),
+        (
+            "estimate_bias = { x_m = 0.0, y_m = 0.0, heading_deg = 2.0 }\n[tolerances]\nheading_deg = 1.0",
+            Failure::HeadingError,
+        ),
+        ("timeout_s = 3.0", Failure::Timeout),
+        (
+            "[tolerances]\ninsertion_depth_m = 1.2",
+            Failure::InsertionDepth,
+        ),
+        // One pocket spacing off: a fork in the wrong pocket, the other beside the pallet.
+        (
+            "estimate_bias = { x_m = 0.0, y_m = 0.535, heading_deg = 0.0 }\n[tolerances]\nlateral_m = 1.0",
+            Failure::ForkOutsidePocket,
+        ),
+    ];
+    for (extra, expected) in &cases {
+        let scn = straight_pick(extra);
+        assert_eq!(
+            failure_of(&scn),
+            Some(*expected),
+            "scenario extra:\n{extra}"
+        );
+    }
+    // Collision: a wall segment reaching into the truck's swept path.
+    let world = World::parse(
+        "name = \"w\"\n[[wall]]\nx_m = 3.0\ny_m = -0.3\nlength_m = 2.0\nwidth_m = 0.3\n",
+        "w.toml",
+    )
+    .expect("world");
+    let text = r#"
+name = "wall"
+planner = "bspline"
+world = "w.toml"
+start = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }
+pallet = { x_m = 8.5, y_m = 1.5, heading_deg = 20.0 }
+"#;
+    let scn = Scenario::parse(text, "wall.toml", |_| Ok(world)).expect("valid");
+    let out = run_trial(&scn, &scn.cases[0], &no_noise());
+    assert_eq!(out.failure, Some(Failure::Collision), "{out:?}");
+}
+
+#[test]
+fn a_deliberately_bad_pick_shows_block_contact_and_a_moved_pallet() {
+    let scn = straight_pick("estimate_bias = { x_m = 0.0, y_m = 0.27, heading_deg = 0.0 }");
+    let out = run_trial(&scn, &scn.cases[0], &no_noise());
+    assert_eq!(out.failure, Some(Failure::ContactForce));
+    assert!(
+        out.max_contact_force_n > scn.tolerances.contact_force_n,
+        "{}",
+        out.max_contact_force_n
+    );
+    assert!(
+        out.pallet_displacement_m > 0.05,
+        "{}",
+        out.pallet_displacement_m
+    );
+}
+
+fn parse_err(text: &str) -> String {
+    match Scenario::parse(text, "bad.toml", |_| Ok(World::default())) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn bad_scenarios_are_rejected_with_file_line_and_field() {
+    let base = "name = \"b\"\nplanner = \"bspline\"\nstart = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }\npallet = { x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }\n";
+    let e = parse_err(&format!("{base}colour = \"red\"\n"));
+    assert!(
+        e.contains("bad.toml") && e.contains("line 5") && e.contains("colour"),
+        "{e}"
+    );
+    let e = parse_err(&format!("{base}[truck]\nwheelbase_m = -1.0\n"));
+    assert!(
+        e.contains("truck.wheelbase_m") && e.contains("positive"),
+        "{e}"
+    );
+    let e = parse_err(&format!("{base}[tracker]\nlookahead_m = 0.0\n"));
+    assert!(e.contains("tracker.lookahead_m"), "{e}");
+    // Pallet under the chassis (which extends 2.45 m behind the fork root).
+    let e = parse_err(
+        "name = \"b\"\nplanner = \"bspline\"\nstart = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }\npallet = { x_m = -1.5, y_m = 0.0, heading_deg = 0.0 }\n",
+    );
+    assert!(e.contains("overlapping the pallet"), "{e}");
+    let e = parse_err(&base.replace("bspline", "rrt"));
+    assert!(e.contains("rrt") && e.contains("line 2"), "{e}");
+    let e = parse_err(&format!("{base}[tolerances]\ninsertion_depth_m = 1.5\n"));
+    assert!(e.contains("tolerances.insertion_depth_m"), "{e}");
+}
+
+#[test]
+fn layouts_that_cannot_exist_are_rejected() {
+    let world = |w: &str| World::parse(w, "w.toml").expect("world");
+    let with_world = |w: World, scn: &str| {
+        Scenario::parse(scn, "s.toml", |_| Ok(w))
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    };
+    let rack = "name = \"w\"\n[[rack]]\nname = \"R\"\nx_m = 8.5\ny_m = 0.0\nlength_m = 1.0\nwidth_m = 3.0\n[[pallet_slot]]\nname = \"A\"\nx_m = 5.0\ny_m = 0.0\nheading_deg = 0.0\n";
+    let scn = "name = \"s\"\nplanner = \"spiral\"\nworld = \"w.toml\"\nstart = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }\npallet = { x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }\n";
+    let e = with_world(world(rack), scn).expect_err("pallet in rack");
+    assert!(e.contains("pallet overlaps rack \"R\""), "{e}");
+    let in_slot = scn.replace(
+        "pallet = { x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }",
+        "pallet = { slot = \"A\" }",
+    );
+    let e = with_world(
+        world(rack),
+        &in_slot.replace("x_m = 0.0, y_m = 0.0", "x_m = 9.0, y_m = 0.0"),
+    )
+    .expect_err("start in rack");
+    assert!(e.contains("start") && e.contains("inside rack"), "{e}");
+    let e = with_world(
+        world(rack),
+        &scn.replace(
+            "pallet = { x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }",
+            "pallet = { slot = \"B\" }",
+        ),
+    )
+    .expect_err("no slot");
+    assert!(e.contains("pallet.slot") && e.contains("\"B\""), "{e}");
+    with_world(
+        world(rack),
+        &scn.replace(
+            "pallet = { x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }",
+            "pallet = { slot = \"A\" }",
+        ),
+    )
+    .expect("slot A is free");
+    let e = World::parse(
+        "name = \"w\"\n[[wall]]\nx_m = 0.0\ny_m = 0.0\nlength_m = -2.0\nwidth_m = 0.2\n",
+        "w.toml",
+    )
+    .expect_err("negative");
+    assert!(e.to_string().contains("wall[0].length_m"), "{e}");
+}
+
+#[test]
+fn unknown_case_lists_the_known_ones() {
+    let scn = Scenario::load(&repo().join("scenarios/bspline-table2.toml")).expect("loads");
+    assert_eq!(scn.cases.len(), 18);
+    match scn.case("19") {
+        Err(TrialError::UnknownCase { known, .. }) => assert!(known.starts_with("1, 2, 3")),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn every_table2_geometry_is_a_trial_case() {
+    let b = Scenario::load(&repo().join("scenarios/bspline-table2.toml")).expect("loads");
+    let s = Scenario::load(&repo().join("scenarios/spiral-table2.toml")).expect("loads");
+    assert_eq!(
+        b.cases.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
+        (1..=18).map(|i| i.to_string()).collect::<Vec<_>>()
+    );
+    assert_eq!(s.cases.len(), 23);
+    // Without noise every B-spline geometry is picked cleanly.
+    for case in &b.cases {
+        let out = run_trial(&b, case, &no_noise());
+        assert!(
+            out.success,
+            "bspline case {}: {:?} {:?}",
+            case.name, out.failure, out.failure_detail
+        );
+    }
+}
