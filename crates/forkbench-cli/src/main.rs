@@ -1,5 +1,6 @@
 //! `forkbench`: the command-line front end (parse, call the libraries, print).
 
+mod batch_cmd;
 mod plan_cmd;
 mod plot;
 mod reproduce_cmd;
@@ -94,6 +95,68 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Monte-Carlo batch over scenarios × cases × planners × trials (default: the embedded scenario set).
+    Batch {
+        /// Scenario files (default: the embedded field-test, rack-pick and Table 2 sets).
+        scenarios: Vec<PathBuf>,
+        /// Trials per scenario × case × planner.
+        #[arg(long, default_value_t = 20)]
+        trials: u64,
+        /// Batch seed; each trial's seed derives from it and the trial's identity.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Planners to run every case with (default: each scenario's own).
+        #[arg(long, num_args = 1..)]
+        planner: Vec<PlannerArg>,
+        /// Worker threads.
+        #[arg(long, default_value_t = 2)]
+        jobs: usize,
+        /// Run only shard I of N (I/N, 0-based); combine shards with `forkbench merge`.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Output directory (trials.jsonl, summary.json, summary.md).
+        #[arg(long, default_value = "recordings/batch")]
+        out: PathBuf,
+        #[arg(long)]
+        json: bool,
+        /// Scale of the pallet-estimate σ for every trial.
+        #[arg(long)]
+        pallet_noise_scale: Option<f64>,
+        /// Re-estimate the pallet and replan on the way in.
+        #[arg(long)]
+        replan: bool,
+        /// Sweep a noise knob, e.g. pallet_noise=0,0.5,1,1.5,2 (table and plot per planner).
+        #[arg(long)]
+        sweep: Option<String>,
+    },
+    /// Combine shard outputs into one summary.
+    Merge {
+        dirs: Vec<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Write a baseline (success counts) from a results directory.
+    Baseline {
+        results: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Compare results with a baseline; exit 1 on a significant drop.
+    Regress {
+        #[arg(long)]
+        baseline: PathBuf,
+        results: PathBuf,
+        /// Significance level of the one-sided two-proportion test.
+        #[arg(long, default_value_t = 0.05)]
+        alpha: f64,
+        /// Absolute floor on every row's success rate (0–1).
+        #[arg(long)]
+        floor: Option<f64>,
+        #[arg(long)]
+        json: bool,
+    },
     /// Reproduce a paper's Table 2 side by side with this project's results.
     Reproduce {
         planner: PlannerArg,
@@ -140,10 +203,53 @@ fn load_truck(path: Option<&PathBuf>) -> anyhow::Result<ForkliftSpec> {
 enum Done {
     Ok,
     PickFailed,
+    Regressed,
 }
 
 fn run(cli: Cli) -> anyhow::Result<Done> {
     match cli.command {
+        Command::Batch {
+            scenarios,
+            trials,
+            seed,
+            planner,
+            jobs,
+            shard,
+            out,
+            json,
+            pallet_noise_scale,
+            replan,
+            sweep,
+        } => batch_cmd::run(batch_cmd::BatchArgs {
+            scenarios,
+            trials,
+            seed,
+            planners: planner.into_iter().map(Into::into).collect(),
+            jobs,
+            shard,
+            out,
+            json,
+            pallet_noise_scale,
+            replan,
+            sweep,
+        })
+        .map(|()| Done::Ok),
+        Command::Merge { dirs, out, json } => {
+            batch_cmd::merge(&dirs, &out, json).map(|()| Done::Ok)
+        }
+        Command::Baseline { results, out } => {
+            batch_cmd::baseline(&results, &out).map(|()| Done::Ok)
+        }
+        Command::Regress {
+            baseline,
+            results,
+            alpha,
+            floor,
+            json,
+        } => {
+            let ok = batch_cmd::regress(&baseline, &results, alpha, floor, json)?;
+            Ok(if ok { Done::Ok } else { Done::Regressed })
+        }
         Command::Trial {
             scenario,
             case,
@@ -214,6 +320,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(Done::Ok) => ExitCode::SUCCESS,
         Ok(Done::PickFailed) => ExitCode::from(3),
+        Ok(Done::Regressed) => ExitCode::from(1),
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

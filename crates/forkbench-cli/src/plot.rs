@@ -223,3 +223,113 @@ where
     root.present().map_err(err)?;
     Ok(())
 }
+
+/// Success rate against the pallet-noise scale, one line per scenario, Wilson 95 % bars.
+pub fn draw_sweep(
+    file: &FsPath,
+    planner: &str,
+    points: &[(f64, forkbench_trial::batch::Summary)],
+) -> anyhow::Result<()> {
+    register_font();
+    let ext = file
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let size = (900, 600);
+    let result = match ext.as_deref() {
+        Some("svg") => draw_sweep_on(
+            SVGBackend::new(file, size).into_drawing_area(),
+            planner,
+            points,
+        ),
+        Some("png") => draw_sweep_on(
+            BitMapBackend::new(file, size).into_drawing_area(),
+            planner,
+            points,
+        ),
+        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
+    };
+    result.with_context(|| format!("drawing {}", file.display()))
+}
+
+fn draw_sweep_on<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    planner: &str,
+    points: &[(f64, forkbench_trial::batch::Summary)],
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let x_max = points.iter().map(|p| p.0).fold(0.0, f64::max).max(0.1);
+    let mut chart = ChartBuilder::on(&root)
+        .margin(20)
+        .x_label_area_size(40)
+        .y_label_area_size(55)
+        .caption(
+            format!("{planner}: fork-entry success vs pallet-estimate noise"),
+            ("sans-serif", 20),
+        )
+        .build_cartesian_2d(-0.05 * x_max..1.05 * x_max, 0.0..100.0)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("pallet-estimate σ scale (1 = ±60 mm, ±6° at 6.5 m as 2σ)")
+        .y_desc("success rate (%)")
+        .draw()
+        .map_err(err)?;
+    let mut scenarios: Vec<String> = points
+        .iter()
+        .flat_map(|(_, s)| {
+            s.rows
+                .iter()
+                .filter(|r| r.planner == planner)
+                .map(|r| r.scenario.clone())
+        })
+        .collect();
+    scenarios.sort();
+    scenarios.dedup();
+    for (i, sc) in scenarios.iter().enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        let pts: Vec<(f64, f64, f64, f64)> = points
+            .iter()
+            .filter_map(|(v, s)| {
+                s.rows
+                    .iter()
+                    .find(|r| &r.scenario == sc && r.planner == planner)
+                    .map(|r| {
+                        (
+                            *v,
+                            100.0 * r.success_rate,
+                            100.0 * r.ci95_low,
+                            100.0 * r.ci95_high,
+                        )
+                    })
+            })
+            .collect();
+        chart
+            .draw_series(LineSeries::new(
+                pts.iter().map(|p| (p.0, p.1)),
+                color.stroke_width(2),
+            ))
+            .map_err(err)?
+            .label(sc.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+            });
+        chart
+            .draw_series(
+                pts.iter()
+                    .map(|p| ErrorBar::new_vertical(p.0, p.2, p.1, p.3, color.filled(), 6)),
+            )
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}

@@ -1,8 +1,11 @@
 //! One pick trial end to end: scenario and world files, noisy estimate → plan → pure pursuit in rapier2d → judged outcome.
 
+pub mod batch;
+pub mod defaults;
 pub mod geometry;
 pub mod outcome;
 pub mod scenario;
+pub mod stats;
 pub mod trial;
 
 pub use outcome::{Failure, TrialOutcome};

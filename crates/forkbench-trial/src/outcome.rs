@@ -61,8 +61,11 @@ pub struct TrialOutcome {
     pub lateral_error_m: Option<f64>,
     pub heading_error_rad: Option<f64>,
     /// The same errors when the truck stopped.
+    #[serde(with = "nan_as_null")]
     pub final_lateral_error_m: f64,
+    #[serde(with = "nan_as_null")]
     pub final_heading_error_rad: f64,
+    #[serde(with = "nan_as_null")]
     pub insertion_depth_m: f64,
     pub max_steer_rad: f64,
     /// Largest fork–pallet contact force before full depth.
@@ -75,4 +78,21 @@ pub struct TrialOutcome {
     pub path_length_m: f64,
     pub sim_time_s: f64,
     pub wall_time_ms: f64,
+}
+
+/// NaN (a trial that never ran far enough to measure) is written as JSON null and read back.
+mod nan_as_null {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_nan() {
+            s.serialize_none()
+        } else {
+            s.serialize_f64(*v)
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+    }
 }

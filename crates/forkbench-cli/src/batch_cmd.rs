@@ -1,0 +1,282 @@
+//! `forkbench batch`, `merge`, `baseline`, `regress`: Monte-Carlo batches and the success-rate gate.
+
+use std::io::IsTerminal as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use anyhow::{Context as _, bail};
+use forkbench_plan::PlannerKind;
+use forkbench_trial::batch::{self, Baseline, BatchSpec, Summary, TrialRecord};
+use forkbench_trial::{Scenario, defaults};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// Batch arguments after parsing.
+#[derive(Debug)]
+pub struct BatchArgs {
+    pub scenarios: Vec<PathBuf>,
+    pub trials: u64,
+    pub seed: u64,
+    pub planners: Vec<PlannerKind>,
+    pub jobs: usize,
+    pub shard: Option<String>,
+    pub out: PathBuf,
+    pub json: bool,
+    pub pallet_noise_scale: Option<f64>,
+    pub replan: bool,
+    pub sweep: Option<String>,
+}
+
+fn parse_shard(text: &str) -> anyhow::Result<(u64, u64)> {
+    let (i, n) = text
+        .split_once('/')
+        .with_context(|| format!("--shard {text:?}: expected I/N, e.g. 0/4"))?;
+    let i: u64 = i
+        .trim()
+        .parse()
+        .with_context(|| format!("--shard {text:?}: index {i:?} is not a whole number"))?;
+    let n: u64 = n
+        .trim()
+        .parse()
+        .with_context(|| format!("--shard {text:?}: count {n:?} is not a whole number"))?;
+    if n == 0 || i >= n {
+        bail!("--shard {text:?}: the index must be below the count (0 ≤ I < N)");
+    }
+    Ok((i, n))
+}
+
+/// `--sweep pallet_noise=0,0.5,1`: the knob and its values.
+fn parse_sweep(text: &str) -> anyhow::Result<Vec<f64>> {
+    let (knob, values) = text
+        .split_once('=')
+        .with_context(|| format!("--sweep {text:?}: expected pallet_noise=V1,V2,…"))?;
+    if knob.trim() != "pallet_noise" {
+        bail!("--sweep {text:?}: unknown knob {knob:?} (supported: pallet_noise)");
+    }
+    values
+        .split(',')
+        .map(|v| {
+            let x: f64 = v
+                .trim()
+                .parse()
+                .with_context(|| format!("--sweep: {v:?} is not a number"))?;
+            if !(x.is_finite() && x >= 0.0) {
+                bail!("--sweep: {x} must be a finite number ≥ 0");
+            }
+            Ok(x)
+        })
+        .collect()
+}
+
+fn progress(total: u64) -> ProgressBar {
+    let target = if std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(total), target);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} trials  {per_sec}  eta {eta}  {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+fn run_one(spec: &BatchSpec, dir: &Path, jobs: usize) -> anyhow::Result<Summary> {
+    let total = spec.jobs().len() as u64;
+    let bar = progress(total);
+    let (done, ok) = (AtomicU64::new(0), AtomicU64::new(0));
+    let on_done = |r: &TrialRecord| {
+        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+        let k = ok.fetch_add(u64::from(r.outcome.success), Ordering::Relaxed)
+            + u64::from(r.outcome.success);
+        bar.inc(1);
+        bar.set_message(format!("success {:.1} %", 100.0 * k as f64 / d as f64));
+    };
+    let summary = batch::run_batch(spec, dir, jobs, &on_done)?;
+    bar.finish_and_clear();
+    Ok(summary)
+}
+
+pub fn run(a: BatchArgs) -> anyhow::Result<()> {
+    let scenarios: Vec<Scenario> = if a.scenarios.is_empty() {
+        defaults::default_scenarios()?
+    } else {
+        a.scenarios
+            .iter()
+            .map(|p| Scenario::load(p))
+            .collect::<Result<_, _>>()?
+    };
+    let shard = a
+        .shard
+        .as_deref()
+        .map(parse_shard)
+        .transpose()?
+        .unwrap_or((0, 1));
+    if a.trials == 0 {
+        bail!("--trials must be at least 1");
+    }
+    if let Some(s) = a.pallet_noise_scale
+        && !(s.is_finite() && s >= 0.0)
+    {
+        bail!("--pallet-noise-scale {s}: must be a finite number ≥ 0");
+    }
+    let mut spec = BatchSpec {
+        scenarios,
+        planners: a.planners.clone(),
+        trials: a.trials,
+        seed: a.seed,
+        shard,
+        pallet_noise_scale: a.pallet_noise_scale,
+        replan: a.replan.then_some(true),
+    };
+    let Some(sweep) = &a.sweep else {
+        let t0 = std::time::Instant::now();
+        let summary = run_one(&spec, &a.out, a.jobs)?;
+        let elapsed = t0.elapsed().as_secs_f64();
+        if a.json {
+            return crate::emit(&format!("{}\n", serde_json::to_string(&summary)?));
+        }
+        return crate::emit(&format!(
+            "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md)\n",
+            summary.markdown(),
+            elapsed,
+            a.jobs,
+            a.out.display()
+        ));
+    };
+    let values = parse_sweep(sweep)?;
+    let mut points: Vec<(f64, Summary)> = Vec::new();
+    for v in values {
+        spec.pallet_noise_scale = Some(v);
+        let dir = a.out.join(format!("pallet_noise-{v}"));
+        points.push((v, run_one(&spec, &dir, a.jobs)?));
+    }
+    let text = sweep_report(&points);
+    std::fs::write(a.out.join("sweep.md"), &text)
+        .with_context(|| format!("writing {}", a.out.display()))?;
+    let json: Vec<_> = points
+        .iter()
+        .map(|(v, s)| serde_json::json!({"pallet_noise": v, "summary": s}))
+        .collect();
+    std::fs::write(
+        a.out.join("sweep.json"),
+        serde_json::to_string_pretty(&json)? + "\n",
+    )?;
+    let mut planners: Vec<String> = points
+        .iter()
+        .flat_map(|(_, s)| s.rows.iter().map(|r| r.planner.clone()))
+        .collect();
+    planners.sort();
+    planners.dedup();
+    for p in &planners {
+        let file = a.out.join(format!("sweep-{p}.png"));
+        crate::plot::draw_sweep(&file, p, &points)?;
+    }
+    if a.json {
+        return crate::emit(&format!("{}\n", serde_json::to_string(&json)?));
+    }
+    crate::emit(&format!(
+        "{text}\nwritten: {}/sweep.md, sweep.json, sweep-<planner>.png\n",
+        a.out.display()
+    ))
+}
+
+fn sweep_report(points: &[(f64, Summary)]) -> String {
+    let mut s = String::from(
+        "| scenario | planner | pallet noise scale | trials | success rate | 95 % CI |\n|---|---|---|---|---|---|\n",
+    );
+    let mut rows: Vec<(String, String, f64, u64, f64, f64, f64)> = Vec::new();
+    for (v, sum) in points {
+        for r in &sum.rows {
+            rows.push((
+                r.scenario.clone(),
+                r.planner.clone(),
+                *v,
+                r.trials,
+                r.success_rate,
+                r.ci95_low,
+                r.ci95_high,
+            ));
+        }
+    }
+    rows.sort_by(|a, b| (&a.0, &a.1).cmp(&(&b.0, &b.1)).then(a.2.total_cmp(&b.2)));
+    for (sc, p, v, n, rate, lo, hi) in rows {
+        s.push_str(&format!(
+            "| {sc} | {p} | {v} | {n} | {:.1} % | {:.1}–{:.1} % |\n",
+            100.0 * rate,
+            100.0 * lo,
+            100.0 * hi
+        ));
+    }
+    s
+}
+
+pub fn merge(dirs: &[PathBuf], out: &Path, json: bool) -> anyhow::Result<()> {
+    let s = batch::merge(dirs, out)?;
+    if json {
+        return crate::emit(&format!("{}\n", serde_json::to_string(&s)?));
+    }
+    crate::emit(&format!(
+        "{}\nmerged into {}/\n",
+        s.markdown(),
+        out.display()
+    ))
+}
+
+fn load_summary(dir: &Path) -> anyhow::Result<Summary> {
+    let path = dir.join("summary.json");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: line {}: {e}", path.display(), e.line()))
+}
+
+pub fn baseline(dir: &Path, out: &Path) -> anyhow::Result<()> {
+    let s = load_summary(dir)?;
+    let b = Baseline::from_summary(&s, format!("success counts from {}", dir.display()));
+    std::fs::write(out, serde_json::to_string_pretty(&b)? + "\n")
+        .with_context(|| format!("writing {}", out.display()))?;
+    crate::emit(&format!(
+        "baseline with {} rows written to {}\n",
+        b.rows.len(),
+        out.display()
+    ))
+}
+
+/// Returns whether the gate passed.
+pub fn regress(
+    baseline: &Path,
+    dir: &Path,
+    alpha: f64,
+    floor: Option<f64>,
+    json: bool,
+) -> anyhow::Result<bool> {
+    if !(alpha > 0.0 && alpha < 1.0) {
+        bail!("--alpha {alpha}: must lie strictly between 0 and 1");
+    }
+    if let Some(f) = floor
+        && !(0.0..=1.0).contains(&f)
+    {
+        bail!("--floor {f}: must be a success rate between 0 and 1");
+    }
+    let b = Baseline::load(baseline)?;
+    let s = load_summary(dir)?;
+    let (rows, failed) = batch::regress(&b, &s, alpha, floor);
+    if json {
+        crate::emit(&format!(
+            "{}\n",
+            serde_json::json!({"passed": !failed, "alpha": alpha, "floor": floor, "rows": rows})
+        ))?;
+    } else {
+        crate::emit(&format!(
+            "{}\n{}\n",
+            batch::regress_markdown(&rows, alpha),
+            if failed {
+                "REGRESSION: at least one row dropped"
+            } else {
+                "no significant drop"
+            }
+        ))?;
+    }
+    Ok(!failed)
+}
