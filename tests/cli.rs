@@ -347,3 +347,85 @@ fn trial_input_errors_are_clear() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("does-not-exist.toml"));
 }
+
+#[test]
+fn batch_writes_results_and_regress_gates_them() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let scn = scn.to_str().expect("utf8");
+    let out_dir = tmp("batch");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let dir = out_dir.to_str().expect("utf8");
+    let out = forkbench(&[
+        "batch",
+        scn,
+        "--trials",
+        "4",
+        "--pallet-noise-scale",
+        "0",
+        "--out",
+        dir,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("| field-test | bspline | 4 | 4 | 100.0 % |")
+    );
+    for f in ["trials.jsonl", "summary.json", "summary.md"] {
+        assert!(out_dir.join(f).exists(), "{f}");
+    }
+    let base = tmp("base.json");
+    assert!(
+        forkbench(&["baseline", dir, "--out", base.to_str().expect("utf8")])
+            .status
+            .success()
+    );
+    let ok = forkbench(&["regress", "--baseline", base.to_str().expect("utf8"), dir]);
+    assert_eq!(
+        ok.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&ok.stdout)
+    );
+    // A baseline claiming 100 of 100 against 4 of 4 is no drop; one claiming a row that
+    // was never run is a failure.
+    std::fs::write(&base, r#"{"description":"x","rows":[{"scenario":"gone","planner":"spiral","trials":10,"successes":9}]}"#).expect("write");
+    let missing = forkbench(&["regress", "--baseline", base.to_str().expect("utf8"), dir]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&missing.stdout).contains("missing"));
+}
+
+#[test]
+fn batch_input_errors_are_clear() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let scn = scn.to_str().expect("utf8");
+    let cases: [(&[&str], &str); 6] = [
+        (&["--shard", "2/2"], "index must be below the count"),
+        (&["--shard", "one/2"], "is not a whole number"),
+        (&["--trials", "0"], "--trials must be at least 1"),
+        (&["--sweep", "nav_noise=1,2"], "unknown knob"),
+        (&["--sweep", "pallet_noise=1,x"], "\"x\" is not a number"),
+        (
+            &["--pallet-noise-scale", "-1"],
+            "must be a finite number ≥ 0",
+        ),
+    ];
+    for (extra, message) in cases {
+        let mut args = vec!["batch", scn, "--out", "/nonexistent-dir-never-written"];
+        args.extend_from_slice(extra);
+        let out = forkbench(&args);
+        assert_eq!(out.status.code(), Some(1), "{extra:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(message), "{extra:?}: {err}");
+    }
+    let out = forkbench(&["batch", scn, "--planner", "rrt"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("rrt"));
+    let bad = tmp("bad-baseline.json");
+    std::fs::write(&bad, "{ not json").expect("write");
+    let out = forkbench(&["regress", "--baseline", bad.to_str().expect("utf8"), "."]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("bad-baseline.json"));
+}

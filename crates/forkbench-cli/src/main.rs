@@ -87,7 +87,7 @@ enum Command {
         #[arg(long)]
         no_noise: bool,
         /// Scale of the pallet-estimate σ (0: perfect estimate, NAV350 noise kept).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         pallet_noise_scale: Option<f64>,
         /// Re-estimate the pallet at the configured ranges and replan when it moved.
         #[arg(long)]
@@ -120,7 +120,7 @@ enum Command {
         #[arg(long)]
         json: bool,
         /// Scale of the pallet-estimate σ for every trial.
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         pallet_noise_scale: Option<f64>,
         /// Re-estimate the pallet and replan on the way in.
         #[arg(long)]
