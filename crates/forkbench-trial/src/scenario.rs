@@ -284,6 +284,9 @@ struct ScenarioFile {
     /// Fixed error of every pallet estimate, in the pallet frame (a miscalibrated camera);
     /// kept with `--no-noise`, since it is not random.
     estimate_bias: Option<PoseDeg>,
+    /// Monte-Carlo jitter of the true pallet pose: σ per axis in the pallet frame,
+    /// drawn per trial (truncated at 3σ).
+    pallet_jitter: Option<PoseDeg>,
     start: Option<PoseDeg>,
     pallet: Option<PalletPlacement>,
     #[serde(default)]
@@ -316,6 +319,8 @@ pub struct Scenario {
     pub tolerances: Tolerances,
     /// Fixed pallet-estimate error in the pallet frame.
     pub estimate_bias: Pose2,
+    /// σ of the per-trial jitter of the true pallet pose (pallet frame; heading in rad).
+    pub pallet_jitter: Pose2,
     pub world: World,
     pub cases: Vec<Case>,
 }
@@ -387,6 +392,22 @@ impl Scenario {
         }
         if let Some(b) = &f.estimate_bias {
             b.check(file, "estimate_bias")?;
+        }
+        if let Some(j) = &f.pallet_jitter {
+            j.check(file, "pallet_jitter")?;
+            for (name, v) in [
+                ("x_m", j.x_m),
+                ("y_m", j.y_m),
+                ("heading_deg", j.heading_deg),
+            ] {
+                if v < 0.0 {
+                    return Err(invalid(
+                        file,
+                        &format!("pallet_jitter.{name}"),
+                        "a standard deviation must be ≥ 0",
+                    ));
+                }
+            }
         }
         let pallet = match f.pallet_kind {
             PalletKind::Field1200 => PalletSpec::field_1200(),
@@ -476,6 +497,9 @@ impl Scenario {
             tolerances: f.tolerances,
             estimate_bias: f
                 .estimate_bias
+                .map_or(Pose2::new(0.0, 0.0, 0.0), PoseDeg::to_pose),
+            pallet_jitter: f
+                .pallet_jitter
                 .map_or(Pose2::new(0.0, 0.0, 0.0), PoseDeg::to_pose),
             world,
             cases,

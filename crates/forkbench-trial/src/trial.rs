@@ -47,6 +47,19 @@ pub fn target_insertion_m(truck: &ForkliftSpec, pallet: &PalletSpec) -> f64 {
     pallet.depth_m.min(truck.fork_length_m) - 0.05
 }
 
+/// The pallet pose moved by a draw of N(0, σ) per axis in its own frame, truncated at 3σ.
+fn jitter(pallet: &Pose2, sigma: &Pose2, rng: &mut ChaCha8Rng) -> Pose2 {
+    if sigma.x_m == 0.0 && sigma.y_m == 0.0 && sigma.heading_rad == 0.0 {
+        return *pallet;
+    }
+    let mut draw = |s: f64| {
+        let z: f64 = rand::RngExt::sample(rng, rand_distr::StandardNormal);
+        s * z.clamp(-3.0, 3.0)
+    };
+    let d = Pose2::new(draw(sigma.x_m), draw(sigma.y_m), draw(sigma.heading_rad));
+    pallet.to_world(&d)
+}
+
 /// Fork-root pose in the pallet frame: x < 0 before the face, y the lateral offset.
 fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
     pallet.to_local(root)
@@ -110,11 +123,13 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
         out
     };
 
+    // Per-trial jitter of where the pallet really stands (its own random stream).
+    let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(seed, 3));
     let mut sim = match Sim::new(
         truck,
         &case.start,
         &scn.pallet,
-        &case.pallet,
+        &true_pallet,
         &scn.world.obstacles(),
         &scn.sim,
     ) {
@@ -147,8 +162,8 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
         }
     };
     let mut pallet_est = estimate(
-        &case.pallet,
-        first_fix.distance_to(&case.pallet),
+        &true_pallet,
+        first_fix.distance_to(&true_pallet),
         &mut est_rng,
     );
     let plan_cfg = PlannerConfig::default();

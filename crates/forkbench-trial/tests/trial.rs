@@ -268,3 +268,27 @@ fn every_table2_geometry_is_a_trial_case() {
         );
     }
 }
+
+#[test]
+fn pallet_jitter_moves_the_true_pallet_per_seed() {
+    let scn = straight_pick("pallet_jitter = { x_m = 0.0, y_m = 0.05, heading_deg = 1.0 }");
+    let opts = |seed| TrialOptions {
+        seed: Some(seed),
+        no_noise: true,
+        ..TrialOptions::default()
+    };
+    // Without estimate noise the truck aims at the jittered pallet itself, so the
+    // entry still succeeds, but the planned path differs from seed to seed.
+    let a = run_trial(&scn, &scn.cases[0], &opts(1));
+    let b = run_trial(&scn, &scn.cases[0], &opts(2));
+    let a2 = run_trial(&scn, &scn.cases[0], &opts(1));
+    assert_ne!(a.path_length_m, b.path_length_m);
+    assert_eq!(a.path_length_m, a2.path_length_m);
+    let e = Scenario::parse(
+        "name = \"j\"\nplanner = \"spiral\"\npallet_jitter = { x_m = 0.0, y_m = -0.1, heading_deg = 0.0 }\nstart = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }\npallet = { x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }\n",
+        "j.toml",
+        |_| Ok(World::default()),
+    )
+    .expect_err("negative sigma");
+    assert!(e.to_string().contains("pallet_jitter.y_m"), "{e}");
+}
