@@ -43,6 +43,13 @@ impl GaussLegendre {
         Self { nodes, weights }
     }
 
+    /// Shared 12-point rule: error ~ (T/24)^24 for a turning T per panel, so ≤ 1e-14
+    /// for panels of up to 6 rad.
+    pub fn rule12() -> &'static GaussLegendre {
+        static RULE: OnceLock<GaussLegendre> = OnceLock::new();
+        RULE.get_or_init(|| GaussLegendre::new(12))
+    }
+
     /// Shared 16-point rule: exact for polynomials to degree 31 and ~1e-13 on the
     /// smooth trigonometric integrands of the spiral (checked against dense sampling).
     pub fn rule16() -> &'static GaussLegendre {

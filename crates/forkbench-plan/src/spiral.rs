@@ -124,8 +124,8 @@ impl SpiralProblem {
 
     /// End position (x(s_f), y(s_f)) and its Jacobian with respect to (b, c).
     ///
-    /// Composite 16-point Gauss–Legendre: one panel per ~10 rad of turning (its error
-    /// scales like (T/32)^32 for a turning T per panel), so
+    /// Composite 12-point Gauss–Legendre: one panel per ~6 rad of turning (its error
+    /// scales like (T/24)^24 for a turning T per panel), so
     /// spirals that sweep through large angles are integrated as accurately as gentle ones.
     /// With `fine` false a single panel is used: cheap, and accurate enough to steer
     /// Newton while it is far from the solution.
@@ -137,22 +137,8 @@ impl SpiralProblem {
         fine: bool,
     ) -> ([f64; 2], [[f64; 2]; 2]) {
         let p = self.params(b, c, sf);
-        let gl = GaussLegendre::rule16();
-        // Total turning ≤ s_f · max|κ|, with max|κ| from a coarse polynomial sample (no
-        // trig, so cheap); coefficient bounds are useless here, they cancel heavily.
-        let panels = if fine {
-            let peak = (0..=16)
-                .map(|i| p.curvature(sf * i as f64 / 16.0).abs())
-                .fold(0.0, f64::max);
-            let turning = 1.25 * sf * peak;
-            if turning.is_finite() {
-                (turning / 10.0).ceil().clamp(1.0, 8.0) as usize
-            } else {
-                1
-            }
-        } else {
-            1
-        };
+        let gl = GaussLegendre::rule12();
+        let panels = if fine { self.panels(&p, sf) } else { 1 };
         let width = sf / panels as f64;
         let half = width / 2.0;
         let (mut x, mut y) = (0.0, 0.0);
@@ -178,6 +164,21 @@ impl SpiralProblem {
             }
         }
         ([x, y], jac)
+    }
+
+    /// Panels the accurate rule needs: total turning ≤ s_f · max|κ|, with max|κ| from a
+    /// coarse polynomial sample (no trig, so cheap); coefficient bounds are useless
+    /// here, they cancel heavily.
+    fn panels(&self, p: &SpiralParams, sf: f64) -> usize {
+        let peak = (0..=16)
+            .map(|i| p.curvature(sf * i as f64 / 16.0).abs())
+            .fold(0.0, f64::max);
+        let turning = 1.25 * sf * peak;
+        if turning.is_finite() {
+            (turning / 6.0).ceil().clamp(1.0, 12.0) as usize
+        } else {
+            1
+        }
     }
 
     /// Normalised ∫₀^{s_f} ½ κ² ds (exact: the integrand is a degree-8 polynomial).
@@ -323,11 +324,14 @@ impl SpiralProblem {
                 return None;
             }
             if !fine && norm < 1e-6 {
-                // Close enough to switch to the accurate rule for the last digits.
+                // Close enough to switch to the accurate rule for the last digits; a
+                // one-panel accurate rule is the coarse rule, so nothing to redo then.
                 fine = true;
-                (r, j, norm) = eval(p, fine);
+                if self.panels(&self.params(p[0], p[1], sf), sf) > 1 {
+                    (r, j, norm) = eval(p, fine);
+                }
             }
-            if fine && norm < 1e-12 {
+            if fine && norm < 1e-11 {
                 return Some(p);
             }
             let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
@@ -379,7 +383,7 @@ impl SpiralProblem {
                 }
             }
         }
-        (fine && norm < 1e-11).then_some(p)
+        (fine && norm < 1e-10).then_some(p)
     }
 }
 
@@ -396,6 +400,7 @@ impl SpiralProblem {
             (r, j, r[0].hypot(r[1]))
         };
         let mut q = [guess[0], guess[1], sf0];
+        let mut pinned = 0;
         let mut fine = false;
         let (mut r, mut j, mut norm) = eval(q, fine);
         for _ in 0..40 {
@@ -430,6 +435,16 @@ impl SpiralProblem {
                 (m[0][0] * r[1] - m10 * r[0]) / det,
             ];
             let step: [f64; 3] = std::array::from_fn(|k| -(a[0][k] * y[0] + a[1][k] * y[1]));
+            // Pinned at a window bound for several steps: the fold lies outside the
+            // window, and this solve cannot converge inside it.
+            if q[2] + step[2] < lo || q[2] + step[2] > hi {
+                pinned += 1;
+                if pinned >= 3 {
+                    return None;
+                }
+            } else {
+                pinned = 0;
+            }
             let mut t = 1.0;
             loop {
                 let mut n = [q[0] + t * step[0], q[1] + t * step[1], q[2] + t * step[2]];
@@ -626,25 +641,29 @@ pub fn plan(req: &PlanRequest, cfg: &SpiralConfig) -> Result<SpiralPlan, PlanErr
     })
 }
 
-/// Dense world-frame samples of a normalised spiral (2-point Gauss–Legendre per ≤ 1 cm step).
+/// Dense world-frame samples of a normalised spiral, ≤ `spacing_m` apart.
+///
+/// x and y advance by the Euler–Maclaurin-corrected trapezoid
+/// ∫f ≈ h/2 (f₀ + f₁) + h²/12 (f′₀ − f′₁), with f = cos θ, f′ = −κ sin θ (and likewise
+/// for sin θ): O(h⁵) per step like Simpson, but one sin_cos per sample.
 pub fn sample(p: &SpiralParams, start: &Pose2, goal: &Pose2, spacing_m: f64) -> Path {
-    let gl = GaussLegendre::new(2);
     let r = p.scale_m;
     let sign = if p.mirrored { -1.0 } else { 1.0 };
     let n = ((p.sf * r / spacing_m).ceil() as usize).max(1);
     let h = p.sf / n as f64;
     let (mut x, mut y) = (0.0, 0.0);
     let mut samples = Vec::with_capacity(n + 1);
+    let mut prev: Option<(f64, f64, f64)> = None; // (sin θ, cos θ, κ) at the last sample
     for i in 0..=n {
         let s = h * i as f64;
-        if i > 0 {
-            let s0 = s - h;
-            for (xi, wi) in gl.nodes.iter().zip(&gl.weights) {
-                let (sn, cs) = p.heading(s0 + h * (1.0 + xi) / 2.0).sin_cos();
-                x += wi * h / 2.0 * cs;
-                y += wi * h / 2.0 * sn;
-            }
+        let theta = p.heading(s);
+        let k = p.curvature(s);
+        let (sn, cs) = theta.sin_cos();
+        if let Some((s0, c0, k0)) = prev {
+            x += h / 2.0 * (c0 + cs) + h * h / 12.0 * (-k0 * s0 + k * sn);
+            y += h / 2.0 * (s0 + sn) + h * h / 12.0 * (k0 * c0 - k * cs);
         }
+        prev = Some((sn, cs, k));
         let local = Pose2::new(r * x, sign * r * y, 0.0);
         let world = start.to_world(&local);
         samples.push(PathSample {
@@ -652,8 +671,8 @@ pub fn sample(p: &SpiralParams, start: &Pose2, goal: &Pose2, spacing_m: f64) -> 
             x_m: world.x_m,
             y_m: world.y_m,
             // Unwrapped heading: the spiral's θ(s) is continuous by construction.
-            heading_rad: start.heading_rad + sign * p.heading(s),
-            curvature_per_m: sign * p.curvature(s) / r,
+            heading_rad: start.heading_rad + sign * theta,
+            curvature_per_m: sign * k / r,
         });
     }
     if let Some(last) = samples.last_mut() {
