@@ -429,3 +429,103 @@ fn batch_input_errors_are_clear() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad-baseline.json"));
 }
+
+#[test]
+fn trial_records_rrd_and_mcap_and_refuses_to_overwrite() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let scn = scn.to_str().expect("utf8");
+    let (rrd, mcap) = (tmp("rec.rrd"), tmp("rec.mcap"));
+    let _ = (std::fs::remove_file(&rrd), std::fs::remove_file(&mcap));
+    let (r, m) = (rrd.to_str().expect("utf8"), mcap.to_str().expect("utf8"));
+    let out = forkbench(&["trial", scn, "--no-noise", "--rrd", r, "--mcap", m]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::metadata(&rrd).expect("rrd").len() > 10_000);
+    assert_eq!(&std::fs::read(&mcap).expect("mcap")[..8], b"\x89MCAP0\r\n");
+    let again = forkbench(&["trial", scn, "--no-noise", "--mcap", m]);
+    assert_eq!(again.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("exists (use --force"));
+    assert!(
+        forkbench(&["trial", scn, "--no-noise", "--mcap", m, "--force"])
+            .status
+            .success()
+    );
+}
+
+#[test]
+fn an_unreachable_viewer_is_reported_and_the_trial_still_runs() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let out = forkbench(&[
+        "trial",
+        scn.to_str().expect("utf8"),
+        "--no-noise",
+        "--connect",
+        "127.0.0.1:9",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("no rerun viewer reachable at 127.0.0.1:9")
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("outcome              SUCCESS"));
+}
+
+#[test]
+fn batch_records_failures_and_replay_reproduces_a_trial() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let dir = tmp("recbatch");
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().expect("utf8");
+    let out = forkbench(&[
+        "batch",
+        scn.to_str().expect("utf8"),
+        "--trials",
+        "6",
+        "--out",
+        d,
+        "--max-recordings",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let files: Vec<String> = std::fs::read_dir(dir.join("recordings"))
+        .expect("recordings written")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        files.iter().filter(|f| f.ends_with(".rrd")).count(),
+        2,
+        "{files:?}"
+    );
+    assert!(
+        files
+            .iter()
+            .all(|f| f.starts_with("field-test-default-bspline-seed")),
+        "{files:?}"
+    );
+    let jsonl = dir.join("trials.jsonl");
+    let rrd = tmp("replayed.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    let out = forkbench(&[
+        "replay",
+        jsonl.to_str().expect("utf8"),
+        "--line",
+        "3",
+        "--scenario",
+        scn.to_str().expect("utf8"),
+        "--rrd",
+        rrd.to_str().expect("utf8"),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("identical to the recorded outcome"),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(rrd.exists());
+}

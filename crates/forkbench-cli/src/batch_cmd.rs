@@ -24,6 +24,9 @@ pub struct BatchArgs {
     pub pallet_noise_scale: Option<f64>,
     pub replan: bool,
     pub sweep: Option<String>,
+    pub record_failures: bool,
+    pub record_successes: bool,
+    pub max_recordings: usize,
 }
 
 fn parse_shard(text: &str) -> anyhow::Result<(u64, u64)> {
@@ -133,15 +136,21 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
         let t0 = std::time::Instant::now();
         let summary = run_one(&spec, &a.out, a.jobs)?;
         let elapsed = t0.elapsed().as_secs_f64();
+        let recorded = record_batch(&spec, &a)?;
         if a.json {
             return crate::emit(&format!("{}\n", serde_json::to_string(&summary)?));
         }
         return crate::emit(&format!(
-            "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md)\n",
+            "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md){}\n",
             summary.markdown(),
             elapsed,
             a.jobs,
-            a.out.display()
+            a.out.display(),
+            if recorded > 0 {
+                format!("; {recorded} trials recorded in recordings/")
+            } else {
+                String::new()
+            }
         ));
     };
     let values = parse_sweep(sweep)?;
@@ -279,4 +288,104 @@ pub fn regress(
         ))?;
     }
     Ok(!failed)
+}
+
+/// Re-runs the batch's failed (or all) trials with recording; trials are deterministic,
+/// so the recording is the trial that ran.
+fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
+    if !a.record_failures && !a.record_successes {
+        return Ok(0);
+    }
+    let mut records = batch::read_records(&a.out.join("trials.jsonl"))?;
+    records.sort_by_key(TrialRecord::key);
+    let dir = a.out.join("recordings");
+    let mut n = 0;
+    for r in records {
+        if n >= a.max_recordings {
+            break;
+        }
+        if r.outcome.success && !a.record_successes {
+            continue;
+        }
+        let Some(scn) = spec.scenarios.iter().find(|s| s.name == r.outcome.scenario) else {
+            continue;
+        };
+        let Ok(case) = scn.case(&r.outcome.case) else {
+            continue;
+        };
+        if r.pallet_noise_scale != spec.pallet_noise_scale {
+            continue; // a record from an earlier run with other settings
+        }
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        crate::record::record_trial(scn, case, &r.options(), &dir)?;
+        n += 1;
+    }
+    Ok(n)
+}
+
+/// `forkbench replay`: re-runs one trial from its JSON line, records it, and checks that
+/// the outcome is the recorded one.
+pub fn replay(
+    file: &Path,
+    line: usize,
+    scenario: Option<&Path>,
+    rec: &crate::record::RecordArgs,
+) -> anyhow::Result<bool> {
+    let text =
+        std::fs::read_to_string(file).with_context(|| format!("reading {}", file.display()))?;
+    let Some(raw) = text.lines().nth(line.saturating_sub(1)) else {
+        bail!("{}: has no line {line}", file.display());
+    };
+    let record: TrialRecord = serde_json::from_str(raw)
+        .map_err(|e| anyhow::anyhow!("{}:{line}: not a trial record: {e}", file.display()))?;
+    let scenarios = match scenario {
+        Some(p) => vec![Scenario::load(p)?],
+        None => defaults::default_scenarios()?,
+    };
+    let scn = scenarios
+        .iter()
+        .find(|s| s.name == record.outcome.scenario)
+        .with_context(|| {
+            format!(
+                "no scenario named {:?}; pass its file with --scenario",
+                record.outcome.scenario
+            )
+        })?;
+    let case = scn.case(&record.outcome.case)?;
+    let opts = record.options();
+    let planner = opts.planner.unwrap_or(scn.planner);
+    let mut sinks = crate::record::Sinks::open(
+        rec,
+        crate::record::metadata(&scn.name, &case.name, planner.name(), record.outcome.seed),
+    )?;
+    let (mut out, written) =
+        sinks.record(|r| forkbench_trial::run_trial_recorded(scn, case, &opts, r));
+    if let Some(e) = sinks.viewer_error.take() {
+        eprintln!("error: {e} (the trial ran without the viewer)");
+    }
+    written.context("writing the recording")?;
+    let mut expected = record.outcome.clone();
+    (out.wall_time_ms, expected.wall_time_ms) = (0.0, 0.0);
+    let same = serde_json::to_value(&out)? == serde_json::to_value(&expected)?;
+    crate::emit(&format!(
+        "replayed {} / case {} / {} / seed {}: {} ({})\n",
+        out.scenario,
+        out.case,
+        out.planner,
+        out.seed,
+        if out.success {
+            "SUCCESS".to_owned()
+        } else {
+            format!("FAILED: {}", out.failure.map_or("?", |f| f.name()))
+        },
+        if same {
+            "identical to the recorded outcome"
+        } else {
+            "DIFFERS from the recorded outcome"
+        }
+    ))?;
+    if !same {
+        bail!("the replay did not reproduce the recorded outcome");
+    }
+    Ok(out.success)
 }

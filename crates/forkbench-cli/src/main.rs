@@ -3,6 +3,7 @@
 mod batch_cmd;
 mod plan_cmd;
 mod plot;
+mod record;
 mod reproduce_cmd;
 mod trial_cmd;
 
@@ -39,6 +40,46 @@ impl From<PlannerArg> for PlannerKind {
             PlannerArg::Spiral => PlannerKind::Spiral,
         }
     }
+}
+
+/// Recording targets of one trial.
+#[derive(Debug, clap::Args)]
+struct RecordFlags {
+    /// Write a rerun recording to FILE (.rrd).
+    #[arg(long)]
+    rrd: Option<PathBuf>,
+    /// Write an MCAP log to FILE (.mcap).
+    #[arg(long)]
+    mcap: Option<PathBuf>,
+    /// Spawn a rerun viewer and stream to it.
+    #[arg(long)]
+    rerun: bool,
+    /// Stream to a running rerun viewer at HOST:PORT (e.g. 127.0.0.1:9876).
+    #[arg(long)]
+    connect: Option<String>,
+    /// Overwrite existing recording files.
+    #[arg(long)]
+    force: bool,
+}
+
+impl RecordFlags {
+    fn args(self) -> record::RecordArgs {
+        record::RecordArgs {
+            rrd: self.rrd,
+            mcap: self.mcap,
+            rerun: self.rerun,
+            connect: self.connect,
+            force: self.force,
+        }
+    }
+}
+
+/// Which batch trials to record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum RecordWhich {
+    Failures,
+    All,
+    None,
 }
 
 #[derive(Debug, Subcommand)]
@@ -94,6 +135,21 @@ enum Command {
         replan: bool,
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        record: RecordFlags,
+    },
+    /// Re-run one trial from its JSON line (in a batch's trials.jsonl) and record it.
+    Replay {
+        /// File with JSON lines (e.g. DIR/trials.jsonl).
+        file: PathBuf,
+        /// 1-based line of the trial to replay (default: the first).
+        #[arg(long, default_value_t = 1)]
+        line: usize,
+        /// Scenario file the trial came from (default: the embedded scenario of that name).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        #[command(flatten)]
+        record: RecordFlags,
     },
     /// Monte-Carlo batch over scenarios × cases × planners × trials (default: the embedded scenario set).
     Batch {
@@ -128,6 +184,12 @@ enum Command {
         /// Sweep a noise knob, e.g. pallet_noise=0,0.5,1,1.5,2 (table and plot per planner).
         #[arg(long)]
         sweep: Option<String>,
+        /// Which trials to record as .rrd and .mcap under OUT/recordings/.
+        #[arg(long, value_enum, default_value_t = RecordWhich::Failures)]
+        record: RecordWhich,
+        /// At most this many recordings (the first in job order).
+        #[arg(long, default_value_t = 20)]
+        max_recordings: usize,
     },
     /// Combine shard outputs into one summary.
     Merge {
@@ -220,6 +282,8 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             pallet_noise_scale,
             replan,
             sweep,
+            record,
+            max_recordings,
         } => batch_cmd::run(batch_cmd::BatchArgs {
             scenarios,
             trials,
@@ -232,6 +296,9 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             pallet_noise_scale,
             replan,
             sweep,
+            record_failures: record != RecordWhich::None,
+            record_successes: record == RecordWhich::All,
+            max_recordings,
         })
         .map(|()| Done::Ok),
         Command::Merge { dirs, out, json } => {
@@ -259,6 +326,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             pallet_noise_scale,
             replan,
             json,
+            record,
         } => {
             let opts = trial_cmd::options(
                 seed,
@@ -267,7 +335,16 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
                 pallet_noise_scale,
                 replan,
             )?;
-            let ok = trial_cmd::run(&scenario, case.as_deref(), &opts, json)?;
+            let ok = trial_cmd::run(&scenario, case.as_deref(), &opts, json, &record.args())?;
+            Ok(if ok { Done::Ok } else { Done::PickFailed })
+        }
+        Command::Replay {
+            file,
+            line,
+            scenario,
+            record,
+        } => {
+            let ok = batch_cmd::replay(&file, line, scenario.as_deref(), &record.args())?;
             Ok(if ok { Done::Ok } else { Done::PickFailed })
         }
         Command::Plan {

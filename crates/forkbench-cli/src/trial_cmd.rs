@@ -4,13 +4,14 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use forkbench_plan::PlannerKind;
-use forkbench_trial::{Scenario, TrialOptions, run_trial};
+use forkbench_trial::{Scenario, TrialOptions};
 
 pub fn run(
     file: &Path,
     case: Option<&str>,
     opts: &TrialOptions,
     json: bool,
+    rec: &crate::record::RecordArgs,
 ) -> anyhow::Result<bool> {
     let scn = Scenario::load(file)?;
     let case = match case {
@@ -27,11 +28,30 @@ pub fn run(
                 .join(", ")
         ),
     };
-    let out = run_trial(&scn, case, opts);
+    let planner = opts.planner.unwrap_or(scn.planner);
+    let seed = opts.seed.unwrap_or(scn.seed);
+    // File targets are checked before the run; a viewer that cannot be reached is
+    // reported and the trial runs anyway.
+    let mut sinks = crate::record::Sinks::open(
+        rec,
+        crate::record::metadata(&scn.name, &case.name, planner.name(), seed),
+    )?;
+    let (out, written) = sinks.record(|r| forkbench_trial::run_trial_recorded(&scn, case, opts, r));
+    let viewer_error = sinks.viewer_error.take();
+    if let Some(e) = &viewer_error {
+        eprintln!("error: {e} (the trial ran without the viewer)");
+    }
+    written.context("writing the recording")?;
+    let finish = |success: bool| -> anyhow::Result<bool> {
+        if viewer_error.is_some() {
+            anyhow::bail!("the requested rerun viewer could not be reached");
+        }
+        Ok(success)
+    };
     if json {
         let text = serde_json::to_string(&out).context("serialising the outcome")?;
         crate::emit(&format!("{text}\n"))?;
-        return Ok(out.success);
+        return finish(out.success);
     }
     let opt = |v: Option<f64>, scale: f64, unit: &str| {
         v.map_or("never entered".to_owned(), |v| {
@@ -87,7 +107,7 @@ pub fn run(
     let _ = writeln!(s, "sim time             {:.2} s", out.sim_time_s);
     let _ = writeln!(s, "wall time            {:.1} ms", out.wall_time_ms);
     crate::emit(&s)?;
-    Ok(out.success)
+    finish(out.success)
 }
 
 /// Planner override from the CLI.

@@ -74,6 +74,8 @@ pub struct Command {
     pub cross_track_m: f64,
     /// Arc length left to the goal.
     pub remaining_m: f64,
+    /// Planned curvature at the closest path sample.
+    pub path_curvature_per_m: f64,
     /// The goal is reached: stop.
     pub done: bool,
 }
@@ -125,6 +127,7 @@ impl PurePursuit {
                 lookahead_point: [pose.x_m, pose.y_m],
                 cross_track_m: 0.0,
                 remaining_m: 0.0,
+                path_curvature_per_m: 0.0,
                 done: true,
             };
         };
@@ -210,6 +213,7 @@ impl PurePursuit {
             lookahead_point: target,
             cross_track_m,
             remaining_m,
+            path_curvature_per_m: near.curvature_per_m,
             done,
         }
     }

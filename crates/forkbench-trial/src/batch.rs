@@ -60,8 +60,26 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> BatchError + '_ {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrialRecord {
     pub trial: u64,
+    /// Batch-wide overrides this trial ran with, so `forkbench replay` can repeat it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pallet_noise_scale: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replan: Option<bool>,
     #[serde(flatten)]
     pub outcome: TrialOutcome,
+}
+
+impl TrialRecord {
+    /// Options that repeat this trial exactly.
+    pub fn options(&self) -> TrialOptions {
+        TrialOptions {
+            seed: Some(self.outcome.seed),
+            planner: self.outcome.planner.parse().ok(),
+            no_noise: !self.outcome.noise,
+            pallet_noise_scale: self.pallet_noise_scale,
+            replan: self.replan,
+        }
+    }
 }
 
 impl TrialRecord {
@@ -162,6 +180,8 @@ impl BatchSpec {
         let outcome = guarded(s, &case.name, j.planner, seed, || run_trial(s, case, &opts));
         TrialRecord {
             trial: j.trial,
+            pallet_noise_scale: self.pallet_noise_scale,
+            replan: self.replan,
             outcome,
         }
     }

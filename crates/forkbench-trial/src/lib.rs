@@ -4,13 +4,15 @@ pub mod batch;
 pub mod defaults;
 pub mod geometry;
 pub mod outcome;
+pub mod recorder;
 pub mod scenario;
 pub mod stats;
 pub mod trial;
 
 pub use outcome::{Failure, TrialOutcome};
+pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord};
 pub use scenario::{Case, PoseDeg, Scenario, Tolerances, World};
-pub use trial::{TrialOptions, run_trial};
+pub use trial::{TrialOptions, run_trial, run_trial_recorded};
 
 /// A scenario or world file that cannot be used, with the file and field named.
 #[derive(Debug, thiserror::Error)]

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{ForkliftSpec, Pose2};
-use forkbench_plan::{PlanRequest, PlannerConfig, PlannerKind};
+use forkbench_plan::{PlanParams, PlanRequest, PlannerConfig, PlannerKind};
 use forkbench_sensors::Nav350;
 use forkbench_sim::{PalletSpec, Sim};
 use forkbench_track::{PosePredictor, PurePursuit};
@@ -12,6 +12,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::outcome::{Failure, TrialOutcome};
+use crate::recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord};
 use crate::scenario::{Case, Scenario};
 
 /// Per-run choices on top of the scenario file.
@@ -82,6 +83,27 @@ fn insertion_depth(pallet: &Pose2, root: &Pose2, truck: &ForkliftSpec) -> f64 {
 
 /// Runs one case of a scenario to its judged outcome.
 pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutcome {
+    run_trial_recorded(scn, case, opts, &mut NoRecorder)
+}
+
+/// Runs one case and reports every step to `rec`.
+pub fn run_trial_recorded<R: Recorder + ?Sized>(
+    scn: &Scenario,
+    case: &Case,
+    opts: &TrialOptions,
+    rec: &mut R,
+) -> TrialOutcome {
+    let out = run_inner(scn, case, opts, rec);
+    rec.outcome(out.sim_time_s, &out);
+    out
+}
+
+fn run_inner<R: Recorder + ?Sized>(
+    scn: &Scenario,
+    case: &Case,
+    opts: &TrialOptions,
+    rec: &mut R,
+) -> TrialOutcome {
     let wall = Instant::now();
     let seed = opts.seed.unwrap_or(scn.seed);
     let planner = opts.planner.unwrap_or(scn.planner);
@@ -125,17 +147,32 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
 
     // Per-trial jitter of where the pallet really stands (its own random stream).
     let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(seed, 3));
+    let obstacles = scn.world.obstacles();
     let mut sim = match Sim::new(
         truck,
         &case.start,
         &scn.pallet,
         &true_pallet,
-        &scn.world.obstacles(),
+        &obstacles,
         &scn.sim,
     ) {
         Ok(s) => s,
-        Err(e) => return finish(out, Some((Failure::Error, e.to_string()))),
+        Err(e) => {
+            rec.event(0.0, Level::Error, &e.to_string());
+            return finish(out, Some((Failure::Error, e.to_string())));
+        }
     };
+    rec.scene(&SceneInfo {
+        scenario: &scn.name,
+        case: &case.name,
+        planner: planner.name(),
+        seed,
+        truck,
+        pallet: &scn.pallet,
+        pallet_pose: true_pallet,
+        obstacles: &obstacles,
+        start: case.start,
+    });
     let mut nav_rng = stream(seed, 1);
     let mut est_rng = stream(seed, 2);
     let mut nav = Nav350::new(scn.noise.nav350.clone(), noise);
@@ -183,10 +220,28 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
             p
         })
     };
+    let polygon = |p: &forkbench_plan::Plan| match &p.params {
+        PlanParams::Bspline {
+            control_points_m, ..
+        } => Some(control_points_m.to_vec()),
+        PlanParams::Spiral(_) => None,
+    };
     let plan = match plan_from(first_fix, 0.0, &pallet_est) {
         Ok(p) => p,
-        Err(e) => return finish(out, Some((Failure::PlanFailed, e.to_string()))),
+        Err(e) => {
+            rec.event(0.0, Level::Error, &format!("planning failed: {e}"));
+            return finish(out, Some((Failure::PlanFailed, e.to_string())));
+        }
     };
+    rec.plan(0.0, 0, &plan.path, polygon(&plan).as_deref());
+    rec.event(
+        0.0,
+        Level::Info,
+        &format!(
+            "{planner} plan: {:.3} m to the pre-entry pose",
+            plan.path.length_m()
+        ),
+    );
     out.path_length_m = plan.path.length_m();
     let mut tracker = PurePursuit::new(
         plan.path,
@@ -208,7 +263,8 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
     let deadline = scn.timeout_s;
     while sim.time_s() < deadline {
         let truth = sim.fork_root_pose();
-        if let Some(fix) = nav.update(sim.time_s(), &truth, &mut nav_rng) {
+        let fix = nav.update(sim.time_s(), &truth, &mut nav_rng);
+        if let Some(fix) = fix {
             predictor.fix(fix);
         }
         let pose = predictor.pose().unwrap_or(first_fix);
@@ -238,6 +294,20 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
                 let k0 = sim.steer_rad().tan() / truck.wheelbase_m;
                 match plan_from(pose, k0, &new_est) {
                     Ok(p) => {
+                        rec.plan(
+                            sim.time_s(),
+                            out.replans + 1,
+                            &p.path,
+                            polygon(&p).as_deref(),
+                        );
+                        rec.event(
+                            sim.time_s(),
+                            Level::Info,
+                            &format!(
+                                "replan at {range:.2} m: estimate moved {moved:.3} m, {:.2}°",
+                                turned.to_degrees()
+                            ),
+                        );
                         tracker = PurePursuit::new(
                             p.path,
                             scn.tracker.clone(),
@@ -247,7 +317,14 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
                         out.replans += 1;
                     }
                     // Keep tracking the old plan: the truck cannot turn onto the new goal.
-                    Err(_) => out.replans_failed += 1,
+                    Err(e) => {
+                        rec.event(
+                            sim.time_s(),
+                            Level::Warn,
+                            &format!("replan refused, keeping the old plan: {e}"),
+                        );
+                        out.replans_failed += 1;
+                    }
                 }
             }
         }
@@ -265,7 +342,26 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
             dt,
         );
         out.max_steer_rad = out.max_steer_rad.max(sim.steer_rad().abs());
+        if sim.obstacle_contact() && !collision {
+            rec.event(sim.time_s(), Level::Error, "truck touched a rack or wall");
+        }
         collision |= sim.obstacle_contact();
+        rec.step(&StepRecord {
+            t_s: sim.time_s(),
+            truth: sim.fork_root_pose(),
+            fix,
+            estimate: pose,
+            pallet: sim.pallet_pose(),
+            pallet_estimate: pallet_est,
+            steer_cmd_rad: cmd.steer_rad,
+            steer_rad: sim.steer_rad(),
+            speed_cmd_mps: cmd.speed_mps,
+            speed_mps: sim.speed_mps(),
+            lookahead: cmd.lookahead_point,
+            cross_track_m: cmd.cross_track_m,
+            path_curvature_per_m: cmd.path_curvature_per_m,
+            contact_force_n: sim.fork_contact_force_n(),
+        });
 
         let root = sim.fork_root_pose();
         let pallet_now = sim.pallet_pose();
@@ -281,6 +377,14 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
         {
             out.lateral_error_m = Some(local.y_m);
             out.heading_error_rad = Some(local.heading_rad);
+            rec.event(
+                sim.time_s(),
+                Level::Info,
+                &format!(
+                    "fork entry: {:.4} m lateral, {:.4} rad heading",
+                    local.y_m, local.heading_rad
+                ),
+            );
         }
     }
     out.sim_time_s = sim.time_s();

@@ -1,0 +1,165 @@
+//! Builds the recording sinks a command asked for (--rrd, --mcap, --rerun, --connect).
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use forkbench_log::{LogError, McapRecorder, RerunRecorder, RerunTarget, check_writable};
+use forkbench_trial::Recorder;
+
+/// What to record to.
+#[derive(Debug, Clone, Default)]
+pub struct RecordArgs {
+    pub rrd: Option<PathBuf>,
+    pub mcap: Option<PathBuf>,
+    pub rerun: bool,
+    pub connect: Option<String>,
+    pub force: bool,
+}
+
+/// Opened sinks: the file-backed ones keep typed handles so they can be finished and
+/// their errors reported; a viewer that could not be reached is reported, not fatal.
+pub struct Sinks {
+    pub mcap: Option<McapRecorder>,
+    pub rerun: Vec<RerunRecorder>,
+    pub viewer_error: Option<LogError>,
+}
+
+impl Sinks {
+    /// Checks file targets before anything runs, then opens every sink.
+    pub fn open(a: &RecordArgs, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
+        for p in a.rrd.iter().chain(&a.mcap) {
+            check_writable(p, a.force)?;
+        }
+        let mut rerun = Vec::new();
+        if let Some(p) = &a.rrd {
+            rerun.push(RerunRecorder::new(&RerunTarget::File(p.clone()))?);
+        }
+        let mut viewer_error = None;
+        let viewer = match (&a.connect, a.rerun) {
+            (Some(addr), _) => Some(RerunTarget::Connect(addr.clone())),
+            (None, true) => Some(RerunTarget::Spawn),
+            (None, false) => None,
+        };
+        if let Some(target) = viewer {
+            match RerunRecorder::new(&target) {
+                Ok(r) => rerun.push(r),
+                Err(e) => viewer_error = Some(e),
+            }
+        }
+        let mcap = a
+            .mcap
+            .as_ref()
+            .map(|p| McapRecorder::create(p, metadata))
+            .transpose()?;
+        Ok(Self {
+            mcap,
+            rerun,
+            viewer_error,
+        })
+    }
+
+    /// Runs `f` with every open sink behind one recorder, then finishes them all.
+    pub fn record<T>(
+        &mut self,
+        f: impl FnOnce(&mut dyn Recorder) -> T,
+    ) -> (T, Result<(), LogError>) {
+        // Move the sinks into the tee for the run and take them back afterwards.
+        let mcap = self.mcap.take();
+        let rerun = std::mem::take(&mut self.rerun);
+        let mut holder = Holder { mcap, rerun };
+        let out = {
+            let mut refs: Vec<&mut dyn Recorder> = Vec::new();
+            if let Some(m) = holder.mcap.as_mut() {
+                refs.push(m);
+            }
+            for r in holder.rerun.iter_mut() {
+                refs.push(r);
+            }
+            let mut fan = RefTee(refs);
+            f(&mut fan)
+        };
+        let mut result = Ok(());
+        if let Some(m) = holder.mcap.as_mut()
+            && let Err(e) = m.finish()
+        {
+            result = Err(e);
+        }
+        for r in holder.rerun.iter_mut() {
+            if let Err(e) = r.finish()
+                && result.is_ok()
+            {
+                result = Err(e);
+            }
+        }
+        (out, result)
+    }
+}
+
+struct Holder {
+    mcap: Option<McapRecorder>,
+    rerun: Vec<RerunRecorder>,
+}
+
+/// A fan-out over borrowed recorders.
+struct RefTee<'a>(Vec<&'a mut dyn Recorder>);
+
+impl Recorder for RefTee<'_> {
+    fn scene(&mut self, s: &forkbench_trial::SceneInfo<'_>) {
+        self.0.iter_mut().for_each(|r| r.scene(s));
+    }
+    fn plan(&mut self, t: f64, i: u32, p: &forkbench_core::Path, c: Option<&[[f64; 2]]>) {
+        self.0.iter_mut().for_each(|r| r.plan(t, i, p, c));
+    }
+    fn step(&mut self, s: &forkbench_trial::StepRecord) {
+        self.0.iter_mut().for_each(|r| r.step(s));
+    }
+    fn event(&mut self, t: f64, l: forkbench_trial::Level, text: &str) {
+        self.0.iter_mut().for_each(|r| r.event(t, l, text));
+    }
+    fn outcome(&mut self, t: f64, o: &forkbench_trial::TrialOutcome) {
+        self.0.iter_mut().for_each(|r| r.outcome(t, o));
+    }
+}
+
+/// Metadata record of a trial's MCAP file.
+pub fn metadata(scenario: &str, case: &str, planner: &str, seed: u64) -> BTreeMap<String, String> {
+    BTreeMap::from([
+        ("scenario".to_owned(), scenario.to_owned()),
+        ("case".to_owned(), case.to_owned()),
+        ("planner".to_owned(), planner.to_owned()),
+        ("seed".to_owned(), seed.to_string()),
+        (
+            "forkbench_version".to_owned(),
+            env!("CARGO_PKG_VERSION").to_owned(),
+        ),
+        ("rerun_version".to_owned(), "0.36.3".to_owned()),
+        (
+            "time".to_owned(),
+            "log time = simulation time in ns".to_owned(),
+        ),
+    ])
+}
+
+/// Re-runs one trial of a scenario into `<dir>/<scenario>-<case>-<planner>-seed<seed>.{rrd,mcap}`.
+pub fn record_trial(
+    scn: &forkbench_trial::Scenario,
+    case: &forkbench_trial::Case,
+    opts: &forkbench_trial::TrialOptions,
+    dir: &std::path::Path,
+) -> anyhow::Result<(forkbench_trial::TrialOutcome, PathBuf)> {
+    let planner = opts.planner.unwrap_or(scn.planner);
+    let seed = opts.seed.unwrap_or(scn.seed);
+    let stem = format!("{}-{}-{}-seed{}", scn.name, case.name, planner, seed);
+    let rrd = dir.join(format!("{stem}.rrd"));
+    let args = RecordArgs {
+        rrd: Some(rrd.clone()),
+        mcap: Some(dir.join(format!("{stem}.mcap"))),
+        force: true,
+        ..RecordArgs::default()
+    };
+    let mut sinks = Sinks::open(&args, metadata(&scn.name, &case.name, planner.name(), seed))?;
+    let (out, written) =
+        sinks.record(|rec| forkbench_trial::run_trial_recorded(scn, case, opts, rec));
+    written?;
+    Ok((out, rrd))
+}

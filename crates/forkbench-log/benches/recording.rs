@@ -1,0 +1,49 @@
+//! Cost of recording one field-test trial to .rrd and .mcap against the plain trial (target < 2×).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use forkbench_log::{McapRecorder, RerunRecorder, RerunTarget};
+use forkbench_trial::{Scenario, TrialOptions, run_trial, run_trial_recorded};
+
+fn bench(c: &mut Criterion) {
+    let scn = Scenario::load(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/field-test.toml"
+    )))
+    .expect("loads");
+    let case = &scn.cases[0];
+    let opts = TrialOptions {
+        seed: Some(7),
+        ..TrialOptions::default()
+    };
+    let dir = std::env::temp_dir().join(format!("forkbench-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let mut g = c.benchmark_group("recording");
+    g.bench_function("off", |b| b.iter(|| run_trial(&scn, case, &opts)));
+    g.bench_function("mcap", |b| {
+        b.iter(|| {
+            let mut m = McapRecorder::create(&dir.join("b.mcap"), BTreeMap::new()).expect("opens");
+            let out = run_trial_recorded(&scn, case, &opts, &mut m);
+            m.finish().expect("finishes");
+            out
+        })
+    });
+    g.bench_function("rrd", |b| {
+        b.iter(|| {
+            let mut r = RerunRecorder::new(&RerunTarget::File(dir.join("b.rrd"))).expect("opens");
+            let out = run_trial_recorded(&scn, case, &opts, &mut r);
+            r.finish().expect("flushes");
+            out
+        })
+    });
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
+    targets = bench
+}
+criterion_main!(benches);

@@ -1,0 +1,130 @@
+//! Recording sinks for forkbench trials: MCAP (Foxglove schemas, JSON) and rerun (.rrd or a live viewer).
+
+pub mod mcap_sink;
+pub mod rerun_sink;
+
+use std::path::Path;
+
+use forkbench_core::Pose2;
+use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
+
+pub use mcap_sink::McapRecorder;
+pub use rerun_sink::{RerunRecorder, RerunTarget};
+
+/// A recording sink that could not be opened or written.
+#[derive(Debug, thiserror::Error)]
+pub enum LogError {
+    #[error("{path}: exists (use --force to overwrite)")]
+    Exists { path: String },
+    #[error("{path}: {message}")]
+    Io { path: String, message: String },
+    #[error("rerun: {0}")]
+    Rerun(String),
+}
+
+/// Checks before a run that `path` can be written: parent exists and is writable, and
+/// the file is absent unless `force`.
+pub fn check_writable(path: &Path, force: bool) -> Result<(), LogError> {
+    let p = path.display().to_string();
+    if path.exists() && !force {
+        return Err(LogError::Exists { path: p });
+    }
+    let parent = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(LogError::Io {
+            path: p,
+            message: format!("directory {} does not exist", parent.display()),
+        });
+    }
+    // Probe: create (or truncate) the file itself, so a read-only place fails now.
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .open(path)
+        .map(|_| ())
+        .map_err(|e| LogError::Io {
+            path: p,
+            message: e.to_string(),
+        })
+}
+
+/// Fans one trial out to several recorders.
+#[derive(Default)]
+pub struct Tee {
+    pub sinks: Vec<Box<dyn Recorder>>,
+}
+
+impl std::fmt::Debug for Tee {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Tee({} sinks)", self.sinks.len())
+    }
+}
+
+impl Recorder for Tee {
+    fn scene(&mut self, s: &SceneInfo<'_>) {
+        self.sinks.iter_mut().for_each(|r| r.scene(s));
+    }
+    fn plan(&mut self, t: f64, i: u32, p: &forkbench_core::Path, c: Option<&[[f64; 2]]>) {
+        self.sinks.iter_mut().for_each(|r| r.plan(t, i, p, c));
+    }
+    fn step(&mut self, s: &StepRecord) {
+        self.sinks.iter_mut().for_each(|r| r.step(s));
+    }
+    fn event(&mut self, t: f64, l: Level, text: &str) {
+        self.sinks.iter_mut().for_each(|r| r.event(t, l, text));
+    }
+    fn outcome(&mut self, t: f64, o: &TrialOutcome) {
+        self.sinks.iter_mut().for_each(|r| r.outcome(t, o));
+    }
+}
+
+/// Corners of a rectangle given by its centre pose and full sizes, closed (5 points).
+pub(crate) fn rect_corners(centre: &Pose2, length_m: f64, width_m: f64) -> [[f64; 2]; 5] {
+    let (hl, hw) = (length_m / 2.0, width_m / 2.0);
+    let c = [[hl, hw], [-hl, hw], [-hl, -hw], [hl, -hw], [hl, hw]];
+    c.map(|[x, y]| {
+        let p = centre.to_world(&Pose2::new(x, y, 0.0));
+        [p.x_m, p.y_m]
+    })
+}
+
+/// Outlines of the truck at a fork-root pose: chassis and the two forks.
+pub(crate) fn truck_outlines(
+    truck: &forkbench_core::ForkliftSpec,
+    root: &Pose2,
+) -> Vec<[[f64; 2]; 5]> {
+    let chassis = root.to_world(&Pose2::new(-truck.body_length_m / 2.0, 0.0, 0.0));
+    let mut v = vec![rect_corners(
+        &chassis,
+        truck.body_length_m,
+        truck.body_width_m,
+    )];
+    for side in [1.0, -1.0] {
+        let f = root.to_world(&Pose2::new(
+            truck.fork_length_m / 2.0,
+            side * truck.fork_spacing_m / 2.0,
+            0.0,
+        ));
+        v.push(rect_corners(&f, truck.fork_length_m, truck.fork_width_m));
+    }
+    v
+}
+
+/// Outlines of the pallet's stringers at its face pose.
+pub(crate) fn pallet_outlines(
+    pallet: &forkbench_sim::PalletSpec,
+    face: &Pose2,
+) -> Vec<[[f64; 2]; 5]> {
+    pallet
+        .stringer_offsets_m()
+        .iter()
+        .map(|y| {
+            let c = face.to_world(&Pose2::new(pallet.depth_m / 2.0, *y, 0.0));
+            rect_corners(&c, pallet.depth_m, pallet.stringer_width_m())
+        })
+        .collect()
+}

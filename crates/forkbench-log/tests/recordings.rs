@@ -1,0 +1,204 @@
+//! Recordings are read back: MCAP with the mcap crate, .rrd with rerun's own decoder.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+use forkbench_log::{McapRecorder, RerunRecorder, RerunTarget};
+use forkbench_trial::{Recorder, Scenario, TrialOptions, run_trial_recorded};
+
+fn field_test() -> Scenario {
+    Scenario::load(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/field-test.toml"
+    )))
+    .expect("loads")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("forkbench-log-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("dir");
+    d.join(name)
+}
+
+fn opts() -> TrialOptions {
+    TrialOptions {
+        seed: Some(3),
+        ..TrialOptions::default()
+    }
+}
+
+#[test]
+fn mcap_has_schemas_channels_time_order_and_the_outcome() {
+    let scn = field_test();
+    let path = tmp("trial.mcap");
+    let meta = BTreeMap::from([("scenario".to_owned(), "field-test".to_owned())]);
+    let mut rec = McapRecorder::create(&path, meta).expect("opens");
+    let out = run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rec);
+    rec.finish().expect("finishes");
+    let bytes = std::fs::read(&path).expect("written");
+
+    let mut per_topic: BTreeMap<String, usize> = BTreeMap::new();
+    let mut schemas = BTreeSet::new();
+    let mut last_time = 0;
+    let mut outcome_msg = None;
+    for m in mcap::MessageStream::new(&bytes).expect("valid mcap") {
+        let m = m.expect("message");
+        assert!(
+            m.log_time >= last_time,
+            "log time goes back at {}",
+            m.channel.topic
+        );
+        last_time = m.log_time;
+        assert_eq!(m.channel.message_encoding, "json");
+        let schema = m.channel.schema.as_ref().expect("schema");
+        assert_eq!(schema.encoding, "jsonschema");
+        serde_json::from_slice::<serde_json::Value>(&schema.data).expect("schema is JSON");
+        schemas.insert(schema.name.clone());
+        *per_topic.entry(m.channel.topic.clone()).or_default() += 1;
+        let v: serde_json::Value = serde_json::from_slice(&m.data).expect("message is JSON");
+        if m.channel.topic == "/forkbench/outcome" {
+            outcome_msg = Some(v);
+        }
+    }
+    for s in [
+        "foxglove.SceneUpdate",
+        "foxglove.FrameTransform",
+        "foxglove.PoseInFrame",
+        "foxglove.Log",
+        "forkbench.Telemetry",
+        "forkbench.Plan",
+        "forkbench.Outcome",
+    ] {
+        assert!(schemas.contains(s), "missing schema {s}: {schemas:?}");
+    }
+    let steps = (out.sim_time_s / scn.sim.dt_s).round() as usize;
+    assert_eq!(per_topic["/forkbench/telemetry"], steps);
+    assert_eq!(per_topic["/tf"], steps);
+    assert_eq!(per_topic["/forkbench/outcome"], 1);
+    // NAV350 at 8 Hz over the trial.
+    let fixes = per_topic["/truck/pose_measured"];
+    assert!(
+        (fixes as f64 - out.sim_time_s * 8.0).abs() <= 2.0,
+        "{fixes} fixes in {} s",
+        out.sim_time_s
+    );
+    assert_eq!(
+        last_time,
+        (out.sim_time_s * 1e9).round() as u64,
+        "log time is simulation time"
+    );
+    assert_eq!(
+        outcome_msg.expect("outcome"),
+        serde_json::to_value(&out).expect("serialises")
+    );
+
+    let summary = mcap::Summary::read(&bytes)
+        .expect("readable")
+        .expect("indexed file has a summary");
+    assert!(!summary.chunk_indexes.is_empty(), "chunked");
+    assert_eq!(summary.metadata_indexes.len(), 1);
+}
+
+#[test]
+fn a_crash_mid_trial_leaves_a_readable_mcap_up_to_the_last_chunk() {
+    struct StopAfter<'a> {
+        inner: &'a mut McapRecorder,
+        steps: usize,
+    }
+    impl Recorder for StopAfter<'_> {
+        fn step(&mut self, s: &forkbench_trial::StepRecord) {
+            self.steps += 1;
+            if self.steps <= 300 {
+                self.inner.step(s);
+            }
+            if self.steps == 300 {
+                self.inner.flush().expect("flush");
+            }
+        }
+    }
+    let scn = field_test();
+    let path = tmp("crash.mcap");
+    let mut rec = McapRecorder::create(&path, BTreeMap::new()).expect("opens");
+    run_trial_recorded(
+        &scn,
+        &scn.cases[0],
+        &opts(),
+        &mut StopAfter {
+            inner: &mut rec,
+            steps: 0,
+        },
+    );
+    rec.abandon(); // no summary, no footer: as if the process died
+    let bytes = std::fs::read(&path).expect("written");
+    let opts = enumset::EnumSet::only(mcap::read::Options::IgnoreEndMagic);
+    let mut telemetry = 0;
+    for m in mcap::MessageStream::new_with_options(&bytes, opts).expect("header readable") {
+        match m {
+            Ok(m) if m.channel.topic == "/forkbench/telemetry" => telemetry += 1,
+            Ok(_) => {}
+            Err(_) => break, // the torn end
+        }
+    }
+    assert_eq!(
+        telemetry, 300,
+        "every step up to the flushed chunk is readable"
+    );
+}
+
+#[test]
+fn rrd_decodes_with_rerun_and_holds_the_entities() {
+    use rerun::external::re_log_encoding::DecoderApp;
+    use rerun::external::re_log_types::LogMsg;
+
+    let scn = field_test();
+    let path = tmp("trial.rrd");
+    {
+        let mut rec = RerunRecorder::new(&RerunTarget::File(path.clone())).expect("opens");
+        run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rec);
+        rec.finish().expect("flushes");
+    }
+    let file = std::io::BufReader::new(std::fs::File::open(&path).expect("written"));
+    let (mut arrow, mut apps, mut kinds) = (0, BTreeSet::new(), BTreeSet::new());
+    let mut entities = BTreeSet::new();
+    for msg in DecoderApp::decode_lazy(file) {
+        match msg.expect("decodes") {
+            LogMsg::SetStoreInfo(info) => {
+                apps.insert(info.info.application_id().to_string());
+                kinds.insert(format!("{:?}", info.info.store_id.kind()));
+            }
+            LogMsg::ArrowMsg(_, m) => {
+                arrow += 1;
+                if let Ok(chunk) = rerun::log::Chunk::from_arrow_msg(&m) {
+                    entities.insert(chunk.entity_path().to_string());
+                }
+            }
+            LogMsg::BlueprintActivationCommand(_) => {}
+        }
+    }
+    assert!(apps.contains("forkbench"), "{apps:?}");
+    assert!(
+        kinds.iter().any(|k| k.contains("Blueprint")),
+        "a blueprint is stored: {kinds:?}"
+    );
+    assert!(arrow > 10, "{arrow} arrow messages");
+    for e in [
+        "/world/pallet",
+        "/truck/outline",
+        "/plan/path",
+        "/plan/path/control_polygon",
+        "/track/trajectory",
+        "/track/lookahead",
+        "/sensors/true_pose",
+        "/sensors/measured_pose",
+        "/sensors/pallet_estimate",
+        "/plots/curvature/planned",
+        "/plots/steering/command",
+        "/plots/steering/actual",
+        "/plots/speed/actual",
+        "/plots/lateral_error",
+        "/plots/contact_force",
+        "/events",
+    ] {
+        assert!(entities.contains(e), "missing {e}: {entities:?}");
+    }
+}

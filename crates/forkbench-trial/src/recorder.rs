@@ -1,0 +1,76 @@
+//! What a trial reports as it runs, for recording sinks (rerun, MCAP) that live outside this crate.
+
+use forkbench_core::{ForkliftSpec, Path, Pose2};
+use forkbench_sim::{Obstacle, PalletSpec};
+
+use crate::outcome::TrialOutcome;
+
+/// The fixed scene of a trial, sent once before the first step.
+#[derive(Debug, Clone)]
+pub struct SceneInfo<'a> {
+    pub scenario: &'a str,
+    pub case: &'a str,
+    pub planner: &'a str,
+    pub seed: u64,
+    pub truck: &'a ForkliftSpec,
+    pub pallet: &'a PalletSpec,
+    /// True pallet pose (front-face centre) at the start.
+    pub pallet_pose: Pose2,
+    pub obstacles: &'a [Obstacle],
+    /// Fork-root start pose.
+    pub start: Pose2,
+}
+
+/// One control step: truth, what the controller saw, what it commanded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepRecord {
+    pub t_s: f64,
+    /// True fork-root pose.
+    pub truth: Pose2,
+    /// A NAV350 fix delivered this step, if any.
+    pub fix: Option<Pose2>,
+    /// The pose the controller used (last fix propagated by odometry).
+    pub estimate: Pose2,
+    pub pallet: Pose2,
+    pub pallet_estimate: Pose2,
+    pub steer_cmd_rad: f64,
+    pub steer_rad: f64,
+    pub speed_cmd_mps: f64,
+    pub speed_mps: f64,
+    pub lookahead: [f64; 2],
+    pub cross_track_m: f64,
+    /// Planned curvature at the tracked point.
+    pub path_curvature_per_m: f64,
+    pub contact_force_n: f64,
+}
+
+/// Severity of a trial event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Level {
+    Info,
+    Warn,
+    Error,
+}
+
+/// Receives a trial as it happens. Every method has an empty default.
+pub trait Recorder {
+    fn scene(&mut self, _scene: &SceneInfo<'_>) {}
+    /// A plan (index 0) or a replan (1, 2, …); `control_polygon` for B-splines.
+    fn plan(
+        &mut self,
+        _t_s: f64,
+        _index: u32,
+        _path: &Path,
+        _control_polygon: Option<&[[f64; 2]]>,
+    ) {
+    }
+    fn step(&mut self, _step: &StepRecord) {}
+    fn event(&mut self, _t_s: f64, _level: Level, _text: &str) {}
+    fn outcome(&mut self, _t_s: f64, _outcome: &TrialOutcome) {}
+}
+
+/// Records nothing; the trial loop is generic, so this compiles away.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoRecorder;
+
+impl Recorder for NoRecorder {}
