@@ -6,7 +6,6 @@ pub mod rerun_sink;
 use std::path::Path;
 
 use forkbench_core::Pose2;
-use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
 
 pub use mcap_sink::McapRecorder;
 pub use rerun_sink::{RerunRecorder, RerunTarget};
@@ -50,36 +49,6 @@ pub fn check_writable(path: &Path, force: bool) -> Result<(), LogError> {
             path: p,
             message: e.to_string(),
         })
-}
-
-/// Fans one trial out to several recorders.
-#[derive(Default)]
-pub struct Tee {
-    pub sinks: Vec<Box<dyn Recorder>>,
-}
-
-impl std::fmt::Debug for Tee {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Tee({} sinks)", self.sinks.len())
-    }
-}
-
-impl Recorder for Tee {
-    fn scene(&mut self, s: &SceneInfo<'_>) {
-        self.sinks.iter_mut().for_each(|r| r.scene(s));
-    }
-    fn plan(&mut self, t: f64, i: u32, p: &forkbench_core::Path, c: Option<&[[f64; 2]]>) {
-        self.sinks.iter_mut().for_each(|r| r.plan(t, i, p, c));
-    }
-    fn step(&mut self, s: &StepRecord) {
-        self.sinks.iter_mut().for_each(|r| r.step(s));
-    }
-    fn event(&mut self, t: f64, l: Level, text: &str) {
-        self.sinks.iter_mut().for_each(|r| r.event(t, l, text));
-    }
-    fn outcome(&mut self, t: f64, o: &TrialOutcome) {
-        self.sinks.iter_mut().for_each(|r| r.outcome(t, o));
-    }
 }
 
 /// Corners of a rectangle given by its centre pose and full sizes, closed (5 points).

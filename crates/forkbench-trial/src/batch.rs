@@ -218,30 +218,10 @@ fn error_outcome(
     seed: u64,
     detail: String,
 ) -> TrialOutcome {
-    TrialOutcome {
-        scenario: s.name.clone(),
-        case: case.to_owned(),
-        planner: planner.name().to_owned(),
-        seed,
-        noise: s.noise.enabled,
-        success: false,
-        failure: Some(Failure::Error),
-        failure_detail: Some(detail),
-        lateral_error_m: None,
-        heading_error_rad: None,
-        final_lateral_error_m: f64::NAN,
-        final_heading_error_rad: f64::NAN,
-        insertion_depth_m: f64::NAN,
-        max_steer_rad: 0.0,
-        max_contact_force_n: 0.0,
-        pallet_displacement_m: 0.0,
-        pallet_rotation_rad: 0.0,
-        replans: 0,
-        replans_failed: 0,
-        path_length_m: 0.0,
-        sim_time_s: 0.0,
-        wall_time_ms: 0.0,
-    }
+    let mut out = TrialOutcome::blank(&s.name, case, planner.name(), seed, s.noise.enabled);
+    out.failure = Some(Failure::Error);
+    out.failure_detail = Some(detail);
+    out
 }
 
 /// Reads `trials.jsonl`. A torn last line (a crash mid-write) is skipped; any other bad

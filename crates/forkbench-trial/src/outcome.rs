@@ -80,6 +80,36 @@ pub struct TrialOutcome {
     pub wall_time_ms: f64,
 }
 
+impl TrialOutcome {
+    /// A not-yet-judged outcome: nothing measured (NaN where a value would be), no failure.
+    pub fn blank(scenario: &str, case: &str, planner: &str, seed: u64, noise: bool) -> Self {
+        Self {
+            scenario: scenario.to_owned(),
+            case: case.to_owned(),
+            planner: planner.to_owned(),
+            seed,
+            noise,
+            success: false,
+            failure: None,
+            failure_detail: None,
+            lateral_error_m: None,
+            heading_error_rad: None,
+            final_lateral_error_m: f64::NAN,
+            final_heading_error_rad: f64::NAN,
+            insertion_depth_m: f64::NAN,
+            max_steer_rad: 0.0,
+            max_contact_force_n: 0.0,
+            pallet_displacement_m: 0.0,
+            pallet_rotation_rad: 0.0,
+            replans: 0,
+            replans_failed: 0,
+            path_length_m: 0.0,
+            sim_time_s: 0.0,
+            wall_time_ms: 0.0,
+        }
+    }
+}
+
 /// NaN (a trial that never ran far enough to measure) is written as JSON null and read back.
 mod nan_as_null {
     use serde::{Deserialize, Deserializer, Serializer};

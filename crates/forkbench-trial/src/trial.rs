@@ -109,30 +109,7 @@ fn run_inner<R: Recorder + ?Sized>(
     let planner = opts.planner.unwrap_or(scn.planner);
     let noise = scn.noise.enabled && !opts.no_noise;
     let truck = &scn.truck;
-    let mut out = TrialOutcome {
-        scenario: scn.name.clone(),
-        case: case.name.clone(),
-        planner: planner.name().to_owned(),
-        seed,
-        noise,
-        success: false,
-        failure: None,
-        failure_detail: None,
-        lateral_error_m: None,
-        heading_error_rad: None,
-        final_lateral_error_m: f64::NAN,
-        final_heading_error_rad: f64::NAN,
-        insertion_depth_m: f64::NAN,
-        max_steer_rad: 0.0,
-        max_contact_force_n: 0.0,
-        pallet_displacement_m: 0.0,
-        pallet_rotation_rad: 0.0,
-        replans: 0,
-        replans_failed: 0,
-        path_length_m: 0.0,
-        sim_time_s: 0.0,
-        wall_time_ms: 0.0,
-    };
+    let mut out = TrialOutcome::blank(&scn.name, &case.name, planner.name(), seed, noise);
     let finish = |mut out: TrialOutcome, failure: Option<(Failure, String)>| {
         if let Some((f, d)) = failure {
             out.failure = Some(f);
