@@ -63,28 +63,23 @@ impl Sinks {
         &mut self,
         f: impl FnOnce(&mut dyn Recorder) -> T,
     ) -> (T, Result<(), LogError>) {
-        // Move the sinks into the tee for the run and take them back afterwards.
-        let mcap = self.mcap.take();
-        let rerun = std::mem::take(&mut self.rerun);
-        let mut holder = Holder { mcap, rerun };
         let out = {
             let mut refs: Vec<&mut dyn Recorder> = Vec::new();
-            if let Some(m) = holder.mcap.as_mut() {
+            if let Some(m) = self.mcap.as_mut() {
                 refs.push(m);
             }
-            for r in holder.rerun.iter_mut() {
+            for r in self.rerun.iter_mut() {
                 refs.push(r);
             }
-            let mut fan = RefTee(refs);
-            f(&mut fan)
+            f(&mut RefTee(refs))
         };
         let mut result = Ok(());
-        if let Some(m) = holder.mcap.as_mut()
+        if let Some(m) = self.mcap.as_mut()
             && let Err(e) = m.finish()
         {
             result = Err(e);
         }
-        for r in holder.rerun.iter_mut() {
+        for r in self.rerun.iter_mut() {
             if let Err(e) = r.finish()
                 && result.is_ok()
             {
@@ -93,11 +88,6 @@ impl Sinks {
         }
         (out, result)
     }
-}
-
-struct Holder {
-    mcap: Option<McapRecorder>,
-    rerun: Vec<RerunRecorder>,
 }
 
 /// A fan-out over borrowed recorders.

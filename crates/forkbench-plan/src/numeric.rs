@@ -50,18 +50,11 @@ impl GaussLegendre {
         RULE.get_or_init(|| GaussLegendre::new(12))
     }
 
-    /// Shared 16-point rule: exact for polynomials to degree 31 and ~1e-13 on the
-    /// smooth trigonometric integrands of the spiral (checked against dense sampling).
+    /// Shared 16-point rule: exact for polynomials to degree 31 (the spiral's cost
+    /// ∫½κ² has degree 8).
     pub fn rule16() -> &'static GaussLegendre {
         static RULE: OnceLock<GaussLegendre> = OnceLock::new();
         RULE.get_or_init(|| GaussLegendre::new(16))
-    }
-
-    /// Shared 24-point rule: exact for polynomials to degree 47 and ~1e-15 on the
-    /// smooth trigonometric integrands of the spiral.
-    pub fn rule24() -> &'static GaussLegendre {
-        static RULE: OnceLock<GaussLegendre> = OnceLock::new();
-        RULE.get_or_init(|| GaussLegendre::new(24))
     }
 }
 
@@ -214,7 +207,7 @@ mod tests {
 
     #[test]
     fn gauss_legendre_integrates_polynomials_and_cosine() {
-        let gl = GaussLegendre::rule24();
+        let gl = GaussLegendre::new(24);
         let wsum: f64 = gl.weights.iter().sum();
         assert!((wsum - 2.0).abs() < 1e-13);
         let x10: f64 = gl

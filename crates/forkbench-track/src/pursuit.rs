@@ -225,21 +225,17 @@ mod tests {
     use forkbench_core::PathSample;
 
     fn straight(len: f64) -> Path {
-        let n = (len / 0.01) as usize;
-        Path {
-            samples: (0..=n)
-                .map(|i| {
-                    let s = i as f64 * 0.01;
-                    PathSample {
-                        s_m: s,
-                        x_m: s,
-                        y_m: 0.0,
-                        heading_rad: 0.0,
-                        curvature_per_m: 0.0,
-                    }
-                })
-                .collect(),
-        }
+        let mut p = Path {
+            samples: vec![PathSample {
+                s_m: 0.0,
+                x_m: 0.0,
+                y_m: 0.0,
+                heading_rad: 0.0,
+                curvature_per_m: 0.0,
+            }],
+        };
+        p.extend_straight(len, 0.01);
+        p
     }
 
     #[test]
