@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use forkbench_log::{LogError, McapRecorder, RerunRecorder, RerunTarget, check_writable};
-use forkbench_trial::Recorder;
+use forkbench_trial::{Recorder, Tee};
 
 /// What to record to.
 #[derive(Debug, Clone, Default)]
@@ -71,7 +71,7 @@ impl Sinks {
             for r in self.rerun.iter_mut() {
                 refs.push(r);
             }
-            f(&mut RefTee(refs))
+            f(&mut Tee(refs))
         };
         let mut result = Ok(());
         if let Some(m) = self.mcap.as_mut()
@@ -87,27 +87,6 @@ impl Sinks {
             }
         }
         (out, result)
-    }
-}
-
-/// A fan-out over borrowed recorders.
-struct RefTee<'a>(Vec<&'a mut dyn Recorder>);
-
-impl Recorder for RefTee<'_> {
-    fn scene(&mut self, s: &forkbench_trial::SceneInfo<'_>) {
-        self.0.iter_mut().for_each(|r| r.scene(s));
-    }
-    fn plan(&mut self, t: f64, i: u32, p: &forkbench_core::Path, c: Option<&[[f64; 2]]>) {
-        self.0.iter_mut().for_each(|r| r.plan(t, i, p, c));
-    }
-    fn step(&mut self, s: &forkbench_trial::StepRecord) {
-        self.0.iter_mut().for_each(|r| r.step(s));
-    }
-    fn event(&mut self, t: f64, l: forkbench_trial::Level, text: &str) {
-        self.0.iter_mut().for_each(|r| r.event(t, l, text));
-    }
-    fn outcome(&mut self, t: f64, o: &forkbench_trial::TrialOutcome) {
-        self.0.iter_mut().for_each(|r| r.outcome(t, o));
     }
 }
 

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use forkbench_log::{McapRecorder, RerunRecorder, RerunTarget};
-use forkbench_trial::{Scenario, TrialOptions, run_trial, run_trial_recorded};
+use forkbench_trial::{Scenario, Tee, TrialOptions, run_trial, run_trial_recorded};
 
 fn bench(c: &mut Criterion) {
     let scn = Scenario::load(Path::new(concat!(
@@ -34,6 +34,22 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let mut r = RerunRecorder::new(&RerunTarget::File(dir.join("b.rrd"))).expect("opens");
             let out = run_trial_recorded(&scn, case, &opts, &mut r);
+            r.finish().expect("flushes");
+            out
+        })
+    });
+    g.bench_function("rrd-setup", |b| {
+        b.iter(|| {
+            let mut r = RerunRecorder::new(&RerunTarget::File(dir.join("e.rrd"))).expect("opens");
+            r.finish().expect("flushes");
+        })
+    });
+    g.bench_function("rrd+mcap", |b| {
+        b.iter(|| {
+            let mut m = McapRecorder::create(&dir.join("c.mcap"), BTreeMap::new()).expect("opens");
+            let mut r = RerunRecorder::new(&RerunTarget::File(dir.join("c.rrd"))).expect("opens");
+            let out = run_trial_recorded(&scn, case, &opts, &mut Tee(vec![&mut m, &mut r]));
+            m.finish().expect("finishes");
             r.finish().expect("flushes");
             out
         })

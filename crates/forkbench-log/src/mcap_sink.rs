@@ -4,11 +4,13 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
+use std::sync::mpsc::{SyncSender, sync_channel};
+use std::thread::JoinHandle;
 
-use forkbench_core::{ForkliftSpec, Pose2};
-use forkbench_sim::PalletSpec;
+use forkbench_core::Pose2;
 use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
-use serde_json::{Value, json};
+use serde::Serialize;
+use serde_json::json;
 
 use crate::{LogError, pallet_outlines, rect_corners, truck_outlines};
 
@@ -37,18 +39,54 @@ const CHANNELS: [(&str, &str, &str); 9] = [
     ("/forkbench/outcome", "forkbench.Outcome", OUTCOME_SCHEMA),
 ];
 
-/// Scene geometry is redrawn every this many control steps (10 Hz at 100 Hz).
-const SCENE_EVERY: u64 = 10;
+/// Steps are handed to the writer thread in batches of this many (0.5 s simulated), so
+/// the threads do not wake each other at every step.
+const STEP_BATCH: usize = 50;
+
+/// A pallet (or its estimate) moving less than this since its last transform is not
+/// re-sent: it is pushed only on contact, so most trials send one transform each.
+const PALLET_MOVE_M: f64 = 5e-4;
+const PALLET_TURN_RAD: f64 = 1e-4;
 
 /// Writes one trial to an indexed, chunked MCAP file.
+///
+/// Serialising and compressing ~3,000 messages per trial cost more than the trial itself,
+/// so a writer thread does it: the trial thread only hands over each step's record (and
+/// serialises the few large messages: scene, plans, events, outcome) through a bounded
+/// channel, which also bounds memory when the disk is slower than the simulation.
 pub struct McapRecorder {
-    writer: Option<mcap::Writer<BufWriter<File>>>,
     path: String,
+    tx: Option<SyncSender<Cmd>>,
+    thread: Option<JoinHandle<Option<String>>>,
+    /// Steps not yet handed over.
+    steps: Vec<StepRecord>,
+    error: Option<String>,
+}
+
+/// Work for the writer thread.
+enum Cmd {
+    /// An already serialised message.
+    Raw {
+        topic: &'static str,
+        t_s: f64,
+        data: Vec<u8>,
+    },
+    Steps(Vec<StepRecord>),
+    /// Flush the current chunk and acknowledge.
+    Flush(SyncSender<Option<String>>),
+    /// Stop without finishing the file, as a crash would.
+    Abandon,
+}
+
+/// The writer thread's state.
+struct Sink {
+    writer: mcap::Writer<BufWriter<File>>,
     channels: BTreeMap<&'static str, u16>,
     sequence: u32,
-    steps: u64,
-    truck: Option<ForkliftSpec>,
-    pallet: Option<PalletSpec>,
+    /// Last transforms sent for the pallet and its estimate.
+    pallet_sent: Option<Pose2>,
+    estimate_sent: Option<Pose2>,
+    buf: Vec<u8>,
     error: Option<String>,
 }
 
@@ -62,49 +100,261 @@ fn ns(t_s: f64) -> u64 {
     (t_s.max(0.0) * 1e9).round() as u64
 }
 
-fn stamp(t_s: f64) -> Value {
-    let n = ns(t_s);
-    json!({"sec": n / 1_000_000_000, "nsec": n % 1_000_000_000})
-}
-
-fn quat(yaw: f64) -> Value {
-    json!({"x": 0.0, "y": 0.0, "z": (yaw / 2.0).sin(), "w": (yaw / 2.0).cos()})
-}
-
-fn pose_json(p: &Pose2) -> Value {
-    json!({"position": {"x": p.x_m, "y": p.y_m, "z": 0.0}, "orientation": quat(p.heading_rad)})
-}
-
-fn line(points: &[[f64; 2]], rgba: [f64; 4], thickness: f64) -> Value {
-    json!({
-        "type": 0,
-        "pose": pose_json(&Pose2::new(0.0, 0.0, 0.0)),
-        "thickness": thickness,
-        "scale_invariant": false,
-        "points": points.iter().map(|p| json!({"x": p[0], "y": p[1], "z": 0.0})).collect::<Vec<_>>(),
-        "color": {"r": rgba[0], "g": rgba[1], "b": rgba[2], "a": rgba[3]},
-        "colors": [],
-        "indices": [],
+fn moved(last: Option<Pose2>, now: &Pose2) -> bool {
+    last.is_none_or(|l| {
+        (l.x_m - now.x_m).hypot(l.y_m - now.y_m) > PALLET_MOVE_M
+            || (l.heading_rad - now.heading_rad).abs() > PALLET_TURN_RAD
     })
 }
 
-fn entity(t_s: f64, id: &str, lines: Vec<Value>) -> Value {
-    json!({
-        "timestamp": stamp(t_s),
-        "frame_id": "world",
-        "id": id,
-        "lifetime": {"sec": 0, "nsec": 0},
-        "frame_locked": false,
-        "metadata": [],
-        "arrows": [], "cubes": [], "spheres": [], "cylinders": [],
-        "lines": lines,
-        "triangles": [], "texts": [], "models": [],
-    })
+/// Typed forms of the per-step messages: serialised straight into a reused buffer, no
+/// `Value` tree (the trial writes three of these per 100 Hz step).
+#[derive(Serialize)]
+struct Stamp {
+    sec: u64,
+    nsec: u64,
+}
+
+impl Stamp {
+    fn at(t_s: f64) -> Self {
+        let n = ns(t_s);
+        Self {
+            sec: n / 1_000_000_000,
+            nsec: n % 1_000_000_000,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct Vec3 {
+    x: f64,
+    y: f64,
+    z: f64,
+}
+
+#[derive(Serialize)]
+struct Quat {
+    x: f64,
+    y: f64,
+    z: f64,
+    w: f64,
+}
+
+impl Quat {
+    fn yaw(yaw_rad: f64) -> Self {
+        let (s, c) = (yaw_rad / 2.0).sin_cos();
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: s,
+            w: c,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct FoxPose {
+    position: Vec3,
+    orientation: Quat,
+}
+
+impl FoxPose {
+    fn of(p: &Pose2) -> Self {
+        Self {
+            position: Vec3 {
+                x: p.x_m,
+                y: p.y_m,
+                z: 0.0,
+            },
+            orientation: Quat::yaw(p.heading_rad),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct FrameTransform {
+    timestamp: Stamp,
+    parent_frame_id: &'static str,
+    child_frame_id: &'static str,
+    translation: Vec3,
+    rotation: Quat,
+}
+
+impl FrameTransform {
+    /// `child`'s pose in the world frame.
+    fn world(t_s: f64, child: &'static str, p: &Pose2) -> Self {
+        Self {
+            timestamp: Stamp::at(t_s),
+            parent_frame_id: "world",
+            child_frame_id: child,
+            translation: Vec3 {
+                x: p.x_m,
+                y: p.y_m,
+                z: 0.0,
+            },
+            rotation: Quat::yaw(p.heading_rad),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct PoseInFrame {
+    timestamp: Stamp,
+    frame_id: &'static str,
+    pose: FoxPose,
+}
+
+impl PoseInFrame {
+    fn world(t_s: f64, p: &Pose2) -> Self {
+        Self {
+            timestamp: Stamp::at(t_s),
+            frame_id: "world",
+            pose: FoxPose::of(p),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct Telemetry {
+    t_s: f64,
+    truth: [f64; 3],
+    estimate: [f64; 3],
+    pallet: [f64; 3],
+    pallet_estimate: [f64; 3],
+    steer_cmd_rad: f64,
+    steer_rad: f64,
+    speed_cmd_mps: f64,
+    speed_mps: f64,
+    lookahead_m: [f64; 2],
+    cross_track_m: f64,
+    path_curvature_per_m: f64,
+    contact_force_n: f64,
+}
+
+fn xyh(p: &Pose2) -> [f64; 3] {
+    [p.x_m, p.y_m, p.heading_rad]
+}
+
+/// An empty JSON array, for the SceneEntity primitive lists we do not use.
+type None0 = [u8; 0];
+
+#[derive(Serialize)]
+struct Color {
+    r: f64,
+    g: f64,
+    b: f64,
+    a: f64,
+}
+
+#[derive(Serialize)]
+struct LinePrimitive {
+    #[serde(rename = "type")]
+    kind: u8,
+    pose: FoxPose,
+    thickness: f64,
+    scale_invariant: bool,
+    points: Vec<Vec3>,
+    color: Color,
+    colors: None0,
+    indices: None0,
+}
+
+#[derive(Serialize)]
+struct SceneEntity {
+    timestamp: Stamp,
+    frame_id: &'static str,
+    id: String,
+    lifetime: Stamp,
+    frame_locked: bool,
+    metadata: None0,
+    arrows: None0,
+    cubes: None0,
+    spheres: None0,
+    cylinders: None0,
+    lines: Vec<LinePrimitive>,
+    triangles: None0,
+    texts: None0,
+    models: None0,
+}
+
+#[derive(Serialize)]
+struct SceneUpdate {
+    deletions: None0,
+    entities: Vec<SceneEntity>,
+}
+
+impl SceneUpdate {
+    fn one(e: SceneEntity) -> Self {
+        Self {
+            deletions: [],
+            entities: vec![e],
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct PlanMsg<'a> {
+    index: u32,
+    t_s: f64,
+    length_m: f64,
+    /// [s_m, x_m, y_m, heading_rad, curvature_per_m]
+    samples: Vec<[f64; 5]>,
+    control_polygon_m: Option<&'a [[f64; 2]]>,
+}
+
+/// A line strip (type 0) in world coordinates.
+fn line(points: &[[f64; 2]], rgba: [f64; 4], thickness: f64) -> LinePrimitive {
+    LinePrimitive {
+        kind: 0,
+        pose: FoxPose::of(&Pose2::new(0.0, 0.0, 0.0)),
+        thickness,
+        scale_invariant: false,
+        points: points
+            .iter()
+            .map(|p| Vec3 {
+                x: p[0],
+                y: p[1],
+                z: 0.0,
+            })
+            .collect(),
+        color: Color {
+            r: rgba[0],
+            g: rgba[1],
+            b: rgba[2],
+            a: rgba[3],
+        },
+        colors: [],
+        indices: [],
+    }
+}
+
+fn entity(t_s: f64, id: &str, lines: Vec<LinePrimitive>) -> SceneEntity {
+    entity_in("world", t_s, id, lines)
+}
+
+/// An entity drawn in `frame`; frame-locked, so it follows that frame's /tf.
+fn entity_in(frame: &'static str, t_s: f64, id: &str, lines: Vec<LinePrimitive>) -> SceneEntity {
+    SceneEntity {
+        timestamp: Stamp::at(t_s),
+        frame_id: frame,
+        id: id.to_owned(),
+        lifetime: Stamp { sec: 0, nsec: 0 },
+        frame_locked: frame != "world",
+        metadata: [],
+        arrows: [],
+        cubes: [],
+        spheres: [],
+        cylinders: [],
+        lines,
+        triangles: [],
+        texts: [],
+        models: [],
+    }
 }
 
 impl McapRecorder {
-    /// Opens `path` (checked beforehand with [`crate::check_writable`]) and writes the
-    /// metadata record.
+    /// Opens `path` (checked beforehand with [`crate::check_writable`]), writes the
+    /// metadata record and starts the writer thread.
     pub fn create(path: &Path, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
         let p = path.display().to_string();
         let io = |e: &dyn std::fmt::Display| LogError::Io {
@@ -143,41 +393,93 @@ impl McapRecorder {
                 metadata,
             })
             .map_err(|e| io(&e))?;
-        Ok(Self {
-            writer: Some(writer),
-            path: p,
+        let mut sink = Sink {
+            writer,
             channels,
             sequence: 0,
-            steps: 0,
-            truck: None,
-            pallet: None,
+            pallet_sent: None,
+            estimate_sent: None,
+            buf: Vec::with_capacity(1024),
+            error: None,
+        };
+        let (tx, rx) = sync_channel::<Cmd>(1024);
+        let thread = std::thread::Builder::new()
+            .name("mcap-writer".into())
+            .spawn(move || {
+                for cmd in rx {
+                    match cmd {
+                        Cmd::Raw { topic, t_s, data } => sink.write_bytes(topic, t_s, &data),
+                        Cmd::Steps(steps) => steps.iter().for_each(|s| sink.step(s)),
+                        Cmd::Flush(ack) => {
+                            let r = sink.writer.flush().err().map(|e| e.to_string());
+                            let _ = ack.send(r);
+                        }
+                        Cmd::Abandon => {
+                            std::mem::forget(sink);
+                            return None;
+                        }
+                    }
+                }
+                if let Err(e) = sink.writer.finish() {
+                    sink.error.get_or_insert(e.to_string());
+                }
+                sink.error
+            })
+            .map_err(|e| io(&e))?;
+        Ok(Self {
+            path: p,
+            tx: Some(tx),
+            thread: Some(thread),
+            steps: Vec::with_capacity(STEP_BATCH),
             error: None,
         })
     }
 
-    fn write(&mut self, topic: &str, t_s: f64, msg: &Value) {
-        let (Some(w), Some(&channel_id)) = (self.writer.as_mut(), self.channels.get(topic)) else {
-            return;
-        };
-        self.sequence += 1;
-        let header = mcap::records::MessageHeader {
-            channel_id,
-            sequence: self.sequence,
-            log_time: ns(t_s),
-            publish_time: ns(t_s),
-        };
-        let data = msg.to_string();
-        if let Err(e) = w.write_to_known_channel(&header, data.as_bytes()) {
-            self.error.get_or_insert(e.to_string());
+    /// Serialises `msg` here and hands it to the writer thread.
+    fn send(&mut self, topic: &'static str, t_s: f64, msg: &impl Serialize) {
+        match serde_json::to_vec(msg) {
+            Ok(data) => self.command(Cmd::Raw { topic, t_s, data }),
+            Err(e) => {
+                self.error.get_or_insert(e.to_string());
+            }
+        }
+    }
+
+    fn send_steps(&mut self) {
+        if !self.steps.is_empty() {
+            let steps = std::mem::replace(&mut self.steps, Vec::with_capacity(STEP_BATCH));
+            self.command(Cmd::Steps(steps));
+        }
+    }
+
+    fn command(&mut self, cmd: Cmd) {
+        if !matches!(cmd, Cmd::Steps(_)) {
+            // Keep messages in order: steps collected so far go first.
+            self.send_steps();
+        }
+        if let Some(tx) = &self.tx
+            && tx.send(cmd).is_err()
+        {
+            self.error
+                .get_or_insert_with(|| "the MCAP writer thread stopped".to_owned());
         }
     }
 
     /// Finishes the file (summary and index); returns the first write error, if any.
     pub fn finish(&mut self) -> Result<(), LogError> {
-        if let Some(mut w) = self.writer.take()
-            && let Err(e) = w.finish()
-        {
-            self.error.get_or_insert(e.to_string());
+        self.send_steps();
+        self.tx = None;
+        if let Some(t) = self.thread.take() {
+            match t.join() {
+                Ok(Some(e)) => {
+                    self.error.get_or_insert(e);
+                }
+                Ok(None) => {}
+                Err(_) => {
+                    self.error
+                        .get_or_insert_with(|| "the MCAP writer thread panicked".to_owned());
+                }
+            }
         }
         match self.error.take() {
             Some(message) => Err(LogError::Io {
@@ -188,22 +490,102 @@ impl McapRecorder {
         }
     }
 
-    /// Flushes the current chunk (used by tests to simulate a crash after it).
+    /// Flushes the current chunk to disk and waits for it (used by tests to simulate a
+    /// crash after it).
     pub fn flush(&mut self) -> Result<(), LogError> {
-        if let Some(w) = self.writer.as_mut() {
-            w.flush().map_err(|e| LogError::Io {
+        let (ack, done) = sync_channel(1);
+        self.command(Cmd::Flush(ack));
+        match done.recv() {
+            Ok(None) => Ok(()),
+            Ok(Some(message)) => Err(LogError::Io {
                 path: self.path.clone(),
-                message: e.to_string(),
-            })?;
+                message,
+            }),
+            Err(_) => Err(LogError::Io {
+                path: self.path.clone(),
+                message: "the MCAP writer thread stopped".to_owned(),
+            }),
         }
-        Ok(())
     }
 
-    /// Drops the writer without finishing, as a crash would (tests).
+    /// Stops writing without finishing the file, as a crash would (tests).
     pub fn abandon(mut self) {
-        if let Some(w) = self.writer.take() {
-            std::mem::forget(w);
+        // What a crash would lose: steps not yet handed over.
+        self.steps.clear();
+        self.command(Cmd::Abandon);
+        self.tx = None;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
         }
+    }
+}
+
+impl Sink {
+    fn write(&mut self, topic: &str, t_s: f64, msg: &impl Serialize) {
+        let mut buf = std::mem::take(&mut self.buf);
+        buf.clear();
+        match serde_json::to_writer(&mut buf, msg) {
+            Ok(()) => self.write_bytes(topic, t_s, &buf),
+            Err(e) => {
+                self.error.get_or_insert(e.to_string());
+            }
+        }
+        self.buf = buf;
+    }
+
+    fn write_bytes(&mut self, topic: &str, t_s: f64, data: &[u8]) {
+        let Some(&channel_id) = self.channels.get(topic) else {
+            return;
+        };
+        self.sequence += 1;
+        let header = mcap::records::MessageHeader {
+            channel_id,
+            sequence: self.sequence,
+            log_time: ns(t_s),
+            publish_time: ns(t_s),
+        };
+        if let Err(e) = self.writer.write_to_known_channel(&header, data) {
+            self.error.get_or_insert(e.to_string());
+        }
+    }
+
+    fn transform(&mut self, t_s: f64, child: &'static str, p: &Pose2) {
+        self.write("/tf", t_s, &FrameTransform::world(t_s, child, p));
+    }
+
+    fn step(&mut self, s: &StepRecord) {
+        let t = s.t_s;
+        self.transform(t, "fork_root", &s.truth);
+        if moved(self.pallet_sent, &s.pallet) {
+            self.transform(t, "pallet", &s.pallet);
+            self.pallet_sent = Some(s.pallet);
+        }
+        if moved(self.estimate_sent, &s.pallet_estimate) {
+            self.transform(t, "pallet_estimate", &s.pallet_estimate);
+            self.estimate_sent = Some(s.pallet_estimate);
+        }
+        // True and measured poses side by side at each NAV350 fix (the true pose at the
+        // full rate is /tf and the telemetry's `truth`).
+        if let Some(f) = &s.fix {
+            self.write("/truck/pose_measured", t, &PoseInFrame::world(t, f));
+            self.write("/truck/pose_true", t, &PoseInFrame::world(t, &s.truth));
+        }
+        let telemetry = Telemetry {
+            t_s: t,
+            truth: xyh(&s.truth),
+            estimate: xyh(&s.estimate),
+            pallet: xyh(&s.pallet),
+            pallet_estimate: xyh(&s.pallet_estimate),
+            steer_cmd_rad: s.steer_cmd_rad,
+            steer_rad: s.steer_rad,
+            speed_cmd_mps: s.speed_cmd_mps,
+            speed_mps: s.speed_mps,
+            lookahead_m: s.lookahead,
+            cross_track_m: s.cross_track_m,
+            path_curvature_per_m: s.path_curvature_per_m,
+            contact_force_n: s.contact_force_n,
+        };
+        self.write("/forkbench/telemetry", t, &telemetry);
     }
 }
 
@@ -215,9 +597,7 @@ impl Drop for McapRecorder {
 
 impl Recorder for McapRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
-        self.truck = Some(s.truck.clone());
-        self.pallet = Some(s.pallet.clone());
-        let mut entities: Vec<Value> = s
+        let entities: Vec<SceneEntity> = s
             .obstacles
             .iter()
             .enumerate()
@@ -233,19 +613,50 @@ impl Recorder for McapRecorder {
                 )
             })
             .collect();
-        entities.push(entity(
-            0.0,
-            "pallet",
-            pallet_outlines(s.pallet, &s.pallet_pose)
-                .iter()
-                .map(|c| line(c, [0.8, 0.55, 0.2, 1.0], 0.02))
-                .collect(),
-        ));
-        self.write(
+        self.send(
             "/world",
             0.0,
-            &json!({"deletions": [], "entities": entities}),
+            &SceneUpdate {
+                deletions: [],
+                entities,
+            },
         );
+        // Truck and pallets are drawn once in their own frames and moved by /tf.
+        let origin = Pose2::new(0.0, 0.0, 0.0);
+        let outlines = |o: Vec<[[f64; 2]; 5]>, rgba: [f64; 4]| -> Vec<LinePrimitive> {
+            o.iter().map(|c| line(c, rgba, 0.02)).collect()
+        };
+        let entities = vec![
+            entity_in(
+                "fork_root",
+                0.0,
+                "truck",
+                outlines(truck_outlines(s.truck, &origin), [0.9, 0.75, 0.1, 1.0]),
+            ),
+            entity_in(
+                "pallet",
+                0.0,
+                "pallet",
+                outlines(pallet_outlines(s.pallet, &origin), [0.8, 0.55, 0.2, 1.0]),
+            ),
+            entity_in(
+                "pallet_estimate",
+                0.0,
+                "pallet_estimate",
+                outlines(pallet_outlines(s.pallet, &origin), [0.85, 0.15, 0.15, 0.6]),
+            ),
+        ];
+        self.send(
+            "/truck/scene",
+            0.0,
+            &SceneUpdate {
+                deletions: [],
+                entities,
+            },
+        );
+        for (child, pose) in [("fork_root", &s.start), ("pallet", &s.pallet_pose)] {
+            self.send("/tf", 0.0, &FrameTransform::world(0.0, child, pose));
+        }
     }
 
     fn plan(
@@ -255,79 +666,31 @@ impl Recorder for McapRecorder {
         path: &forkbench_core::Path,
         control_polygon: Option<&[[f64; 2]]>,
     ) {
-        let msg = json!({
-            "index": index,
-            "t_s": t_s,
-            "length_m": path.length_m(),
-            "samples": path.samples.iter().map(|p| [p.s_m, p.x_m, p.y_m, p.heading_rad, p.curvature_per_m]).collect::<Vec<_>>(),
-            "control_polygon_m": control_polygon,
-        });
-        self.write("/forkbench/plan", t_s, &msg);
+        let msg = PlanMsg {
+            index,
+            t_s,
+            length_m: path.length_m(),
+            samples: path
+                .samples
+                .iter()
+                .map(|p| [p.s_m, p.x_m, p.y_m, p.heading_rad, p.curvature_per_m])
+                .collect(),
+            control_polygon_m: control_polygon,
+        };
+        self.send("/forkbench/plan", t_s, &msg);
         let pts: Vec<[f64; 2]> = path.samples.iter().map(|p| [p.x_m, p.y_m]).collect();
         let mut lines = vec![line(&pts, [0.1, 0.4, 0.9, 1.0], 0.02)];
         if let Some(c) = control_polygon {
             lines.push(line(c, [0.1, 0.4, 0.9, 0.4], 0.01));
         }
-        let scene =
-            json!({"deletions": [], "entities": [entity(t_s, &format!("plan/{index}"), lines)]});
-        self.write("/world", t_s, &scene);
+        let scene = SceneUpdate::one(entity(t_s, &format!("plan/{index}"), lines));
+        self.send("/world", t_s, &scene);
     }
 
     fn step(&mut self, s: &StepRecord) {
-        self.steps += 1;
-        let t = s.t_s;
-        let tf = json!({
-            "timestamp": stamp(t),
-            "parent_frame_id": "world",
-            "child_frame_id": "fork_root",
-            "translation": {"x": s.truth.x_m, "y": s.truth.y_m, "z": 0.0},
-            "rotation": quat(s.truth.heading_rad),
-        });
-        self.write("/tf", t, &tf);
-        self.write(
-            "/truck/pose_true",
-            t,
-            &json!({"timestamp": stamp(t), "frame_id": "world", "pose": pose_json(&s.truth)}),
-        );
-        if let Some(f) = &s.fix {
-            self.write(
-                "/truck/pose_measured",
-                t,
-                &json!({"timestamp": stamp(t), "frame_id": "world", "pose": pose_json(f)}),
-            );
-        }
-        let telemetry = json!({
-            "t_s": t,
-            "estimate": [s.estimate.x_m, s.estimate.y_m, s.estimate.heading_rad],
-            "pallet": [s.pallet.x_m, s.pallet.y_m, s.pallet.heading_rad],
-            "pallet_estimate": [s.pallet_estimate.x_m, s.pallet_estimate.y_m, s.pallet_estimate.heading_rad],
-            "steer_cmd_rad": s.steer_cmd_rad,
-            "steer_rad": s.steer_rad,
-            "speed_cmd_mps": s.speed_cmd_mps,
-            "speed_mps": s.speed_mps,
-            "lookahead_m": s.lookahead,
-            "cross_track_m": s.cross_track_m,
-            "path_curvature_per_m": s.path_curvature_per_m,
-            "contact_force_n": s.contact_force_n,
-        });
-        self.write("/forkbench/telemetry", t, &telemetry);
-        if self.steps % SCENE_EVERY == 1
-            && let (Some(truck), Some(pallet)) = (self.truck.clone(), self.pallet.clone())
-        {
-            let mut lines: Vec<Value> = truck_outlines(&truck, &s.truth)
-                .iter()
-                .map(|c| line(c, [0.9, 0.75, 0.1, 1.0], 0.02))
-                .collect();
-            lines.extend(
-                pallet_outlines(&pallet, &s.pallet)
-                    .iter()
-                    .map(|c| line(c, [0.8, 0.55, 0.2, 1.0], 0.02)),
-            );
-            self.write(
-                "/truck/scene",
-                t,
-                &json!({"deletions": [], "entities": [entity(t, "truck_and_pallet", lines)]}),
-            );
+        self.steps.push(*s);
+        if self.steps.len() >= STEP_BATCH {
+            self.send_steps();
         }
     }
 
@@ -337,20 +700,15 @@ impl Recorder for McapRecorder {
             Level::Warn => 3,
             Level::Error => 4,
         };
-        self.write(
+        self.send(
             "/log",
             t_s,
-            &json!({"timestamp": stamp(t_s), "level": level, "message": text, "name": "forkbench", "file": "", "line": 0}),
+            &json!({"timestamp": Stamp::at(t_s), "level": level, "message": text, "name": "forkbench", "file": "", "line": 0}),
         );
     }
 
     fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
-        match serde_json::to_value(outcome) {
-            Ok(v) => self.write("/forkbench/outcome", t_s, &v),
-            Err(e) => {
-                self.error.get_or_insert(e.to_string());
-            }
-        }
+        self.send("/forkbench/outcome", t_s, outcome);
     }
 }
 
@@ -362,7 +720,7 @@ const POSE_IN_FRAME_SCHEMA: &str = r#"{"title":"foxglove.PoseInFrame","type":"ob
 
 const LOG_SCHEMA: &str = r#"{"title":"foxglove.Log","type":"object","properties":{"timestamp":{"type":"object"},"level":{"type":"integer","minimum":0,"maximum":5},"message":{"type":"string"},"name":{"type":"string"},"file":{"type":"string"},"line":{"type":"integer","minimum":0}}}"#;
 
-const TELEMETRY_SCHEMA: &str = r#"{"title":"forkbench.Telemetry","description":"One control step, SI units","type":"object","properties":{"t_s":{"type":"number"},"estimate":{"type":"array","items":{"type":"number"},"description":"x_m, y_m, heading_rad the controller used"},"pallet":{"type":"array","items":{"type":"number"}},"pallet_estimate":{"type":"array","items":{"type":"number"}},"steer_cmd_rad":{"type":"number"},"steer_rad":{"type":"number"},"speed_cmd_mps":{"type":"number"},"speed_mps":{"type":"number"},"lookahead_m":{"type":"array","items":{"type":"number"}},"cross_track_m":{"type":"number"},"path_curvature_per_m":{"type":"number"},"contact_force_n":{"type":"number"}}}"#;
+const TELEMETRY_SCHEMA: &str = r#"{"title":"forkbench.Telemetry","description":"One control step, SI units","type":"object","properties":{"t_s":{"type":"number"},"truth":{"type":"array","items":{"type":"number"},"description":"true fork-root x_m, y_m, heading_rad"},"estimate":{"type":"array","items":{"type":"number"},"description":"x_m, y_m, heading_rad the controller used"},"pallet":{"type":"array","items":{"type":"number"}},"pallet_estimate":{"type":"array","items":{"type":"number"}},"steer_cmd_rad":{"type":"number"},"steer_rad":{"type":"number"},"speed_cmd_mps":{"type":"number"},"speed_mps":{"type":"number"},"lookahead_m":{"type":"array","items":{"type":"number"}},"cross_track_m":{"type":"number"},"path_curvature_per_m":{"type":"number"},"contact_force_n":{"type":"number"}}}"#;
 
 const PLAN_SCHEMA: &str = r#"{"title":"forkbench.Plan","type":"object","properties":{"index":{"type":"integer"},"t_s":{"type":"number"},"length_m":{"type":"number"},"samples":{"type":"array","description":"[s_m, x_m, y_m, heading_rad, curvature_per_m]","items":{"type":"array","items":{"type":"number"}}},"control_polygon_m":{"type":["array","null"]}}}"#;
 

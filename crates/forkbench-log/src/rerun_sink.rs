@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use forkbench_core::{ForkliftSpec, Pose2};
-use forkbench_sim::PalletSpec;
 use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
 use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimeSeriesView, Vertical};
 
@@ -20,31 +19,48 @@ pub enum RerunTarget {
     Connect(String),
 }
 
-/// Geometry is re-logged every this many control steps (20 Hz at 100 Hz).
-const GEOMETRY_EVERY: u64 = 5;
-/// The driven trajectory is re-logged every this many steps.
-const TRAJECTORY_EVERY: u64 = 25;
+/// The driven trajectory (a growing strip) is re-logged every this many steps (2 Hz; the
+/// truck outline moves at the full rate); it keeps a point every `TRAJECTORY_POINT_EVERY`
+/// steps (1.6 cm apart at 0.8 m/s), since its size grows with the square of the trial's
+/// length.
+const TRAJECTORY_EVERY: u64 = 50;
+const TRAJECTORY_POINT_EVERY: u64 = 2;
+/// Buffered per-step data is sent as columns every this many steps (5 s simulated) and at
+/// the end: one `send_columns` per entity instead of one `log` per entity and step, since
+/// rerun's cost is mostly per chunk. Sending during the trial, not only at its end, lets
+/// rerun's writer thread encode while the simulation runs.
+const SEND_EVERY: usize = 500;
 
-const PLOTS: [&str; 8] = [
-    "plots/curvature/planned",
-    "plots/steering/command",
-    "plots/steering/actual",
-    "plots/speed/command",
-    "plots/speed/actual",
-    "plots/lateral_error",
-    "plots/contact_force",
-    "plots/curvature/actual",
+/// Plot entities and their series (several series share one entity, so one chunk).
+const PLOTS: [(&str, &[&str]); 5] = [
+    ("plots/curvature", &["planned", "actual"]),
+    ("plots/steering", &["command", "actual"]),
+    ("plots/speed", &["command", "actual"]),
+    ("plots/lateral_error", &["cross-track"]),
+    ("plots/contact_force", &["fork contact"]),
 ];
 
 /// Streams one trial to rerun.
 pub struct RerunRecorder {
     rec: rerun::RecordingStream,
     truck: Option<ForkliftSpec>,
-    pallet: Option<PalletSpec>,
     steps: u64,
     trajectory: Vec<[f32; 2]>,
+    /// Per-step columns not yet sent.
     times: Vec<f64>,
-    plots: [Vec<f64>; 8],
+    /// One flat vector per plot entity, its series interleaved per step.
+    plots: [Vec<f64>; 5],
+    truth: Vec<Pose2>,
+    /// Pallet poses, only when it moved (it moves only when pushed).
+    pallet_pose: (Vec<f64>, Vec<Pose2>),
+    /// Growing trajectory strips not yet sent.
+    strips: (Vec<f64>, Vec<Vec<[f32; 2]>>),
+    lookahead: Vec<[f32; 2]>,
+    /// Pallet estimates and NAV350 fixes, only when they change or arrive.
+    estimates: (Vec<f64>, Vec<Pose2>),
+    fixes: (Vec<f64>, Vec<Pose2>),
+    last_estimate: Option<Pose2>,
+    last_pallet: Option<Pose2>,
     error: Option<String>,
 }
 
@@ -84,13 +100,46 @@ fn blueprint() -> Blueprint {
     )
 }
 
+/// The blueprint's messages, built once per process: building them spins up a whole
+/// in-memory recording stream, which cost as much as a trial (5 ms) when done per file.
+fn blueprint_msgs() -> Result<&'static [rerun::log::LogMsg], LogError> {
+    use rerun::log::LogMsg;
+    static MSGS: std::sync::OnceLock<Result<Vec<LogMsg>, String>> = std::sync::OnceLock::new();
+    MSGS.get_or_init(|| {
+        let (rec, storage) = rerun::RecordingStreamBuilder::new("forkbench")
+            .memory()
+            .map_err(|e| e.to_string())?;
+        blueprint()
+            .send(
+                &rec,
+                rerun::blueprint::BlueprintActivation {
+                    make_active: true,
+                    make_default: true,
+                },
+            )
+            .map_err(|e| e.to_string())?;
+        rec.flush_blocking().map_err(|e| e.to_string())?;
+        // Keep only the blueprint store and its activation, not the carrier recording.
+        Ok(storage
+            .take()
+            .into_iter()
+            .filter(|m| match m {
+                LogMsg::BlueprintActivationCommand(_) => true,
+                m => m.store_id().kind() == rerun::StoreKind::Blueprint,
+            })
+            .collect())
+    })
+    .as_deref()
+    .map_err(|e| LogError::Rerun(format!("building the blueprint: {e}")))
+}
+
 fn strip(points: &[[f64; 2]]) -> Vec<[f32; 2]> {
     points.iter().map(|p| [p[0] as f32, p[1] as f32]).collect()
 }
 
 impl RerunRecorder {
     pub fn new(target: &RerunTarget) -> Result<Self, LogError> {
-        let builder = rerun::RecordingStreamBuilder::new("forkbench").with_blueprint(blueprint());
+        let builder = rerun::RecordingStreamBuilder::new("forkbench");
         let rec = match target {
             RerunTarget::File(p) => builder.save(p),
             RerunTarget::Spawn => builder.spawn(),
@@ -108,14 +157,24 @@ impl RerunRecorder {
             }
         }
         .map_err(|e| LogError::Rerun(e.to_string()))?;
+        for msg in blueprint_msgs()? {
+            rec.record_msg(msg.clone());
+        }
         Ok(Self {
             rec,
             truck: None,
-            pallet: None,
             steps: 0,
             trajectory: Vec::new(),
             times: Vec::new(),
             plots: Default::default(),
+            truth: Vec::new(),
+            pallet_pose: Default::default(),
+            strips: Default::default(),
+            lookahead: Vec::new(),
+            estimates: Default::default(),
+            fixes: Default::default(),
+            last_estimate: None,
+            last_pallet: None,
             error: None,
         })
     }
@@ -130,9 +189,10 @@ impl RerunRecorder {
         }
     }
 
-    fn outlines(&mut self, entity: &str, outlines: &[[[f64; 2]; 5]], rgb: [u8; 3]) {
+    /// Static outlines in the entity's own frame; its transform column moves them.
+    fn local_outlines(&mut self, entity: &str, outlines: &[[[f64; 2]; 5]], rgb: [u8; 3]) {
         let strips: Vec<Vec<[f32; 2]>> = outlines.iter().map(|c| strip(c)).collect();
-        let r = self.rec.log(
+        let r = self.rec.log_static(
             entity,
             &rerun::LineStrips2D::new(strips)
                 .with_colors([rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])])
@@ -141,43 +201,107 @@ impl RerunRecorder {
         self.note(r);
     }
 
-    fn pose_marker(&mut self, entity: &str, p: &Pose2, rgb: [u8; 3], radius: f32) {
-        let tip = p.to_world(&Pose2::new(0.3, 0.0, 0.0));
-        let r = self.rec.log(
+    /// A static pose marker (a 0.3 m heading arrow from the pose) in the entity's own frame.
+    fn local_marker(&mut self, entity: &str, rgb: [u8; 3]) {
+        let r = self.rec.log_static(
             entity,
-            &rerun::Points2D::new([[p.x_m as f32, p.y_m as f32]])
-                .with_colors([rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])])
-                .with_radii([radius]),
-        );
-        self.note(r);
-        let r = self.rec.log(
-            format!("{entity}/heading"),
-            &rerun::LineStrips2D::new([[
-                [p.x_m as f32, p.y_m as f32],
-                [tip.x_m as f32, tip.y_m as f32],
-            ]])
-            .with_colors([rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])]),
+            &rerun::Arrows2D::from_vectors([[0.3, 0.0]])
+                .with_origins([[0.0, 0.0]])
+                .with_radii([0.02])
+                .with_colors([rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])]),
         );
         self.note(r);
     }
 
-    /// Sends the collected plots and flushes; returns the first logging error, if any.
-    pub fn finish(&mut self) -> Result<(), LogError> {
-        if !self.times.is_empty() {
-            let times = std::mem::take(&mut self.times);
-            let plots = std::mem::take(&mut self.plots);
-            for (name, values) in PLOTS.iter().zip(plots) {
-                let column =
-                    rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
-                match rerun::Scalars::new(values).columns_of_unit_batches() {
-                    Ok(cols) => {
-                        let r = self.rec.send_columns(*name, [column], cols);
-                        self.note(r);
-                    }
-                    Err(e) => self.note::<(), _>(Err(e)),
+    /// One planar pose per row on `sim_time`.
+    fn send_poses(&mut self, entity: &str, times: &[f64], poses: &[Pose2]) {
+        if times.is_empty() {
+            return;
+        }
+        let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
+        let cols = rerun::Transform3D::update_fields()
+            .with_many_translation(poses.iter().map(|p| [p.x_m as f32, p.y_m as f32, 0.0]))
+            .with_many_rotation_axis_angle(poses.iter().map(|p| {
+                rerun::RotationAxisAngle::new(
+                    [0.0, 0.0, 1.0],
+                    rerun::Angle::from_radians(p.heading_rad as f32),
+                )
+            }))
+            .columns_of_unit_batches();
+        match cols {
+            Ok(cols) => {
+                let r = self.rec.send_columns(entity, [column], cols);
+                self.note(r);
+            }
+            Err(e) => self.note::<(), _>(Err(e)),
+        }
+    }
+
+    /// Sends the buffered per-step columns.
+    fn send_buffered(&mut self) {
+        if self.times.is_empty() {
+            return;
+        }
+        let times = std::mem::take(&mut self.times);
+        let plots = std::mem::take(&mut self.plots);
+        for ((name, series), values) in PLOTS.iter().zip(plots) {
+            let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
+            match rerun::Scalars::new(values)
+                .columns(std::iter::repeat_n(series.len(), times.len()))
+            {
+                Ok(cols) => {
+                    let r = self.rec.send_columns(*name, [column], cols);
+                    self.note(r);
                 }
+                Err(e) => self.note::<(), _>(Err(e)),
             }
         }
+        let truth = std::mem::take(&mut self.truth);
+        self.send_poses("truck", &times, &truth);
+        let (t, p) = std::mem::take(&mut self.pallet_pose);
+        self.send_poses("world/pallet", &t, &p);
+        let (t, p) = std::mem::take(&mut self.estimates);
+        self.send_poses("sensors/pallet_estimate", &t, &p);
+        // True and measured pose side by side at each NAV350 fix; the truck outline shows
+        // the true pose at every step.
+        let (t, p) = std::mem::take(&mut self.fixes);
+        self.send_poses("sensors/measured_pose", &t, &p);
+        let truth_at_fixes: Vec<Pose2> = t
+            .iter()
+            .map(|tf| truth[times.partition_point(|x| x < tf).min(truth.len() - 1)])
+            .collect();
+        self.send_poses("sensors/true_pose", &t, &truth_at_fixes);
+        let (t, strips) = std::mem::take(&mut self.strips);
+        if !t.is_empty() {
+            let column = rerun::TimeColumn::new_duration_secs("sim_time", t.iter().copied());
+            match rerun::LineStrips2D::update_fields()
+                .with_strips(strips)
+                .columns_of_unit_batches()
+            {
+                Ok(cols) => {
+                    let r = self.rec.send_columns("track/trajectory", [column], cols);
+                    self.note(r);
+                }
+                Err(e) => self.note::<(), _>(Err(e)),
+            }
+        }
+        let lookahead = std::mem::take(&mut self.lookahead);
+        let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
+        match rerun::Points2D::update_fields()
+            .with_positions(lookahead)
+            .columns_of_unit_batches()
+        {
+            Ok(cols) => {
+                let r = self.rec.send_columns("track/lookahead", [column], cols);
+                self.note(r);
+            }
+            Err(e) => self.note::<(), _>(Err(e)),
+        }
+    }
+
+    /// Sends what is buffered and flushes; returns the first logging error, if any.
+    pub fn finish(&mut self) -> Result<(), LogError> {
+        self.send_buffered();
         let r = self.rec.flush_blocking();
         self.note(r);
         match self.error.take() {
@@ -196,7 +320,6 @@ impl Drop for RerunRecorder {
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
         self.truck = Some(s.truck.clone());
-        self.pallet = Some(s.pallet.clone());
         let info = format!(
             "scenario {} / case {} / planner {} / seed {}",
             s.scenario, s.case, s.planner, s.seed
@@ -218,17 +341,43 @@ impl Recorder for RerunRecorder {
             );
             self.note(r);
         }
-        self.at(0.0);
-        self.outlines(
+        for (name, series) in PLOTS {
+            let r = self.rec.log_static(
+                name,
+                &rerun::SeriesLines::new().with_names(series.iter().copied()),
+            );
+            self.note(r);
+        }
+        let origin = Pose2::new(0.0, 0.0, 0.0);
+        self.local_outlines(
             "world/pallet",
-            &pallet_outlines(s.pallet, &s.pallet_pose),
+            &pallet_outlines(s.pallet, &origin),
             [205, 140, 50],
         );
-        self.outlines(
+        self.local_outlines(
+            "sensors/pallet_estimate",
+            &pallet_outlines(s.pallet, &origin),
+            [220, 40, 40],
+        );
+        self.local_outlines(
             "truck/outline",
-            &truck_outlines(s.truck, &s.start),
+            &truck_outlines(s.truck, &origin),
             [230, 190, 25],
         );
+        self.local_marker("sensors/true_pose", [30, 160, 60]);
+        self.local_marker("sensors/measured_pose", [220, 40, 40]);
+        self.send_poses("truck", &[0.0], &[s.start]);
+        // The pallet's first pose goes out with the first columns.
+        self.pallet_pose.0.push(0.0);
+        self.pallet_pose.1.push(s.pallet_pose);
+        self.last_pallet = Some(s.pallet_pose);
+        let r = self.rec.log_static(
+            "track/trajectory",
+            &rerun::LineStrips2D::update_fields()
+                .with_colors([rerun::Color::from_rgb(30, 160, 60)])
+                .with_radii([0.01]),
+        );
+        self.note(r);
     }
 
     fn plan(
@@ -275,64 +424,46 @@ impl Recorder for RerunRecorder {
 
     fn step(&mut self, s: &StepRecord) {
         self.steps += 1;
-        self.trajectory
-            .push([s.truth.x_m as f32, s.truth.y_m as f32]);
+        if self.steps % TRAJECTORY_POINT_EVERY == 1 {
+            self.trajectory
+                .push([s.truth.x_m as f32, s.truth.y_m as f32]);
+        }
         self.times.push(s.t_s);
         let actual_curvature =
             s.steer_rad.tan() / self.truck.as_ref().map_or(1.0, |t| t.wheelbase_m);
-        let values = [
-            s.path_curvature_per_m,
-            s.steer_cmd_rad,
-            s.steer_rad,
-            s.speed_cmd_mps,
-            s.speed_mps,
-            s.cross_track_m,
-            s.contact_force_n,
-            actual_curvature,
+        let values: [&[f64]; 5] = [
+            &[s.path_curvature_per_m, actual_curvature],
+            &[s.steer_cmd_rad, s.steer_rad],
+            &[s.speed_cmd_mps, s.speed_mps],
+            &[s.cross_track_m],
+            &[s.contact_force_n],
         ];
         for (v, series) in values.iter().zip(self.plots.iter_mut()) {
-            series.push(*v);
+            series.extend_from_slice(v);
         }
-        if let Some(fix) = &s.fix {
-            self.at(s.t_s);
-            self.pose_marker("sensors/measured_pose", fix, [220, 40, 40], 0.04);
+        self.truth.push(s.truth);
+        if self.last_pallet != Some(s.pallet) {
+            self.last_pallet = Some(s.pallet);
+            self.pallet_pose.0.push(s.t_s);
+            self.pallet_pose.1.push(s.pallet);
         }
-        if self.steps % GEOMETRY_EVERY == 1 {
-            self.at(s.t_s);
-            if let (Some(truck), Some(pallet)) = (self.truck.clone(), self.pallet.clone()) {
-                self.outlines(
-                    "truck/outline",
-                    &truck_outlines(&truck, &s.truth),
-                    [230, 190, 25],
-                );
-                self.outlines(
-                    "world/pallet",
-                    &pallet_outlines(&pallet, &s.pallet),
-                    [205, 140, 50],
-                );
-                self.outlines(
-                    "sensors/pallet_estimate",
-                    &pallet_outlines(&pallet, &s.pallet_estimate),
-                    [220, 40, 40],
-                );
-            }
-            self.pose_marker("sensors/true_pose", &s.truth, [30, 160, 60], 0.04);
-            let r = self.rec.log(
-                "track/lookahead",
-                &rerun::Points2D::new([[s.lookahead[0] as f32, s.lookahead[1] as f32]])
-                    .with_radii([0.05])
-                    .with_colors([rerun::Color::from_rgb(150, 60, 200)]),
-            );
-            self.note(r);
+        self.lookahead
+            .push([s.lookahead[0] as f32, s.lookahead[1] as f32]);
+        if self.last_estimate != Some(s.pallet_estimate) {
+            self.last_estimate = Some(s.pallet_estimate);
+            self.estimates.0.push(s.t_s);
+            self.estimates.1.push(s.pallet_estimate);
+        }
+        if let Some(fix) = s.fix {
+            self.fixes.0.push(s.t_s);
+            self.fixes.1.push(fix);
         }
         if self.steps % TRAJECTORY_EVERY == 1 {
-            self.at(s.t_s);
-            let r = self.rec.log(
-                "track/trajectory",
-                &rerun::LineStrips2D::new([self.trajectory.clone()])
-                    .with_colors([rerun::Color::from_rgb(30, 160, 60)]),
-            );
-            self.note(r);
+            self.strips.0.push(s.t_s);
+            self.strips.1.push(self.trajectory.clone());
+        }
+        if self.times.len() >= SEND_EVERY {
+            self.send_buffered();
         }
     }
 
@@ -351,12 +482,8 @@ impl Recorder for RerunRecorder {
 
     fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
         self.at(t_s);
-        let r = self.rec.log(
-            "track/trajectory",
-            &rerun::LineStrips2D::new([self.trajectory.clone()])
-                .with_colors([rerun::Color::from_rgb(30, 160, 60)]),
-        );
-        self.note(r);
+        self.strips.0.push(t_s);
+        self.strips.1.push(self.trajectory.clone());
         let verdict = match (outcome.success, outcome.failure) {
             (true, _) => "SUCCESS".to_owned(),
             (false, Some(f)) => format!(

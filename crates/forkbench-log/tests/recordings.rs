@@ -41,6 +41,8 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
     let mut schemas = BTreeSet::new();
     let mut last_time = 0;
     let mut outcome_msg = None;
+    let mut frames: BTreeMap<String, usize> = BTreeMap::new();
+    let mut locked = BTreeSet::new();
     for m in mcap::MessageStream::new(&bytes).expect("valid mcap") {
         let m = m.expect("message");
         assert!(
@@ -56,6 +58,19 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
         schemas.insert(schema.name.clone());
         *per_topic.entry(m.channel.topic.clone()).or_default() += 1;
         let v: serde_json::Value = serde_json::from_slice(&m.data).expect("message is JSON");
+        if m.channel.topic == "/tf" {
+            *frames
+                .entry(v["child_frame_id"].as_str().expect("child").to_owned())
+                .or_default() += 1;
+        }
+        if m.channel.topic == "/truck/scene" {
+            for e in v["entities"].as_array().expect("entities") {
+                locked.insert((
+                    e["frame_id"].as_str().expect("frame").to_owned(),
+                    e["frame_locked"].as_bool().expect("flag"),
+                ));
+            }
+        }
         if m.channel.topic == "/forkbench/outcome" {
             outcome_msg = Some(v);
         }
@@ -73,7 +88,21 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
     }
     let steps = (out.sim_time_s / scn.sim.dt_s).round() as usize;
     assert_eq!(per_topic["/forkbench/telemetry"], steps);
-    assert_eq!(per_topic["/tf"], steps);
+    // The truck's frame at every step (and at the start); the pallet only when it moves;
+    // geometry drawn once in those frames, frame-locked.
+    assert_eq!(frames["fork_root"], steps + 1, "{frames:?}");
+    assert!(
+        frames["pallet"] >= 1 && frames["pallet"] < steps / 10,
+        "{frames:?}"
+    );
+    assert!(frames.contains_key("pallet_estimate"), "{frames:?}");
+    for frame in ["fork_root", "pallet", "pallet_estimate"] {
+        assert!(locked.contains(&(frame.to_owned(), true)), "{locked:?}");
+    }
+    assert_eq!(
+        per_topic["/truck/pose_true"],
+        per_topic["/truck/pose_measured"]
+    );
     assert_eq!(per_topic["/forkbench/outcome"], 1);
     // NAV350 at 8 Hz over the trial.
     let fixes = per_topic["/truck/pose_measured"];
@@ -152,14 +181,16 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
 
     let scn = field_test();
     let path = tmp("trial.rrd");
-    {
+    let out = {
         let mut rec = RerunRecorder::new(&RerunTarget::File(path.clone())).expect("opens");
-        run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rec);
+        let out = run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rec);
         rec.finish().expect("flushes");
-    }
+        out
+    };
     let file = std::io::BufReader::new(std::fs::File::open(&path).expect("written"));
     let (mut arrow, mut apps, mut kinds) = (0, BTreeSet::new(), BTreeSet::new());
     let mut entities = BTreeSet::new();
+    let mut rows: BTreeMap<String, usize> = BTreeMap::new();
     for msg in DecoderApp::decode_lazy(file) {
         match msg.expect("decodes") {
             LogMsg::SetStoreInfo(info) => {
@@ -170,6 +201,10 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
                 arrow += 1;
                 if let Ok(chunk) = rerun::log::Chunk::from_arrow_msg(&m) {
                     entities.insert(chunk.entity_path().to_string());
+                    if !chunk.is_static() {
+                        *rows.entry(chunk.entity_path().to_string()).or_default() +=
+                            chunk.num_rows();
+                    }
                 }
             }
             LogMsg::BlueprintActivationCommand(_) => {}
@@ -183,6 +218,7 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
     assert!(arrow > 10, "{arrow} arrow messages");
     for e in [
         "/world/pallet",
+        "/truck",
         "/truck/outline",
         "/plan/path",
         "/plan/path/control_polygon",
@@ -191,14 +227,24 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
         "/sensors/true_pose",
         "/sensors/measured_pose",
         "/sensors/pallet_estimate",
-        "/plots/curvature/planned",
-        "/plots/steering/command",
-        "/plots/steering/actual",
-        "/plots/speed/actual",
+        "/plots/curvature",
+        "/plots/steering",
+        "/plots/speed",
         "/plots/lateral_error",
         "/plots/contact_force",
         "/events",
     ] {
         assert!(entities.contains(e), "missing {e}: {entities:?}");
     }
+    // Every step's truck pose and plot values (sent as columns), plus the start pose.
+    let steps = (out.sim_time_s / scn.sim.dt_s).round() as usize;
+    assert_eq!(rows["/truck"], steps + 1, "{rows:?}");
+    for p in [
+        "/plots/steering",
+        "/plots/contact_force",
+        "/track/lookahead",
+    ] {
+        assert_eq!(rows[p], steps, "{p}: {rows:?}");
+    }
+    assert_eq!(rows["/sensors/true_pose"], rows["/sensors/measured_pose"]);
 }

@@ -10,7 +10,7 @@ pub mod stats;
 pub mod trial;
 
 pub use outcome::{Failure, TrialOutcome};
-pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord};
+pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord, Tee};
 pub use scenario::{Case, PoseDeg, Scenario, Tolerances, World};
 pub use trial::{TrialOptions, run_trial, run_trial_recorded};
 

@@ -74,3 +74,30 @@ pub trait Recorder {
 pub struct NoRecorder;
 
 impl Recorder for NoRecorder {}
+
+/// Fans every call out to several borrowed recorders (e.g. a file and a viewer).
+pub struct Tee<'a>(pub Vec<&'a mut dyn Recorder>);
+
+impl std::fmt::Debug for Tee<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Tee({} recorders)", self.0.len())
+    }
+}
+
+impl Recorder for Tee<'_> {
+    fn scene(&mut self, s: &SceneInfo<'_>) {
+        self.0.iter_mut().for_each(|r| r.scene(s));
+    }
+    fn plan(&mut self, t: f64, i: u32, p: &Path, c: Option<&[[f64; 2]]>) {
+        self.0.iter_mut().for_each(|r| r.plan(t, i, p, c));
+    }
+    fn step(&mut self, s: &StepRecord) {
+        self.0.iter_mut().for_each(|r| r.step(s));
+    }
+    fn event(&mut self, t: f64, l: Level, text: &str) {
+        self.0.iter_mut().for_each(|r| r.event(t, l, text));
+    }
+    fn outcome(&mut self, t: f64, o: &TrialOutcome) {
+        self.0.iter_mut().for_each(|r| r.outcome(t, o));
+    }
+}
