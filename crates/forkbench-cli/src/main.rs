@@ -1,6 +1,7 @@
 //! `forkbench`: the command-line front end (parse, call the libraries, print).
 
 mod batch_cmd;
+mod corridor_cmd;
 mod plan_cmd;
 mod plot;
 mod record;
@@ -28,6 +29,13 @@ struct Cli {
 
 /// Planner names as the CLI spells them.
 #[derive(Debug, Clone, Copy, ValueEnum)]
+enum ReproduceArg {
+    Bspline,
+    Spiral,
+    Corridor,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
 enum PlannerArg {
     Bspline,
     Spiral,
@@ -219,9 +227,38 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Reproduce a paper's Table 2 side by side with this project's results.
+    /// Corridor bends: minimum width per turning mode and angle, and G regions at a width.
+    Corridor {
+        /// Vehicle LENGTHxWIDTH in metres (default: the paper's AMV 0.56x0.40).
+        #[arg(long, value_parser = corridor_cmd::parse_vehicle, conflicts_with = "truck")]
+        vehicle: Option<forkbench_corridor::Vehicle>,
+        /// The forklift body (--truck-spec or the A30 defaults), adds the `truck` mode.
+        #[arg(long)]
+        truck: bool,
+        /// Forklift spec TOML for --truck.
+        #[arg(long, requires = "truck")]
+        truck_spec: Option<PathBuf>,
+        /// Corridor width (m): also compute the G regions and compare with circle inflation.
+        #[arg(long)]
+        width: Option<f64>,
+        /// Bend angle (degrees).
+        #[arg(long, conflicts_with = "sweep_angles")]
+        angle: Option<f64>,
+        /// Bend angles A:B:STEP (degrees).
+        #[arg(long, value_parser = corridor_cmd::parse_sweep)]
+        sweep_angles: Option<Vec<f64>>,
+        /// Grid cell (m); default Wc/40 (1 cm for the AMV, 3 cm for the A30).
+        #[arg(long)]
+        resolution: Option<f64>,
+        /// W_min vs θ, or with --width and one angle the G regions (.svg or .png).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Reproduce a paper's table side by side with this project's results.
     Reproduce {
-        planner: PlannerArg,
+        what: ReproduceArg,
         /// Reference table (default: the embedded scenarios/reference/<planner>-table2.toml).
         #[arg(long)]
         table: Option<PathBuf>,
@@ -383,12 +420,54 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             .map(|()| Done::Ok)
         }
         Command::Reproduce {
-            planner,
+            what,
             table,
             json,
             plot,
-        } => reproduce_cmd::run(planner.into(), table.as_deref(), json, plot.as_deref())
-            .map(|()| Done::Ok),
+        } => match what {
+            ReproduceArg::Bspline | ReproduceArg::Spiral => {
+                let planner = if matches!(what, ReproduceArg::Bspline) {
+                    PlannerKind::Bspline
+                } else {
+                    PlannerKind::Spiral
+                };
+                reproduce_cmd::run(planner, table.as_deref(), json, plot.as_deref())
+            }
+            ReproduceArg::Corridor => {
+                if table.is_some() {
+                    anyhow::bail!("--table: reproduce corridor has no reference table file");
+                }
+                corridor_cmd::reproduce(json, plot.as_deref())
+            }
+        }
+        .map(|()| Done::Ok),
+        Command::Corridor {
+            vehicle,
+            truck,
+            truck_spec,
+            width,
+            angle,
+            sweep_angles,
+            resolution,
+            plot,
+            json,
+        } => {
+            let v = if truck {
+                corridor_cmd::truck(&load_truck(truck_spec.as_ref())?)
+            } else {
+                vehicle.unwrap_or_else(corridor_cmd::amv)
+            };
+            let angles_deg = sweep_angles.unwrap_or_else(|| vec![angle.unwrap_or(90.0)]);
+            corridor_cmd::run(&corridor_cmd::Args {
+                vehicle: v,
+                width_m: width,
+                angles_deg,
+                cell_m: resolution.unwrap_or(v.width_m / 40.0),
+                plot: plot.as_deref(),
+                json,
+            })
+            .map(|()| Done::Ok)
+        }
     }
 }
 

@@ -29,6 +29,11 @@ fn register_font() {
     });
 }
 
+/// Registers the embedded font (other figure modules).
+pub fn register_font_pub() {
+    register_font();
+}
+
 /// Draws to FILE; the format follows the extension (.svg or .png).
 pub fn draw_plans(
     file: &FsPath,

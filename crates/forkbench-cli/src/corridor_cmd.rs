@@ -1,0 +1,412 @@
+//! `forkbench corridor` and `reproduce corridor`: minimum widths and G regions per turning mode.
+
+use std::fmt::Write as _;
+use std::path::Path as FsPath;
+
+use anyhow::{Context as _, bail};
+use forkbench_core::ForkliftSpec;
+use forkbench_corridor::{
+    Bend, GRegion, Mode, Resolution, Vehicle, check_inputs, compare, min_width_m,
+    oblique_min_width_m, validate,
+};
+use plotters::prelude::*;
+
+/// The paper's AMV (Lc 0.56 m, Wc 0.40 m).
+pub fn amv() -> Vehicle {
+    Vehicle {
+        length_m: 0.56,
+        width_m: 0.40,
+        kinematic_ahead_m: 0.0,
+        min_radius_m: 0.0,
+    }
+}
+
+/// The forklift body (forks excluded) turning about its front axle at r_min = L / tan α_max.
+pub fn truck(spec: &ForkliftSpec) -> Vehicle {
+    Vehicle {
+        length_m: spec.body_length_m,
+        width_m: spec.body_width_m,
+        kinematic_ahead_m: spec.body_length_m / 2.0 - spec.fork_root_ahead_of_front_axle_m,
+        min_radius_m: spec.wheelbase_m / spec.max_steer_rad.tan(),
+    }
+}
+
+/// Parses "0.56x0.40" (metres).
+pub fn parse_vehicle(text: &str) -> Result<Vehicle, String> {
+    let (l, w) = text.split_once(['x', 'X']).ok_or_else(|| {
+        format!("--vehicle {text:?}: expected LENGTHxWIDTH in metres, e.g. 0.56x0.40")
+    })?;
+    let num = |s: &str, what: &str| {
+        s.trim()
+            .parse::<f64>()
+            .map_err(|e| format!("--vehicle {text:?}: {what} {s:?}: {e}"))
+    };
+    Ok(Vehicle {
+        length_m: num(l, "length")?,
+        width_m: num(w, "width")?,
+        kinematic_ahead_m: 0.0,
+        min_radius_m: 0.0,
+    })
+}
+
+/// Parses "A:B:STEP" in degrees.
+pub fn parse_sweep(text: &str) -> Result<Vec<f64>, String> {
+    let parts: Vec<&str> = text.split(':').collect();
+    let nums: Result<Vec<f64>, _> = parts.iter().map(|p| p.trim().parse::<f64>()).collect();
+    match nums.as_deref() {
+        Ok([a, b, step]) if *step > 0.0 && b >= a => {
+            let n = ((b - a) / step + 1e-9).floor() as usize;
+            Ok((0..=n).map(|i| a + i as f64 * step).collect())
+        }
+        _ => Err(format!(
+            "--sweep-angles {text:?}: expected A:B:STEP in degrees with STEP > 0 and B ≥ A"
+        )),
+    }
+}
+
+fn modes_for(v: &Vehicle) -> Vec<Mode> {
+    if v.min_radius_m > 0.0 {
+        Mode::ALL.to_vec()
+    } else {
+        Mode::ALL[..4].to_vec()
+    }
+}
+
+#[derive(serde::Serialize)]
+struct Row {
+    angle_deg: f64,
+    mode: Mode,
+    min_width_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    g_area_m2: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    closed_form_m: Option<f64>,
+}
+
+/// Options of one `corridor` run.
+#[derive(Debug)]
+pub struct Args<'a> {
+    pub vehicle: Vehicle,
+    pub width_m: Option<f64>,
+    pub angles_deg: Vec<f64>,
+    pub cell_m: f64,
+    pub plot: Option<&'a FsPath>,
+    pub json: bool,
+}
+
+pub fn run(a: &Args) -> anyhow::Result<()> {
+    check_inputs(&a.vehicle, a.width_m, &a.angles_deg, a.cell_m)?;
+    let res = Resolution {
+        cell_m: a.cell_m,
+        heading_rad: 1f64.to_radians(),
+    };
+    let modes = modes_for(&a.vehicle);
+    let mut rows = Vec::new();
+    let mut regions = Vec::new();
+    for &deg in &a.angles_deg {
+        let th = deg.to_radians();
+        for &mode in &modes {
+            let w = min_width_m(
+                &a.vehicle,
+                mode,
+                th,
+                res,
+                20.0 * a.vehicle.circumscribed_m(),
+            );
+            let g = a
+                .width_m
+                .map(|w| GRegion::compute(Bend::new(w, th), a.vehicle, mode, res));
+            rows.push(Row {
+                angle_deg: deg,
+                mode,
+                min_width_m: w,
+                g_area_m2: g.as_ref().map(GRegion::area_m2),
+                closed_form_m: (mode == Mode::Oblique).then(|| oblique_min_width_m(&a.vehicle, th)),
+            });
+            if let Some(g) = g {
+                regions.push((deg, g));
+            }
+        }
+    }
+    if let Some(p) = a.plot {
+        if a.width_m.is_some() && a.angles_deg.len() == 1 {
+            plot_regions(p, &a.vehicle, &regions)?;
+        } else {
+            plot_widths(p, &a.vehicle, &rows)?;
+        }
+    }
+    if a.json {
+        let doc = serde_json::json!({
+            "vehicle": {"length_m": a.vehicle.length_m, "width_m": a.vehicle.width_m},
+            "resolution_m": a.cell_m,
+            "rows": rows,
+        });
+        crate::emit(&format!("{}\n", serde_json::to_string_pretty(&doc)?))?;
+        return Ok(());
+    }
+    let v = &a.vehicle;
+    let mut out = format!(
+        "vehicle {:.3} × {:.3} m (Li {:.3} m, L0 {:.3} m), resolution {:.3} m / 1°\n\n",
+        v.length_m,
+        v.width_m,
+        v.inscribed_m(),
+        v.circumscribed_m(),
+        a.cell_m
+    );
+    out.push_str("| angle (°) | mode | W_min (m) | oblique closed form (m) | G area (m²) |\n|---|---|---|---|---|\n");
+    for r in &rows {
+        let _ = writeln!(
+            out,
+            "| {:.2} | {} | {} | {} | {} |",
+            r.angle_deg,
+            r.mode.name(),
+            r.min_width_m
+                .map_or("no passage".into(), |w| format!("{w:.4}")),
+            r.closed_form_m.map_or(String::new(), |w| format!("{w:.4}")),
+            r.g_area_m2.map_or(String::new(), |g| format!("{g:.4}")),
+        );
+    }
+    if !regions.is_empty() {
+        out.push_str("\nAgainst circle inflation (areas in m², within the searched legs):\n\n| angle (°) | mode | G | inscribed claims | inscribed wrong | circumscribed claims | circumscribed wrongly blocks | G passages swept clean (parry2d, 1 mm / 0.1°) | inscribed-wrong positions colliding at every heading |\n|---|---|---|---|---|---|---|---|---|\n");
+        for (deg, g) in &regions {
+            let c = compare(g);
+            let val = validate(g, 100);
+            let _ = writeln!(
+                out,
+                "| {deg:.2} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {}/{} | {}/{} |",
+                c.mode.name(),
+                c.g_area_m2,
+                c.inscribed_area_m2,
+                c.inscribed_wrong_m2,
+                c.circumscribed_area_m2,
+                c.circumscribed_wrong_m2,
+                val.g_passed,
+                val.g_sampled,
+                val.inscribed_wrong_colliding,
+                val.inscribed_wrong_sampled,
+            );
+        }
+    }
+    crate::emit(&out)
+}
+
+/// `reproduce corridor`: the paper's AMV and the A30 truck over bend angles.
+pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
+    let v = amv();
+    let worst = (v.length_m / v.width_m).atan().to_degrees();
+    let mut angles = vec![15.0, 30.0, 45.0, worst, 60.0, 75.0, 90.0];
+    angles.sort_by(f64::total_cmp);
+    if !json {
+        crate::emit(&format!(
+            "# Quan & Wang 2021, corridor bends\n\nThe paper's equations 1–3 and Table 1 are not in its text; oblique translation has a closed form (Lc·sin θ + Wc·cos θ), the rest is searched. Worst angle for oblique translation: arctan(Lc/Wc) = {worst:.2}°.\n\n## AMV 0.56 × 0.40 m\n\n"
+        ))?;
+    }
+    run(&Args {
+        vehicle: v,
+        width_m: None,
+        angles_deg: angles.clone(),
+        cell_m: 0.01,
+        plot,
+        json,
+    })?;
+    if !json {
+        crate::emit("\n## AMV G regions at W = 0.60 m, θ = 90°\n\n")?;
+        run(&Args {
+            vehicle: v,
+            width_m: Some(0.60),
+            angles_deg: vec![90.0],
+            cell_m: 0.01,
+            plot: None,
+            json: false,
+        })?;
+        crate::emit("\n## A30 truck body 2.45 × 1.2 m (r_min 0.94 m about the front axle)\n\n")?;
+        run(&Args {
+            vehicle: truck(&ForkliftSpec::default()),
+            width_m: None,
+            angles_deg: vec![30.0, 60.0, 90.0],
+            cell_m: 0.03,
+            plot: None,
+            json: false,
+        })?;
+    }
+    Ok(())
+}
+
+const COLORS: [RGBColor; 5] = [
+    RGBColor(214, 39, 40),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(31, 119, 180),
+    RGBColor(148, 103, 189),
+];
+
+fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow::anyhow!("{e:?}")
+}
+
+fn backend_dispatch(
+    file: &FsPath,
+    size: (u32, u32),
+    draw_svg: impl FnOnce(DrawingArea<SVGBackend, plotters::coord::Shift>) -> anyhow::Result<()>,
+    draw_png: impl FnOnce(DrawingArea<BitMapBackend, plotters::coord::Shift>) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    crate::plot::register_font_pub();
+    let ext = file
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let r = match ext.as_deref() {
+        Some("svg") => draw_svg(SVGBackend::new(file, size).into_drawing_area()),
+        Some("png") => draw_png(BitMapBackend::new(file, size).into_drawing_area()),
+        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
+    };
+    r.with_context(|| format!("drawing {}", file.display()))
+}
+
+fn plot_widths(file: &FsPath, v: &Vehicle, rows: &[Row]) -> anyhow::Result<()> {
+    backend_dispatch(
+        file,
+        (1000, 650),
+        |a| widths_on(a, v, rows),
+        |a| widths_on(a, v, rows),
+    )
+}
+
+fn widths_on<DB: DrawingBackend>(
+    area: DrawingArea<DB, plotters::coord::Shift>,
+    v: &Vehicle,
+    rows: &[Row],
+) -> anyhow::Result<()> {
+    {
+        area.fill(&WHITE).map_err(err)?;
+        let ws: Vec<f64> = rows.iter().filter_map(|r| r.min_width_m).collect();
+        let top = ws.iter().copied().fold(v.circumscribed_m(), f64::max) * 1.05;
+        let a0 = rows
+            .iter()
+            .map(|r| r.angle_deg)
+            .fold(f64::INFINITY, f64::min);
+        let a1 = rows
+            .iter()
+            .map(|r| r.angle_deg)
+            .fold(f64::NEG_INFINITY, f64::max)
+            .max(a0 + 1.0);
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                format!(
+                    "minimum corridor width, {:.2} × {:.2} m",
+                    v.length_m, v.width_m
+                ),
+                ("sans-serif", 22),
+            )
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(a0..a1, v.width_m * 0.95..top)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("bend angle θ (°)")
+            .y_desc("W_min (m)")
+            .draw()
+            .map_err(err)?;
+        for (i, mode) in Mode::ALL.iter().enumerate() {
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.mode == *mode)
+                .filter_map(|r| r.min_width_m.map(|w| (r.angle_deg, w)))
+                .collect();
+            if pts.is_empty() {
+                continue;
+            }
+            let c = COLORS[i];
+            chart
+                .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                .map_err(err)?
+                .label(mode.name())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(2)));
+        }
+        for (label, w) in [("Li", v.inscribed_m()), ("L0", v.circumscribed_m())] {
+            chart
+                .draw_series(LineSeries::new([(a0, w), (a1, w)], BLACK.mix(0.4)))
+                .map_err(err)?
+                .label(label)
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.mix(0.4)));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(err)?;
+        area.present().map_err(err)
+    }
+}
+
+fn plot_regions(file: &FsPath, v: &Vehicle, regions: &[(f64, GRegion)]) -> anyhow::Result<()> {
+    let n = regions.len().max(1);
+    backend_dispatch(
+        file,
+        (520 * n as u32, 560),
+        |a| regions_on(a, v, regions),
+        |a| regions_on(a, v, regions),
+    )
+}
+
+fn regions_on<DB: DrawingBackend>(
+    area: DrawingArea<DB, plotters::coord::Shift>,
+    v: &Vehicle,
+    regions: &[(f64, GRegion)],
+) -> anyhow::Result<()> {
+    let n = regions.len().max(1);
+    {
+        area.fill(&WHITE).map_err(err)?;
+        let panels = area.split_evenly((1, n));
+        for ((_, g), panel) in regions.iter().zip(panels.iter()) {
+            let s = &g.space;
+            let (x1, y1) = (
+                s.x0 + s.nx as f64 * s.res.cell_m,
+                s.y0 + s.ny as f64 * s.res.cell_m,
+            );
+            let c = compare(g);
+            let mut chart = ChartBuilder::on(panel)
+                .caption(
+                    format!(
+                        "{}: G {:.3} m² (inscribed claims {:.3})",
+                        s.mode.name(),
+                        c.g_area_m2,
+                        c.inscribed_area_m2
+                    ),
+                    ("sans-serif", 16),
+                )
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(40)
+                .build_cartesian_2d(s.x0..x1, s.y0..y1)
+                .map_err(err)?;
+            chart.configure_mesh().draw().map_err(err)?;
+            let h = s.res.cell_m;
+            let cells = (0..s.cells()).filter_map(|cell| {
+                let p = s.cell_centre(cell);
+                if !s.in_window_pub(p) {
+                    return None;
+                }
+                let colour = if g.through[cell].is_some() {
+                    RGBColor(44, 160, 44).filled()
+                } else if s.bend.clearance(p) >= v.inscribed_m() / 2.0 {
+                    RGBColor(214, 39, 40).filled()
+                } else {
+                    RGBColor(225, 225, 225).filled()
+                };
+                Some(Rectangle::new(
+                    [
+                        (p[0] - h / 2.0, p[1] - h / 2.0),
+                        (p[0] + h / 2.0, p[1] + h / 2.0),
+                    ],
+                    colour,
+                ))
+            });
+            chart.draw_series(cells).map_err(err)?;
+        }
+        area.present().map_err(err)
+    }
+}

@@ -1,0 +1,203 @@
+//! G regions against circle inflation, and their validation with parry2d at finer resolution than the search.
+
+use forkbench_core::Pose2;
+
+use crate::bend::Vehicle;
+use crate::search::{GRegion, Mode};
+
+/// Bad corridor-analysis input.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CorridorError {
+    #[error("{field} = {value}: {reason}")]
+    Invalid {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+}
+
+/// Checks the inputs of an analysis; every field is named in the error.
+pub fn check_inputs(
+    v: &Vehicle,
+    width_m: Option<f64>,
+    angles_deg: &[f64],
+    cell_m: f64,
+) -> Result<(), CorridorError> {
+    let bad = |field, value, reason| {
+        Err(CorridorError::Invalid {
+            field,
+            value,
+            reason,
+        })
+    };
+    for (field, value) in [
+        ("vehicle length_m", v.length_m),
+        ("vehicle width_m", v.width_m),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return bad(field, value, "must be a positive size");
+        }
+    }
+    if v.width_m > v.length_m {
+        return bad(
+            "vehicle width_m",
+            v.width_m,
+            "must not exceed the length (give LcxWc)",
+        );
+    }
+    if !(cell_m.is_finite() && cell_m > 0.0 && cell_m <= v.width_m / 4.0) {
+        return bad(
+            "resolution_m",
+            cell_m,
+            "must be positive and at most a quarter of the vehicle width",
+        );
+    }
+    if let Some(w) = width_m {
+        if !(w.is_finite() && w > 0.0) {
+            return bad("width_m", w, "must be a positive corridor width");
+        }
+        if w <= v.width_m {
+            return bad(
+                "width_m",
+                w,
+                "is not wider than the vehicle (Li = Wc): no pose passes",
+            );
+        }
+    }
+    for &a in angles_deg {
+        if !(a.is_finite() && (0.0..=135.0).contains(&a)) {
+            return bad("angle_deg", a, "must lie in 0…135°");
+        }
+    }
+    Ok(())
+}
+
+/// Areas claimed passable by circle inflation, and where each is wrong, for one mode.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Comparison {
+    pub mode: Mode,
+    pub g_area_m2: f64,
+    /// Inflation by the inscribed circle (radius Wc/2): centres it calls free.
+    pub inscribed_area_m2: f64,
+    /// …of which outside G: the body collides or cannot pass there in this mode.
+    pub inscribed_wrong_m2: f64,
+    /// Inflation by the circumscribed circle (radius L0/2).
+    pub circumscribed_area_m2: f64,
+    /// G positions it wrongly blocks.
+    pub circumscribed_wrong_m2: f64,
+}
+
+pub fn compare(g: &GRegion) -> Comparison {
+    let s = &g.space;
+    let a = s.res.cell_m.powi(2);
+    let (mut ins, mut ins_wrong, mut circ, mut circ_wrong, mut area) = (0, 0, 0, 0, 0);
+    for (cell, through) in g.through.iter().enumerate() {
+        let p = s.cell_centre(cell);
+        if !s.in_window_pub(p) {
+            continue;
+        }
+        let c = s.bend.clearance(p);
+        let in_g = through.is_some();
+        area += usize::from(in_g);
+        if c >= s.vehicle.inscribed_m() / 2.0 {
+            ins += 1;
+            ins_wrong += usize::from(!in_g);
+        }
+        if c >= s.vehicle.circumscribed_m() / 2.0 {
+            circ += 1;
+        } else if in_g {
+            circ_wrong += 1;
+        }
+    }
+    let m2 = |n: usize| n as f64 * a;
+    Comparison {
+        mode: s.mode,
+        g_area_m2: m2(area),
+        inscribed_area_m2: m2(ins),
+        inscribed_wrong_m2: m2(ins_wrong),
+        circumscribed_area_m2: m2(circ),
+        circumscribed_wrong_m2: m2(circ_wrong),
+    }
+}
+
+/// Outcome of checking sampled positions with parry2d.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Validation {
+    /// G positions whose whole passage was swept at 1 mm / 0.1° without contact.
+    pub g_sampled: usize,
+    pub g_passed: usize,
+    /// Positions inscribed inflation calls free but outside G…
+    pub inscribed_wrong_sampled: usize,
+    /// …where the body touches a wall at every heading the mode can have there.
+    pub inscribed_wrong_colliding: usize,
+}
+
+const FINE_STEP_M: f64 = 1e-3;
+const FINE_STEP_RAD: f64 = 0.1 * std::f64::consts::PI / 180.0;
+
+/// Sweeps up to `samples` G passages and inscribed-but-outside-G positions with parry2d.
+pub fn validate(g: &GRegion, samples: usize) -> Validation {
+    let s = &g.space;
+    let obs = s.bend.obstacles(s.reach_m);
+    let fp = s.vehicle.footprint();
+    let hits = |p: [f64; 2], h: f64| obs.collides(&fp, &Pose2::new(p[0], p[1], h));
+    let cells: Vec<usize> = g.cells().collect();
+    let stride = (cells.len() / samples.max(1)).max(1);
+    let (mut g_sampled, mut g_passed) = (0, 0);
+    for &cell in cells.iter().step_by(stride) {
+        let Some(path) = g.witness(cell) else {
+            continue;
+        };
+        g_sampled += 1;
+        let clean = path.windows(2).all(|w| {
+            let ((a, ha), (b, hb)) = (w[0], w[1]);
+            let d = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let n = ((d / FINE_STEP_M)
+                .max((hb - ha).abs() / FINE_STEP_RAD)
+                .ceil() as usize)
+                .max(1);
+            (0..=n).all(|i| {
+                let t = i as f64 / n as f64;
+                !hits(
+                    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])],
+                    ha + t * (hb - ha),
+                )
+            })
+        });
+        g_passed += usize::from(clean);
+    }
+    let (h1, h2) = s.bend.headings();
+    let headings: Vec<f64> = if s.mode == Mode::Oblique {
+        vec![h1]
+    } else {
+        let n = ((h1 - h2) / FINE_STEP_RAD).ceil().max(1.0) as usize;
+        (0..=n)
+            .map(|i| h1 - (h1 - h2) * i as f64 / n as f64)
+            .collect()
+    };
+    let wrong: Vec<usize> = g
+        .through
+        .iter()
+        .enumerate()
+        .filter(|(c, t)| {
+            let p = s.cell_centre(*c);
+            t.is_none()
+                && s.in_window_pub(p)
+                && s.bend.clearance(p) >= s.vehicle.inscribed_m() / 2.0
+        })
+        .map(|(c, _)| c)
+        .collect();
+    let stride = (wrong.len() / samples.max(1)).max(1);
+    let (mut w_sampled, mut w_colliding) = (0, 0);
+    for &cell in wrong.iter().step_by(stride) {
+        let p = s.cell_centre(cell);
+        w_sampled += 1;
+        w_colliding += usize::from(headings.iter().all(|&h| hits(p, h)));
+    }
+    Validation {
+        g_sampled,
+        g_passed,
+        inscribed_wrong_sampled: w_sampled,
+        inscribed_wrong_colliding: w_colliding,
+    }
+}

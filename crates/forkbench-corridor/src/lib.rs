@@ -1,0 +1,9 @@
+//! Rectangular vehicles in corridor bends (Quan & Wang 2021): minimum widths and movable ranges per turning mode.
+
+pub mod analysis;
+pub mod bend;
+pub mod search;
+
+pub use analysis::{Comparison, CorridorError, Validation, check_inputs, compare, validate};
+pub use bend::{Bend, MARGIN_M, Vehicle, oblique_min_width_m};
+pub use search::{GRegion, Mode, Resolution, Space, min_width_m};

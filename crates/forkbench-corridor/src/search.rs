@@ -1,0 +1,443 @@
+//! Feasibility search per turning mode on a grid of body-centre positions × headings; minimum width by bisection; G regions.
+
+use std::collections::VecDeque;
+
+use crate::bend::{Bend, Vehicle};
+
+/// How the vehicle changes direction at the bend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Omnidirectional base: slides through with leg 1's heading, never turning.
+    Oblique,
+    /// Turns on the spot at one point (between straight slides in each leg).
+    Spin,
+    /// Drives forward while turning with any curvature, including on the spot.
+    Curve,
+    /// Turns along one arc of fixed radius (the paper's R = Wc/2) about the body centre.
+    CurveFixedRadius,
+    /// Forward driving about the kinematic point (front axle) with radius ≥ the vehicle's
+    /// minimum; no sideways motion at all.
+    Truck,
+}
+
+impl Mode {
+    pub const ALL: [Mode; 5] = [
+        Mode::Oblique,
+        Mode::Spin,
+        Mode::Curve,
+        Mode::CurveFixedRadius,
+        Mode::Truck,
+    ];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Mode::Oblique => "oblique",
+            Mode::Spin => "spin",
+            Mode::Curve => "curve",
+            Mode::CurveFixedRadius => "curve_fixed_radius",
+            Mode::Truck => "truck",
+        }
+    }
+}
+
+/// Grid and heading resolution of the search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resolution {
+    pub cell_m: f64,
+    pub heading_rad: f64,
+}
+
+/// The search space around one bend.
+#[derive(Debug)]
+pub struct Space {
+    pub bend: Bend,
+    pub vehicle: Vehicle,
+    pub mode: Mode,
+    pub res: Resolution,
+    /// Legs are searched this far from the corner (centre lines' crossing).
+    pub reach_m: f64,
+    pub x0: f64,
+    pub y0: f64,
+    pub nx: usize,
+    pub ny: usize,
+    /// Heading layers: 0 = leg 1's heading … `layers - 1` = leg 2's.
+    pub layers: usize,
+    pub dphi: f64,
+}
+
+/// One search's visited states: parent (state index + 1; 0 = unvisited) and the exact
+/// pose each state was first reached with.
+#[derive(Debug)]
+pub struct Reached {
+    pub parent: Vec<u32>,
+    pub pos: Vec<[f64; 2]>,
+    pub goal: Option<u32>,
+}
+
+const ROOT: u32 = u32::MAX;
+
+impl Space {
+    pub fn new(bend: Bend, vehicle: Vehicle, mode: Mode, res: Resolution) -> Self {
+        let l0 = vehicle.circumscribed_m();
+        let turn_room = if mode == Mode::Truck {
+            2.0 * (vehicle.min_radius_m + vehicle.kinematic_ahead_m.abs())
+        } else {
+            0.0
+        };
+        let reach_m = bend.width_m / 2.0 + l0 + turn_room + 2.0 * res.cell_m;
+        let hw = bend.width_m / 2.0;
+        let corners = [
+            [-hw, -reach_m],
+            [hw, -reach_m],
+            bend.j,
+            bend.i,
+            [
+                bend.d2[0] * reach_m + bend.l2[0] * hw,
+                bend.d2[1] * reach_m + bend.l2[1] * hw,
+            ],
+            [
+                bend.d2[0] * reach_m - bend.l2[0] * hw,
+                bend.d2[1] * reach_m - bend.l2[1] * hw,
+            ],
+        ];
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for c in corners {
+            for k in 0..2 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        }
+        let h = res.cell_m;
+        let layers = if mode == Mode::Oblique || bend.angle_rad == 0.0 {
+            1
+        } else {
+            (bend.angle_rad / res.heading_rad).ceil() as usize + 1
+        };
+        let dphi = if layers > 1 {
+            bend.angle_rad / (layers - 1) as f64
+        } else {
+            0.0
+        };
+        Self {
+            bend,
+            vehicle,
+            mode,
+            res,
+            reach_m,
+            x0: lo[0],
+            y0: lo[1],
+            nx: ((hi[0] - lo[0]) / h).ceil() as usize + 1,
+            ny: ((hi[1] - lo[1]) / h).ceil() as usize + 1,
+            layers,
+            dphi,
+        }
+    }
+
+    pub fn cells(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    pub fn cell_of(&self, p: [f64; 2]) -> Option<usize> {
+        let ix = ((p[0] - self.x0) / self.res.cell_m).floor();
+        let iy = ((p[1] - self.y0) / self.res.cell_m).floor();
+        if ix < 0.0 || iy < 0.0 || ix >= self.nx as f64 || iy >= self.ny as f64 {
+            return None;
+        }
+        Some(iy as usize * self.nx + ix as usize)
+    }
+
+    pub fn cell_centre(&self, cell: usize) -> [f64; 2] {
+        let h = self.res.cell_m;
+        [
+            self.x0 + ((cell % self.nx) as f64 + 0.5) * h,
+            self.y0 + ((cell / self.nx) as f64 + 0.5) * h,
+        ]
+    }
+
+    pub fn heading(&self, layer: usize) -> f64 {
+        self.bend.headings().0 - layer as f64 * self.dphi
+    }
+
+    /// Inside the searched part of the corridor (legs cut at `reach_m`).
+    fn in_window(&self, p: [f64; 2]) -> bool {
+        p[1] >= -self.reach_m
+            && self.bend.d2[0] * p[0] + self.bend.d2[1] * p[1] <= self.reach_m
+            && self.bend.clearance(p) > 0.0
+    }
+
+    /// Whether a point is inside the searched part of the corridor.
+    pub fn in_window_pub(&self, p: [f64; 2]) -> bool {
+        self.in_window(p)
+    }
+
+    fn is_start(&self, p: [f64; 2]) -> bool {
+        p[1] < -self.reach_m + self.res.cell_m
+    }
+
+    fn is_goal(&self, p: [f64; 2]) -> bool {
+        self.bend.d2[0] * p[0] + self.bend.d2[1] * p[1] > self.reach_m - self.res.cell_m
+    }
+
+    fn translates(&self, layer: usize) -> bool {
+        self.mode != Mode::Truck && (layer == 0 || layer + 1 == self.layers)
+    }
+
+    fn drives_straight(&self, layer: usize) -> bool {
+        matches!(self.mode, Mode::Curve | Mode::Truck)
+            && (self.mode == Mode::Truck || (layer > 0 && layer + 1 < self.layers))
+    }
+
+    /// Turning radii (about the body centre) one heading step may use: free curvature is
+    /// any sequence of on-the-spot steps, arcs of Wc/2 (the fixed-radius mode's), L0/2, L0
+    /// and 2·L0, and straight steps; a single radius for the fixed-radius mode.
+    fn turn_radii(&self) -> &'static [f64] {
+        match self.mode {
+            Mode::Oblique | Mode::Spin => &[0.0],
+            Mode::Curve => &[0.0, 1.0, 2.0, 3.0, 4.0],
+            Mode::CurveFixedRadius | Mode::Truck => &[1.0],
+        }
+    }
+
+    /// Body-centre displacement of the turn from `layer` to `layer + 1` with the radius
+    /// picked by `which` (an entry of [`Self::turn_radii`]).
+    fn turn_displacement(&self, layer: usize, which: f64) -> [f64; 2] {
+        let (a, b) = (self.heading(layer), self.heading(layer + 1));
+        let mid = (a + b) / 2.0;
+        let chord = |r: f64| 2.0 * r * (self.dphi / 2.0).sin();
+        let l0 = self.vehicle.circumscribed_m();
+        let along = |r: f64| [chord(r) * mid.cos(), chord(r) * mid.sin()];
+        match self.mode {
+            Mode::Oblique | Mode::Spin => [0.0, 0.0],
+            Mode::Curve => along(match which as u32 {
+                0 => 0.0,
+                1 => self.vehicle.width_m / 2.0,
+                2 => l0 / 2.0,
+                3 => l0,
+                _ => 2.0 * l0,
+            }),
+            Mode::CurveFixedRadius => along(self.vehicle.width_m / 2.0),
+            Mode::Truck => {
+                let (k, c) = (
+                    self.vehicle.kinematic_ahead_m,
+                    chord(self.vehicle.min_radius_m),
+                );
+                [
+                    k * (a.cos() - b.cos()) + c * mid.cos(),
+                    k * (a.sin() - b.sin()) + c * mid.sin(),
+                ]
+            }
+        }
+    }
+
+    fn free(&self, a: [f64; 2], ha: f64, b: [f64; 2], hb: f64) -> bool {
+        self.bend
+            .sweep_free(&self.vehicle.corners(a, ha), &self.vehicle.corners(b, hb))
+    }
+
+    /// Breadth-first search from leg 1 (`forward`) or back from leg 2; stops at the first
+    /// goal when `stop_at_goal`.
+    pub fn search(&self, forward: bool, stop_at_goal: bool) -> Reached {
+        let n = self.cells() * self.layers;
+        let mut parent = vec![0u32; n];
+        let mut pos = vec![[0.0f64; 2]; n];
+        let mut queue = VecDeque::new();
+        let (first, last) = (0, self.layers - 1);
+        let start_layer = if forward { first } else { last };
+        for cell in 0..self.cells() {
+            let p = self.cell_centre(cell);
+            let h = self.heading(start_layer);
+            let starts = if forward {
+                self.is_start(p)
+            } else {
+                self.is_goal(p)
+            };
+            if starts && self.in_window(p) && self.free(p, h, p, h) {
+                let s = start_layer * self.cells() + cell;
+                parent[s] = ROOT;
+                pos[s] = p;
+                queue.push_back(s as u32);
+            }
+        }
+        let h = self.res.cell_m;
+        let sign = if forward { 1.0 } else { -1.0 };
+        let mut goal = None;
+        let mut moves: Vec<([f64; 2], usize)> = Vec::with_capacity(10);
+        while let Some(s) = queue.pop_front() {
+            let s = s as usize;
+            let (layer, p) = (s / self.cells(), pos[s]);
+            let done = if forward {
+                layer == last && self.is_goal(p)
+            } else {
+                layer == first && self.is_start(p)
+            };
+            if done {
+                goal = Some(s as u32);
+                if stop_at_goal {
+                    break;
+                }
+            }
+            let head = self.heading(layer);
+            moves.clear();
+            if self.translates(layer) {
+                for (dx, dy) in [
+                    (1, 0),
+                    (-1, 0),
+                    (0, 1),
+                    (0, -1),
+                    (1, 1),
+                    (1, -1),
+                    (-1, 1),
+                    (-1, -1),
+                ] {
+                    moves.push(([p[0] + dx as f64 * h, p[1] + dy as f64 * h], layer));
+                }
+            }
+            if self.drives_straight(layer) {
+                moves.push((
+                    [p[0] + sign * h * head.cos(), p[1] + sign * h * head.sin()],
+                    layer,
+                ));
+            }
+            for &r in self.turn_radii() {
+                if forward && layer < last {
+                    let d = self.turn_displacement(layer, r);
+                    moves.push(([p[0] + d[0], p[1] + d[1]], layer + 1));
+                }
+                if !forward && layer > first {
+                    let d = self.turn_displacement(layer - 1, r);
+                    moves.push(([p[0] - d[0], p[1] - d[1]], layer - 1));
+                }
+            }
+            for &(q, ql) in &moves {
+                if !self.in_window(q) {
+                    continue;
+                }
+                let Some(cell) = self.cell_of(q) else {
+                    continue;
+                };
+                let t = ql * self.cells() + cell;
+                if parent[t] != 0 || !self.free(p, head, q, self.heading(ql)) {
+                    continue;
+                }
+                parent[t] = s as u32 + 1;
+                pos[t] = q;
+                queue.push_back(t as u32);
+            }
+        }
+        Reached { parent, pos, goal }
+    }
+
+    /// The chain of (position, heading) from a search root to state `s`.
+    pub fn chain(&self, r: &Reached, mut s: usize) -> Vec<([f64; 2], f64)> {
+        let mut out = Vec::new();
+        loop {
+            out.push((r.pos[s], self.heading(s / self.cells())));
+            match r.parent[s] {
+                ROOT => break,
+                0 => break,
+                p => s = p as usize - 1,
+            }
+        }
+        out.reverse();
+        out
+    }
+}
+
+/// The movable range of one mode at one width.
+#[derive(Debug)]
+pub struct GRegion {
+    pub space: Space,
+    /// Per cell: one state on a passage through it (forward-reached and backward-reached
+    /// in the same heading layer), if any.
+    pub through: Vec<Option<usize>>,
+    pub forward: Reached,
+    pub backward: Reached,
+}
+
+impl GRegion {
+    pub fn compute(bend: Bend, vehicle: Vehicle, mode: Mode, res: Resolution) -> Self {
+        let space = Space::new(bend, vehicle, mode, res);
+        let forward = space.search(true, false);
+        let backward = space.search(false, false);
+        let through = (0..space.cells())
+            .map(|c| {
+                (0..space.layers)
+                    .map(|l| l * space.cells() + c)
+                    .find(|&s| forward.parent[s] != 0 && backward.parent[s] != 0)
+            })
+            .collect();
+        Self {
+            space,
+            through,
+            forward,
+            backward,
+        }
+    }
+
+    pub fn cells(&self) -> impl Iterator<Item = usize> + '_ {
+        self.through
+            .iter()
+            .enumerate()
+            .filter_map(|(c, s)| s.map(|_| c))
+    }
+
+    pub fn area_m2(&self) -> f64 {
+        self.cells().count() as f64 * self.space.res.cell_m.powi(2)
+    }
+
+    /// A whole passage through `cell`: from leg 1 to the cell, a step of at most one cell
+    /// inside it, and on to leg 2.
+    pub fn witness(&self, cell: usize) -> Option<Vec<([f64; 2], f64)>> {
+        let s = self.through[cell]?;
+        let mut path = self.space.chain(&self.forward, s);
+        let mut back = self.space.chain(&self.backward, s);
+        back.reverse();
+        path.extend(back);
+        Some(path)
+    }
+}
+
+/// Smallest width (bisection to a quarter cell; the grid itself limits it to about one
+/// cell) at which `mode` passes the bend, or `None`
+/// when even `max_width_m` does not.
+pub fn min_width_m(
+    vehicle: &Vehicle,
+    mode: Mode,
+    angle_rad: f64,
+    res: Resolution,
+    max_width_m: f64,
+) -> Option<f64> {
+    let passes = |w: f64| {
+        Space::new(Bend::new(w, angle_rad), *vehicle, mode, res)
+            .search(true, true)
+            .goal
+            .is_some()
+    };
+    let mut lo = vehicle.width_m;
+    let mut hi = vehicle.circumscribed_m() + res.cell_m;
+    while !passes(hi) {
+        lo = hi;
+        hi *= 1.5;
+        if hi > max_width_m {
+            return if passes(max_width_m) {
+                bisect(lo, max_width_m, res.cell_m / 4.0, passes)
+            } else {
+                None
+            };
+        }
+    }
+    bisect(lo, hi, res.cell_m / 4.0, passes)
+}
+
+fn bisect(mut lo: f64, mut hi: f64, tol: f64, passes: impl Fn(f64) -> bool) -> Option<f64> {
+    while hi - lo > tol {
+        let mid = (lo + hi) / 2.0;
+        if passes(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}

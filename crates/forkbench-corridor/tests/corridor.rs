@@ -1,0 +1,90 @@
+//! The paper's AMV: closed form vs search, mode ordering, and G regions checked with parry2d.
+
+use forkbench_corridor::{
+    Bend, GRegion, Mode, Resolution, Vehicle, compare, min_width_m, oblique_min_width_m, validate,
+};
+
+const AMV: Vehicle = Vehicle {
+    length_m: 0.56,
+    width_m: 0.40,
+    kinematic_ahead_m: 0.0,
+    min_radius_m: 0.0,
+};
+
+fn res(cell_m: f64) -> Resolution {
+    Resolution {
+        cell_m,
+        heading_rad: 1f64.to_radians(),
+    }
+}
+
+#[test]
+fn oblique_search_matches_the_closed_form_to_the_grid() {
+    let h = 0.01;
+    for deg in [10.0, 30.0, 54.46, 75.0, 90.0] {
+        let th = f64::to_radians(deg);
+        let w = min_width_m(&AMV, Mode::Oblique, th, res(h), 5.0).expect("passes");
+        let exact = oblique_min_width_m(&AMV, th);
+        // Never below the exact width; above it by the lattice of centre positions (≤ 1.35
+        // cells measured, shrinking with the cell: 1.2 cm at 1 cm, 0.3 cm at 2.5 mm).
+        assert!(
+            w >= exact - 1e-9 && w - exact <= 1.5 * h,
+            "{deg}°: {w} vs {exact}"
+        );
+    }
+}
+
+#[test]
+fn modes_order_oblique_spin_curve_and_worst_angle() {
+    let h = 0.01;
+    for deg in [30.0, 54.46, 90.0] {
+        let th = f64::to_radians(deg);
+        let w = |m| min_width_m(&AMV, m, th, res(h), 5.0).expect("passes");
+        let (o, s, c) = (w(Mode::Oblique), w(Mode::Spin), w(Mode::Curve));
+        assert!(o > s && s > c, "{deg}°: oblique {o}, spin {s}, curve {c}");
+    }
+    let worst = [15.0, 30.0, 45.0, 54.46, 60.0, 75.0, 90.0]
+        .into_iter()
+        .max_by(|a: &f64, b: &f64| {
+            let f = |d: f64| min_width_m(&AMV, Mode::Oblique, d.to_radians(), res(h), 5.0);
+            f(*a).partial_cmp(&f(*b)).expect("numbers")
+        })
+        .expect("angles");
+    assert_eq!(worst, 54.46, "arctan(0.56/0.40) = 54.46°");
+}
+
+#[test]
+fn g_regions_order_validate_and_beat_circle_inflation() {
+    let bend = Bend::new(0.60, 90f64.to_radians());
+    let mut areas = Vec::new();
+    for mode in [Mode::Oblique, Mode::Spin, Mode::Curve] {
+        let g = GRegion::compute(bend, AMV, mode, res(0.01));
+        let c = compare(&g);
+        let v = validate(&g, 60);
+        assert!(v.g_sampled >= 50, "{mode:?}: {v:?}");
+        assert_eq!(
+            v.g_passed, v.g_sampled,
+            "{mode:?}: G passages touch a wall: {v:?}"
+        );
+        // Inscribed inflation claims more than any mode can use; the circumscribed one
+        // closes the corridor (0.60 m < L0 = 0.688 m) though every mode passes.
+        assert!(
+            c.inscribed_area_m2 > c.g_area_m2 && c.inscribed_wrong_m2 > 0.0,
+            "{c:?}"
+        );
+        assert!(c.circumscribed_area_m2 < 0.01 * c.g_area_m2, "{c:?}");
+        if mode == Mode::Oblique {
+            // Every sampled position inscribed inflation calls free outside G collides.
+            assert!(v.inscribed_wrong_sampled >= 50, "{v:?}");
+            assert_eq!(
+                v.inscribed_wrong_colliding, v.inscribed_wrong_sampled,
+                "{v:?}"
+            );
+        }
+        areas.push(c.g_area_m2);
+    }
+    assert!(
+        areas[2] > areas[1] && areas[1] > areas[0],
+        "curve > spin > oblique: {areas:?}"
+    );
+}
