@@ -3,13 +3,14 @@
 use std::fmt::Write as _;
 use std::path::Path as FsPath;
 
-use anyhow::{Context as _, bail};
 use forkbench_core::ForkliftSpec;
 use forkbench_corridor::{
     Bend, GRegion, Mode, Resolution, Vehicle, check_inputs, compare, min_width_m,
     oblique_min_width_m, validate,
 };
 use plotters::prelude::*;
+
+use crate::plot::{COLORS, err, to_file};
 
 /// The paper's AMV (Lc 0.56 m, Wc 0.40 m).
 pub fn amv() -> Vehicle {
@@ -232,39 +233,8 @@ pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
     Ok(())
 }
 
-const COLORS: [RGBColor; 5] = [
-    RGBColor(214, 39, 40),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(31, 119, 180),
-    RGBColor(148, 103, 189),
-];
-
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow::anyhow!("{e:?}")
-}
-
-fn backend_dispatch(
-    file: &FsPath,
-    size: (u32, u32),
-    draw_svg: impl FnOnce(DrawingArea<SVGBackend, plotters::coord::Shift>) -> anyhow::Result<()>,
-    draw_png: impl FnOnce(DrawingArea<BitMapBackend, plotters::coord::Shift>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    crate::plot::register_font_pub();
-    let ext = file
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let r = match ext.as_deref() {
-        Some("svg") => draw_svg(SVGBackend::new(file, size).into_drawing_area()),
-        Some("png") => draw_png(BitMapBackend::new(file, size).into_drawing_area()),
-        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
-    };
-    r.with_context(|| format!("drawing {}", file.display()))
-}
-
 fn plot_widths(file: &FsPath, v: &Vehicle, rows: &[Row]) -> anyhow::Result<()> {
-    backend_dispatch(
+    to_file(
         file,
         (1000, 650),
         |a| widths_on(a, v, rows),
@@ -344,7 +314,7 @@ fn widths_on<DB: DrawingBackend>(
 
 fn plot_regions(file: &FsPath, v: &Vehicle, regions: &[(f64, GRegion)]) -> anyhow::Result<()> {
     let n = regions.len().max(1);
-    backend_dispatch(
+    to_file(
         file,
         (520 * n as u32, 560),
         |a| regions_on(a, v, regions),
@@ -387,7 +357,7 @@ fn regions_on<DB: DrawingBackend>(
             let h = s.res.cell_m;
             let cells = (0..s.cells()).filter_map(|cell| {
                 let p = s.cell_centre(cell);
-                if !s.in_window_pub(p) {
+                if !s.in_window(p) {
                     return None;
                 }
                 let colour = if g.through[cell].is_some() {

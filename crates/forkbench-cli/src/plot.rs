@@ -29,9 +29,25 @@ fn register_font() {
     });
 }
 
-/// Registers the embedded font (other figure modules).
-pub fn register_font_pub() {
+/// Draws to FILE with the backend its extension names (.svg or .png). The two closures
+/// are the same drawing code, one per backend type.
+pub fn to_file(
+    file: &FsPath,
+    size: (u32, u32),
+    svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> anyhow::Result<()>,
+    png: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
     register_font();
+    let ext = file
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let result = match ext.as_deref() {
+        Some("svg") => svg(SVGBackend::new(file, size).into_drawing_area()),
+        Some("png") => png(BitMapBackend::new(file, size).into_drawing_area()),
+        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
+    };
+    result.with_context(|| format!("drawing {}", file.display()))
 }
 
 /// Draws to FILE; the format follows the extension (.svg or .png).
@@ -41,38 +57,22 @@ pub fn draw_plans(
     series: &[Series],
     truck: &ForkliftSpec,
 ) -> anyhow::Result<()> {
-    register_font();
-    let size = (1400, 800);
-    let ext = file
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let result = match ext.as_deref() {
-        Some("svg") => draw(
-            SVGBackend::new(file, size).into_drawing_area(),
-            title,
-            series,
-            truck,
-        ),
-        Some("png") => draw(
-            BitMapBackend::new(file, size).into_drawing_area(),
-            title,
-            series,
-            truck,
-        ),
-        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
-    };
-    result.with_context(|| format!("drawing {}", file.display()))
+    to_file(
+        file,
+        (1400, 800),
+        |a| draw(a, title, series, truck),
+        |a| draw(a, title, series, truck),
+    )
 }
 
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+pub fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow::anyhow!("{e:?}")
 }
 
 /// One curvature-derived panel: caption, y label, limit line, and κ ↦ plotted value.
 type Panel<'a> = (&'a str, &'a str, f64, Box<dyn Fn(f64) -> f64 + 'a>);
 
-const COLORS: [RGBColor; 8] = [
+pub const COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -235,26 +235,12 @@ pub fn draw_sweep(
     planner: &str,
     points: &[(f64, forkbench_trial::batch::Summary)],
 ) -> anyhow::Result<()> {
-    register_font();
-    let ext = file
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let size = (900, 600);
-    let result = match ext.as_deref() {
-        Some("svg") => draw_sweep_on(
-            SVGBackend::new(file, size).into_drawing_area(),
-            planner,
-            points,
-        ),
-        Some("png") => draw_sweep_on(
-            BitMapBackend::new(file, size).into_drawing_area(),
-            planner,
-            points,
-        ),
-        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
-    };
-    result.with_context(|| format!("drawing {}", file.display()))
+    to_file(
+        file,
+        (900, 600),
+        |a| draw_sweep_on(a, planner, points),
+        |a| draw_sweep_on(a, planner, points),
+    )
 }
 
 fn draw_sweep_on<DB: DrawingBackend>(

@@ -93,7 +93,7 @@ pub fn compare(g: &GRegion) -> Comparison {
     let (mut ins, mut ins_wrong, mut circ, mut circ_wrong, mut area) = (0, 0, 0, 0, 0);
     for (cell, through) in g.through.iter().enumerate() {
         let p = s.cell_centre(cell);
-        if !s.in_window_pub(p) {
+        if !s.in_window(p) {
             continue;
         }
         let c = s.bend.clearance(p);
@@ -181,9 +181,7 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
         .enumerate()
         .filter(|(c, t)| {
             let p = s.cell_centre(*c);
-            t.is_none()
-                && s.in_window_pub(p)
-                && s.bend.clearance(p) >= s.vehicle.inscribed_m() / 2.0
+            t.is_none() && s.in_window(p) && s.bend.clearance(p) >= s.vehicle.inscribed_m() / 2.0
         })
         .map(|(c, _)| c)
         .collect();

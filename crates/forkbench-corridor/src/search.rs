@@ -64,6 +64,10 @@ pub struct Space {
     /// Heading layers: 0 = leg 1's heading … `layers - 1` = leg 2's.
     pub layers: usize,
     pub dphi: f64,
+    /// Radii one heading step may turn on. Free curvature is any sequence of on-the-spot
+    /// steps, arcs of Wc/2 (the fixed-radius mode's), L0/2, L0 and 2·L0, and straight
+    /// steps; the fixed-radius mode and the truck have one radius each.
+    pub turn_radii_m: Vec<f64>,
 }
 
 /// One search's visited states: parent (state index + 1; 0 = unvisited) and the exact
@@ -119,7 +123,14 @@ impl Space {
         } else {
             0.0
         };
+        let turn_radii_m = match mode {
+            Mode::Oblique | Mode::Spin => vec![0.0],
+            Mode::Curve => vec![0.0, vehicle.width_m / 2.0, l0 / 2.0, l0, 2.0 * l0],
+            Mode::CurveFixedRadius => vec![vehicle.width_m / 2.0],
+            Mode::Truck => vec![vehicle.min_radius_m],
+        };
         Self {
+            turn_radii_m,
             bend,
             vehicle,
             mode,
@@ -160,15 +171,10 @@ impl Space {
     }
 
     /// Inside the searched part of the corridor (legs cut at `reach_m`).
-    fn in_window(&self, p: [f64; 2]) -> bool {
+    pub fn in_window(&self, p: [f64; 2]) -> bool {
         p[1] >= -self.reach_m
             && self.bend.d2[0] * p[0] + self.bend.d2[1] * p[1] <= self.reach_m
             && self.bend.clearance(p) > 0.0
-    }
-
-    /// Whether a point is inside the searched part of the corridor.
-    pub fn in_window_pub(&self, p: [f64; 2]) -> bool {
-        self.in_window(p)
     }
 
     fn is_start(&self, p: [f64; 2]) -> bool {
@@ -188,46 +194,22 @@ impl Space {
             && (self.mode == Mode::Truck || (layer > 0 && layer + 1 < self.layers))
     }
 
-    /// Turning radii (about the body centre) one heading step may use: free curvature is
-    /// any sequence of on-the-spot steps, arcs of Wc/2 (the fixed-radius mode's), L0/2, L0
-    /// and 2·L0, and straight steps; a single radius for the fixed-radius mode.
-    fn turn_radii(&self) -> &'static [f64] {
-        match self.mode {
-            Mode::Oblique | Mode::Spin => &[0.0],
-            Mode::Curve => &[0.0, 1.0, 2.0, 3.0, 4.0],
-            Mode::CurveFixedRadius | Mode::Truck => &[1.0],
-        }
-    }
-
-    /// Body-centre displacement of the turn from `layer` to `layer + 1` with the radius
-    /// picked by `which` (an entry of [`Self::turn_radii`]).
-    fn turn_displacement(&self, layer: usize, which: f64) -> [f64; 2] {
+    /// Body-centre displacement of one heading step from `layer` to `layer + 1` on an
+    /// arc of `radius_m` (0: on the spot) about the turning point: the body centre for the
+    /// AMV modes, the kinematic point for the truck.
+    fn turn_displacement(&self, layer: usize, radius_m: f64) -> [f64; 2] {
         let (a, b) = (self.heading(layer), self.heading(layer + 1));
         let mid = (a + b) / 2.0;
-        let chord = |r: f64| 2.0 * r * (self.dphi / 2.0).sin();
-        let l0 = self.vehicle.circumscribed_m();
-        let along = |r: f64| [chord(r) * mid.cos(), chord(r) * mid.sin()];
-        match self.mode {
-            Mode::Oblique | Mode::Spin => [0.0, 0.0],
-            Mode::Curve => along(match which as u32 {
-                0 => 0.0,
-                1 => self.vehicle.width_m / 2.0,
-                2 => l0 / 2.0,
-                3 => l0,
-                _ => 2.0 * l0,
-            }),
-            Mode::CurveFixedRadius => along(self.vehicle.width_m / 2.0),
-            Mode::Truck => {
-                let (k, c) = (
-                    self.vehicle.kinematic_ahead_m,
-                    chord(self.vehicle.min_radius_m),
-                );
-                [
-                    k * (a.cos() - b.cos()) + c * mid.cos(),
-                    k * (a.sin() - b.sin()) + c * mid.sin(),
-                ]
-            }
-        }
+        let chord = 2.0 * radius_m * (self.dphi / 2.0).sin();
+        let k = if self.mode == Mode::Truck {
+            self.vehicle.kinematic_ahead_m
+        } else {
+            0.0
+        };
+        [
+            k * (a.cos() - b.cos()) + chord * mid.cos(),
+            k * (a.sin() - b.sin()) + chord * mid.sin(),
+        ]
     }
 
     fn free(&self, a: [f64; 2], ha: f64, b: [f64; 2], hb: f64) -> bool {
@@ -299,7 +281,7 @@ impl Space {
                     layer,
                 ));
             }
-            for &r in self.turn_radii() {
+            for &r in &self.turn_radii_m {
                 if forward && layer < last {
                     let d = self.turn_displacement(layer, r);
                     moves.push(([p[0] + d[0], p[1] + d[1]], layer + 1));
