@@ -127,17 +127,17 @@ impl Stamp {
 
 #[derive(Serialize)]
 struct Vec3 {
-    x: f64,
-    y: f64,
-    z: f64,
+    x: f32,
+    y: f32,
+    z: f32,
 }
 
 #[derive(Serialize)]
 struct Quat {
-    x: f64,
-    y: f64,
-    z: f64,
-    w: f64,
+    x: f32,
+    y: f32,
+    z: f32,
+    w: f32,
 }
 
 impl Quat {
@@ -146,8 +146,8 @@ impl Quat {
         Self {
             x: 0.0,
             y: 0.0,
-            z: s,
-            w: c,
+            z: s as f32,
+            w: c as f32,
         }
     }
 }
@@ -162,8 +162,8 @@ impl FoxPose {
     fn of(p: &Pose2) -> Self {
         Self {
             position: Vec3 {
-                x: p.x_m,
-                y: p.y_m,
+                x: p.x_m as f32,
+                y: p.y_m as f32,
                 z: 0.0,
             },
             orientation: Quat::yaw(p.heading_rad),
@@ -188,8 +188,8 @@ impl FrameTransform {
             parent_frame_id: "world",
             child_frame_id: child,
             translation: Vec3 {
-                x: p.x_m,
-                y: p.y_m,
+                x: p.x_m as f32,
+                y: p.y_m as f32,
                 z: 0.0,
             },
             rotation: Quat::yaw(p.heading_rad),
@@ -217,22 +217,22 @@ impl PoseInFrame {
 #[derive(Serialize)]
 struct Telemetry {
     t_s: f64,
-    truth: [f64; 3],
-    estimate: [f64; 3],
-    pallet: [f64; 3],
-    pallet_estimate: [f64; 3],
-    steer_cmd_rad: f64,
-    steer_rad: f64,
-    speed_cmd_mps: f64,
-    speed_mps: f64,
-    lookahead_m: [f64; 2],
-    cross_track_m: f64,
-    path_curvature_per_m: f64,
-    contact_force_n: f64,
+    truth: [f32; 3],
+    estimate: [f32; 3],
+    pallet: [f32; 3],
+    pallet_estimate: [f32; 3],
+    steer_cmd_rad: f32,
+    steer_rad: f32,
+    speed_cmd_mps: f32,
+    speed_mps: f32,
+    lookahead_m: [f32; 2],
+    cross_track_m: f32,
+    path_curvature_per_m: f32,
+    contact_force_n: f32,
 }
 
-fn xyh(p: &Pose2) -> [f64; 3] {
-    [p.x_m, p.y_m, p.heading_rad]
+fn xyh(p: &Pose2) -> [f32; 3] {
+    [p.x_m as f32, p.y_m as f32, p.heading_rad as f32]
 }
 
 /// An empty JSON array, for the SceneEntity primitive lists we do not use.
@@ -312,8 +312,8 @@ fn line(points: &[[f64; 2]], rgba: [f64; 4], thickness: f64) -> LinePrimitive {
         points: points
             .iter()
             .map(|p| Vec3 {
-                x: p[0],
-                y: p[1],
+                x: p[0] as f32,
+                y: p[1] as f32,
                 z: 0.0,
             })
             .collect(),
@@ -576,14 +576,14 @@ impl Sink {
             estimate: xyh(&s.estimate),
             pallet: xyh(&s.pallet),
             pallet_estimate: xyh(&s.pallet_estimate),
-            steer_cmd_rad: s.steer_cmd_rad,
-            steer_rad: s.steer_rad,
-            speed_cmd_mps: s.speed_cmd_mps,
-            speed_mps: s.speed_mps,
-            lookahead_m: s.lookahead,
-            cross_track_m: s.cross_track_m,
-            path_curvature_per_m: s.path_curvature_per_m,
-            contact_force_n: s.contact_force_n,
+            steer_cmd_rad: s.steer_cmd_rad as f32,
+            steer_rad: s.steer_rad as f32,
+            speed_cmd_mps: s.speed_cmd_mps as f32,
+            speed_mps: s.speed_mps as f32,
+            lookahead_m: s.lookahead.map(|v| v as f32),
+            cross_track_m: s.cross_track_m as f32,
+            path_curvature_per_m: s.path_curvature_per_m as f32,
+            contact_force_n: s.contact_force_n as f32,
         };
         self.write("/forkbench/telemetry", t, &telemetry);
     }
