@@ -2,7 +2,6 @@
 
 pub mod batch;
 pub mod defaults;
-pub mod geometry;
 pub mod outcome;
 pub mod recorder;
 pub mod scenario;

@@ -3,6 +3,7 @@
 use std::path::{Path as FsPath, PathBuf};
 
 use forkbench_core::{ForkliftSpec, Pose2};
+use forkbench_geom::{Footprint, Obstacles};
 use forkbench_plan::PlannerKind;
 use forkbench_sensors::{Nav350Config, PalletEstimateConfig};
 use forkbench_sim::{Obstacle, PalletSpec, SimConfig};
@@ -10,7 +11,6 @@ use forkbench_track::TrackerConfig;
 use serde::{Deserialize, Serialize};
 
 use crate::TrialError;
-use crate::geometry::Rect;
 
 /// A pose as written in files: metres and degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -144,6 +144,27 @@ impl World {
         Ok(w)
     }
 
+    /// Racks and walls for the footprint checker, with a label per obstacle for messages.
+    pub fn footprint_obstacles(&self) -> (Obstacles, Vec<String>) {
+        let mut obstacles = Obstacles::new();
+        let mut labels = Vec::new();
+        for (kind, list) in [("rack", &self.rack), ("wall", &self.wall)] {
+            for r in list {
+                obstacles.add_rect(
+                    &Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
+                    r.length_m,
+                    r.width_m,
+                );
+                labels.push(if r.name.is_empty() {
+                    kind.to_owned()
+                } else {
+                    format!("{kind} {:?}", r.name)
+                });
+            }
+        }
+        (obstacles, labels)
+    }
+
     /// Racks and walls as simulator obstacles.
     pub fn obstacles(&self) -> Vec<Obstacle> {
         self.rack
@@ -269,6 +290,10 @@ struct ScenarioFile {
     pallet_kind: PalletKind,
     #[serde(default = "default_timeout")]
     timeout_s: f64,
+    /// Refuse plans (and replans) whose swept truck body hits a rack or wall; off lets a
+    /// colliding plan be driven, to study the collision itself.
+    #[serde(default = "default_true")]
+    validate_paths: bool,
     #[serde(default)]
     truck: ForkliftSpec,
     #[serde(default)]
@@ -293,6 +318,10 @@ struct ScenarioFile {
     case: Vec<CaseFile>,
 }
 
+fn default_true() -> bool {
+    true
+}
+
 fn default_pallet_kind() -> PalletKind {
     PalletKind::Field1200
 }
@@ -311,6 +340,8 @@ pub struct Scenario {
     pub seed: u64,
     pub pallet: PalletSpec,
     pub timeout_s: f64,
+    /// Plans whose swept truck body hits a rack or wall count as `plan_failed`.
+    pub validate_paths: bool,
     pub truck: ForkliftSpec,
     pub tracker: TrackerConfig,
     pub sim: SimConfig,
@@ -489,6 +520,7 @@ impl Scenario {
             seed: f.seed,
             pallet,
             timeout_s: f.timeout_s,
+            validate_paths: f.validate_paths,
             truck: f.truck,
             tracker: f.tracker,
             sim: f.sim,
@@ -523,21 +555,34 @@ impl Scenario {
     }
 }
 
-/// Truck footprint at a fork-root pose: chassis ending at the fork root.
-pub fn truck_rect(truck: &ForkliftSpec, root: &Pose2) -> Rect {
-    Rect {
-        centre: root.to_world(&Pose2::new(-truck.body_length_m / 2.0, 0.0, 0.0)),
+/// The truck body's footprint referenced to the fork root: the chassis ends there (forks
+/// excluded, since they are meant to enter the pallet).
+pub fn truck_footprint(truck: &ForkliftSpec) -> Footprint {
+    Footprint {
         length_m: truck.body_length_m,
         width_m: truck.body_width_m,
+        centre_ahead_m: -truck.body_length_m / 2.0,
     }
 }
 
-/// Pallet footprint from its face-centre pose.
-pub fn pallet_rect(pallet: &PalletSpec, face: &Pose2) -> Rect {
-    Rect {
-        centre: face.to_world(&Pose2::new(pallet.depth_m / 2.0, 0.0, 0.0)),
+/// The pallet's footprint referenced to its face centre.
+pub fn pallet_footprint(pallet: &PalletSpec) -> Footprint {
+    Footprint {
         length_m: pallet.depth_m,
         width_m: pallet.width_m,
+        centre_ahead_m: pallet.depth_m / 2.0,
+    }
+}
+
+/// Layouts may touch (a pallet against a rack's back, a truck parked flush to a wall):
+/// footprints are shrunk by this on every side before the overlap test.
+const LAYOUT_TOLERANCE_M: f64 = 1e-3;
+
+fn shrunk(fp: Footprint) -> Footprint {
+    Footprint {
+        length_m: fp.length_m - 2.0 * LAYOUT_TOLERANCE_M,
+        width_m: fp.width_m - 2.0 * LAYOUT_TOLERANCE_M,
+        ..fp
     }
 }
 
@@ -549,37 +594,32 @@ fn check_layout(
     file: &str,
     field: &str,
 ) -> Result<(), TrialError> {
-    let p = pallet_rect(pallet, &case.pallet);
-    let t = truck_rect(truck, &case.start);
-    for (kind, list) in [("rack", &world.rack), ("wall", &world.wall)] {
-        for r in list {
-            let o = Rect {
-                centre: Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
-                length_m: r.length_m,
-                width_m: r.width_m,
-            };
-            let label = if r.name.is_empty() {
-                kind.to_owned()
-            } else {
-                format!("{kind} {:?}", r.name)
-            };
-            if p.overlaps(&o, 1e-3) {
-                return Err(invalid(
-                    file,
-                    &format!("{field}pallet"),
-                    &format!("pallet overlaps {label}"),
-                ));
-            }
-            if t.overlaps(&o, 1e-3) {
-                return Err(invalid(
-                    file,
-                    &format!("{field}start"),
-                    &format!("truck starts inside {label}"),
-                ));
-            }
-        }
+    let (obstacles, labels) = world.footprint_obstacles();
+    let (pallet_fp, truck_fp) = (
+        shrunk(pallet_footprint(pallet)),
+        shrunk(truck_footprint(truck)),
+    );
+    if let Some(i) = obstacles.hit(&pallet_fp, &case.pallet) {
+        return Err(invalid(
+            file,
+            &format!("{field}pallet"),
+            &format!("pallet overlaps {}", labels[i]),
+        ));
     }
-    if p.overlaps(&t, 1e-3) {
+    if let Some(i) = obstacles.hit(&truck_fp, &case.start) {
+        return Err(invalid(
+            file,
+            &format!("{field}start"),
+            &format!("truck starts inside {}", labels[i]),
+        ));
+    }
+    let mut pallet_only = Obstacles::new();
+    pallet_only.add_rect(
+        &pallet_fp.centre(&case.pallet),
+        pallet_fp.length_m,
+        pallet_fp.width_m,
+    );
+    if pallet_only.collides(&truck_fp, &case.start) {
         return Err(invalid(
             file,
             &format!("{field}start"),

@@ -13,7 +13,12 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord};
-use crate::scenario::{Case, Scenario};
+use crate::scenario::{Case, Scenario, truck_footprint};
+
+/// Arc-length spacing of the footprint checks along a plan (its samples are 1 cm apart):
+/// between two checks the fork root moves 2 cm and a body corner a few cm more in a turn,
+/// far below the racks' and walls' thickness.
+const PATH_CHECK_STEP_M: f64 = 0.02;
 
 /// Per-run choices on top of the scenario file.
 #[derive(Debug, Clone, Default)]
@@ -203,6 +208,23 @@ fn run_inner<R: Recorder + ?Sized>(
         } => Some(control_points_m.to_vec()),
         PlanParams::Spiral(_) => None,
     };
+    // Path validation: the truck body swept along a plan must clear every rack and wall,
+    // with the same footprint checker the corridor analysis uses.
+    let (footprint_obstacles, obstacle_labels) = scn.world.footprint_obstacles();
+    let body = truck_footprint(truck);
+    let clash = |path: &forkbench_core::Path| {
+        if !scn.validate_paths {
+            return None;
+        }
+        footprint_obstacles
+            .first_hit_along(&body, path, PATH_CHECK_STEP_M)
+            .map(|h| {
+                format!(
+                    "the planned path runs the truck body into {} at s = {:.2} m",
+                    obstacle_labels[h.obstacle], h.s_m
+                )
+            })
+    };
     let plan = match plan_from(first_fix, 0.0, &pallet_est) {
         Ok(p) => p,
         Err(e) => {
@@ -211,6 +233,11 @@ fn run_inner<R: Recorder + ?Sized>(
         }
     };
     rec.plan(0.0, 0, &plan.path, polygon(&plan).as_deref());
+    if let Some(why) = clash(&plan.path) {
+        rec.event(0.0, Level::Error, &why);
+        out.path_length_m = plan.path.length_m();
+        return finish(out, Some((Failure::PlanFailed, why)));
+    }
     rec.event(
         0.0,
         Level::Info,
@@ -269,7 +296,12 @@ fn run_inner<R: Recorder + ?Sized>(
                 || turned > scn.replan.heading_threshold_deg.to_radians()
             {
                 let k0 = sim.steer_rad().tan() / truck.wheelbase_m;
-                match plan_from(pose, k0, &new_est) {
+                let replan = plan_from(pose, k0, &new_est).map_err(|e| e.to_string());
+                let replan = replan.and_then(|p| match clash(&p.path) {
+                    Some(why) => Err(why),
+                    None => Ok(p),
+                });
+                match replan {
                     Ok(p) => {
                         rec.plan(
                             sim.time_s(),

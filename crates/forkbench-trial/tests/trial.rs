@@ -124,7 +124,7 @@ fn every_failure_criterion_can_trigger() {
             "scenario extra:\n{extra}"
         );
     }
-    // Collision: a wall segment reaching into the truck's swept path.
+    // Collision: a wall segment reaching into the truck's swept path, driven anyway.
     let world = World::parse(
         "name = \"w\"\n[[wall]]\nx_m = 3.0\ny_m = -0.3\nlength_m = 2.0\nwidth_m = 0.3\n",
         "w.toml",
@@ -134,12 +134,18 @@ fn every_failure_criterion_can_trigger() {
 name = "wall"
 planner = "bspline"
 world = "w.toml"
+validate_paths = false
 start = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }
 pallet = { x_m = 8.5, y_m = 1.5, heading_deg = 20.0 }
 "#;
-    let scn = Scenario::parse(text, "wall.toml", |_| Ok(world)).expect("valid");
+    let scn = Scenario::parse(text, "wall.toml", |_| Ok(world.clone())).expect("valid");
     let out = run_trial(&scn, &scn.cases[0], &no_noise());
     assert_eq!(out.failure, Some(Failure::Collision), "{out:?}");
+    // With path validation on (the default) the same plan is refused before driving.
+    let text = text.replace("validate_paths = false\n", "");
+    let scn = Scenario::parse(&text, "wall.toml", |_| Ok(world)).expect("valid");
+    let out = run_trial(&scn, &scn.cases[0], &no_noise());
+    assert_eq!(out.failure, Some(Failure::PlanFailed), "{out:?}");
 }
 
 #[test]
@@ -291,4 +297,39 @@ fn pallet_jitter_moves_the_true_pallet_per_seed() {
     )
     .expect_err("negative sigma");
     assert!(e.to_string().contains("pallet_jitter.y_m"), "{e}");
+}
+
+#[test]
+fn a_plan_through_a_pillar_is_refused_by_path_validation() {
+    let text = r#"
+name = "pillar"
+planner = "bspline"
+world = "w.toml"
+start = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }
+pallet = { x_m = 8.5, y_m = 0.5, heading_deg = 0.0 }
+"#;
+    // A 0.3 m pillar on the way, and a wall the pallet's back rests against (touching is
+    // a legal layout).
+    let w = |pillar_y: f64| {
+        World::parse(
+            &format!(
+                "name = \"w\"\n[[wall]]\nname = \"pillar\"\nx_m = 4.0\ny_m = {pillar_y}\nlength_m = 0.3\nwidth_m = 0.3\n\
+                 [[wall]]\nname = \"back\"\nx_m = 9.8\ny_m = 0.5\nlength_m = 0.2\nwidth_m = 3.0\n"
+            ),
+            "w.toml",
+        )
+        .expect("world")
+    };
+    let blocked = Scenario::parse(text, "s.toml", |_| Ok(w(0.25))).expect("valid layout");
+    let out = run_trial(&blocked, &blocked.cases[0], &no_noise());
+    assert_eq!(out.failure, Some(Failure::PlanFailed), "{out:?}");
+    let why = out.failure_detail.unwrap_or_default();
+    assert!(
+        why.contains("wall \"pillar\"") && why.contains("s = "),
+        "{why}"
+    );
+    // The same pick with the pillar 3 m aside is flown and succeeds.
+    let open = Scenario::parse(text, "s.toml", |_| Ok(w(3.5))).expect("valid layout");
+    let out = run_trial(&open, &open.cases[0], &no_noise());
+    assert!(out.success, "{out:?}");
 }
