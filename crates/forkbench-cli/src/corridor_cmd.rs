@@ -22,16 +22,6 @@ pub fn amv() -> Vehicle {
     }
 }
 
-/// The forklift body (forks excluded) turning about its front axle at r_min = L / tan α_max.
-pub fn truck(spec: &ForkliftSpec) -> Vehicle {
-    Vehicle {
-        length_m: spec.body_length_m,
-        width_m: spec.body_width_m,
-        kinematic_ahead_m: spec.body_length_m / 2.0 - spec.fork_root_ahead_of_front_axle_m,
-        min_radius_m: spec.wheelbase_m / spec.max_steer_rad.tan(),
-    }
-}
-
 /// Parses "0.56x0.40" (metres).
 pub fn parse_vehicle(text: &str) -> Result<Vehicle, String> {
     let (l, w) = text.split_once(['x', 'X']).ok_or_else(|| {
@@ -50,14 +40,19 @@ pub fn parse_vehicle(text: &str) -> Result<Vehicle, String> {
     })
 }
 
+/// Bend angles in degrees from `--sweep-angles` (a newtype: clap would read a bare
+/// `Vec<f64>` as a list of separate values).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Angles(pub Vec<f64>);
+
 /// Parses "A:B:STEP" in degrees.
-pub fn parse_sweep(text: &str) -> Result<Vec<f64>, String> {
+pub fn parse_sweep(text: &str) -> Result<Angles, String> {
     let parts: Vec<&str> = text.split(':').collect();
     let nums: Result<Vec<f64>, _> = parts.iter().map(|p| p.trim().parse::<f64>()).collect();
     match nums.as_deref() {
         Ok([a, b, step]) if *step > 0.0 && b >= a => {
             let n = ((b - a) / step + 1e-9).floor() as usize;
-            Ok((0..=n).map(|i| a + i as f64 * step).collect())
+            Ok(Angles((0..=n).map(|i| a + i as f64 * step).collect()))
         }
         _ => Err(format!(
             "--sweep-angles {text:?}: expected A:B:STEP in degrees with STEP > 0 and B ≥ A"
@@ -222,7 +217,7 @@ pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
         })?;
         crate::emit("\n## A30 truck body 2.45 × 1.2 m (r_min 0.94 m about the front axle)\n\n")?;
         run(&Args {
-            vehicle: truck(&ForkliftSpec::default()),
+            vehicle: Vehicle::forklift(&ForkliftSpec::default()),
             width_m: None,
             angles_deg: vec![30.0, 60.0, 90.0],
             cell_m: 0.03,

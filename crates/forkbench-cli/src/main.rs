@@ -246,7 +246,7 @@ enum Command {
         angle: Option<f64>,
         /// Bend angles A:B:STEP (degrees).
         #[arg(long, value_parser = corridor_cmd::parse_sweep)]
-        sweep_angles: Option<Vec<f64>>,
+        sweep_angles: Option<corridor_cmd::Angles>,
         /// Grid cell (m); default Wc/40 (1 cm for the AMV, 3 cm for the A30).
         #[arg(long)]
         resolution: Option<f64>,
@@ -453,11 +453,11 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             json,
         } => {
             let v = if truck {
-                corridor_cmd::truck(&load_truck(truck_spec.as_ref())?)
+                forkbench_corridor::Vehicle::forklift(&load_truck(truck_spec.as_ref())?)
             } else {
                 vehicle.unwrap_or_else(corridor_cmd::amv)
             };
-            let angles_deg = sweep_angles.unwrap_or_else(|| vec![angle.unwrap_or(90.0)]);
+            let angles_deg = sweep_angles.map_or_else(|| vec![angle.unwrap_or(90.0)], |a| a.0);
             corridor_cmd::run(&corridor_cmd::Args {
                 vehicle: v,
                 width_m: width,

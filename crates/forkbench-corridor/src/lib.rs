@@ -6,4 +6,4 @@ pub mod search;
 
 pub use analysis::{Comparison, CorridorError, Validation, check_inputs, compare, validate};
 pub use bend::{Bend, MARGIN_M, Vehicle, oblique_min_width_m};
-pub use search::{GRegion, Mode, Resolution, Space, min_width_m};
+pub use search::{GRegion, Mode, Resolution, Space, min_width_m, passes};

@@ -2,7 +2,7 @@
 
 use std::collections::VecDeque;
 
-use crate::bend::{Bend, Vehicle};
+use crate::bend::{Bend, MARGIN_M, Vehicle};
 
 /// How the vehicle changes direction at the bend.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
@@ -68,6 +68,9 @@ pub struct Space {
     /// steps, arcs of Wc/2 (the fixed-radius mode's), L0/2, L0 and 2·L0, and straight
     /// steps; the fixed-radius mode and the truck have one radius each.
     pub turn_radii_m: Vec<f64>,
+    /// Clearance every step keeps: the sagitta of the widest arc a body point follows in
+    /// one heading step (0.26 mm for the A30 body on a 2·L0 arc), at least `MARGIN_M`.
+    pub margin_m: f64,
 }
 
 /// One search's visited states: parent (state index + 1; 0 = unvisited) and the exact
@@ -129,8 +132,16 @@ impl Space {
             Mode::CurveFixedRadius => vec![vehicle.width_m / 2.0],
             Mode::Truck => vec![vehicle.min_radius_m],
         };
+        // Body points turn about the arc centre at up to radius + |offset of the turning
+        // point| + half the diagonal; between two states they bulge past the chord by the
+        // sagitta r·(1 − cos(Δφ/2)).
+        let widest = turn_radii_m.iter().copied().fold(0.0, f64::max)
+            + vehicle.kinematic_ahead_m.abs()
+            + l0 / 2.0;
+        let margin_m = MARGIN_M.max(1.25 * widest * (1.0 - (dphi / 2.0).cos()));
         Self {
             turn_radii_m,
+            margin_m,
             bend,
             vehicle,
             mode,
@@ -142,6 +153,17 @@ impl Space {
             ny: ((hi[1] - lo[1]) / h).ceil() as usize + 1,
             layers,
             dphi,
+        }
+    }
+
+    /// Moves the grid origin back by a fraction of a cell (the window keeps covering the
+    /// legs: one more cell in each direction).
+    pub fn shift_grid(&mut self, fraction: [f64; 2]) {
+        if fraction != [0.0, 0.0] {
+            self.x0 -= fraction[0] * self.res.cell_m;
+            self.y0 -= fraction[1] * self.res.cell_m;
+            self.nx += 1;
+            self.ny += 1;
         }
     }
 
@@ -212,9 +234,33 @@ impl Space {
         ]
     }
 
-    fn free(&self, a: [f64; 2], ha: f64, b: [f64; 2], hb: f64) -> bool {
-        self.bend
-            .sweep_free(&self.vehicle.corners(a, ha), &self.vehicle.corners(b, hb))
+    /// How far a straight drive from `p` along the unit vector `dir` goes to just leave
+    /// p's cell. Straight steps are one cell long or this, whichever is longer: a fixed
+    /// one-cell step can end in the same cell on oblique headings (the diagonal is longer
+    /// than a side), where first-arrival pruning dropped it, and a vehicle that cannot
+    /// slide sideways was then stuck in legs that are not axis-aligned.
+    fn exit_distance(&self, p: [f64; 2], dir: [f64; 2]) -> f64 {
+        let h = self.res.cell_m;
+        let origin = [self.x0, self.y0];
+        let mut t = f64::INFINITY;
+        for k in 0..2 {
+            let i = ((p[k] - origin[k]) / h).floor();
+            if dir[k] > 1e-12 {
+                t = t.min((origin[k] + (i + 1.0) * h - p[k]) / dir[k]);
+            } else if dir[k] < -1e-12 {
+                t = t.min((p[k] - (origin[k] + i * h)) / -dir[k]);
+            }
+        }
+        // Just past the boundary, so the end lies in the neighbouring cell.
+        t + 1e-6 * h
+    }
+
+    pub(crate) fn free(&self, a: [f64; 2], ha: f64, b: [f64; 2], hb: f64) -> bool {
+        self.bend.sweep_free(
+            &self.vehicle.corners(a, ha),
+            &self.vehicle.corners(b, hb),
+            self.margin_m,
+        )
     }
 
     /// Breadth-first search from leg 1 (`forward`) or back from leg 2; stops at the first
@@ -276,10 +322,9 @@ impl Space {
                 }
             }
             if self.drives_straight(layer) {
-                moves.push((
-                    [p[0] + sign * h * head.cos(), p[1] + sign * h * head.sin()],
-                    layer,
-                ));
+                let dir = [sign * head.cos(), sign * head.sin()];
+                let t = self.exit_distance(p, dir).max(h);
+                moves.push(([p[0] + t * dir[0], p[1] + t * dir[1]], layer));
             }
             for &r in &self.turn_radii_m {
                 if forward && layer < last {
@@ -344,9 +389,14 @@ impl GRegion {
         let backward = space.search(false, false);
         let through = (0..space.cells())
             .map(|c| {
-                (0..space.layers)
-                    .map(|l| l * space.cells() + c)
-                    .find(|&s| forward.parent[s] != 0 && backward.parent[s] != 0)
+                (0..space.layers).map(|l| l * space.cells() + c).find(|&s| {
+                    // Both searches reached the state, each with its own pose in the
+                    // cell; the passage joins them by a slide, which must be free too.
+                    let h = space.heading(s / space.cells());
+                    forward.parent[s] != 0
+                        && backward.parent[s] != 0
+                        && space.free(forward.pos[s], h, backward.pos[s], h)
+                })
             })
             .collect();
         Self {
@@ -380,6 +430,29 @@ impl GRegion {
     }
 }
 
+/// Whether the search finds a passage through a bend of `width_m`. A passage found is
+/// real (every step is an exact sweep); a miss may be the grid's. The truck cannot slide
+/// sideways, so which pose a cell keeps matters most there: it is searched on four
+/// half-cell-shifted grids and passes if any finds a way.
+pub fn passes(
+    vehicle: &Vehicle,
+    mode: Mode,
+    angle_rad: f64,
+    res: Resolution,
+    width_m: f64,
+) -> bool {
+    let shifts: &[[f64; 2]] = if mode == Mode::Truck {
+        &[[0.0, 0.0], [0.5, 0.0], [0.0, 0.5], [0.5, 0.5]]
+    } else {
+        &[[0.0, 0.0]]
+    };
+    shifts.iter().any(|s| {
+        let mut space = Space::new(Bend::new(width_m, angle_rad), *vehicle, mode, res);
+        space.shift_grid(*s);
+        space.search(true, true).goal.is_some()
+    })
+}
+
 /// Smallest width (bisection to a quarter cell; the grid itself limits it to about one
 /// cell) at which `mode` passes the bend, or `None`
 /// when even `max_width_m` does not.
@@ -390,12 +463,7 @@ pub fn min_width_m(
     res: Resolution,
     max_width_m: f64,
 ) -> Option<f64> {
-    let passes = |w: f64| {
-        Space::new(Bend::new(w, angle_rad), *vehicle, mode, res)
-            .search(true, true)
-            .goal
-            .is_some()
-    };
+    let passes = |w: f64| passes(vehicle, mode, angle_rad, res, w);
     let mut lo = vehicle.width_m;
     let mut hi = vehicle.circumscribed_m() + res.cell_m;
     while !passes(hi) {
