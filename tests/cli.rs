@@ -529,3 +529,93 @@ fn batch_records_failures_and_replay_reproduces_a_trial() {
     );
     assert!(rrd.exists());
 }
+
+#[test]
+fn corridor_sweep_json_and_g_plot() {
+    let v = stdout_json(&forkbench(&[
+        "corridor",
+        "--sweep-angles",
+        "30:90:30",
+        "--resolution",
+        "0.02",
+        "--json",
+    ]));
+    assert_eq!(v["vehicle"]["length_m"], 0.56);
+    assert_eq!(v["resolution_m"], 0.02);
+    let rows = v["rows"].as_array().expect("rows");
+    // 3 angles × the 4 AMV modes, each with a width, none with a G area (no --width).
+    assert_eq!(rows.len(), 12);
+    for r in rows {
+        assert!(
+            r["min_width_m"]
+                .as_f64()
+                .is_some_and(|w| w > 0.40 && w < 0.75),
+            "{r}"
+        );
+        assert!(
+            r.get("g_area_m2").is_none_or(serde_json::Value::is_null),
+            "{r}"
+        );
+    }
+    let at = |deg: f64, mode: &str| {
+        rows.iter()
+            .find(|r| r["angle_deg"] == deg && r["mode"] == mode)
+            .and_then(|r| r["min_width_m"].as_f64())
+            .expect("row")
+    };
+    for deg in [30.0, 60.0, 90.0] {
+        assert!(at(deg, "oblique") > at(deg, "spin") && at(deg, "spin") > at(deg, "curve"));
+    }
+    let svg = tmp("g.svg");
+    let out = forkbench(&[
+        "corridor",
+        "--width",
+        "0.6",
+        "--angle",
+        "90",
+        "--resolution",
+        "0.02",
+        "--plot",
+        svg.to_str().expect("utf-8"),
+        "--json",
+    ]);
+    let v = stdout_json(&out);
+    let g = |mode: &str| {
+        v["rows"]
+            .as_array()
+            .and_then(|r| r.iter().find(|r| r["mode"] == mode))
+            .and_then(|r| r["g_area_m2"].as_f64())
+            .expect("G area")
+    };
+    assert!(g("curve") > g("spin") && g("spin") > g("oblique"));
+    let text = std::fs::read_to_string(&svg).expect("plot written");
+    assert!(
+        text.starts_with("<svg") || text.starts_with("<?xml"),
+        "{}",
+        &text[..40]
+    );
+}
+
+#[test]
+fn corridor_input_errors_are_clear() {
+    for (args, needle) in [
+        (vec!["--vehicle", "0x0.4"], "length_m"),
+        (vec!["--vehicle", "0.56x-1"], "width_m"),
+        (vec!["--vehicle", "big"], "LENGTHxWIDTH"),
+        (vec!["--angle", "200"], "angle_deg"),
+        (vec!["--angle", "-5"], "angle_deg"),
+        (vec!["--sweep-angles", "90:30:10"], "B ≥ A"),
+        (vec!["--sweep-angles", "0:90"], "A:B:STEP"),
+        (vec!["--width", "0.3"], "width_m"),
+        (vec!["--resolution", "0"], "resolution"),
+        (vec!["--truck", "--width", "1.0"], "width_m"),
+    ] {
+        let mut a = vec!["corridor"];
+        a.extend(&args);
+        let out = forkbench(&a);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}

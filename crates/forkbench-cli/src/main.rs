@@ -239,16 +239,16 @@ enum Command {
         #[arg(long, requires = "truck")]
         truck_spec: Option<PathBuf>,
         /// Corridor width (m): also compute the G regions and compare with circle inflation.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         width: Option<f64>,
         /// Bend angle (degrees).
-        #[arg(long, conflicts_with = "sweep_angles")]
+        #[arg(long, conflicts_with = "sweep_angles", allow_negative_numbers = true)]
         angle: Option<f64>,
         /// Bend angles A:B:STEP (degrees).
         #[arg(long, value_parser = corridor_cmd::parse_sweep)]
         sweep_angles: Option<corridor_cmd::Angles>,
         /// Grid cell (m); default Wc/40 (1 cm for the AMV, 3 cm for the A30).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         resolution: Option<f64>,
         /// W_min vs θ, or with --width and one angle the G regions (.svg or .png).
         #[arg(long)]
