@@ -362,11 +362,15 @@ impl McapRecorder {
             message: e.to_string(),
         };
         let file = File::create(path).map_err(|e| io(&e))?;
-        // Small chunks: a crash loses at most the chunk being written. lz4 rather than
-        // the default zstd: recording must stay cheap next to the trial itself.
+        // Small chunks: a crash loses at most the chunk being written. zstd at level 1 on
+        // this thread only (the crate's default spawns a compressor per core, which would
+        // take the trial's core): as cheap as lz4 here (within run-to-run noise) and files
+        // 2.3× smaller (276 KB vs 630 KB for the field test).
         let mut writer = mcap::WriteOptions::new()
             .chunk_size(Some(64 * 1024))
-            .compression(Some(mcap::Compression::Lz4))
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_level(1)
+            .compression_threads(0)
             .create(BufWriter::new(file))
             .map_err(|e| io(&e))?;
         let mut schemas = BTreeMap::new();
