@@ -1,4 +1,4 @@
-//! Minimum corridor width per mode at one angle, 1 cm / 1° (target ≤ 1 s each).
+//! Minimum corridor width per mode at one angle: the AMV at 1 cm / 1° (target ≤ 1 s each), the forklift at 3 cm.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use forkbench_corridor::{Mode, Resolution, Vehicle, min_width_m};
@@ -23,6 +23,19 @@ fn bench(c: &mut Criterion) {
     ] {
         g.bench_function(mode.name(), |b| {
             b.iter(|| min_width_m(&amv, mode, 90f64.to_radians(), res, 5.0))
+        });
+    }
+    g.finish();
+    // The forklift at the same relative resolution (Wc/40 = 3 cm), four shifted grids.
+    let truck = Vehicle::forklift(&forkbench_core::ForkliftSpec::default());
+    let res3 = Resolution {
+        cell_m: truck.width_m / 40.0,
+        ..res
+    };
+    let mut g = c.benchmark_group("min_width_a30_3cm");
+    for deg in [60.0f64, 90.0] {
+        g.bench_function(format!("truck_{deg}deg"), |b| {
+            b.iter(|| min_width_m(&truck, Mode::Truck, deg.to_radians(), res3, 20.0))
         });
     }
     g.finish();

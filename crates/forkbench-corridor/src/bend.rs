@@ -71,6 +71,28 @@ impl Bend {
     /// the two outer walls (convex side). Testing a subset of axes can only err towards
     /// "collides", never the other way.
     pub fn sweep_free(&self, a: &[[f64; 2]; 4], b: &[[f64; 2]; 4], margin_m: f64) -> bool {
+        let edge = |q: &[[f64; 2]; 4], i: usize| {
+            let d = [q[(i + 1) % 4][0] - q[i][0], q[(i + 1) % 4][1] - q[i][1]];
+            let n = d[0].hypot(d[1]).max(1e-12);
+            [-d[1] / n, d[0] / n]
+        };
+        self.sweep_free_axes(
+            a,
+            b,
+            [edge(a, 0), edge(a, 1), edge(b, 0), edge(b, 1)],
+            margin_m,
+        )
+    }
+
+    /// [`Bend::sweep_free`] with the bodies' edge normals given (unit vectors of `a`'s two
+    /// edge directions' normals, then `b`'s), as a search that caches them per heading does.
+    pub fn sweep_free_axes(
+        &self,
+        a: &[[f64; 2]; 4],
+        b: &[[f64; 2]; 4],
+        edge_normals: [[f64; 2]; 4],
+        margin_m: f64,
+    ) -> bool {
         let hw = self.width_m / 2.0;
         let m = margin_m;
         let pts = a.iter().chain(b.iter());
@@ -88,15 +110,7 @@ impl Bend {
         let e1 = [0.0, -1.0];
         let e2 = self.d2;
         let mut axes: [[f64; 2]; 5] = [[0.0; 2]; 5];
-        let edge = |q: &[[f64; 2]; 4], i: usize| {
-            let d = [q[(i + 1) % 4][0] - q[i][0], q[(i + 1) % 4][1] - q[i][1]];
-            let n = d[0].hypot(d[1]).max(1e-12);
-            [-d[1] / n, d[0] / n]
-        };
-        axes[0] = edge(a, 0);
-        axes[1] = edge(a, 1);
-        axes[2] = edge(b, 0);
-        axes[3] = edge(b, 1);
+        axes[..4].copy_from_slice(&edge_normals);
         let v = [b[0][0] - a[0][0], b[0][1] - a[0][1]];
         let nv = v[0].hypot(v[1]);
         let count = if nv > 1e-12 {

@@ -2,6 +2,8 @@
 
 use std::collections::VecDeque;
 
+use rayon::prelude::*;
+
 use crate::bend::{Bend, MARGIN_M, Vehicle};
 
 /// How the vehicle changes direction at the bend.
@@ -71,6 +73,9 @@ pub struct Space {
     /// Clearance every step keeps: the sagitta of the widest arc a body point follows in
     /// one heading step (0.26 mm for the A30 body on a 2·L0 arc), at least `MARGIN_M`.
     pub margin_m: f64,
+    /// (sin, cos) of each layer's heading: corners and edge normals without trigonometry
+    /// in the search's inner loop.
+    trig: Vec<[f64; 2]>,
 }
 
 /// One search's visited states: parent (state index + 1; 0 = unvisited) and the exact
@@ -139,9 +144,17 @@ impl Space {
             + vehicle.kinematic_ahead_m.abs()
             + l0 / 2.0;
         let margin_m = MARGIN_M.max(1.25 * widest * (1.0 - (dphi / 2.0).cos()));
+        let h1 = bend.headings().0;
+        let trig = (0..layers)
+            .map(|l| {
+                let (s, c) = (h1 - l as f64 * dphi).sin_cos();
+                [s, c]
+            })
+            .collect();
         Self {
             turn_radii_m,
             margin_m,
+            trig,
             bend,
             vehicle,
             mode,
@@ -255,6 +268,22 @@ impl Space {
         t + 1e-6 * h
     }
 
+    /// The body's corners at `p` in heading layer `layer`, and its two edge normals.
+    fn body(&self, p: [f64; 2], layer: usize) -> ([[f64; 2]; 4], [[f64; 2]; 2]) {
+        let [s, c] = self.trig[layer];
+        let (hl, hw) = (self.vehicle.length_m / 2.0, self.vehicle.width_m / 2.0);
+        let corners = [[hl, hw], [-hl, hw], [-hl, -hw], [hl, -hw]]
+            .map(|[x, y]| [p[0] + c * x - s * y, p[1] + s * x + c * y]);
+        (corners, [[c, s], [-s, c]])
+    }
+
+    /// Whether the body moves freely from `a` (see [`Space::body`]) to `q` in layer `ql`.
+    fn free_to(&self, a: &([[f64; 2]; 4], [[f64; 2]; 2]), q: [f64; 2], ql: usize) -> bool {
+        let b = self.body(q, ql);
+        self.bend
+            .sweep_free_axes(&a.0, &b.0, [a.1[0], a.1[1], b.1[0], b.1[1]], self.margin_m)
+    }
+
     pub(crate) fn free(&self, a: [f64; 2], ha: f64, b: [f64; 2], hb: f64) -> bool {
         self.bend.sweep_free(
             &self.vehicle.corners(a, ha),
@@ -274,13 +303,15 @@ impl Space {
         let start_layer = if forward { first } else { last };
         for cell in 0..self.cells() {
             let p = self.cell_centre(cell);
-            let h = self.heading(start_layer);
             let starts = if forward {
                 self.is_start(p)
             } else {
                 self.is_goal(p)
             };
-            if starts && self.in_window(p) && self.free(p, h, p, h) {
+            if starts
+                && self.in_window(p)
+                && self.free_to(&self.body(p, start_layer), p, start_layer)
+            {
                 let s = start_layer * self.cells() + cell;
                 parent[s] = ROOT;
                 pos[s] = p;
@@ -306,6 +337,7 @@ impl Space {
                 }
             }
             let head = self.heading(layer);
+            let here = self.body(p, layer);
             moves.clear();
             if self.translates(layer) {
                 for (dx, dy) in [
@@ -344,7 +376,7 @@ impl Space {
                     continue;
                 };
                 let t = ql * self.cells() + cell;
-                if parent[t] != 0 || !self.free(p, head, q, self.heading(ql)) {
+                if parent[t] != 0 || !self.free_to(&here, q, ql) {
                     continue;
                 }
                 parent[t] = s as u32 + 1;
@@ -446,7 +478,8 @@ pub fn passes(
     } else {
         &[[0.0, 0.0]]
     };
-    shifts.iter().any(|s| {
+    // The shifted searches are independent: run them on all cores, stop at the first way.
+    shifts.par_iter().any(|s| {
         let mut space = Space::new(Bend::new(width_m, angle_rad), *vehicle, mode, res);
         space.shift_grid(*s);
         space.search(true, true).goal.is_some()
