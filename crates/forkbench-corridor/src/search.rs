@@ -79,7 +79,8 @@ pub struct Space {
 }
 
 /// One search's visited states: parent (state index + 1; 0 = unvisited) and the exact
-/// pose each state was first reached with.
+/// pose each state keeps (of the arrivals before it was expanded, the one nearest its
+/// cell's centre).
 #[derive(Debug)]
 pub struct Reached {
     pub parent: Vec<u32>,
@@ -299,6 +300,8 @@ impl Space {
         let mut parent = vec![0u32; n];
         let mut pos = vec![[0.0f64; 2]; n];
         let mut queue = VecDeque::new();
+        // A queued state not yet expanded takes a later arrival nearer its cell's centre.
+        let mut expanded = vec![false; n];
         let (first, last) = (0, self.layers - 1);
         let start_layer = if forward { first } else { last };
         for cell in 0..self.cells() {
@@ -324,6 +327,7 @@ impl Space {
         let mut moves: Vec<([f64; 2], usize)> = Vec::with_capacity(10);
         while let Some(s) = queue.pop_front() {
             let s = s as usize;
+            expanded[s] = true;
             let (layer, p) = (s / self.cells(), pos[s]);
             let done = if forward {
                 layer == last && self.is_goal(p)
@@ -376,12 +380,25 @@ impl Space {
                     continue;
                 };
                 let t = ql * self.cells() + cell;
-                if parent[t] != 0 || !self.free_to(&here, q, ql) {
+                let seen = parent[t] != 0;
+                // The pose a state keeps decides what follows, above all for the truck,
+                // which cannot slide: keeping the first arrival made its W_min jump by
+                // several cells under 1e-7 m changes. Preferring the arrival nearest the
+                // cell centre (until the state is expanded) ties the choice to the grid,
+                // not to the order of arrival; each kept move is still checked exactly.
+                let better = seen && !expanded[t] && {
+                    let c = self.cell_centre(cell);
+                    let d = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
+                    d(q) < d(pos[t])
+                };
+                if (seen && !better) || !self.free_to(&here, q, ql) {
                     continue;
                 }
                 parent[t] = s as u32 + 1;
                 pos[t] = q;
-                queue.push_back(t as u32);
+                if !seen {
+                    queue.push_back(t as u32);
+                }
             }
         }
         Reached { parent, pos, goal }
