@@ -609,6 +609,8 @@ fn corridor_input_errors_are_clear() {
         (vec!["--width", "0.3"], "width_m"),
         (vec!["--resolution", "0"], "resolution"),
         (vec!["--truck", "--width", "1.0"], "width_m"),
+        (vec!["--junction", "t", "--angle", "60"], "T junction"),
+        (vec!["--junction", "y"], "--junction"),
     ] {
         let mut a = vec!["corridor"];
         a.extend(&args);

@@ -5,7 +5,7 @@ use std::path::Path as FsPath;
 
 use forkbench_core::ForkliftSpec;
 use forkbench_corridor::{
-    Bend, GRegion, Mode, Resolution, Vehicle, check_inputs, compare, min_width_m,
+    GRegion, Junction, Mode, Resolution, Vehicle, check_inputs, compare, min_width_m,
     oblique_min_width_m, validate,
 };
 use plotters::prelude::*;
@@ -38,6 +38,17 @@ pub fn parse_vehicle(text: &str) -> Result<Vehicle, String> {
         kinematic_ahead_m: 0.0,
         min_radius_m: 0.0,
     })
+}
+
+/// `l` or `t` (either case).
+pub fn parse_junction(text: &str) -> Result<Junction, String> {
+    match text {
+        "l" | "L" => Ok(Junction::L),
+        "t" | "T" => Ok(Junction::T),
+        _ => Err(format!(
+            "--junction {text:?}: expected l (a bend) or t (a T junction)"
+        )),
+    }
 }
 
 /// Bend angles in degrees from `--sweep-angles` (a newtype: clap would read a bare
@@ -83,6 +94,7 @@ struct Row {
 #[derive(Debug)]
 pub struct Args<'a> {
     pub vehicle: Vehicle,
+    pub junction: Junction,
     pub width_m: Option<f64>,
     pub angles_deg: Vec<f64>,
     pub cell_m: f64,
@@ -91,7 +103,7 @@ pub struct Args<'a> {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    check_inputs(&a.vehicle, a.width_m, &a.angles_deg, a.cell_m)?;
+    check_inputs(&a.vehicle, a.junction, a.width_m, &a.angles_deg, a.cell_m)?;
     let res = Resolution {
         cell_m: a.cell_m,
         heading_rad: 1f64.to_radians(),
@@ -105,13 +117,14 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
             let w = min_width_m(
                 &a.vehicle,
                 mode,
+                a.junction,
                 th,
                 res,
                 20.0 * a.vehicle.circumscribed_m(),
             );
             let g = a
                 .width_m
-                .map(|w| GRegion::compute(Bend::new(w, th), a.vehicle, mode, res));
+                .map(|w| GRegion::compute(a.junction.bend(w, th), a.vehicle, mode, res));
             rows.push(Row {
                 angle_deg: deg,
                 mode,
@@ -134,6 +147,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     if a.json {
         let doc = serde_json::json!({
             "vehicle": {"length_m": a.vehicle.length_m, "width_m": a.vehicle.width_m},
+            "junction": a.junction.name(),
             "resolution_m": a.cell_m,
             "rows": rows,
         });
@@ -142,11 +156,12 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     }
     let v = &a.vehicle;
     let mut out = format!(
-        "vehicle {:.3} × {:.3} m (Li {:.3} m, L0 {:.3} m), resolution {:.3} m / 1°\n\n",
+        "vehicle {:.3} × {:.3} m (Li {:.3} m, L0 {:.3} m), {} junction, resolution {:.3} m / 1°\n\n",
         v.length_m,
         v.width_m,
         v.inscribed_m(),
         v.circumscribed_m(),
+        a.junction.name(),
         a.cell_m
     );
     out.push_str("| angle (°) | mode | W_min (m) | oblique closed form (m) | G area (m²) |\n|---|---|---|---|---|\n");
@@ -199,6 +214,7 @@ pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
     }
     run(&Args {
         vehicle: v,
+        junction: Junction::L,
         width_m: None,
         angles_deg: angles.clone(),
         cell_m: 0.01,
@@ -209,6 +225,17 @@ pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
         crate::emit("\n## AMV G regions at W = 0.60 m, θ = 90°\n\n")?;
         run(&Args {
             vehicle: v,
+            junction: Junction::L,
+            width_m: Some(0.60),
+            angles_deg: vec![90.0],
+            cell_m: 0.01,
+            plot: None,
+            json: false,
+        })?;
+        crate::emit("\n## AMV turning from the stem of a T junction, W = 0.60 m\n\n")?;
+        run(&Args {
+            vehicle: v,
+            junction: Junction::T,
             width_m: Some(0.60),
             angles_deg: vec![90.0],
             cell_m: 0.01,
@@ -218,6 +245,7 @@ pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
         crate::emit("\n## A30 truck body 2.45 × 1.2 m (r_min 0.94 m about the front axle)\n\n")?;
         run(&Args {
             vehicle: Vehicle::forklift(&ForkliftSpec::default()),
+            junction: Junction::L,
             width_m: None,
             angles_deg: vec![30.0, 60.0, 90.0],
             cell_m: 0.03,

@@ -241,6 +241,10 @@ enum Command {
         /// Corridor width (m): also compute the G regions and compare with circle inflation.
         #[arg(long, allow_negative_numbers = true)]
         width: Option<f64>,
+        /// Junction: `l` (a bend of --angle) or `t` (from the stem of a T into its right
+        /// arm, 90°).
+        #[arg(long, value_parser = corridor_cmd::parse_junction, default_value = "l")]
+        junction: forkbench_corridor::Junction,
         /// Bend angle (degrees).
         #[arg(long, conflicts_with = "sweep_angles", allow_negative_numbers = true)]
         angle: Option<f64>,
@@ -446,6 +450,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             truck,
             truck_spec,
             width,
+            junction,
             angle,
             sweep_angles,
             resolution,
@@ -460,6 +465,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             let angles_deg = sweep_angles.map_or_else(|| vec![angle.unwrap_or(90.0)], |a| a.0);
             corridor_cmd::run(&corridor_cmd::Args {
                 vehicle: v,
+                junction,
                 width_m: width,
                 angles_deg,
                 cell_m: resolution.unwrap_or(v.width_m / 40.0),

@@ -1,7 +1,7 @@
 //! Minimum corridor width per mode at one angle: the AMV at 1 cm / 1° (target ≤ 1 s each), the forklift at 3 cm.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use forkbench_corridor::{Mode, Resolution, Vehicle, min_width_m};
+use forkbench_corridor::{Junction, Mode, Resolution, Vehicle, min_width_m};
 
 fn bench(c: &mut Criterion) {
     let amv = Vehicle {
@@ -22,7 +22,7 @@ fn bench(c: &mut Criterion) {
         Mode::CurveFixedRadius,
     ] {
         g.bench_function(mode.name(), |b| {
-            b.iter(|| min_width_m(&amv, mode, 90f64.to_radians(), res, 5.0))
+            b.iter(|| min_width_m(&amv, mode, Junction::L, 90f64.to_radians(), res, 5.0))
         });
     }
     g.finish();
@@ -35,7 +35,16 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("min_width_a30_3cm");
     for deg in [60.0f64, 90.0] {
         g.bench_function(format!("truck_{deg}deg"), |b| {
-            b.iter(|| min_width_m(&truck, Mode::Truck, deg.to_radians(), res3, 20.0))
+            b.iter(|| {
+                min_width_m(
+                    &truck,
+                    Mode::Truck,
+                    Junction::L,
+                    deg.to_radians(),
+                    res3,
+                    20.0,
+                )
+            })
         });
     }
     g.finish();

@@ -2,7 +2,7 @@
 
 use forkbench_core::Pose2;
 
-use crate::bend::Vehicle;
+use crate::bend::{Junction, Vehicle};
 use crate::search::{GRegion, Mode};
 
 /// Bad corridor-analysis input.
@@ -19,6 +19,7 @@ pub enum CorridorError {
 /// Checks the inputs of an analysis; every field is named in the error.
 pub fn check_inputs(
     v: &Vehicle,
+    junction: Junction,
     width_m: Option<f64>,
     angles_deg: &[f64],
     cell_m: f64,
@@ -67,6 +68,9 @@ pub fn check_inputs(
     for &a in angles_deg {
         if !(a.is_finite() && (0.0..=135.0).contains(&a)) {
             return bad("angle_deg", a, "must lie in 0…135°");
+        }
+        if junction == Junction::T && a != 90.0 {
+            return bad("angle_deg", a, "a T junction turns by 90°");
         }
     }
     Ok(())

@@ -9,7 +9,9 @@ pub const MARGIN_M: f64 = 1e-4;
 
 /// The bend: leg 1 runs along +y (centre line x = 0) up to the corner, leg 2 leaves it
 /// turned right by `angle_rad`; the centre lines cross at the origin. The outer corner I
-/// is on the left, the inner corner J on the right.
+/// is on the left, the inner corner J on the right. In a T junction (90° only) leg 2 is
+/// one arm of a crossbar that continues to the left: no outer wall along leg 1, and a
+/// second inner corner K on the left.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bend {
     pub width_m: f64,
@@ -19,8 +21,35 @@ pub struct Bend {
     pub l2: [f64; 2],
     /// Inner corner.
     pub j: [f64; 2],
-    /// Outer corner.
+    /// Outer corner (L) or the left arm's inner corner K (T).
     pub i: [f64; 2],
+    pub tee: bool,
+}
+
+/// The junction a vehicle turns through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Junction {
+    /// Two legs meeting at an angle (an L at 90°).
+    L,
+    /// Turning from the stem of a T into its right arm (90°).
+    T,
+}
+
+impl Junction {
+    pub fn bend(self, width_m: f64, angle_rad: f64) -> Bend {
+        match self {
+            Junction::L => Bend::new(width_m, angle_rad),
+            Junction::T => Bend::tee(width_m),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Junction::L => "L",
+            Junction::T => "T",
+        }
+    }
 }
 
 fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -39,7 +68,26 @@ impl Bend {
             l2: [-c, s],
             j: [hw, -hw * t],
             i: [-hw, hw * t],
+            tee: false,
         }
+    }
+
+    /// A T junction of corridors of width `width_m`, turning right from the stem.
+    pub fn tee(width_m: f64) -> Self {
+        let hw = width_m / 2.0;
+        Self {
+            i: [-hw, -hw],
+            tee: true,
+            ..Self::new(width_m, std::f64::consts::FRAC_PI_2)
+        }
+    }
+
+    /// The inner blocks: apex and the two directions they extend in (down leg 1, and
+    /// along the crossbar away from the stem).
+    fn blocks(&self) -> impl Iterator<Item = ([f64; 2], [f64; 2], [f64; 2])> {
+        let j = (self.j, [0.0, -1.0], self.d2);
+        let k = (self.i, [0.0, -1.0], [-self.d2[0], -self.d2[1]]);
+        std::iter::once(j).chain(self.tee.then_some(k))
     }
 
     /// Heading of leg 1 and of leg 2 (rad, from +x).
@@ -51,18 +99,25 @@ impl Bend {
     /// Distance from a point of the corridor to its nearest wall (negative outside).
     pub fn clearance(&self, p: [f64; 2]) -> f64 {
         let hw = self.width_m / 2.0;
-        let outer = (p[0] + hw).min(hw - dot(self.l2, p));
-        let inside_b = p[0] > hw && dot(self.l2, p) < -hw;
-        if inside_b {
+        let mut outer = hw - dot(self.l2, p);
+        if !self.tee {
+            outer = outer.min(p[0] + hw);
+        }
+        if p[0] > hw && dot(self.l2, p) < -hw {
             return -(p[0] - hw).min(-hw - dot(self.l2, p));
         }
-        // Distance to the inner wall: the ray down leg 1 from J and the ray along leg 2.
-        let ray = |dir: [f64; 2]| {
-            let v = [p[0] - self.j[0], p[1] - self.j[1]];
+        if self.tee && p[0] < -hw && dot(self.l2, p) < -hw {
+            return -(-hw - p[0]).min(-hw - dot(self.l2, p));
+        }
+        // Distance to each inner block: the rays from its apex along its two walls.
+        let ray = |apex: [f64; 2], dir: [f64; 2]| {
+            let v = [p[0] - apex[0], p[1] - apex[1]];
             let t = dot(v, dir).max(0.0);
             (v[0] - t * dir[0]).hypot(v[1] - t * dir[1])
         };
-        outer.min(ray([0.0, -1.0])).min(ray(self.d2))
+        self.blocks()
+            .map(|(apex, e1, e2)| ray(apex, e1).min(ray(apex, e2)))
+            .fold(outer, f64::min)
     }
 
     /// True when the body sweeping linearly from corners `a` to corners `b` (a translation
@@ -96,46 +151,51 @@ impl Bend {
         let hw = self.width_m / 2.0;
         let m = margin_m;
         let pts = a.iter().chain(b.iter());
-        // Outer walls: x ≥ -W/2 and l2·p ≤ W/2 for every corner (the sweep lies in their hull).
+        // Outer walls: x ≥ -W/2 (L only) and l2·p ≤ W/2 for every corner (the sweep lies
+        // in their hull).
         for p in pts.clone() {
-            if p[0] < -hw + m || dot(self.l2, *p) > hw - m {
+            if (!self.tee && p[0] < -hw + m) || dot(self.l2, *p) > hw - m {
                 return false;
             }
         }
-        // Inner block B = {x > W/2, l2·p < -W/2}: separated along its own normals?
-        if pts.clone().all(|p| p[0] <= hw - m) || pts.clone().all(|p| -dot(self.l2, *p) <= hw - m) {
-            return true;
-        }
-        // Along the body's edge normals (both ends) and across the motion.
-        let e1 = [0.0, -1.0];
-        let e2 = self.d2;
-        let mut axes: [[f64; 2]; 5] = [[0.0; 2]; 5];
-        axes[..4].copy_from_slice(&edge_normals);
+        // Each inner block (a convex wedge) must be separated along one axis: its own wall
+        // normals, the body's edge normals at both ends, or the normal of the motion.
+        let mut axes: [[f64; 2]; 7] = [
+            [1.0, 0.0],
+            self.l2,
+            [0.0; 2],
+            [0.0; 2],
+            [0.0; 2],
+            [0.0; 2],
+            [0.0; 2],
+        ];
+        axes[2..6].copy_from_slice(&edge_normals);
         let v = [b[0][0] - a[0][0], b[0][1] - a[0][1]];
         let nv = v[0].hypot(v[1]);
         let count = if nv > 1e-12 {
-            axes[4] = [-v[1] / nv, v[0] / nv];
-            5
+            axes[6] = [-v[1] / nv, v[0] / nv];
+            7
         } else {
-            4
+            6
         };
-        for u in &axes[..count] {
-            let (ue1, ue2) = (dot(*u, e1), dot(*u, e2));
-            let ju = dot(*u, self.j);
-            let (lo, hi) = pts
-                .clone()
-                .map(|p| dot(*u, *p))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
-                    (l.min(x), h.max(x))
-                });
-            if ue1 >= 0.0 && ue2 >= 0.0 && hi <= ju - m {
-                return true;
-            }
-            if ue1 <= 0.0 && ue2 <= 0.0 && lo >= ju + m {
-                return true;
-            }
-        }
-        false
+        let axes = &axes[..count];
+        self.blocks().all(|(apex, e1, e2)| {
+            axes.iter().any(|u| {
+                // The wedge projects onto [u·apex, ∞) when both its directions have
+                // u·e ≥ 0, onto (-∞, u·apex] when both have u·e ≤ 0 (1e-12: exact zeros
+                // computed with rounding), and onto everything otherwise.
+                let (ue1, ue2) = (dot(*u, e1), dot(*u, e2));
+                let au = dot(*u, apex);
+                let (lo, hi) = pts
+                    .clone()
+                    .map(|p| dot(*u, *p))
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                        (l.min(x), h.max(x))
+                    });
+                (ue1 >= -1e-12 && ue2 >= -1e-12 && hi <= au - m)
+                    || (ue1 <= 1e-12 && ue2 <= 1e-12 && lo >= au + m)
+            })
+        })
     }
 
     /// The same walls as parry2d obstacles, for independent validation. The inner block
@@ -171,7 +231,21 @@ impl Bend {
                 [j[0] + self.d2[0] * far, j[1] + self.d2[1] * far],
             ]);
         }
-        for (heading, normal) in [(h1, [-1.0, 0.0]), (h2, self.l2)] {
+        if self.tee {
+            // The left arm's inner block, a quadrant below-left of K.
+            let k = self.i;
+            o.add_rect(
+                &Pose2::new(k[0] - far / 2.0, k[1] - far / 2.0, 0.0),
+                far,
+                far,
+            );
+        }
+        let outer: &[(f64, [f64; 2])] = if self.tee {
+            &[(h2, self.l2)]
+        } else {
+            &[(h1, [-1.0, 0.0]), (h2, self.l2)]
+        };
+        for &(heading, normal) in outer {
             let centre = [normal[0] * (hw + far / 2.0), normal[1] * (hw + far / 2.0)];
             o.add_rect(&Pose2::new(centre[0], centre[1], heading), 4.0 * far, far);
         }
@@ -244,8 +318,18 @@ mod tests {
         };
         let mut disagreements = 0;
         let mut n = 0;
-        for (wi, deg) in [(0.55, 30.0), (0.62, 55.0), (0.7, 90.0), (0.5, 120.0)] {
-            let bend = Bend::new(wi, f64::to_radians(deg));
+        for (wi, deg, tee) in [
+            (0.55, 30.0, false),
+            (0.62, 55.0, false),
+            (0.7, 90.0, false),
+            (0.5, 120.0, false),
+            (0.6, 90.0, true),
+        ] {
+            let bend = if tee {
+                Bend::tee(wi)
+            } else {
+                Bend::new(wi, f64::to_radians(deg))
+            };
             let obs = bend.obstacles(2.0);
             let mut seed = 12345u64;
             let mut rnd = || {

@@ -5,5 +5,5 @@ pub mod bend;
 pub mod search;
 
 pub use analysis::{Comparison, CorridorError, Validation, check_inputs, compare, validate};
-pub use bend::{Bend, MARGIN_M, Vehicle, oblique_min_width_m};
+pub use bend::{Bend, Junction, MARGIN_M, Vehicle, oblique_min_width_m};
 pub use search::{GRegion, Mode, Resolution, Space, min_width_m, passes};

@@ -4,7 +4,7 @@ use std::collections::VecDeque;
 
 use rayon::prelude::*;
 
-use crate::bend::{Bend, MARGIN_M, Vehicle};
+use crate::bend::{Bend, Junction, MARGIN_M, Vehicle};
 
 /// How the vehicle changes direction at the bend.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
@@ -114,6 +114,20 @@ impl Space {
                 bend.d2[1] * reach_m - bend.l2[1] * hw,
             ],
         ];
+        // A T's left arm, searched as far as leg 2.
+        let left_arm = [
+            [
+                -bend.d2[0] * reach_m + bend.l2[0] * hw,
+                -bend.d2[1] * reach_m + bend.l2[1] * hw,
+            ],
+            [
+                -bend.d2[0] * reach_m - bend.l2[0] * hw,
+                -bend.d2[1] * reach_m - bend.l2[1] * hw,
+            ],
+        ];
+        let corners = corners
+            .into_iter()
+            .chain(left_arm.into_iter().filter(|_| bend.tee));
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for c in corners {
             for k in 0..2 {
@@ -208,8 +222,10 @@ impl Space {
 
     /// Inside the searched part of the corridor (legs cut at `reach_m`).
     pub fn in_window(&self, p: [f64; 2]) -> bool {
+        let along = self.bend.d2[0] * p[0] + self.bend.d2[1] * p[1];
         p[1] >= -self.reach_m
-            && self.bend.d2[0] * p[0] + self.bend.d2[1] * p[1] <= self.reach_m
+            && along <= self.reach_m
+            && (!self.bend.tee || along >= -self.reach_m)
             && self.bend.clearance(p) > 0.0
     }
 
@@ -486,6 +502,7 @@ impl GRegion {
 pub fn passes(
     vehicle: &Vehicle,
     mode: Mode,
+    junction: Junction,
     angle_rad: f64,
     res: Resolution,
     width_m: f64,
@@ -497,7 +514,7 @@ pub fn passes(
     };
     // The shifted searches are independent: run them on all cores, stop at the first way.
     shifts.par_iter().any(|s| {
-        let mut space = Space::new(Bend::new(width_m, angle_rad), *vehicle, mode, res);
+        let mut space = Space::new(junction.bend(width_m, angle_rad), *vehicle, mode, res);
         space.shift_grid(*s);
         space.search(true, true).goal.is_some()
     })
@@ -509,11 +526,12 @@ pub fn passes(
 pub fn min_width_m(
     vehicle: &Vehicle,
     mode: Mode,
+    junction: Junction,
     angle_rad: f64,
     res: Resolution,
     max_width_m: f64,
 ) -> Option<f64> {
-    let passes = |w: f64| passes(vehicle, mode, angle_rad, res, w);
+    let passes = |w: f64| passes(vehicle, mode, junction, angle_rad, res, w);
     let mut lo = vehicle.width_m;
     let mut hi = vehicle.circumscribed_m() + res.cell_m;
     while !passes(hi) {
