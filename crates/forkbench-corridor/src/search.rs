@@ -372,6 +372,13 @@ impl Space {
                 ] {
                     moves.push(([p[0] + dx as f64 * h, p[1] + dy as f64 * h], layer));
                 }
+                // Slides along leg 2 itself: lattice steps alone need a channel about a
+                // cell wider than the body to zigzag along an oblique leg.
+                let d2 = self.bend.d2;
+                for dir in [d2, [-d2[0], -d2[1]]] {
+                    let t = self.exit_distance(p, dir).max(h);
+                    moves.push(([p[0] + t * dir[0], p[1] + t * dir[1]], layer));
+                }
             }
             if self.drives_straight(layer) {
                 let dir = [sign * head.cos(), sign * head.sin()];
