@@ -298,10 +298,10 @@ impl Vehicle {
 }
 
 /// Closed form, oblique translation: the body keeps leg 1's heading, so across leg 2 it
-/// is a rectangle turned by θ, whose width there is Lc·sin θ + Wc·cos θ (and Wc in leg 1).
-/// Largest at θ = arctan(Lc/Wc), where it equals the diagonal L0.
+/// is a rectangle turned by θ, whose width there is Lc·|sin θ| + Wc·|cos θ| (and Wc in
+/// leg 1). Largest at θ = arctan(Lc/Wc), where it equals the diagonal L0.
 pub fn oblique_min_width_m(v: &Vehicle, angle_rad: f64) -> f64 {
-    (v.length_m * angle_rad.sin() + v.width_m * angle_rad.cos()).max(v.width_m)
+    (v.length_m * angle_rad.sin().abs() + v.width_m * angle_rad.cos().abs()).max(v.width_m)
 }
 
 #[cfg(test)]
