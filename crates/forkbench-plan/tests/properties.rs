@@ -50,7 +50,7 @@ fn check(kind: PlannerKind, req: &PlanRequest, endpoint_tol_m: f64) -> Result<()
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 160, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 160, rng_seed: proptest::test_runner::RngSeed::Fixed(21), ..ProptestConfig::default() })]
 
     /// Goals anywhere around the truck, including behind it and far too close.
     #[test]
