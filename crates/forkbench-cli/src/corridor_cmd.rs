@@ -178,13 +178,13 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         );
     }
     if !regions.is_empty() {
-        out.push_str("\nAgainst circle inflation (areas in m², within the searched legs):\n\n| angle (°) | mode | G | inscribed claims | inscribed wrong | circumscribed claims | circumscribed wrongly blocks | G passages swept clean (parry2d, 1 mm / 0.1°) | inscribed-wrong positions colliding at every heading |\n|---|---|---|---|---|---|---|---|---|\n");
+        out.push_str("\nAgainst circle inflation (areas in m², within the searched legs):\n\n| angle (°) | mode | G | inscribed claims | inscribed wrong | circumscribed claims | circumscribed wrongly blocks | G passages swept clean (parry2d, 1 mm / 0.1°) | inscribed-wrong positions colliding at every heading | …confirmed (colliding, or outside G at half the cell) |\n|---|---|---|---|---|---|---|---|---|---|\n");
         for (deg, g) in &regions {
             let c = compare(g);
             let val = validate(g, 100);
             let _ = writeln!(
                 out,
-                "| {deg:.2} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {}/{} | {}/{} |",
+                "| {deg:.2} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {}/{} | {}/{} | {}/{} |",
                 c.mode.name(),
                 c.g_area_m2,
                 c.inscribed_area_m2,
@@ -194,6 +194,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
                 val.g_passed,
                 val.g_sampled,
                 val.inscribed_wrong_colliding,
+                val.inscribed_wrong_sampled,
+                val.inscribed_wrong_confirmed,
                 val.inscribed_wrong_sampled,
             );
         }
@@ -249,6 +251,16 @@ pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
             width_m: None,
             angles_deg: vec![30.0, 60.0, 90.0],
             cell_m: 0.03,
+            plot: None,
+            json: false,
+        })?;
+        crate::emit("\n## A30 G regions at W = 2.6 m, θ = 90° (5 cm cells)\n\n")?;
+        run(&Args {
+            vehicle: Vehicle::forklift(&ForkliftSpec::default()),
+            junction: Junction::L,
+            width_m: Some(2.6),
+            angles_deg: vec![90.0],
+            cell_m: 0.05,
             plot: None,
             json: false,
         })?;

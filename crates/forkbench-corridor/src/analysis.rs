@@ -3,7 +3,7 @@
 use forkbench_core::Pose2;
 
 use crate::bend::{Junction, Vehicle};
-use crate::search::{GRegion, Mode};
+use crate::search::{GRegion, Mode, Resolution};
 
 /// Bad corridor-analysis input.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -134,6 +134,9 @@ pub struct Validation {
     pub inscribed_wrong_sampled: usize,
     /// …where the body touches a wall at every heading the mode can have there.
     pub inscribed_wrong_colliding: usize,
+    /// …confirmed wrong: colliding at every heading, or outside G again when the search
+    /// is repeated with half the cell (all four half-cells around the position).
+    pub inscribed_wrong_confirmed: usize,
 }
 
 const FINE_STEP_M: f64 = 1e-3;
@@ -190,16 +193,34 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
         .map(|(c, _)| c)
         .collect();
     let stride = (wrong.len() / samples.max(1)).max(1);
-    let (mut w_sampled, mut w_colliding) = (0, 0);
+    let fine = (!wrong.is_empty()).then(|| {
+        let res = Resolution {
+            cell_m: s.res.cell_m / 2.0,
+            ..s.res
+        };
+        GRegion::compute(s.bend, s.vehicle, s.mode, res)
+    });
+    let outside_fine_g = |p: [f64; 2]| {
+        let Some(f) = &fine else { return false };
+        let q = s.res.cell_m / 4.0;
+        [[-q, -q], [-q, q], [q, -q], [q, q]].iter().all(|d| {
+            let c = [p[0] + d[0], p[1] + d[1]];
+            f.space.in_window(c) && f.space.cell_of(c).is_some_and(|i| f.through[i].is_none())
+        })
+    };
+    let (mut w_sampled, mut w_colliding, mut w_confirmed) = (0, 0, 0);
     for &cell in wrong.iter().step_by(stride) {
         let p = s.cell_centre(cell);
         w_sampled += 1;
-        w_colliding += usize::from(headings.iter().all(|&h| hits(p, h)));
+        let collides = headings.iter().all(|&h| hits(p, h));
+        w_colliding += usize::from(collides);
+        w_confirmed += usize::from(collides || outside_fine_g(p));
     }
     Validation {
         g_sampled,
         g_passed,
         inscribed_wrong_sampled: w_sampled,
         inscribed_wrong_colliding: w_colliding,
+        inscribed_wrong_confirmed: w_confirmed,
     }
 }

@@ -93,7 +93,9 @@ const ROOT: u32 = u32::MAX;
 impl Space {
     pub fn new(bend: Bend, vehicle: Vehicle, mode: Mode, res: Resolution) -> Self {
         let l0 = vehicle.circumscribed_m();
-        let turn_room = if mode == Mode::Truck {
+        // Room for the forklift's turning circle; every mode of one vehicle gets the same
+        // legs, so their G areas compare.
+        let turn_room = if vehicle.min_radius_m > 0.0 {
             2.0 * (vehicle.min_radius_m + vehicle.kinematic_ahead_m.abs())
         } else {
             0.0

@@ -92,6 +92,14 @@ fn g_regions_order_validate_and_beat_circle_inflation() {
                 "{v:?}"
             );
         }
+        // The rest of inscribed inflation's mistakes: the body fits there at some heading
+        // but no passage of this mode goes through. A search with half the cell agrees
+        // for nearly all of them (measured: all for spin, 64 of 65 for curve; the odd one
+        // sits on G's edge, where the finer grid finds a way).
+        assert!(
+            v.inscribed_wrong_confirmed * 10 >= v.inscribed_wrong_sampled * 9,
+            "{mode:?}: {v:?}"
+        );
         areas.push(c.g_area_m2);
     }
     assert!(
