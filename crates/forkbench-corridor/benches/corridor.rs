@@ -26,7 +26,7 @@ fn bench(c: &mut Criterion) {
         });
     }
     g.finish();
-    // The forklift at the same relative resolution (Wc/40 = 3 cm), four shifted grids.
+    // The forklift at the same relative resolution (Wc/40 = 3 cm), two shifted grids.
     let truck = Vehicle::forklift(&forkbench_core::ForkliftSpec::default());
     let res3 = Resolution {
         cell_m: truck.width_m / 40.0,
