@@ -224,46 +224,37 @@ pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
         json,
     })?;
     if !json {
-        crate::emit("\n## AMV G regions at W = 0.60 m, θ = 90°\n\n")?;
-        run(&Args {
-            vehicle: v,
-            junction: Junction::L,
-            width_m: Some(0.60),
-            angles_deg: vec![90.0],
-            cell_m: 0.01,
+        let truck = Vehicle::forklift(&ForkliftSpec::default());
+        let section = |vehicle, junction, width_m, angles_deg: &[f64], cell_m| Args {
+            vehicle,
+            junction,
+            width_m,
+            angles_deg: angles_deg.to_vec(),
+            cell_m,
             plot: None,
             json: false,
-        })?;
-        crate::emit("\n## AMV turning from the stem of a T junction, W = 0.60 m\n\n")?;
-        run(&Args {
-            vehicle: v,
-            junction: Junction::T,
-            width_m: Some(0.60),
-            angles_deg: vec![90.0],
-            cell_m: 0.01,
-            plot: None,
-            json: false,
-        })?;
-        crate::emit("\n## A30 truck body 2.45 × 1.2 m (r_min 0.94 m about the front axle)\n\n")?;
-        run(&Args {
-            vehicle: Vehicle::forklift(&ForkliftSpec::default()),
-            junction: Junction::L,
-            width_m: None,
-            angles_deg: vec![30.0, 60.0, 90.0],
-            cell_m: 0.03,
-            plot: None,
-            json: false,
-        })?;
-        crate::emit("\n## A30 G regions at W = 2.6 m, θ = 90° (5 cm cells)\n\n")?;
-        run(&Args {
-            vehicle: Vehicle::forklift(&ForkliftSpec::default()),
-            junction: Junction::L,
-            width_m: Some(2.6),
-            angles_deg: vec![90.0],
-            cell_m: 0.05,
-            plot: None,
-            json: false,
-        })?;
+        };
+        for (title, args) in [
+            (
+                "AMV G regions at W = 0.60 m, θ = 90°",
+                section(v, Junction::L, Some(0.60), &[90.0], 0.01),
+            ),
+            (
+                "AMV turning from the stem of a T junction, W = 0.60 m",
+                section(v, Junction::T, Some(0.60), &[90.0], 0.01),
+            ),
+            (
+                "A30 truck body 2.45 × 1.2 m (r_min 0.94 m about the front axle)",
+                section(truck, Junction::L, None, &[30.0, 60.0, 90.0], 0.03),
+            ),
+            (
+                "A30 G regions at W = 2.6 m, θ = 90° (5 cm cells)",
+                section(truck, Junction::L, Some(2.6), &[90.0], 0.05),
+            ),
+        ] {
+            crate::emit(&format!("\n## {title}\n\n"))?;
+            run(&args)?;
+        }
     }
     Ok(())
 }

@@ -1,29 +1,21 @@
 //! Recording overhead as a ratio: off, MCAP, .rrd and both, interleaved trial by trial so
 //! that drift in the machine's speed (large on shared VMs) hits every mode alike.
 
+mod common;
+
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::time::Instant;
 
 use forkbench_log::{McapRecorder, RerunRecorder, RerunTarget};
-use forkbench_trial::{NoRecorder, Recorder, Scenario, Tee, TrialOptions, run_trial_recorded};
+use forkbench_trial::{NoRecorder, Recorder, Tee, run_trial_recorded};
 
 const MODES: [&str; 4] = ["off", "mcap", "rrd", "rrd+mcap"];
 const ROUNDS: usize = 60;
 
 fn main() {
-    let scn = Scenario::load(Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../scenarios/field-test.toml"
-    )))
-    .expect("loads");
+    let (scn, opts) = common::field_test();
     let case = &scn.cases[0];
-    let opts = TrialOptions {
-        seed: Some(7),
-        ..TrialOptions::default()
-    };
-    let dir = std::env::temp_dir().join(format!("forkbench-overhead-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("dir");
+    let dir = common::scratch_dir("overhead");
     let mut times_ms: [Vec<f64>; 4] = Default::default();
     for round in 0..ROUNDS {
         for (mode, times) in MODES.iter().zip(times_ms.iter_mut()) {

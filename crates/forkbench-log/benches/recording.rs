@@ -1,25 +1,17 @@
 //! Cost of recording one field-test trial to .rrd and .mcap against the plain trial (target < 2×).
 
+mod common;
+
 use std::collections::BTreeMap;
-use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use forkbench_log::{McapRecorder, RerunRecorder, RerunTarget};
-use forkbench_trial::{Scenario, Tee, TrialOptions, run_trial, run_trial_recorded};
+use forkbench_trial::{Tee, run_trial, run_trial_recorded};
 
 fn bench(c: &mut Criterion) {
-    let scn = Scenario::load(Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../scenarios/field-test.toml"
-    )))
-    .expect("loads");
+    let (scn, opts) = common::field_test();
     let case = &scn.cases[0];
-    let opts = TrialOptions {
-        seed: Some(7),
-        ..TrialOptions::default()
-    };
-    let dir = std::env::temp_dir().join(format!("forkbench-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("dir");
+    let dir = common::scratch_dir("bench");
     let mut g = c.benchmark_group("recording");
     g.bench_function("off", |b| b.iter(|| run_trial(&scn, case, &opts)));
     g.bench_function("mcap", |b| {
