@@ -161,17 +161,10 @@ impl Space {
             + vehicle.kinematic_ahead_m.abs()
             + l0 / 2.0;
         let margin_m = MARGIN_M.max(1.25 * widest * (1.0 - (dphi / 2.0).cos()));
-        let h1 = bend.headings().0;
-        let trig = (0..layers)
-            .map(|l| {
-                let (s, c) = (h1 - l as f64 * dphi).sin_cos();
-                [s, c]
-            })
-            .collect();
-        Self {
+        let mut space = Self {
             turn_radii_m,
             margin_m,
-            trig,
+            trig: Vec::new(),
             bend,
             vehicle,
             mode,
@@ -183,7 +176,14 @@ impl Space {
             ny: ((hi[1] - lo[1]) / h).ceil() as usize + 1,
             layers,
             dphi,
-        }
+        };
+        space.trig = (0..layers)
+            .map(|l| {
+                let (s, c) = space.heading(l).sin_cos();
+                [s, c]
+            })
+            .collect();
+        space
     }
 
     /// Moves the grid origin back by a fraction of a cell (the window keeps covering the
@@ -266,11 +266,18 @@ impl Space {
         ]
     }
 
+    /// Where a straight step from `p` along the unit vector `dir` ends: one cell on, or
+    /// just out of p's cell if that is farther. A fixed one-cell step can end in the same
+    /// cell on oblique headings (the diagonal is longer than a side), where pruning dropped
+    /// it, and a vehicle that cannot slide sideways was then stuck in legs that are not
+    /// axis-aligned.
+    fn straight_step(&self, p: [f64; 2], dir: [f64; 2]) -> [f64; 2] {
+        let t = self.exit_distance(p, dir).max(self.res.cell_m);
+        [p[0] + t * dir[0], p[1] + t * dir[1]]
+    }
+
     /// How far a straight drive from `p` along the unit vector `dir` goes to just leave
-    /// p's cell. Straight steps are one cell long or this, whichever is longer: a fixed
-    /// one-cell step can end in the same cell on oblique headings (the diagonal is longer
-    /// than a side), where first-arrival pruning dropped it, and a vehicle that cannot
-    /// slide sideways was then stuck in legs that are not axis-aligned.
+    /// p's cell.
     fn exit_distance(&self, p: [f64; 2], dir: [f64; 2]) -> f64 {
         let h = self.res.cell_m;
         let origin = [self.x0, self.y0];
@@ -301,14 +308,6 @@ impl Space {
         let b = self.body(q, ql);
         self.bend
             .sweep_free_axes(&a.0, &b.0, [a.1[0], a.1[1], b.1[0], b.1[1]], self.margin_m)
-    }
-
-    pub(crate) fn free(&self, a: [f64; 2], ha: f64, b: [f64; 2], hb: f64) -> bool {
-        self.bend.sweep_free(
-            &self.vehicle.corners(a, ha),
-            &self.vehicle.corners(b, hb),
-            self.margin_m,
-        )
     }
 
     /// Breadth-first search from leg 1 (`forward`) or back from leg 2; stops at the first
@@ -378,14 +377,12 @@ impl Space {
                 // cell wider than the body to zigzag along an oblique leg.
                 let d2 = self.bend.d2;
                 for dir in [d2, [-d2[0], -d2[1]]] {
-                    let t = self.exit_distance(p, dir).max(h);
-                    moves.push(([p[0] + t * dir[0], p[1] + t * dir[1]], layer));
+                    moves.push((self.straight_step(p, dir), layer));
                 }
             }
             if self.drives_straight(layer) {
                 let dir = [sign * head.cos(), sign * head.sin()];
-                let t = self.exit_distance(p, dir).max(h);
-                moves.push(([p[0] + t * dir[0], p[1] + t * dir[1]], layer));
+                moves.push((self.straight_step(p, dir), layer));
             }
             for &r in &self.turn_radii_m {
                 if forward && layer < last {
@@ -466,10 +463,10 @@ impl GRegion {
                 (0..space.layers).map(|l| l * space.cells() + c).find(|&s| {
                     // Both searches reached the state, each with its own pose in the
                     // cell; the passage joins them by a slide, which must be free too.
-                    let h = space.heading(s / space.cells());
+                    let layer = s / space.cells();
                     forward.parent[s] != 0
                         && backward.parent[s] != 0
-                        && space.free(forward.pos[s], h, backward.pos[s], h)
+                        && space.free_to(&space.body(forward.pos[s], layer), backward.pos[s], layer)
                 })
             })
             .collect();

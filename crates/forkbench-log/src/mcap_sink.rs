@@ -183,16 +183,16 @@ struct FrameTransform {
 impl FrameTransform {
     /// `child`'s pose in the world frame.
     fn world(t_s: f64, child: &'static str, p: &Pose2) -> Self {
+        let FoxPose {
+            position,
+            orientation,
+        } = FoxPose::of(p);
         Self {
             timestamp: Stamp::at(t_s),
             parent_frame_id: "world",
             child_frame_id: child,
-            translation: Vec3 {
-                x: p.x_m as f32,
-                y: p.y_m as f32,
-                z: 0.0,
-            },
-            rotation: Quat::yaw(p.heading_rad),
+            translation: position,
+            rotation: orientation,
         }
     }
 }

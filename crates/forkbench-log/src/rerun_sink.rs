@@ -218,7 +218,6 @@ impl RerunRecorder {
         if times.is_empty() {
             return;
         }
-        let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
         let cols = rerun::Transform3D::update_fields()
             .with_many_translation(poses.iter().map(|p| [p.x_m as f32, p.y_m as f32, 0.0]))
             .with_many_rotation_axis_angle(poses.iter().map(|p| {
@@ -228,6 +227,17 @@ impl RerunRecorder {
                 )
             }))
             .columns_of_unit_batches();
+        self.send_cols(entity, times, cols);
+    }
+
+    /// Sends one entity's columns on `sim_time`, noting an error from building or sending.
+    fn send_cols<C: IntoIterator<Item = rerun::SerializedComponentColumn>>(
+        &mut self,
+        entity: &str,
+        times: &[f64],
+        cols: rerun::SerializationResult<C>,
+    ) {
+        let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
         match cols {
             Ok(cols) => {
                 let r = self.rec.send_columns(entity, [column], cols);
@@ -245,16 +255,9 @@ impl RerunRecorder {
         let times = std::mem::take(&mut self.times);
         let plots = std::mem::take(&mut self.plots);
         for ((name, series), values) in PLOTS.iter().zip(plots) {
-            let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
-            match rerun::Scalars::new(values)
-                .columns(std::iter::repeat_n(series.len(), times.len()))
-            {
-                Ok(cols) => {
-                    let r = self.rec.send_columns(*name, [column], cols);
-                    self.note(r);
-                }
-                Err(e) => self.note::<(), _>(Err(e)),
-            }
+            let cols =
+                rerun::Scalars::new(values).columns(std::iter::repeat_n(series.len(), times.len()));
+            self.send_cols(name, &times, cols);
         }
         let truth = std::mem::take(&mut self.truth);
         self.send_poses("truck", &times, &truth);
@@ -273,30 +276,16 @@ impl RerunRecorder {
         self.send_poses("sensors/true_pose", &t, &truth_at_fixes);
         let (t, strips) = std::mem::take(&mut self.strips);
         if !t.is_empty() {
-            let column = rerun::TimeColumn::new_duration_secs("sim_time", t.iter().copied());
-            match rerun::LineStrips2D::update_fields()
+            let cols = rerun::LineStrips2D::update_fields()
                 .with_strips(strips)
-                .columns_of_unit_batches()
-            {
-                Ok(cols) => {
-                    let r = self.rec.send_columns("track/trajectory", [column], cols);
-                    self.note(r);
-                }
-                Err(e) => self.note::<(), _>(Err(e)),
-            }
+                .columns_of_unit_batches();
+            self.send_cols("track/trajectory", &t, cols);
         }
         let lookahead = std::mem::take(&mut self.lookahead);
-        let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
-        match rerun::Points2D::update_fields()
+        let cols = rerun::Points2D::update_fields()
             .with_positions(lookahead)
-            .columns_of_unit_batches()
-        {
-            Ok(cols) => {
-                let r = self.rec.send_columns("track/lookahead", [column], cols);
-                self.note(r);
-            }
-            Err(e) => self.note::<(), _>(Err(e)),
-        }
+            .columns_of_unit_batches();
+        self.send_cols("track/lookahead", &times, cols);
     }
 
     /// Sends what is buffered and flushes; returns the first logging error, if any.
