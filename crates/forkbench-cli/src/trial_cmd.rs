@@ -41,8 +41,10 @@ pub fn run(
     if let Some(e) = &viewer_error {
         eprintln!("error: {e} (the trial ran without the viewer)");
     }
-    written.context("writing the recording")?;
+    // The outcome is printed even when a recording failed (it is computed); the error
+    // then makes the exit status non-zero.
     let finish = |success: bool| -> anyhow::Result<bool> {
+        written.context("writing the recording")?;
         if viewer_error.is_some() {
             anyhow::bail!("the requested rerun viewer could not be reached");
         }

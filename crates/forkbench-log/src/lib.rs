@@ -2,6 +2,7 @@
 
 pub mod mcap_sink;
 pub mod rerun_sink;
+mod rrd_file;
 
 use std::path::Path;
 

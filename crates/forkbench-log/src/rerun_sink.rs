@@ -6,6 +6,7 @@ use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
 use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimeSeriesView, Vertical};
 
+use crate::rrd_file::{ErrorSlot, RrdFileSink};
 use crate::{LogError, pallet_outlines, rect_corners, truck_outlines};
 
 /// Where the recording goes.
@@ -25,11 +26,18 @@ pub enum RerunTarget {
 /// length.
 const TRAJECTORY_EVERY: u64 = 50;
 const TRAJECTORY_POINT_EVERY: u64 = 2;
-/// Buffered per-step data is sent as columns every this many steps (5 s simulated) and at
-/// the end: one `send_columns` per entity instead of one `log` per entity and step, since
-/// rerun's cost is mostly per chunk. Sending during the trial, not only at its end, lets
-/// rerun's writer thread encode while the simulation runs.
-const SEND_EVERY: usize = 500;
+const TRAJECTORY_RGB: [u8; 3] = [30, 160, 60];
+/// True (green) and measured (red) pose at a NAV350 fix: arrows this long along the heading.
+const TRUE_RGB: [u8; 3] = [30, 160, 60];
+const MEASURED_RGB: [u8; 3] = [220, 40, 40];
+const FIX_ARROW_M: f64 = 0.3;
+/// Buffered per-step data is sent as columns every this many steps and at the end: one
+/// `send_columns` per entity instead of one `log` per entity and step, since rerun's cost
+/// is per chunk (about 0.7 M instructions each: Arrow schema, validation, footer
+/// manifest). Files take 10 s of simulated time per chunk; a live viewer gets 0.1 s, so
+/// it follows the truck smoothly.
+const SEND_EVERY_FILE: usize = 1000;
+const SEND_EVERY_LIVE: usize = 10;
 
 /// Plot entities and their series (several series share one entity, so one chunk).
 const PLOTS: [(&str, &[&str]); 5] = [
@@ -43,6 +51,7 @@ const PLOTS: [(&str, &[&str]); 5] = [
 /// Streams one trial to rerun.
 pub struct RerunRecorder {
     rec: rerun::RecordingStream,
+    send_every: usize,
     truck: Option<ForkliftSpec>,
     steps: u64,
     trajectory: Vec<[f32; 2]>,
@@ -62,6 +71,14 @@ pub struct RerunRecorder {
     last_estimate: Option<Pose2>,
     last_pallet: Option<Pose2>,
     error: Option<String>,
+    /// Set once the trial's outcome is logged: the thread that flushes the stream and
+    /// closes it (rerun writes the file's footer on close).
+    closing: Option<std::thread::JoinHandle<Option<String>>>,
+    closed: bool,
+    /// Write errors of the .rrd file, also those found while closing it.
+    file_errors: Option<ErrorSlot>,
+    /// The truck's pose before the first step, sent with the first columns.
+    truck_start: Option<Pose2>,
 }
 
 impl std::fmt::Debug for RerunRecorder {
@@ -133,6 +150,10 @@ fn blueprint_msgs() -> Result<&'static [rerun::log::LogMsg], LogError> {
     .map_err(|e| LogError::Rerun(format!("building the blueprint: {e}")))
 }
 
+fn color(rgb: [u8; 3]) -> rerun::Color {
+    rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])
+}
+
 fn strip(points: &[[f64; 2]]) -> Vec<[f32; 2]> {
     points.iter().map(|p| [p[0] as f32, p[1] as f32]).collect()
 }
@@ -140,8 +161,13 @@ fn strip(points: &[[f64; 2]]) -> Vec<[f32; 2]> {
 impl RerunRecorder {
     pub fn new(target: &RerunTarget) -> Result<Self, LogError> {
         let builder = rerun::RecordingStreamBuilder::new("forkbench");
+        let mut file_errors = None;
         let rec = match target {
-            RerunTarget::File(p) => builder.save(p),
+            RerunTarget::File(p) => {
+                let sink = RrdFileSink::create(p).map_err(LogError::Rerun)?;
+                file_errors = Some(sink.error_slot());
+                builder.set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
+            }
             RerunTarget::Spawn => builder.spawn(),
             RerunTarget::Connect(addr) => {
                 // Fail now, clearly, if nothing listens there (the gRPC client would
@@ -162,6 +188,10 @@ impl RerunRecorder {
         }
         Ok(Self {
             rec,
+            send_every: match target {
+                RerunTarget::File(_) => SEND_EVERY_FILE,
+                RerunTarget::Spawn | RerunTarget::Connect(_) => SEND_EVERY_LIVE,
+            },
             truck: None,
             steps: 0,
             trajectory: Vec::new(),
@@ -176,6 +206,10 @@ impl RerunRecorder {
             last_estimate: None,
             last_pallet: None,
             error: None,
+            closing: None,
+            closed: false,
+            file_errors,
+            truck_start: None,
         })
     }
 
@@ -195,20 +229,8 @@ impl RerunRecorder {
         let r = self.rec.log_static(
             entity,
             &rerun::LineStrips2D::new(strips)
-                .with_colors([rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])])
+                .with_colors([color(rgb)])
                 .with_radii([0.01]),
-        );
-        self.note(r);
-    }
-
-    /// A static pose marker (a 0.3 m heading arrow from the pose) in the entity's own frame.
-    fn local_marker(&mut self, entity: &str, rgb: [u8; 3]) {
-        let r = self.rec.log_static(
-            entity,
-            &rerun::Arrows2D::from_vectors([[0.3, 0.0]])
-                .with_origins([[0.0, 0.0]])
-                .with_radii([0.02])
-                .with_colors([rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])]),
         );
         self.note(r);
     }
@@ -260,24 +282,61 @@ impl RerunRecorder {
             self.send_cols(name, &times, cols);
         }
         let truth = std::mem::take(&mut self.truth);
-        self.send_poses("truck", &times, &truth);
+        match self.truck_start.take() {
+            Some(start) => {
+                let t: Vec<f64> = std::iter::once(0.0).chain(times.iter().copied()).collect();
+                let p: Vec<Pose2> = std::iter::once(start)
+                    .chain(truth.iter().copied())
+                    .collect();
+                self.send_poses("truck", &t, &p);
+            }
+            None => self.send_poses("truck", &times, &truth),
+        }
         let (t, p) = std::mem::take(&mut self.pallet_pose);
         self.send_poses("world/pallet", &t, &p);
         let (t, p) = std::mem::take(&mut self.estimates);
         self.send_poses("sensors/pallet_estimate", &t, &p);
-        // True and measured pose side by side at each NAV350 fix; the truck outline shows
-        // the true pose at every step.
-        let (t, p) = std::mem::take(&mut self.fixes);
-        self.send_poses("sensors/measured_pose", &t, &p);
-        let truth_at_fixes: Vec<Pose2> = t
-            .iter()
-            .map(|tf| truth[times.partition_point(|x| x < tf).min(truth.len() - 1)])
-            .collect();
-        self.send_poses("sensors/true_pose", &t, &truth_at_fixes);
+        // True and measured pose side by side at each NAV350 fix, as two arrows of one
+        // entity (one chunk); the truck outline shows the true pose at every step.
+        let (t, measured) = std::mem::take(&mut self.fixes);
+        if !t.is_empty() {
+            let pairs: Vec<[Pose2; 2]> = t
+                .iter()
+                .zip(&measured)
+                .map(|(tf, m)| {
+                    let truth = truth[times.partition_point(|x| x < tf).min(truth.len() - 1)];
+                    [truth, *m]
+                })
+                .collect();
+            let arrow = |p: &Pose2| {
+                let (s, c) = p.heading_rad.sin_cos();
+                (
+                    [p.x_m as f32, p.y_m as f32],
+                    [(FIX_ARROW_M * c) as f32, (FIX_ARROW_M * s) as f32],
+                )
+            };
+            // Style rides along in every row: a static style would cost a chunk.
+            let n = pairs.len();
+            let cols = rerun::Arrows2D::update_fields()
+                .with_origins(pairs.iter().flatten().map(|p| arrow(p).0))
+                .with_vectors(pairs.iter().flatten().map(|p| arrow(p).1))
+                .with_colors(
+                    std::iter::repeat_n([color(TRUE_RGB), color(MEASURED_RGB)], n).flatten(),
+                )
+                .with_labels(std::iter::repeat_n(["true", "measured"], n).flatten())
+                .with_radii(std::iter::repeat_n(0.02, 2 * n))
+                .columns(std::iter::repeat_n(2, n));
+            self.send_cols("sensors/nav350_fix", &t, cols);
+        }
         let (t, strips) = std::mem::take(&mut self.strips);
         if !t.is_empty() {
+            // The strip's style rides in the same chunk (one chunk fewer than a static
+            // style of its own).
+            let n = strips.len();
             let cols = rerun::LineStrips2D::update_fields()
                 .with_strips(strips)
+                .with_colors(std::iter::repeat_n(color(TRAJECTORY_RGB), n))
+                .with_radii(std::iter::repeat_n(0.01, n))
                 .columns_of_unit_batches();
             self.send_cols("track/trajectory", &t, cols);
         }
@@ -288,11 +347,48 @@ impl RerunRecorder {
         self.send_cols("track/lookahead", &times, cols);
     }
 
-    /// Sends what is buffered and flushes; returns the first logging error, if any.
-    pub fn finish(&mut self) -> Result<(), LogError> {
+    /// Sends what is buffered, then flushes and closes the stream on a thread of its own,
+    /// so that the footer is built while other sinks finish; later calls log nothing.
+    fn close_async(&mut self) {
+        if self.closed {
+            return;
+        }
+        self.closed = true;
         self.send_buffered();
-        let r = self.rec.flush_blocking();
-        self.note(r);
+        let rec = std::mem::replace(&mut self.rec, rerun::RecordingStream::disabled());
+        let closing = std::thread::Builder::new()
+            .name("rrd-close".into())
+            .spawn(move || {
+                let r = rec.flush_blocking().err().map(|e| e.to_string());
+                // Dropping the last handle closes the sink: the footer is written and the
+                // writer thread joined.
+                drop(rec);
+                r
+            });
+        match closing {
+            Ok(h) => self.closing = Some(h),
+            Err(e) => self.note::<(), _>(Err(e)),
+        }
+    }
+
+    /// Sends what is buffered and closes the recording (the .rrd is complete when this
+    /// returns); returns the first logging error, if any.
+    pub fn finish(&mut self) -> Result<(), LogError> {
+        self.close_async();
+        if let Some(h) = self.closing.take() {
+            match h.join() {
+                Ok(Some(e)) => self.note::<(), _>(Err(e)),
+                Ok(None) => {}
+                Err(_) => self.note::<(), _>(Err("the rerun closing thread panicked")),
+            }
+        }
+        if let Some(e) = self
+            .file_errors
+            .as_ref()
+            .and_then(|slot| slot.lock().ok().and_then(|e| e.clone()))
+        {
+            self.error.get_or_insert(e);
+        }
         match self.error.take() {
             Some(e) => Err(LogError::Rerun(e)),
             None => Ok(()),
@@ -313,7 +409,13 @@ impl Recorder for RerunRecorder {
             "scenario {} / case {} / planner {} / seed {}",
             s.scenario, s.case, s.planner, s.seed
         );
-        let r = self.rec.log_static("info", &rerun::TextDocument::new(info));
+        // The trial's identity opens the event log (an entity of its own would cost a
+        // chunk).
+        self.at(0.0);
+        let r = self.rec.log(
+            "events",
+            &rerun::TextLog::new(info).with_level(rerun::TextLogLevel::INFO),
+        );
         self.note(r);
         let obstacles: Vec<[[f64; 2]; 5]> = s
             .obstacles
@@ -353,20 +455,12 @@ impl Recorder for RerunRecorder {
             &truck_outlines(s.truck, &origin),
             [230, 190, 25],
         );
-        self.local_marker("sensors/true_pose", [30, 160, 60]);
-        self.local_marker("sensors/measured_pose", [220, 40, 40]);
-        self.send_poses("truck", &[0.0], &[s.start]);
+        // The start pose goes out with the first columns.
+        self.truck_start = Some(s.start);
         // The pallet's first pose goes out with the first columns.
         self.pallet_pose.0.push(0.0);
         self.pallet_pose.1.push(s.pallet_pose);
         self.last_pallet = Some(s.pallet_pose);
-        let r = self.rec.log_static(
-            "track/trajectory",
-            &rerun::LineStrips2D::update_fields()
-                .with_colors([rerun::Color::from_rgb(30, 160, 60)])
-                .with_radii([0.01]),
-        );
-        self.note(r);
     }
 
     fn plan(
@@ -395,20 +489,23 @@ impl Recorder for RerunRecorder {
         );
         self.note(r);
         if let Some(c) = control_polygon {
+            // Polygon and points in one row of one entity: one chunk.
+            let polygon = rerun::LineStrips2D::new([strip(c)])
+                .with_colors([rerun::Color::from_rgb(120, 150, 230)]);
+            let points = rerun::Points2D::new(strip(c))
+                .with_radii([0.05])
+                .with_colors([rerun::Color::from_rgb(120, 150, 230)]);
             let r = self.rec.log(
                 format!("{entity}/control_polygon"),
-                &rerun::LineStrips2D::new([strip(c)])
-                    .with_colors([rerun::Color::from_rgb(120, 150, 230)]),
-            );
-            self.note(r);
-            let r = self.rec.log(
-                format!("{entity}/control_points"),
-                &rerun::Points2D::new(strip(c))
-                    .with_radii([0.05])
-                    .with_colors([rerun::Color::from_rgb(120, 150, 230)]),
+                &[&polygon as &dyn rerun::AsComponents, &points],
             );
             self.note(r);
         }
+        // Logged rows wait in rerun's batcher until its 200 ms tick, longer than a whole
+        // trial: push the shapes and the plan to the file writer now, so it encodes them
+        // while the trial runs instead of after it.
+        let r = self.rec.flush_async();
+        self.note(r);
     }
 
     fn step(&mut self, s: &StepRecord) {
@@ -451,7 +548,7 @@ impl Recorder for RerunRecorder {
             self.strips.0.push(s.t_s);
             self.strips.1.push(self.trajectory.clone());
         }
-        if self.times.len() >= SEND_EVERY {
+        if self.times.len() >= self.send_every {
             self.send_buffered();
         }
     }
@@ -497,5 +594,7 @@ impl Recorder for RerunRecorder {
             &rerun::TextDocument::new(serde_json::to_string_pretty(outcome).unwrap_or_default()),
         );
         self.note(r);
+        // The outcome is the trial's last call: close now, in parallel with other sinks.
+        self.close_async();
     }
 }

@@ -181,9 +181,22 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
 
     let scn = field_test();
     let path = tmp("trial.rrd");
+    /// Counts the NAV350 fixes the trial reports.
+    struct Fixes(usize);
+    impl Recorder for Fixes {
+        fn step(&mut self, s: &forkbench_trial::StepRecord) {
+            self.0 += usize::from(s.fix.is_some());
+        }
+    }
+    let mut fixes = Fixes(0);
     let out = {
         let mut rec = RerunRecorder::new(&RerunTarget::File(path.clone())).expect("opens");
-        let out = run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rec);
+        let out = run_trial_recorded(
+            &scn,
+            &scn.cases[0],
+            &opts(),
+            &mut forkbench_trial::Tee(vec![&mut rec, &mut fixes]),
+        );
         rec.finish().expect("flushes");
         out
     };
@@ -224,8 +237,7 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
         "/plan/path/control_polygon",
         "/track/trajectory",
         "/track/lookahead",
-        "/sensors/true_pose",
-        "/sensors/measured_pose",
+        "/sensors/nav350_fix",
         "/sensors/pallet_estimate",
         "/plots/curvature",
         "/plots/steering",
@@ -246,5 +258,27 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
     ] {
         assert_eq!(rows[p], steps, "{p}: {rows:?}");
     }
-    assert_eq!(rows["/sensors/true_pose"], rows["/sensors/measured_pose"]);
+    // One row (true and measured arrow) per NAV350 fix.
+    assert!(fixes.0 > 10, "{} fixes", fixes.0);
+    assert_eq!(rows["/sensors/nav350_fix"], fixes.0, "{rows:?}");
+}
+
+/// A full disk reaches the caller as an error naming the file and the reason, for both
+/// sinks (`/dev/full` opens, then every write fails with ENOSPC): the .rrd mid-trial, the
+/// MCAP already when its header is written.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_full_disk_is_reported_by_both_sinks() {
+    let scn = field_test();
+    let full = Path::new("/dev/full");
+    let mcap = McapRecorder::create(full, BTreeMap::new())
+        .expect_err("the header does not fit")
+        .to_string();
+    assert!(mcap.contains("/dev/full"), "{mcap}");
+    assert!(mcap.to_lowercase().contains("no space"), "{mcap}");
+    let mut rrd = RerunRecorder::new(&RerunTarget::File(full.to_path_buf())).expect("opens");
+    run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rrd);
+    let e = rrd.finish().expect_err("the chunks do not fit").to_string();
+    assert!(e.contains("/dev/full"), "{e}");
+    assert!(e.to_lowercase().contains("no space"), "{e}");
 }
