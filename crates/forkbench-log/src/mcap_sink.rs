@@ -725,11 +725,11 @@ impl Recorder for McapRecorder {
     }
 
     fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
+        // `send` hands over the steps collected so far first.
         self.send("/forkbench/outcome", t_s, outcome);
         // The outcome is the trial's last message: let the writer thread finish the file
         // (last chunk, summary, index) now, while the other sinks finish theirs;
         // `finish` then only joins it.
-        self.send_steps();
         self.tx = None;
     }
 }

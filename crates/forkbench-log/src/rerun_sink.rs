@@ -27,10 +27,13 @@ pub enum RerunTarget {
 const TRAJECTORY_EVERY: u64 = 50;
 const TRAJECTORY_POINT_EVERY: u64 = 2;
 const TRAJECTORY_RGB: [u8; 3] = [30, 160, 60];
-/// True (green) and measured (red) pose at a NAV350 fix: arrows this long along the heading.
+/// True (green) and measured (red) pose at a NAV350 fix.
 const TRUE_RGB: [u8; 3] = [30, 160, 60];
 const MEASURED_RGB: [u8; 3] = [220, 40, 40];
+/// Length of a fix's arrow along its heading.
 const FIX_ARROW_M: f64 = 0.3;
+/// B-spline control polygon and its points.
+const CONTROL_RGB: [u8; 3] = [120, 150, 230];
 /// Buffered per-step data is sent as columns every this many steps and at the end: one
 /// `send_columns` per entity instead of one `log` per entity and step, since rerun's cost
 /// is per chunk (about 0.7 M instructions each: Arrow schema, validation, footer
@@ -308,18 +311,22 @@ impl RerunRecorder {
                     [truth, *m]
                 })
                 .collect();
-            let arrow = |p: &Pose2| {
-                let (s, c) = p.heading_rad.sin_cos();
-                (
-                    [p.x_m as f32, p.y_m as f32],
-                    [(FIX_ARROW_M * c) as f32, (FIX_ARROW_M * s) as f32],
-                )
-            };
+            let (origins, vectors): (Vec<[f32; 2]>, Vec<[f32; 2]>) = pairs
+                .iter()
+                .flatten()
+                .map(|p| {
+                    let (s, c) = p.heading_rad.sin_cos();
+                    (
+                        [p.x_m as f32, p.y_m as f32],
+                        [(FIX_ARROW_M * c) as f32, (FIX_ARROW_M * s) as f32],
+                    )
+                })
+                .unzip();
             // Style rides along in every row: a static style would cost a chunk.
             let n = pairs.len();
             let cols = rerun::Arrows2D::update_fields()
-                .with_origins(pairs.iter().flatten().map(|p| arrow(p).0))
-                .with_vectors(pairs.iter().flatten().map(|p| arrow(p).1))
+                .with_origins(origins)
+                .with_vectors(vectors)
                 .with_colors(
                     std::iter::repeat_n([color(TRUE_RGB), color(MEASURED_RGB)], n).flatten(),
                 )
@@ -490,11 +497,10 @@ impl Recorder for RerunRecorder {
         self.note(r);
         if let Some(c) = control_polygon {
             // Polygon and points in one row of one entity: one chunk.
-            let polygon = rerun::LineStrips2D::new([strip(c)])
-                .with_colors([rerun::Color::from_rgb(120, 150, 230)]);
+            let polygon = rerun::LineStrips2D::new([strip(c)]).with_colors([color(CONTROL_RGB)]);
             let points = rerun::Points2D::new(strip(c))
                 .with_radii([0.05])
-                .with_colors([rerun::Color::from_rgb(120, 150, 230)]);
+                .with_colors([color(CONTROL_RGB)]);
             let r = self.rec.log(
                 format!("{entity}/control_polygon"),
                 &[&polygon as &dyn rerun::AsComponents, &points],
