@@ -94,9 +94,13 @@ fn main() {
     let cpu_base = median(&cpu_ms[0]);
     for ((mode, times), cpu) in MODES.iter().zip(&times_ms).zip(&cpu_ms) {
         let (m, c) = (median(times), median(cpu));
+        // Each round's time over the same round's plain trial: the machine's speed drifts
+        // between rounds far more than within one, so this ratio is the steadier figure.
+        let ratios: Vec<f64> = times.iter().zip(&times_ms[0]).map(|(t, b)| t / b).collect();
         println!(
-            "  {mode:9} median {m:6.2} ms  {:.2}x the plain trial   CPU (all threads) {c:6.2} ms  {:.2}x",
+            "  {mode:9} median {m:6.2} ms  {:.2}x the plain trial (per round: {:.2}x)   CPU (all threads) {c:6.2} ms  {:.2}x",
             m / base,
+            median(&ratios),
             c / cpu_base
         );
     }

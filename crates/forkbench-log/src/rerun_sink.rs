@@ -37,9 +37,9 @@ const CONTROL_RGB: [u8; 3] = [120, 150, 230];
 /// Buffered per-step data is sent as columns every this many steps and at the end: one
 /// `send_columns` per entity instead of one `log` per entity and step, since rerun's cost
 /// is per chunk (about 0.7 M instructions each: Arrow schema, validation, footer
-/// manifest). Files take 10 s of simulated time per chunk; a live viewer gets 0.1 s, so
-/// it follows the truck smoothly.
-const SEND_EVERY_FILE: usize = 1000;
+/// manifest). Files take a minute of simulated time per chunk (a pick trial sends each
+/// entity once); a live viewer gets 0.1 s, so it follows the truck smoothly.
+const SEND_EVERY_FILE: usize = 6000;
 const SEND_EVERY_LIVE: usize = 10;
 
 /// Plot entities and their series (several series share one entity, so one chunk).
@@ -82,6 +82,9 @@ pub struct RerunRecorder {
     file_errors: Option<ErrorSlot>,
     /// The truck's pose before the first step, sent with the first columns.
     truck_start: Option<Pose2>,
+    /// Data set once (outlines, series names), per entity: it rides as the first row of
+    /// the entity's first columns instead of costing a chunk of its own.
+    first_rows: Vec<(&'static str, Vec<rerun::SerializedComponentColumn>)>,
 }
 
 impl std::fmt::Debug for RerunRecorder {
@@ -153,6 +156,27 @@ fn blueprint_msgs() -> Result<&'static [rerun::log::LogMsg], LogError> {
     .map_err(|e| LogError::Rerun(format!("building the blueprint: {e}")))
 }
 
+/// `col` (one row) as the first row of a column of `rows` rows, null after it: rerun reads
+/// a null as "nothing logged at this row", so the value holds from the first row on.
+fn first_row_only(
+    col: rerun::SerializedComponentColumn,
+    rows: usize,
+) -> Result<rerun::SerializedComponentColumn, rerun::external::arrow::error::ArrowError> {
+    use rerun::external::arrow::array::{Array as _, ListArray};
+    use rerun::external::arrow::buffer::{NullBuffer, OffsetBuffer};
+    let (field, _, values, _) = col.list_array.into_parts();
+    let rest = rows.saturating_sub(1);
+    let offsets = OffsetBuffer::from_lengths(
+        std::iter::once(values.len()).chain(std::iter::repeat_n(0, rest)),
+    );
+    let nulls =
+        NullBuffer::from_iter(std::iter::once(true).chain(std::iter::repeat_n(false, rest)));
+    Ok(rerun::SerializedComponentColumn::new(
+        ListArray::try_new(field, offsets, values, Some(nulls))?,
+        col.descriptor,
+    ))
+}
+
 fn color(rgb: [u8; 3]) -> rerun::Color {
     rerun::Color::from_rgb(rgb[0], rgb[1], rgb[2])
 }
@@ -213,6 +237,7 @@ impl RerunRecorder {
             closed: false,
             file_errors,
             truck_start: None,
+            first_rows: Vec::new(),
         })
     }
 
@@ -226,16 +251,27 @@ impl RerunRecorder {
         }
     }
 
-    /// Static outlines in the entity's own frame; its transform column moves them.
-    fn local_outlines(&mut self, entity: &str, outlines: &[[[f64; 2]; 5]], rgb: [u8; 3]) {
+    /// Outlines in the entity's own frame, sent with its first transform (which moves them).
+    fn local_outlines(&mut self, entity: &'static str, outlines: &[[[f64; 2]; 5]], rgb: [u8; 3]) {
         let strips: Vec<Vec<[f32; 2]>> = outlines.iter().map(|c| strip(c)).collect();
-        let r = self.rec.log_static(
+        self.set_once(
             entity,
             &rerun::LineStrips2D::new(strips)
                 .with_colors([color(rgb)])
                 .with_radii([0.01]),
         );
-        self.note(r);
+    }
+
+    /// Queues `data` for the first row of `entity`'s first columns.
+    fn set_once(&mut self, entity: &'static str, data: &dyn rerun::AsComponents) {
+        let cols = data
+            .as_serialized_batches()
+            .into_iter()
+            .map(rerun::SerializedComponentColumn::from);
+        match self.first_rows.iter_mut().find(|(e, _)| *e == entity) {
+            Some((_, c)) => c.extend(cols),
+            None => self.first_rows.push((entity, cols.collect())),
+        }
     }
 
     /// One planar pose per row on `sim_time`.
@@ -263,12 +299,23 @@ impl RerunRecorder {
         cols: rerun::SerializationResult<C>,
     ) {
         let column = rerun::TimeColumn::new_duration_secs("sim_time", times.iter().copied());
-        match cols {
-            Ok(cols) => {
-                let r = self.rec.send_columns(entity, [column], cols);
+        let first = match self.first_rows.iter().position(|(e, _)| *e == entity) {
+            Some(i) => self.first_rows.swap_remove(i).1,
+            None => Vec::new(),
+        };
+        let first: Result<Vec<_>, _> = first
+            .into_iter()
+            .map(|c| first_row_only(c, times.len()))
+            .collect();
+        match (cols, first) {
+            (Ok(cols), Ok(first)) => {
+                let r = self
+                    .rec
+                    .send_columns(entity, [column], cols.into_iter().chain(first));
                 self.note(r);
             }
-            Err(e) => self.note::<(), _>(Err(e)),
+            (Err(e), _) => self.note::<(), _>(Err(e)),
+            (_, Err(e)) => self.note::<(), _>(Err(e)),
         }
     }
 
@@ -362,6 +409,11 @@ impl RerunRecorder {
         }
         self.closed = true;
         self.send_buffered();
+        // Set-once data of entities that got no columns (a trial without steps).
+        let left: Vec<&'static str> = self.first_rows.iter().map(|(e, _)| *e).collect();
+        for entity in left {
+            self.send_cols(entity, &[0.0], Ok(Vec::new()));
+        }
         let rec = std::mem::replace(&mut self.rec, rerun::RecordingStream::disabled());
         let closing = std::thread::Builder::new()
             .name("rrd-close".into())
@@ -440,11 +492,10 @@ impl Recorder for RerunRecorder {
             self.note(r);
         }
         for (name, series) in PLOTS {
-            let r = self.rec.log_static(
+            self.set_once(
                 name,
                 &rerun::SeriesLines::new().with_names(series.iter().copied()),
             );
-            self.note(r);
         }
         let origin = Pose2::new(0.0, 0.0, 0.0);
         self.local_outlines(
@@ -457,11 +508,7 @@ impl Recorder for RerunRecorder {
             &pallet_outlines(s.pallet, &origin),
             [220, 40, 40],
         );
-        self.local_outlines(
-            "truck/outline",
-            &truck_outlines(s.truck, &origin),
-            [230, 190, 25],
-        );
+        self.local_outlines("truck", &truck_outlines(s.truck, &origin), [230, 190, 25]);
         // The start pose goes out with the first columns.
         self.truck_start = Some(s.start);
         // The pallet's first pose goes out with the first columns.

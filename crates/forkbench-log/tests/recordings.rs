@@ -204,6 +204,7 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
     let (mut arrow, mut apps, mut kinds) = (0, BTreeSet::new(), BTreeSet::new());
     let mut entities = BTreeSet::new();
     let mut rows: BTreeMap<String, usize> = BTreeMap::new();
+    let mut chunks: BTreeMap<String, Vec<rerun::log::Chunk>> = BTreeMap::new();
     for msg in DecoderApp::decode_lazy(file) {
         match msg.expect("decodes") {
             LogMsg::SetStoreInfo(info) => {
@@ -218,6 +219,10 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
                         *rows.entry(chunk.entity_path().to_string()).or_default() +=
                             chunk.num_rows();
                     }
+                    chunks
+                        .entry(chunk.entity_path().to_string())
+                        .or_default()
+                        .push(chunk);
                 }
             }
             LogMsg::BlueprintActivationCommand(_) => {}
@@ -232,7 +237,6 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
     for e in [
         "/world/pallet",
         "/truck",
-        "/truck/outline",
         "/plan/path",
         "/plan/path/control_polygon",
         "/track/trajectory",
@@ -257,6 +261,27 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
         "/track/lookahead",
     ] {
         assert_eq!(rows[p], steps, "{p}: {rows:?}");
+    }
+    // Outlines and series names are sent once, as the first row of their entity's columns
+    // (null after it): a latest-at query at the end of the trial still finds them.
+    let end = rerun::external::re_chunk_store::LatestAtQuery::new(
+        "sim_time".into(),
+        rerun::external::re_log_types::TimeInt::new_temporal((out.sim_time_s * 1e9).round() as i64),
+    );
+    let strips = rerun::LineStrips2D::descriptor_strips().component;
+    let names = rerun::SeriesLines::descriptor_names().component;
+    for (entity, component) in [
+        ("/truck", strips),
+        ("/world/pallet", strips),
+        ("/sensors/pallet_estimate", strips),
+        ("/plots/curvature", names),
+        ("/plots/contact_force", names),
+    ] {
+        let found = chunks[entity]
+            .iter()
+            .filter_map(|c| c.latest_at(&end, component))
+            .count();
+        assert_eq!(found, 1, "{entity} {component} at the end of the trial");
     }
     // One row (true and measured arrow) per NAV350 fix.
     assert!(fixes.0 > 10, "{} fixes", fixes.0);
