@@ -178,13 +178,13 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         );
     }
     if !regions.is_empty() {
-        out.push_str("\nAgainst circle inflation (areas in m², within the searched legs):\n\n| angle (°) | mode | G | inscribed claims | inscribed wrong | circumscribed claims | circumscribed wrongly blocks | G passages swept clean (parry2d, 1 mm / 0.1°) | inscribed-wrong positions colliding at every heading | …confirmed (colliding, or outside G at half the cell) |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        out.push_str("\nAgainst circle inflation (areas in m², within the searched legs):\n\n| angle (°) | mode | G | inscribed claims | inscribed wrong | circumscribed claims | circumscribed wrongly blocks | G passages swept clean (parry2d, 1 mm / 0.1°) | inscribed-wrong positions colliding at every heading | …confirmed (colliding, or outside G at half the cell) | …of those more than a cell outside G, confirmed |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
         for (deg, g) in &regions {
             let c = compare(g);
             let val = validate(g, 100);
             let _ = writeln!(
                 out,
-                "| {deg:.2} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {}/{} | {}/{} | {}/{} |",
+                "| {deg:.2} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {}/{} | {}/{} | {}/{} | {}/{} |",
                 c.mode.name(),
                 c.g_area_m2,
                 c.inscribed_area_m2,
@@ -197,6 +197,8 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
                 val.inscribed_wrong_sampled,
                 val.inscribed_wrong_confirmed,
                 val.inscribed_wrong_sampled,
+                val.inscribed_wrong_beyond_edge_confirmed,
+                val.inscribed_wrong_beyond_edge,
             );
         }
     }

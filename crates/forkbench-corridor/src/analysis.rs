@@ -137,6 +137,10 @@ pub struct Validation {
     /// …confirmed wrong: colliding at every heading, or outside G again when the search
     /// is repeated with half the cell (all four half-cells around the position).
     pub inscribed_wrong_confirmed: usize,
+    /// …more than a cell outside G (no G cell among the eight around it), where the grid
+    /// cannot explain a miss: each of these must be confirmed.
+    pub inscribed_wrong_beyond_edge: usize,
+    pub inscribed_wrong_beyond_edge_confirmed: usize,
 }
 
 const FINE_STEP_M: f64 = 1e-3;
@@ -182,16 +186,34 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
             .map(|i| h1 - (h1 - h2) * i as f64 / n as f64)
             .collect()
     };
+    // The legs' cut ends are left out: passages start and end there, in a band one cell
+    // deep, so G there depends on where each grid cuts the window rather than on the bend.
     let wrong: Vec<usize> = g
         .through
         .iter()
         .enumerate()
         .filter(|(c, t)| {
             let p = s.cell_centre(*c);
-            t.is_none() && s.in_window(p) && s.bend.clearance(p) >= s.vehicle.inscribed_m() / 2.0
+            t.is_none()
+                && s.in_window(p)
+                && !s.is_start(p)
+                && !s.is_goal(p)
+                && s.bend.clearance(p) >= s.vehicle.inscribed_m() / 2.0
         })
         .map(|(c, _)| c)
         .collect();
+    // G's edge: cells next to (or diagonal to) a G cell.
+    let on_edge = |cell: usize| {
+        let (x, y) = ((cell % s.nx) as i64, (cell / s.nx) as i64);
+        (-1..=1).any(|dy| {
+            (-1..=1).any(|dx| {
+                let (i, j) = (x + dx, y + dy);
+                (0..s.nx as i64).contains(&i)
+                    && (0..s.ny as i64).contains(&j)
+                    && g.through[(j * s.nx as i64 + i) as usize].is_some()
+            })
+        })
+    };
     let stride = (wrong.len() / samples.max(1)).max(1);
     let fine = (!wrong.is_empty()).then(|| {
         let res = Resolution {
@@ -209,12 +231,18 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
         })
     };
     let (mut w_sampled, mut w_colliding, mut w_confirmed) = (0, 0, 0);
+    let (mut beyond, mut beyond_confirmed) = (0, 0);
     for &cell in wrong.iter().step_by(stride) {
         let p = s.cell_centre(cell);
         w_sampled += 1;
         let collides = headings.iter().all(|&h| hits(p, h));
         w_colliding += usize::from(collides);
-        w_confirmed += usize::from(collides || outside_fine_g(p));
+        let confirmed = collides || outside_fine_g(p);
+        w_confirmed += usize::from(confirmed);
+        if !on_edge(cell) {
+            beyond += 1;
+            beyond_confirmed += usize::from(confirmed);
+        }
     }
     Validation {
         g_sampled,
@@ -222,5 +250,7 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
         inscribed_wrong_sampled: w_sampled,
         inscribed_wrong_colliding: w_colliding,
         inscribed_wrong_confirmed: w_confirmed,
+        inscribed_wrong_beyond_edge: beyond,
+        inscribed_wrong_beyond_edge_confirmed: beyond_confirmed,
     }
 }

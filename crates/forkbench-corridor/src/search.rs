@@ -231,11 +231,13 @@ impl Space {
             && self.bend.clearance(p) > 0.0
     }
 
-    fn is_start(&self, p: [f64; 2]) -> bool {
+    /// In the first cell of the entry leg's cut end, where passages start.
+    pub fn is_start(&self, p: [f64; 2]) -> bool {
         p[1] < -self.reach_m + self.res.cell_m
     }
 
-    fn is_goal(&self, p: [f64; 2]) -> bool {
+    /// In the last cell of the exit leg's cut end, where passages end.
+    pub fn is_goal(&self, p: [f64; 2]) -> bool {
         self.bend.d2[0] * p[0] + self.bend.d2[1] * p[1] > self.reach_m - self.res.cell_m
     }
 
