@@ -51,6 +51,16 @@ const PLOTS: [(&str, &[&str]); 5] = [
     ("plots/contact_force", &["fork contact"]),
 ];
 
+/// Where a recording is in its closing.
+enum Close {
+    Open,
+    /// The trial's outcome is logged: this thread flushes the stream and closes it (rerun
+    /// writes the file's footer on close).
+    Closing(std::thread::JoinHandle<Option<String>>),
+    /// Joined (or closed without a thread); later calls log nothing.
+    Closed,
+}
+
 /// Streams one trial to rerun.
 pub struct RerunRecorder {
     rec: rerun::RecordingStream,
@@ -74,10 +84,7 @@ pub struct RerunRecorder {
     last_estimate: Option<Pose2>,
     last_pallet: Option<Pose2>,
     error: Option<String>,
-    /// Set once the trial's outcome is logged: the thread that flushes the stream and
-    /// closes it (rerun writes the file's footer on close).
-    closing: Option<std::thread::JoinHandle<Option<String>>>,
-    closed: bool,
+    close: Close,
     /// Write errors of the .rrd file, also those found while closing it.
     file_errors: Option<ErrorSlot>,
     /// The truck's pose before the first step, sent with the first columns.
@@ -233,8 +240,7 @@ impl RerunRecorder {
             last_estimate: None,
             last_pallet: None,
             error: None,
-            closing: None,
-            closed: false,
+            close: Close::Open,
             file_errors,
             truck_start: None,
             first_rows: Vec::new(),
@@ -404,10 +410,10 @@ impl RerunRecorder {
     /// Sends what is buffered, then flushes and closes the stream on a thread of its own,
     /// so that the footer is built while other sinks finish; later calls log nothing.
     fn close_async(&mut self) {
-        if self.closed {
+        if !matches!(self.close, Close::Open) {
             return;
         }
-        self.closed = true;
+        self.close = Close::Closed;
         self.send_buffered();
         // Set-once data of entities that got no columns (a trial without steps).
         let left: Vec<&'static str> = self.first_rows.iter().map(|(e, _)| *e).collect();
@@ -425,7 +431,7 @@ impl RerunRecorder {
                 r
             });
         match closing {
-            Ok(h) => self.closing = Some(h),
+            Ok(h) => self.close = Close::Closing(h),
             Err(e) => self.note::<(), _>(Err(e)),
         }
     }
@@ -434,7 +440,7 @@ impl RerunRecorder {
     /// returns); returns the first logging error, if any.
     pub fn finish(&mut self) -> Result<(), LogError> {
         self.close_async();
-        if let Some(h) = self.closing.take() {
+        if let Close::Closing(h) = std::mem::replace(&mut self.close, Close::Closed) {
             match h.join() {
                 Ok(Some(e)) => self.note::<(), _>(Err(e)),
                 Ok(None) => {}

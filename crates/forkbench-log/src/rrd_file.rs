@@ -28,6 +28,8 @@ enum Cmd {
 
 /// Writes one .rrd file (header, chunks, footer) from a thread of its own.
 pub struct RrdFileSink {
+    /// The file, as errors name it.
+    name: String,
     tx: Mutex<Option<SyncSender<Cmd>>>,
     thread: Mutex<Option<JoinHandle<()>>>,
     error: ErrorSlot,
@@ -54,11 +56,13 @@ impl RrdFileSink {
         // Bounded: a disk slower than the trial holds the trial back instead of the heap.
         let (tx, rx) = sync_channel(1024);
         let slot = error.clone();
+        let thread_name = name.clone();
         let thread = std::thread::Builder::new()
             .name("rrd-writer".into())
-            .spawn(move || write_all(encoder, &rx, &slot, &name))
-            .map_err(|e| e.to_string())?;
+            .spawn(move || write_all(encoder, &rx, &slot, &thread_name))
+            .map_err(|e| format!("{name}: {e}"))?;
         Ok(Self {
+            name,
             tx: Mutex::new(Some(tx)),
             thread: Mutex::new(Some(thread)),
             error,
@@ -121,14 +125,17 @@ fn write_all(
 impl LogSink for RrdFileSink {
     fn send(&self, msg: LogMsg) {
         if !self.command(Cmd::Msg(msg)) {
-            keep(&self.error, "rrd", "the writer thread stopped");
+            keep(&self.error, &self.name, "the writer thread stopped");
         }
     }
 
     fn flush_blocking(&self, timeout: Duration) -> Result<(), SinkFlushError> {
         let (ack, done) = sync_channel(1);
         if !self.command(Cmd::Flush(ack)) {
-            return Err(SinkFlushError::failed("the rrd writer thread stopped"));
+            return Err(SinkFlushError::failed(format!(
+                "{}: the writer thread stopped",
+                self.name
+            )));
         }
         done.recv_timeout(timeout)
             .map_err(|_| SinkFlushError::Timeout)?;
@@ -153,7 +160,7 @@ impl Drop for RrdFileSink {
             && let Some(t) = t.take()
             && t.join().is_err()
         {
-            keep(&self.error, "rrd", "the writer thread panicked");
+            keep(&self.error, &self.name, "the writer thread panicked");
         }
     }
 }
