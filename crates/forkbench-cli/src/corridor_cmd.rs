@@ -178,7 +178,7 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
         );
     }
     if !regions.is_empty() {
-        out.push_str("\nAgainst circle inflation (areas in m², within the searched legs):\n\n| angle (°) | mode | G | inscribed claims | inscribed wrong | circumscribed claims | circumscribed wrongly blocks | G passages swept clean (parry2d, 1 mm / 0.1°) | inscribed-wrong positions colliding at every heading | …confirmed (colliding, or outside G at half the cell) | …of those more than a cell outside G, confirmed |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+        out.push_str("\nAgainst circle inflation (areas in m², within the searched legs):\n\n| angle (°) | mode | G | inscribed claims | inscribed wrong | circumscribed claims | circumscribed wrongly blocks | G passages swept clean (parry2d, 1 mm / 0.1°) | inscribed-wrong positions colliding at every heading | …confirmed (colliding, or outside G at half the cell) | …of those beyond G's edge (1 cell, truck 2), confirmed |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
         for (deg, g) in &regions {
             let c = compare(g);
             let val = validate(g, 100);

@@ -137,8 +137,8 @@ pub struct Validation {
     /// …confirmed wrong: colliding at every heading, or outside G again when the search
     /// is repeated with half the cell (all four half-cells around the position).
     pub inscribed_wrong_confirmed: usize,
-    /// …more than a cell outside G (no G cell among the eight around it), where the grid
-    /// cannot explain a miss: each of these must be confirmed.
+    /// …beyond G's edge, where the grid cannot explain a miss (more than one cell from any
+    /// G cell, two for the truck): each of these must be confirmed.
     pub inscribed_wrong_beyond_edge: usize,
     pub inscribed_wrong_beyond_edge_confirmed: usize,
 }
@@ -202,11 +202,14 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
         })
         .map(|(c, _)| c)
         .collect();
-    // G's edge: cells next to (or diagonal to) a G cell.
+    // G's edge, as far as the grid blurs it: one cell of rasterisation, and for the truck
+    // one more for the single pose a search state keeps (a vehicle that slides can move
+    // onto any pose in a cell; the truck, driving forward only, cannot).
+    let edge = if s.mode == Mode::Truck { 2 } else { 1 };
     let on_edge = |cell: usize| {
         let (x, y) = ((cell % s.nx) as i64, (cell / s.nx) as i64);
-        (-1..=1).any(|dy| {
-            (-1..=1).any(|dx| {
+        (-edge..=edge).any(|dy| {
+            (-edge..=edge).any(|dx| {
                 let (i, j) = (x + dx, y + dy);
                 (0..s.nx as i64).contains(&i)
                     && (0..s.ny as i64).contains(&j)

@@ -384,7 +384,30 @@ impl Space {
             }
             if self.drives_straight(layer) {
                 let dir = [sign * head.cos(), sign * head.sin()];
-                moves.push((self.straight_step(p, dir), layer));
+                let q = self.straight_step(p, dir);
+                moves.push((q, layer));
+                if self.mode == Mode::Truck && !stop_at_goal {
+                    // A truck cannot slide back onto a ray whose cells other poses took
+                    // over: for the whole reachable set (G regions) it also drives on
+                    // through cells already reached to the first one that is not (one
+                    // sweep covers the stretch: a translation's hull). Without it the
+                    // truck's G missed strips along the walls up to 4 cells wide; a search
+                    // for one passage (W_min) skips it, at 2.5× the time it moves W_min by
+                    // under a cell.
+                    // (Cells outside the corridor are never reached, so the walk stops
+                    // at a wall; the move's own checks then drop it.)
+                    let mut far = q;
+                    let layer_base = layer * self.cells();
+                    while self
+                        .cell_of(far)
+                        .is_some_and(|c| parent[layer_base + c] != 0)
+                    {
+                        far = self.straight_step(far, dir);
+                    }
+                    if far != q {
+                        moves.push((far, layer));
+                    }
+                }
             }
             for &r in &self.turn_radii_m {
                 if forward && layer < last {

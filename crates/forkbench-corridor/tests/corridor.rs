@@ -205,3 +205,32 @@ fn a_t_junction_is_never_harder_than_an_l_bend() {
         );
     }
 }
+
+#[test]
+fn truck_g_misses_no_position_beyond_its_edge() {
+    // The forward-only truck keeps one pose per cell and heading; driving straight it
+    // once stopped at cells other poses had taken, and its G missed strips along the
+    // walls up to 4 cells wide (20 cm at 5 cm cells), where a search with half the cell
+    // found passages. Now every sampled position inscribed inflation calls free is
+    // confirmed (it collides, or the half-cell search finds no passage either) once it
+    // is more than G's two-cell edge away, and every sampled passage is swept clean.
+    let truck = Vehicle::forklift(&forkbench_core::ForkliftSpec::default());
+    for (w, deg) in [(2.6, 60.0), (2.6, 90.0), (2.3, 60.0)] {
+        let g = GRegion::compute(
+            Bend::new(w, f64::to_radians(deg)),
+            truck,
+            Mode::Truck,
+            res(0.05),
+        );
+        let v = validate(&g, 100);
+        assert!(
+            v.g_sampled >= 50 && v.g_passed == v.g_sampled,
+            "{w} m, {deg}°: {v:?}"
+        );
+        assert!(v.inscribed_wrong_beyond_edge >= 40, "{w} m, {deg}°: {v:?}");
+        assert_eq!(
+            v.inscribed_wrong_beyond_edge_confirmed, v.inscribed_wrong_beyond_edge,
+            "{w} m, {deg}°: {v:?}"
+        );
+    }
+}
