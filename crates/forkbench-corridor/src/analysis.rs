@@ -206,14 +206,12 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
     // one more for the single pose a search state keeps (a vehicle that slides can move
     // onto any pose in a cell; the truck, driving forward only, cannot).
     let edge = if s.mode == Mode::Truck { 2 } else { 1 };
-    let on_edge = |cell: usize| {
-        let (x, y) = ((cell % s.nx) as i64, (cell / s.nx) as i64);
+    let on_edge = |p: [f64; 2]| {
+        let h = s.res.cell_m;
         (-edge..=edge).any(|dy| {
             (-edge..=edge).any(|dx| {
-                let (i, j) = (x + dx, y + dy);
-                (0..s.nx as i64).contains(&i)
-                    && (0..s.ny as i64).contains(&j)
-                    && g.through[(j * s.nx as i64 + i) as usize].is_some()
+                s.cell_of([p[0] + f64::from(dx) * h, p[1] + f64::from(dy) * h])
+                    .is_some_and(|c| g.through[c].is_some())
             })
         })
     };
@@ -242,7 +240,7 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
         w_colliding += usize::from(collides);
         let confirmed = collides || outside_fine_g(p);
         w_confirmed += usize::from(confirmed);
-        if !on_edge(cell) {
+        if !on_edge(p) {
             beyond += 1;
             beyond_confirmed += usize::from(confirmed);
         }
