@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
-use std::sync::mpsc::{SyncSender, sync_channel};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
 use forkbench_core::Pose2;
@@ -51,9 +51,9 @@ const PALLET_TURN_RAD: f64 = 1e-4;
 /// Writes one trial to an indexed, chunked MCAP file.
 ///
 /// Serialising and compressing ~3,000 messages per trial cost more than the trial itself,
-/// so a writer thread does it: the trial thread only hands over each step's record (and
-/// serialises the few large messages: scene, plans, events, outcome) through a bounded
-/// channel, which also bounds memory when the disk is slower than the simulation.
+/// so a writer thread does it, from the file's header on: the trial thread only hands over
+/// each step's record and the other messages, unserialised, through a bounded channel,
+/// which also bounds memory when the disk is slower than the simulation.
 pub struct McapRecorder {
     path: String,
     tx: Option<SyncSender<Cmd>>,
@@ -63,13 +63,15 @@ pub struct McapRecorder {
     error: Option<String>,
 }
 
+/// A message, serialised by the writer thread into its buffer.
+type JsonMsg = Box<dyn FnOnce(&mut Vec<u8>) -> serde_json::Result<()> + Send>;
+
 /// Work for the writer thread.
 enum Cmd {
-    /// An already serialised message.
-    Raw {
+    Json {
         topic: &'static str,
         t_s: f64,
-        data: Vec<u8>,
+        msg: JsonMsg,
     },
     Steps(Vec<StepRecord>),
     /// Flush the current chunk and acknowledge.
@@ -306,13 +308,13 @@ impl SceneUpdate {
 }
 
 #[derive(Serialize)]
-struct PlanMsg<'a> {
+struct PlanMsg {
     index: u32,
     t_s: f64,
     length_m: f64,
     /// [s_m, x_m, y_m, heading_rad, curvature_per_m]
     samples: Vec<[f64; 5]>,
-    control_polygon_m: Option<&'a [[f64; 2]]>,
+    control_polygon_m: Option<Vec<[f64; 2]>>,
 }
 
 /// A line strip (type 0) in world coordinates.
@@ -365,16 +367,10 @@ fn entity_in(frame: &'static str, t_s: f64, id: &str, lines: Vec<LinePrimitive>)
     }
 }
 
-impl McapRecorder {
-    /// Opens `path` (checked beforehand with [`crate::check_writable`]), writes the
-    /// metadata record and starts the writer thread.
-    pub fn create(path: &Path, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
-        let p = path.display().to_string();
-        let io = |e: &dyn std::error::Error| LogError::Io {
-            path: p.clone(),
-            message: with_causes(e),
-        };
-        let file = File::create(path).map_err(|e| io(&e))?;
+impl Sink {
+    /// Starts the MCAP file in `file`: header, schemas, channels and the metadata record.
+    fn open(file: File, metadata: BTreeMap<String, String>) -> Result<Self, String> {
+        let io = |e: &dyn std::error::Error| with_causes(e);
         // Small chunks: a crash loses at most the chunk being written. LZ4 on this thread
         // only (no compressor threads, which would take the trial's core): on the field
         // test it costs 8.7 M instructions less per trial than zstd level 1 (49.5 vs
@@ -410,7 +406,7 @@ impl McapRecorder {
                 metadata,
             })
             .map_err(|e| io(&e))?;
-        let mut sink = Sink {
+        Ok(Self {
             writer,
             channels,
             sequence: 0,
@@ -418,29 +414,59 @@ impl McapRecorder {
             estimate_sent: None,
             buf: Vec::with_capacity(1024),
             error: None,
+        })
+    }
+
+    /// Runs the writer thread's commands, then finishes the file; returns the first error.
+    fn run(mut self, rx: Receiver<Cmd>) -> Option<String> {
+        for cmd in rx {
+            match cmd {
+                Cmd::Json { topic, t_s, msg } => {
+                    let mut buf = std::mem::take(&mut self.buf);
+                    buf.clear();
+                    match msg(&mut buf) {
+                        Ok(()) => self.write_bytes(topic, t_s, &buf),
+                        Err(e) => {
+                            self.error.get_or_insert(e.to_string());
+                        }
+                    }
+                    self.buf = buf;
+                }
+                Cmd::Steps(steps) => steps.iter().for_each(|s| self.step(s)),
+                Cmd::Flush(ack) => {
+                    let r = self.writer.flush().err().map(|e| with_causes(&e));
+                    let _ = ack.send(r);
+                }
+                Cmd::Abandon => {
+                    std::mem::forget(self);
+                    return None;
+                }
+            }
+        }
+        if let Err(e) = self.writer.finish() {
+            self.error.get_or_insert(with_causes(&e));
+        }
+        self.error
+    }
+}
+
+impl McapRecorder {
+    /// Creates `path` (checked beforehand with [`crate::check_writable`]) and starts the
+    /// writer thread, which writes the header, schemas and metadata record: only creating
+    /// the file, the step that fails on a bad path, holds up the trial.
+    pub fn create(path: &Path, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
+        let p = path.display().to_string();
+        let io = |e: &dyn std::error::Error| LogError::Io {
+            path: p.clone(),
+            message: with_causes(e),
         };
+        let file = File::create(path).map_err(|e| io(&e))?;
         let (tx, rx) = sync_channel::<Cmd>(1024);
         let thread = std::thread::Builder::new()
             .name("mcap-writer".into())
-            .spawn(move || {
-                for cmd in rx {
-                    match cmd {
-                        Cmd::Raw { topic, t_s, data } => sink.write_bytes(topic, t_s, &data),
-                        Cmd::Steps(steps) => steps.iter().for_each(|s| sink.step(s)),
-                        Cmd::Flush(ack) => {
-                            let r = sink.writer.flush().err().map(|e| with_causes(&e));
-                            let _ = ack.send(r);
-                        }
-                        Cmd::Abandon => {
-                            std::mem::forget(sink);
-                            return None;
-                        }
-                    }
-                }
-                if let Err(e) = sink.writer.finish() {
-                    sink.error.get_or_insert(with_causes(&e));
-                }
-                sink.error
+            .spawn(move || match Sink::open(file, metadata) {
+                Ok(sink) => sink.run(rx),
+                Err(e) => Some(e),
             })
             .map_err(|e| io(&e))?;
         Ok(Self {
@@ -452,14 +478,13 @@ impl McapRecorder {
         })
     }
 
-    /// Serialises `msg` here and hands it to the writer thread.
-    fn send(&mut self, topic: &'static str, t_s: f64, msg: &impl Serialize) {
-        match serde_json::to_vec(msg) {
-            Ok(data) => self.command(Cmd::Raw { topic, t_s, data }),
-            Err(e) => {
-                self.error.get_or_insert(e.to_string());
-            }
-        }
+    /// Hands `msg` to the writer thread, which serialises it.
+    fn send<M: Serialize + Send + 'static>(&mut self, topic: &'static str, t_s: f64, msg: M) {
+        self.command(Cmd::Json {
+            topic,
+            t_s,
+            msg: Box::new(move |buf: &mut Vec<u8>| serde_json::to_writer(buf, &msg)),
+        });
     }
 
     fn send_steps(&mut self) {
@@ -488,9 +513,8 @@ impl McapRecorder {
         self.tx = None;
         if let Some(t) = self.thread.take() {
             match t.join() {
-                Ok(Some(e)) => {
-                    self.error.get_or_insert(e);
-                }
+                // The thread's own error is the cause of a "stopped" noted here.
+                Ok(Some(e)) => self.error = Some(e),
                 Ok(None) => {}
                 Err(_) => {
                     self.error
@@ -633,7 +657,7 @@ impl Recorder for McapRecorder {
         self.send(
             "/world",
             0.0,
-            &SceneUpdate {
+            SceneUpdate {
                 deletions: [],
                 entities,
             },
@@ -666,13 +690,13 @@ impl Recorder for McapRecorder {
         self.send(
             "/truck/scene",
             0.0,
-            &SceneUpdate {
+            SceneUpdate {
                 deletions: [],
                 entities,
             },
         );
         for (child, pose) in [("fork_root", &s.start), ("pallet", &s.pallet_pose)] {
-            self.send("/tf", 0.0, &FrameTransform::world(0.0, child, pose));
+            self.send("/tf", 0.0, FrameTransform::world(0.0, child, pose));
         }
     }
 
@@ -692,16 +716,16 @@ impl Recorder for McapRecorder {
                 .iter()
                 .map(|p| [p.s_m, p.x_m, p.y_m, p.heading_rad, p.curvature_per_m])
                 .collect(),
-            control_polygon_m: control_polygon,
+            control_polygon_m: control_polygon.map(<[_]>::to_vec),
         };
-        self.send("/forkbench/plan", t_s, &msg);
+        self.send("/forkbench/plan", t_s, msg);
         let pts: Vec<[f64; 2]> = path.samples.iter().map(|p| [p.x_m, p.y_m]).collect();
         let mut lines = vec![line(&pts, [0.1, 0.4, 0.9, 1.0], 0.02)];
         if let Some(c) = control_polygon {
             lines.push(line(c, [0.1, 0.4, 0.9, 0.4], 0.01));
         }
         let scene = SceneUpdate::one(entity(t_s, &format!("plan/{index}"), lines));
-        self.send("/world", t_s, &scene);
+        self.send("/world", t_s, scene);
     }
 
     fn step(&mut self, s: &StepRecord) {
@@ -720,13 +744,13 @@ impl Recorder for McapRecorder {
         self.send(
             "/log",
             t_s,
-            &json!({"timestamp": Stamp::at(t_s), "level": level, "message": text, "name": "forkbench", "file": "", "line": 0}),
+            json!({"timestamp": Stamp::at(t_s), "level": level, "message": text, "name": "forkbench", "file": "", "line": 0}),
         );
     }
 
     fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
         // `send` hands over the steps collected so far first.
-        self.send("/forkbench/outcome", t_s, outcome);
+        self.send("/forkbench/outcome", t_s, outcome.clone());
         // The outcome is the trial's last message: let the writer thread finish the file
         // (last chunk, summary, index) now, while the other sinks finish theirs;
         // `finish` then only joins it.

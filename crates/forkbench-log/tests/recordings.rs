@@ -289,21 +289,27 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
 }
 
 /// A full disk reaches the caller as an error naming the file and the reason, for both
-/// sinks (`/dev/full` opens, then every write fails with ENOSPC): the .rrd mid-trial, the
-/// MCAP already when its header is written.
+/// sinks (`/dev/full` opens, then every write fails with ENOSPC): both write on threads of
+/// their own, so the error comes when the recording is finished.
 #[test]
 #[cfg(target_os = "linux")]
 fn a_full_disk_is_reported_by_both_sinks() {
     let scn = field_test();
     let full = Path::new("/dev/full");
-    let mcap = McapRecorder::create(full, BTreeMap::new())
-        .expect_err("the header does not fit")
-        .to_string();
-    assert!(mcap.contains("/dev/full"), "{mcap}");
-    assert!(mcap.to_lowercase().contains("no space"), "{mcap}");
+    let mut mcap = McapRecorder::create(full, BTreeMap::new()).expect("opens");
     let mut rrd = RerunRecorder::new(&RerunTarget::File(full.to_path_buf())).expect("opens");
-    run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rrd);
-    let e = rrd.finish().expect_err("the chunks do not fit").to_string();
-    assert!(e.contains("/dev/full"), "{e}");
-    assert!(e.to_lowercase().contains("no space"), "{e}");
+    run_trial_recorded(
+        &scn,
+        &scn.cases[0],
+        &opts(),
+        &mut forkbench_trial::Tee(vec![&mut mcap, &mut rrd]),
+    );
+    for e in [
+        mcap.finish().expect_err("the MCAP does not fit"),
+        rrd.finish().expect_err("the .rrd does not fit"),
+    ] {
+        let e = e.to_string();
+        assert!(e.contains("/dev/full"), "{e}");
+        assert!(e.to_lowercase().contains("no space"), "{e}");
+    }
 }
