@@ -6,7 +6,7 @@ use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
 use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimeSeriesView, Vertical};
 
-use crate::rrd_file::{ErrorSlot, RrdFileSink};
+use crate::rrd_file::{ErrorSlot, Prefix, RrdFileSink};
 use crate::{LogError, pallet_outlines, rect_corners, truck_outlines};
 
 /// Where the recording goes.
@@ -163,6 +163,16 @@ fn blueprint_msgs() -> Result<&'static [rerun::log::LogMsg], LogError> {
     .map_err(|e| LogError::Rerun(format!("building the blueprint: {e}")))
 }
 
+/// The start of an .rrd file (stream header and blueprint), encoded once per process.
+fn blueprint_prefix() -> Result<&'static Prefix, LogError> {
+    static PREFIX: std::sync::OnceLock<Result<Prefix, String>> = std::sync::OnceLock::new();
+    let msgs = blueprint_msgs()?;
+    PREFIX
+        .get_or_init(|| Prefix::encode(msgs))
+        .as_ref()
+        .map_err(|e| LogError::Rerun(format!("encoding the blueprint: {e}")))
+}
+
 /// `col` (one row) as the first row of a column of `rows` rows, null after it: rerun reads
 /// a null as "nothing logged at this row", so the value holds from the first row on.
 fn first_row_only(
@@ -198,7 +208,7 @@ impl RerunRecorder {
         let mut file_errors = None;
         let rec = match target {
             RerunTarget::File(p) => {
-                let sink = RrdFileSink::create(p).map_err(LogError::Rerun)?;
+                let sink = RrdFileSink::create(p, blueprint_prefix()?).map_err(LogError::Rerun)?;
                 file_errors = Some(sink.error_slot());
                 builder.set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
             }
@@ -217,8 +227,14 @@ impl RerunRecorder {
             }
         }
         .map_err(|e| LogError::Rerun(e.to_string()))?;
-        for msg in blueprint_msgs()? {
-            rec.record_msg(msg.clone());
+        // `sim_time` is the recording's only timeline: a wall-clock `log_time` on some
+        // entities would only confuse (and costs a manifest column per component).
+        rec.set_log_time_enabled(false);
+        if !matches!(target, RerunTarget::File(_)) {
+            // A file starts with the blueprint already (its sink writes it first).
+            for msg in blueprint_msgs()? {
+                rec.record_msg(msg.clone());
+            }
         }
         Ok(Self {
             rec,

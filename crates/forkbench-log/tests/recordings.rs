@@ -288,6 +288,66 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
     assert_eq!(rows["/sensors/nav350_fix"], fixes.0, "{rows:?}");
 }
 
+/// The .rrd footer (written by forkbench's own sink, from rerun's pieces) is what rerun's
+/// reader expects: one manifest per store (recording and blueprint), and every chunk it
+/// lists decodes, at the byte span it gives, to the chunk of that id; together they list
+/// every chunk of the file. Two files from one process check the blueprint, encoded once,
+/// in a second file too.
+#[test]
+fn rrd_footer_lists_every_chunk_where_it_is() {
+    use rerun::external::re_log_encoding::{
+        DecoderApp, MessageHeader, RawRrdManifest, StreamHeader,
+    };
+    use rerun::external::re_log_types::LogMsg;
+
+    let scn = field_test();
+    for name in ["footer-a.rrd", "footer-b.rrd"] {
+        let path = tmp(name);
+        let mut rec = RerunRecorder::new(&RerunTarget::File(path.clone())).expect("opens");
+        run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rec);
+        rec.finish().expect("flushes");
+        let bytes = std::fs::read(&path).expect("written");
+        // The chunks the file holds, in order, by decoding it from the start.
+        let chunk_of = |msg: LogMsg| match msg {
+            LogMsg::ArrowMsg(store, m) => Some((
+                format!("{:?}", store.kind()),
+                rerun::log::Chunk::from_arrow_msg(&m).expect("chunk").id(),
+            )),
+            _ => None,
+        };
+        let in_file: BTreeSet<_> = DecoderApp::decode_lazy(bytes.as_slice())
+            .filter_map(|m| chunk_of(m.expect("decodes")))
+            .collect();
+        let manifests = RawRrdManifest::from_rrd_bytes(&bytes).expect("footer reads");
+        let kinds: BTreeSet<String> = manifests
+            .iter()
+            .map(|m| format!("{:?}", m.store_id.kind()))
+            .collect();
+        assert_eq!(kinds.len(), 2, "{name}: one manifest per store: {kinds:?}");
+        let header = &bytes[..StreamHeader::ENCODED_SIZE_BYTES];
+        let mut listed = BTreeSet::new();
+        for m in &manifests {
+            let kind = format!("{:?}", m.store_id.kind());
+            let ids: Vec<_> = m.col_chunk_id().expect("ids").collect();
+            let offsets: Vec<_> = m.col_chunk_byte_offset().expect("offsets").collect();
+            let sizes: Vec<_> = m.col_chunk_byte_size().expect("sizes").collect();
+            assert_eq!(ids.len(), offsets.len());
+            for ((id, offset), size) in ids.iter().zip(offsets).zip(sizes) {
+                // The span excludes the message header: decode header + span on its own.
+                let start = offset as usize - MessageHeader::ENCODED_SIZE_BYTES;
+                let one = [header, &bytes[start..offset as usize + size as usize]].concat();
+                let decoded: Vec<_> = DecoderApp::decode_lazy(one.as_slice())
+                    .filter_map(|m| chunk_of(m.expect("the span decodes")))
+                    .collect();
+                assert_eq!(decoded, [(kind.clone(), *id)], "{name}: chunk at {offset}");
+                listed.insert((kind.clone(), *id));
+            }
+        }
+        assert_eq!(listed, in_file, "{name}: the footer lists every chunk");
+        assert!(listed.len() > 20, "{name}: {} chunks", listed.len());
+    }
+}
+
 /// A full disk reaches the caller as an error naming the file and the reason, for both
 /// sinks (`/dev/full` opens, then every write fails with ENOSPC): both write on threads of
 /// their own, so the error comes when the recording is finished.
