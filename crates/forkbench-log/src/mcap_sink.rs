@@ -421,17 +421,7 @@ impl Sink {
     fn run(mut self, rx: Receiver<Cmd>) -> Option<String> {
         for cmd in rx {
             match cmd {
-                Cmd::Json { topic, t_s, msg } => {
-                    let mut buf = std::mem::take(&mut self.buf);
-                    buf.clear();
-                    match msg(&mut buf) {
-                        Ok(()) => self.write_bytes(topic, t_s, &buf),
-                        Err(e) => {
-                            self.error.get_or_insert(e.to_string());
-                        }
-                    }
-                    self.buf = buf;
-                }
+                Cmd::Json { topic, t_s, msg } => self.write_json(topic, t_s, msg),
                 Cmd::Steps(steps) => steps.iter().for_each(|s| self.step(s)),
                 Cmd::Flush(ack) => {
                     let r = self.writer.flush().err().map(|e| with_causes(&e));
@@ -563,9 +553,19 @@ impl McapRecorder {
 
 impl Sink {
     fn write(&mut self, topic: &str, t_s: f64, msg: &impl Serialize) {
+        self.write_json(topic, t_s, |buf| serde_json::to_writer(buf, msg));
+    }
+
+    /// Serialises a message with `to_json` into the reused buffer and writes it.
+    fn write_json(
+        &mut self,
+        topic: &str,
+        t_s: f64,
+        to_json: impl FnOnce(&mut Vec<u8>) -> serde_json::Result<()>,
+    ) {
         let mut buf = std::mem::take(&mut self.buf);
         buf.clear();
-        match serde_json::to_writer(&mut buf, msg) {
+        match to_json(&mut buf) {
             Ok(()) => self.write_bytes(topic, t_s, &buf),
             Err(e) => {
                 self.error.get_or_insert(e.to_string());
