@@ -189,16 +189,16 @@ fn spiral_markdown(
     );
     let _ = writeln!(
         s,
-        "| # | K0 (1/m) | Y_f (m) | Θ_f (°) | paper b | paper c | paper s_f | paper J | paper endpoint err (cm) | b | c | s_f | J | ΔJ | endpoint err (m) | max κ (1/m) | max steer (rad) | solve (µs) |"
+        "| # | K0 (1/m) | Y_f (m) | Θ_f (°) | paper b | paper c | paper s_f | paper J | paper endpoint err (cm) | b | c | s_f | s_f window | J | ΔJ | endpoint err (m) | max κ (1/m) | max steer (rad) | solve (µs) |"
     );
     let _ = writeln!(
         s,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for (r, _) in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.0} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {:.4} | {:.4} | {:.4} | {:.4} | {:+.1} % | {:.1e} | {:.4} | {:.4} | {:.0} |",
+            "| {} | {} | {} | {:.0} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {:.4} | {:.4} | {:.4} | {:.4}–{:.4}{} | {:.4} | {:+.1} % | {:.1e} | {:.4} | {:.4} | {:.0} |",
             r.name,
             r.start_curvature_per_m,
             r.goal_lateral_m,
@@ -211,6 +211,9 @@ fn spiral_markdown(
             r.b,
             r.c,
             r.sf,
+            r.window_lo,
+            r.window_hi,
+            r.sf_at_bound.map(|b| format!(" ({b})")).unwrap_or_default(),
             r.cost,
             100.0 * (r.cost / r.paper_cost - 1.0),
             r.endpoint_error_m,
@@ -219,8 +222,46 @@ fn spiral_markdown(
             r.solve_time_us
         );
     }
-    let higher: Vec<_> = rows.iter().filter(|(r, _)| r.cost > r.paper_cost).collect();
     let _ = writeln!(s);
+    s.push_str(&window_bounds(rows));
+    s.push_str(&paper_comparison(rows));
+    let _ = writeln!(
+        s,
+        "\nmedian solve time {:.0} µs over {} scenarios (this run, wall clock; see the criterion bench)",
+        median(rows.iter().map(|(r, _)| r.solve_time_us).collect()),
+        rows.len()
+    );
+    s
+}
+
+/// Which rows' optimum sits at a bound of the length window, and how many inside it.
+fn window_bounds(rows: &[(forkbench_plan::reproduce::SpiralRow, Plan)]) -> String {
+    let mut s = String::new();
+    for bound in ["short end", "long end"] {
+        let at: Vec<&str> = rows
+            .iter()
+            .filter(|(r, _)| r.sf_at_bound == Some(bound))
+            .map(|(r, _)| r.name.as_str())
+            .collect();
+        let _ = writeln!(
+            s,
+            "The optimum sits at the window's {bound} on rows: {}.",
+            if at.is_empty() {
+                "none".to_string()
+            } else {
+                at.join(", ")
+            }
+        );
+    }
+    let interior = rows.iter().filter(|(r, _)| r.sf_at_bound.is_none()).count();
+    let _ = writeln!(s, "It lies inside the window on {interior} rows.\n");
+    s
+}
+
+/// Rows where our cost is above the paper's (and why), and the paper's reported endpoint errors.
+fn paper_comparison(rows: &[(forkbench_plan::reproduce::SpiralRow, Plan)]) -> String {
+    let mut s = String::new();
+    let higher: Vec<_> = rows.iter().filter(|(r, _)| r.cost > r.paper_cost).collect();
     if higher.is_empty() {
         let _ = writeln!(s, "Our cost is at or below the paper's on every row.");
     } else {
@@ -252,11 +293,5 @@ fn spiral_markdown(
             );
         }
     }
-    let _ = writeln!(
-        s,
-        "\nmedian solve time {:.0} µs over {} scenarios (this run, wall clock; see the criterion bench)",
-        median(rows.iter().map(|(r, _)| r.solve_time_us).collect()),
-        rows.len()
-    );
     s
 }

@@ -278,6 +278,11 @@ pub struct SpiralRow {
     pub d: f64,
     pub e: f64,
     pub sf: f64,
+    /// The length window searched (normalised).
+    pub window_lo: f64,
+    pub window_hi: f64,
+    /// "short end" or "long end" when the optimum sits at a window bound.
+    pub sf_at_bound: Option<&'static str>,
     pub cost: f64,
     pub max_curvature_per_m: f64,
     pub max_steer_rad: f64,
@@ -303,6 +308,7 @@ pub fn reproduce_spiral(
             let m = p.path.metrics(&req.start, &req.goal, truck);
             let prob = SpiralProblem::from_request(&req, 0.0);
             let paper = prob.evaluate(c.paper_b, c.paper_c, c.paper_sf);
+            let (window_lo, window_hi) = prob.length_window(cfg.enforce_length_window);
             let row = SpiralRow {
                 name: c.name.clone(),
                 start_curvature_per_m: c.start_curvature_per_m,
@@ -321,6 +327,9 @@ pub fn reproduce_spiral(
                 d: p.params.d,
                 e: p.params.e,
                 sf: p.params.sf,
+                window_lo,
+                window_hi,
+                sf_at_bound: spiral::window_bound(p.params.sf, (window_lo, window_hi)),
                 cost: p.cost,
                 max_curvature_per_m: p.max_abs_curvature_per_m,
                 max_steer_rad: truck.steer_for_curvature(p.max_abs_curvature_per_m),
