@@ -27,6 +27,7 @@ pub struct BatchArgs {
     pub record_failures: bool,
     pub record_successes: bool,
     pub max_recordings: usize,
+    pub force_new: bool,
 }
 
 fn parse_shard(text: &str) -> anyhow::Result<(u64, u64)> {
@@ -131,6 +132,7 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
         shard,
         pallet_noise_scale: a.pallet_noise_scale,
         replan: a.replan.then_some(true),
+        force_new: a.force_new,
     };
     let Some(sweep) = &a.sweep else {
         let t0 = std::time::Instant::now();
@@ -233,11 +235,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path, json: bool) -> anyhow::Result<()> {
 }
 
 fn load_summary(dir: &Path) -> anyhow::Result<Summary> {
-    let path = dir.join("summary.json");
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    serde_json::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{}: line {}: {e}", path.display(), e.line()))
+    Ok(batch::load_results(dir)?)
 }
 
 pub fn baseline(dir: &Path, out: &Path) -> anyhow::Result<()> {

@@ -198,6 +198,10 @@ enum Command {
         /// At most this many recordings (the first in job order).
         #[arg(long, default_value_t = 20)]
         max_recordings: usize,
+        /// Discard what OUT holds from a batch with other settings and start over
+        /// (without it such a directory is refused, naming the differences).
+        #[arg(long)]
+        force_new: bool,
     },
     /// Combine shard outputs into one summary.
     Merge {
@@ -325,6 +329,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             sweep,
             record,
             max_recordings,
+            force_new,
         } => batch_cmd::run(batch_cmd::BatchArgs {
             scenarios,
             trials,
@@ -340,6 +345,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             record_failures: record != RecordWhich::None,
             record_successes: record == RecordWhich::All,
             max_recordings,
+            force_new,
         })
         .map(|()| Done::Ok),
         Command::Merge { dirs, out, json } => {

@@ -330,8 +330,8 @@ fn default_timeout() -> f64 {
     120.0
 }
 
-/// A loaded, validated scenario file.
-#[derive(Debug, Clone)]
+/// A loaded, validated scenario file (serialisable: a batch's manifest records it whole).
+#[derive(Debug, Clone, Serialize)]
 pub struct Scenario {
     pub file: String,
     pub name: String,
@@ -357,7 +357,7 @@ pub struct Scenario {
 }
 
 /// One start/pallet geometry of a scenario.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Case {
     pub name: String,
     /// Fork-root start pose.

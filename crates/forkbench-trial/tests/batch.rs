@@ -1,4 +1,4 @@
-//! Batches: identical results whatever the jobs and shards, resume after a crash, errors kept, the regression gate.
+//! Batches: identical results whatever the jobs and shards, resume after a crash, errors kept, the regression gate, and a directory's integrity (manifest, lock, merge checks).
 
 use std::path::{Path, PathBuf};
 
@@ -26,6 +26,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, seed: u64) -> BatchSpec {
         shard: (0, 1),
         pallet_noise_scale: None,
         replan: Some(true),
+        force_new: false,
     }
 }
 
@@ -82,6 +83,8 @@ fn a_crashed_batch_resumes_without_losing_or_repeating_trials() {
     let text = std::fs::read_to_string(full.join("trials.jsonl")).expect("written");
     let lines: Vec<&str> = text.lines().collect();
     std::fs::create_dir_all(&crashed).expect("dir");
+    // The manifest is written when a batch starts, so a crashed directory has it.
+    std::fs::copy(full.join("manifest.json"), crashed.join("manifest.json")).expect("copy");
     std::fs::write(
         crashed.join("trials.jsonl"),
         format!("{}\n{}", lines[..8].join("\n"), &lines[8][..40]),
@@ -180,4 +183,176 @@ fn baselines_reject_impossible_counts() {
         e.to_string().contains("b.json") && e.to_string().contains(":2"),
         "{e}"
     );
+}
+
+fn err(r: Result<batch::Summary, batch::BatchError>) -> String {
+    r.expect_err("must be refused").to_string()
+}
+
+/// Defect 1: a re-run with other settings into the same --out reused the old trials.
+#[test]
+fn resume_refuses_other_settings_and_force_new_starts_over() {
+    let d = tmp("resume-settings");
+    let base = spec(vec![scenario("field-test.toml")], 6, 3);
+    batch::run_batch(&base, &d, 2, &|_| {}).expect("runs");
+    let mut quiet = base.clone();
+    quiet.pallet_noise_scale = Some(0.0);
+    let e = err(batch::run_batch(&quiet, &d, 2, &|_| {}));
+    assert!(
+        e.contains("pallet_noise_scale: null → 0.0") && e.contains("--force-new"),
+        "{e}"
+    );
+    let mut seed = base.clone();
+    seed.seed = 4;
+    assert!(err(batch::run_batch(&seed, &d, 2, &|_| {})).contains("seed: 3 → 4"));
+    let mut tol = base.clone();
+    tol.scenarios[0].tolerances.lateral_m *= 0.5;
+    let e = err(batch::run_batch(&tol, &d, 2, &|_| {}));
+    assert!(e.contains("tolerances.lateral_m"), "{e}");
+    // --force-new starts over: the same results as a fresh directory.
+    quiet.force_new = true;
+    let forced = batch::run_batch(&quiet, &d, 2, &|_| {}).expect("starts over");
+    quiet.force_new = false;
+    let fresh_dir = tmp("resume-fresh");
+    let fresh = batch::run_batch(&quiet, &fresh_dir, 2, &|_| {}).expect("runs");
+    assert_eq!(without_wall(forced), without_wall(fresh));
+    assert_eq!(records(&d), records(&fresh_dir));
+    // The same settings resume (nothing to run again).
+    let seen = std::sync::atomic::AtomicU64::new(0);
+    batch::run_batch(&quiet, &d, 2, &|_| {
+        seen.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    })
+    .expect("resumes");
+    assert_eq!(seen.into_inner(), 0);
+}
+
+/// Defect 2: merge combined shards of different batches, duplicates, missing shards,
+/// no inputs, and merged into one of its inputs.
+#[test]
+fn merge_checks_manifests_and_shard_coverage() {
+    let s = spec(vec![scenario("field-test.toml")], 4, 5);
+    let shard = |i: u64, n: u64, seed: u64, name: &str| {
+        let mut sp = s.clone();
+        sp.shard = (i, n);
+        sp.seed = seed;
+        let d = tmp(name);
+        batch::run_batch(&sp, &d, 1, &|_| {}).expect("runs");
+        d
+    };
+    let (a0, a1) = (shard(0, 2, 5, "m-a0"), shard(1, 2, 5, "m-a1"));
+    let b1 = shard(1, 2, 6, "m-b1");
+    let c0 = shard(0, 3, 5, "m-c0");
+    let out = tmp("m-out");
+    let e = err(batch::merge(&[a0.clone(), b1], &out));
+    assert!(e.contains("different batches") && e.contains("seed"), "{e}");
+    let e = err(batch::merge(&[a0.clone(), c0], &out));
+    assert!(
+        e.contains("different batches") && e.contains("shard"),
+        "{e}"
+    );
+    let e = err(batch::merge(&[a0.clone(), a0.clone()], &out));
+    assert!(e.contains("shard 0/2 given twice"), "{e}");
+    let e = err(batch::merge(std::slice::from_ref(&a0), &out));
+    assert!(e.contains("shards 1 of 2 are missing"), "{e}");
+    assert!(err(batch::merge(&[], &out)).contains("at least one input"));
+    let e = err(batch::merge(&[a0.clone(), a1.clone()], &a1));
+    assert!(e.contains("both an input and --out"), "{e}");
+    // An unfinished shard is refused too.
+    let text = std::fs::read_to_string(a1.join("trials.jsonl")).expect("written");
+    let first = text.lines().next().expect("a line");
+    std::fs::write(a1.join("trials.jsonl"), format!("{first}\n")).expect("write");
+    let e = err(batch::merge(&[a0.clone(), a1.clone()], &out));
+    assert!(e.contains("holds 1 of the 2 trials"), "{e}");
+}
+
+/// Defect 3: two writers at once duplicated records; the lock refuses the second, and
+/// a directory that already has duplicates is refused rather than summarised.
+#[test]
+fn one_writer_at_a_time_and_no_duplicate_records() {
+    let d = tmp("lock");
+    let s = spec(vec![scenario("field-test.toml")], 3, 8);
+    std::fs::create_dir_all(&d).expect("dir");
+    let held = batch::DirLock::take(&d).expect("first writer");
+    let e = err(batch::run_batch(&s, &d, 1, &|_| {}));
+    assert!(e.contains("another forkbench process is writing"), "{e}");
+    drop(held);
+    batch::run_batch(&s, &d, 1, &|_| {}).expect("runs once the lock is free");
+    let text = std::fs::read_to_string(d.join("trials.jsonl")).expect("written");
+    std::fs::write(d.join("trials.jsonl"), format!("{text}{text}")).expect("write");
+    assert!(err(batch::load_results(&d)).contains("3 duplicate trial records"));
+    assert!(err(batch::run_batch(&s, &d, 1, &|_| {})).contains("duplicate trial records"));
+}
+
+/// Defect 4: the same file twice, or two files sharing a name, shared rows and seeds.
+#[test]
+fn scenario_names_must_be_unique_in_a_batch() {
+    let d = tmp("names");
+    let twice = spec(
+        vec![scenario("field-test.toml"), scenario("field-test.toml")],
+        2,
+        1,
+    );
+    let e = err(batch::run_batch(&twice, &d, 1, &|_| {}));
+    assert!(e.contains("\"field-test\" is used by both"), "{e}");
+    let mut other = scenario("rack-pick.toml");
+    other.name = "field-test".into();
+    let clash = spec(vec![scenario("field-test.toml"), other], 2, 1);
+    let e = err(batch::run_batch(&clash, &d, 1, &|_| {}));
+    assert!(e.contains("rack-pick.toml"), "{e}");
+}
+
+/// Defect 5: empty or duplicate-row baselines passed everything; results read a stale
+/// summary.json or an unfinished directory.
+#[test]
+fn results_come_from_a_complete_trials_file_and_baselines_have_rows() {
+    let d = tmp("results");
+    let s = spec(vec![scenario("field-test.toml")], 4, 2);
+    let summary = batch::run_batch(&s, &d, 1, &|_| {}).expect("runs");
+    // A stale summary.json is never read: results come from trials.jsonl.
+    std::fs::write(d.join("summary.json"), "{\"stale\": true}").expect("write");
+    assert_eq!(batch::load_results(&d).expect("complete"), summary);
+    // An interrupted directory is refused.
+    let text = std::fs::read_to_string(d.join("trials.jsonl")).expect("written");
+    let kept: Vec<&str> = text.lines().take(2).collect();
+    std::fs::write(d.join("trials.jsonl"), kept.join("\n") + "\n").expect("write");
+    assert!(err(batch::load_results(&d)).contains("holds 2 of the 4 trials"));
+    // Nor is a directory that is not a batch.
+    let empty = tmp("results-empty");
+    std::fs::create_dir_all(&empty).expect("dir");
+    assert!(err(batch::load_results(&empty)).contains("no manifest.json"));
+    let bad = tmp("baselines");
+    std::fs::create_dir_all(&bad).expect("dir");
+    let none = bad.join("none.json");
+    std::fs::write(&none, r#"{"description": "x", "rows": []}"#).expect("write");
+    let e = Baseline::load(&none).expect_err("empty").to_string();
+    assert!(e.contains("rows is empty"), "{e}");
+    let dup = bad.join("dup.json");
+    let row = r#"{"scenario": "a", "planner": "bspline", "trials": 10, "successes": 5}"#;
+    std::fs::write(
+        &dup,
+        format!(r#"{{"description": "x", "rows": [{row}, {row}]}}"#),
+    )
+    .expect("write");
+    let e = Baseline::load(&dup).expect_err("duplicate").to_string();
+    assert!(e.contains("rows[1] repeats rows[0]"), "{e}");
+}
+
+/// Defect 6: a corrupt last line ending in a newline wedged the directory.
+#[test]
+fn a_corrupt_last_line_is_dropped_before_resuming() {
+    let d = tmp("corrupt");
+    let s = spec(vec![scenario("field-test.toml")], 5, 9);
+    batch::run_batch(&s, &d, 1, &|_| {}).expect("runs");
+    let full = records(&d);
+    let text = std::fs::read_to_string(d.join("trials.jsonl")).expect("written");
+    let lines: Vec<&str> = text.lines().collect();
+    std::fs::write(
+        d.join("trials.jsonl"),
+        format!("{}\n{{\"trial\": 3, garbage\n", lines[..3].join("\n")),
+    )
+    .expect("write");
+    batch::run_batch(&s, &d, 1, &|_| {}).expect("resumes");
+    batch::run_batch(&s, &d, 1, &|_| {}).expect("and again");
+    assert_eq!(records(&d), full);
+    batch::load_results(&d).expect("readable");
 }

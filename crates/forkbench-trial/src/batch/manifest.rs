@@ -1,0 +1,219 @@
+//! A batch directory's identity: the manifest of what its trials were run with, and the lock that keeps one writer.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use super::{BatchError, BatchSpec, io};
+
+/// Everything a batch's results depend on. Resuming, merging and reading results check
+/// it, so a directory never mixes trials run with different settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    pub forkbench_version: String,
+    pub seed: u64,
+    pub trials: u64,
+    /// [index, count]; [0, 1] for an unsharded batch or a merge.
+    pub shard: [u64; 2],
+    /// Planners every case ran with; empty = each scenario's own.
+    pub planners: Vec<String>,
+    pub pallet_noise_scale: Option<f64>,
+    pub replan: Option<bool>,
+    pub scenarios: Vec<ScenarioEntry>,
+}
+
+/// One scenario as it was resolved (file contents, world, truck, tracker, sensors,
+/// tolerances and cases): its identity is its content, not its name or path.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioEntry {
+    pub name: String,
+    /// Where it was loaded from: informative only, not compared.
+    pub file: String,
+    /// FNV-1a of `settings` as compact JSON.
+    pub settings_hash: String,
+    pub settings: Value,
+}
+
+pub(super) const FILE: &str = "manifest.json";
+
+impl Manifest {
+    /// The manifest of a batch spec.
+    pub fn of(spec: &BatchSpec) -> Result<Self, BatchError> {
+        let scenarios = spec
+            .scenarios
+            .iter()
+            .map(|s| {
+                let mut settings =
+                    serde_json::to_value(s).map_err(|e| BatchError::Invalid(e.to_string()))?;
+                if let Some(map) = settings.as_object_mut() {
+                    map.remove("file");
+                }
+                Ok(ScenarioEntry {
+                    name: s.name.clone(),
+                    file: s.file.clone(),
+                    settings_hash: format!("{:016x}", fnv1a(settings.to_string().as_bytes())),
+                    settings,
+                })
+            })
+            .collect::<Result<_, BatchError>>()?;
+        Ok(Manifest {
+            forkbench_version: env!("CARGO_PKG_VERSION").to_owned(),
+            seed: spec.seed,
+            trials: spec.trials,
+            shard: [spec.shard.0, spec.shard.1],
+            planners: spec.planners.iter().map(|p| p.name().to_owned()).collect(),
+            pallet_noise_scale: spec.pallet_noise_scale,
+            replan: spec.replan,
+            scenarios,
+        })
+    }
+
+    /// The manifest in `dir`, if there is one.
+    pub fn read(dir: &Path) -> Result<Option<Self>, BatchError> {
+        let path = dir.join(FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(io(&path)(e)),
+        };
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| BatchError::Record {
+                path: path.display().to_string(),
+                line: e.line(),
+                message: e.to_string(),
+            })
+    }
+
+    pub fn write(&self, dir: &Path) -> Result<(), BatchError> {
+        let path = dir.join(FILE);
+        let text =
+            serde_json::to_string_pretty(self).map_err(|e| BatchError::Invalid(e.to_string()))?;
+        std::fs::write(&path, text + "\n").map_err(io(&path))
+    }
+
+    /// Where two manifests differ, as `field: ours → theirs` lines (paths into the JSON;
+    /// scenario files' paths are left out, their content is compared).
+    pub fn differences(&self, other: &Manifest) -> Vec<String> {
+        let mut out = Vec::new();
+        let (a, b) = (self.comparable(), other.comparable());
+        diff_values("", &a, &b, &mut out);
+        out
+    }
+
+    /// The same batch but for the shard index (what shards of one batch share).
+    pub fn same_batch(&self, other: &Manifest) -> bool {
+        let mut o = other.clone();
+        o.shard[0] = self.shard[0];
+        self.differences(&o).is_empty()
+    }
+
+    fn comparable(&self) -> Value {
+        let mut v = serde_json::to_value(self).unwrap_or(Value::Null);
+        if let Some(list) = v.get_mut("scenarios").and_then(Value::as_array_mut) {
+            for s in list {
+                if let Some(map) = s.as_object_mut() {
+                    map.remove("file");
+                    map.remove("settings_hash");
+                }
+            }
+        }
+        v
+    }
+
+    /// Trials this manifest's batch (this shard of it) runs.
+    pub fn expected_trials(&self) -> u64 {
+        let planners = self.planners.len().max(1) as u64;
+        let total: u64 = self
+            .scenarios
+            .iter()
+            .map(|s| {
+                let cases = s.settings.get("cases").and_then(Value::as_array);
+                cases.map_or(0, |c| c.len() as u64) * planners * self.trials
+            })
+            .sum();
+        let [i, n] = self.shard;
+        if n == 0 || i >= total {
+            return 0;
+        }
+        (total - i).div_ceil(n)
+    }
+}
+
+fn diff_values(path: &str, a: &Value, b: &Value, out: &mut Vec<String>) {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            for k in keys {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                diff_values(
+                    &p,
+                    x.get(k).unwrap_or(&Value::Null),
+                    y.get(k).unwrap_or(&Value::Null),
+                    out,
+                );
+            }
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+            for (i, (u, v)) in x.iter().zip(y).enumerate() {
+                diff_values(&format!("{path}[{i}]"), u, v, out);
+            }
+        }
+        _ if a != b => out.push(format!("{path}: {} → {}", short(a), short(b))),
+        _ => {}
+    }
+}
+
+fn short(v: &Value) -> String {
+    let s = v.to_string();
+    if s.chars().count() > 60 {
+        format!("{}…", s.chars().take(60).collect::<String>())
+    } else {
+        s
+    }
+}
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// An exclusive lock on a batch directory, held while a batch or merge writes it.
+#[derive(Debug)]
+pub struct DirLock {
+    _file: File,
+    pub path: PathBuf,
+}
+
+impl DirLock {
+    /// Takes the lock on `dir` (creating `dir/.lock`), or names the directory another
+    /// process is writing.
+    pub fn take(dir: &Path) -> Result<Self, BatchError> {
+        let path = dir.join(".lock");
+        let file = File::create(&path).map_err(io(&path))?;
+        match file.try_lock() {
+            Ok(()) => Ok(DirLock { _file: file, path }),
+            Err(std::fs::TryLockError::WouldBlock) => Err(BatchError::Invalid(format!(
+                "{}: another forkbench process is writing this directory (lock held on {}); \
+                 wait for it to finish or choose another --out",
+                dir.display(),
+                path.display()
+            ))),
+            Err(std::fs::TryLockError::Error(e)) => Err(io(&path)(e)),
+        }
+    }
+}

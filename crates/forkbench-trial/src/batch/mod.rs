@@ -1,0 +1,377 @@
+//! Monte-Carlo batches: scenario × case × planner × trial, in parallel, streamed to JSON lines, summarised, compared.
+
+use std::collections::HashSet;
+use std::fs::OpenOptions;
+use std::io::{BufWriter, Write as _};
+use std::path::Path;
+use std::sync::Mutex;
+
+use forkbench_plan::PlannerKind;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+mod baseline;
+mod manifest;
+mod store;
+mod summary;
+
+pub use baseline::{Baseline, BaselineRow, RegressRow, regress, regress_markdown};
+pub use manifest::{DirLock, Manifest};
+pub use store::{load_results, merge, read_records};
+pub use summary::{Summary, SummaryRow, summarize};
+
+use store::{check_unique, read_records_torn, remove_if_present, rewrite_records};
+use summary::write_summary;
+
+use crate::outcome::{Failure, TrialOutcome};
+use crate::scenario::Scenario;
+use crate::trial::{TrialOptions, run_trial};
+
+/// What a batch runs.
+#[derive(Debug, Clone)]
+pub struct BatchSpec {
+    pub scenarios: Vec<Scenario>,
+    /// Planners to run every case with; empty = each scenario's own planner.
+    pub planners: Vec<PlannerKind>,
+    /// Trials per scenario × case × planner.
+    pub trials: u64,
+    pub seed: u64,
+    /// This shard's index and the shard count (0/1 = everything).
+    pub shard: (u64, u64),
+    pub pallet_noise_scale: Option<f64>,
+    pub replan: Option<bool>,
+    /// Discard the output directory's trials when they were run with other settings,
+    /// instead of refusing to resume.
+    pub force_new: bool,
+}
+
+/// Why a batch could not run or be read.
+#[derive(Debug, thiserror::Error)]
+pub enum BatchError {
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}: {message}")]
+    Record {
+        path: String,
+        line: usize,
+        message: String,
+    },
+    #[error("{0}")]
+    Invalid(String),
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> BatchError + '_ {
+    move |source| BatchError::Io {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
+/// One line of `trials.jsonl`: the trial index and its outcome.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialRecord {
+    pub trial: u64,
+    /// Batch-wide overrides this trial ran with, so `forkbench replay` can repeat it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pallet_noise_scale: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replan: Option<bool>,
+    #[serde(flatten)]
+    pub outcome: TrialOutcome,
+}
+
+impl TrialRecord {
+    /// Options that repeat this trial exactly.
+    pub fn options(&self) -> TrialOptions {
+        TrialOptions {
+            seed: Some(self.outcome.seed),
+            planner: self.outcome.planner.parse().ok(),
+            no_noise: !self.outcome.noise,
+            pallet_noise_scale: self.pallet_noise_scale,
+            replan: self.replan,
+        }
+    }
+}
+
+impl TrialRecord {
+    pub fn key(&self) -> (String, String, String, u64) {
+        (
+            self.outcome.scenario.clone(),
+            self.outcome.case.clone(),
+            self.outcome.planner.clone(),
+            self.trial,
+        )
+    }
+}
+
+/// Seed of one trial from its identity alone, so results do not depend on `--jobs`,
+/// sharding or order (FNV-1a over the key, finished with SplitMix64).
+pub fn trial_seed(batch_seed: u64, scenario: &str, case: &str, planner: &str, trial: u64) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |bytes: &[u8]| {
+        for b in bytes {
+            h ^= u64::from(*b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h ^= 0xff;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    eat(&batch_seed.to_le_bytes());
+    eat(scenario.as_bytes());
+    eat(case.as_bytes());
+    eat(planner.as_bytes());
+    eat(&trial.to_le_bytes());
+    let mut z = h.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// One unit of work.
+#[derive(Debug, Clone)]
+pub struct Job {
+    pub scenario: usize,
+    pub case: usize,
+    pub planner: PlannerKind,
+    pub trial: u64,
+}
+
+impl BatchSpec {
+    /// Every job of this shard, in a fixed global order.
+    pub fn jobs(&self) -> Vec<Job> {
+        let mut out = Vec::new();
+        let mut k: u64 = 0;
+        for (si, s) in self.scenarios.iter().enumerate() {
+            let planners = if self.planners.is_empty() {
+                vec![s.planner]
+            } else {
+                self.planners.clone()
+            };
+            for ci in 0..s.cases.len() {
+                for &p in &planners {
+                    for t in 0..self.trials {
+                        if k % self.shard.1 == self.shard.0 {
+                            out.push(Job {
+                                scenario: si,
+                                case: ci,
+                                planner: p,
+                                trial: t,
+                            });
+                        }
+                        k += 1;
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn key(&self, j: &Job) -> (String, String, String, u64) {
+        let s = &self.scenarios[j.scenario];
+        (
+            s.name.clone(),
+            s.cases[j.case].name.clone(),
+            j.planner.name().to_owned(),
+            j.trial,
+        )
+    }
+
+    /// Runs one job; a panic inside the trial becomes that trial's `error` outcome.
+    pub fn run_job(&self, j: &Job) -> TrialRecord {
+        let s = &self.scenarios[j.scenario];
+        let case = &s.cases[j.case];
+        let seed = trial_seed(self.seed, &s.name, &case.name, j.planner.name(), j.trial);
+        let opts = TrialOptions {
+            seed: Some(seed),
+            planner: Some(j.planner),
+            no_noise: false,
+            pallet_noise_scale: self.pallet_noise_scale,
+            replan: self.replan,
+        };
+        let outcome = guarded(s, &case.name, j.planner, seed, || run_trial(s, case, &opts));
+        TrialRecord {
+            trial: j.trial,
+            pallet_noise_scale: self.pallet_noise_scale,
+            replan: self.replan,
+            outcome,
+        }
+    }
+}
+
+/// Runs `f`, turning a panic into an `error` outcome that carries the message and seed.
+pub fn guarded(
+    s: &Scenario,
+    case: &str,
+    planner: PlannerKind,
+    seed: u64,
+    f: impl FnOnce() -> TrialOutcome,
+) -> TrialOutcome {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|panic| {
+        let message = panic
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_owned())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "panic with a non-text payload".to_owned());
+        error_outcome(
+            s,
+            case,
+            planner,
+            seed,
+            format!("trial panicked (seed {seed}): {message}"),
+        )
+    })
+}
+
+fn error_outcome(
+    s: &Scenario,
+    case: &str,
+    planner: PlannerKind,
+    seed: u64,
+    detail: String,
+) -> TrialOutcome {
+    let mut out = TrialOutcome::blank(&s.name, case, planner.name(), seed, s.noise.enabled);
+    out.failure = Some(Failure::Error);
+    out.failure_detail = Some(detail);
+    out
+}
+
+impl BatchSpec {
+    /// Scenario names key rows and seeds: two scenarios may not share one.
+    fn check_names(&self) -> Result<(), BatchError> {
+        for (i, a) in self.scenarios.iter().enumerate() {
+            if let Some(b) = self.scenarios[..i].iter().find(|b| b.name == a.name) {
+                return Err(BatchError::Invalid(format!(
+                    "scenario name {:?} is used by both {} and {}: names identify result rows \
+                     and seeds, so each scenario in a batch needs its own",
+                    a.name, b.file, a.file
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Makes `dir` hold this batch: a new directory gets the manifest; an existing one
+    /// must have been started with the same settings (or is cleared with `force_new`).
+    fn prepare_dir(&self, dir: &Path) -> Result<(), BatchError> {
+        let want = Manifest::of(self)?;
+        let trials = dir.join("trials.jsonl");
+        if self.force_new {
+            for f in ["trials.jsonl", "summary.json", "summary.md", manifest::FILE] {
+                remove_if_present(&dir.join(f))?;
+            }
+            let rec = dir.join("recordings");
+            if rec.is_dir() {
+                std::fs::remove_dir_all(&rec).map_err(io(&rec))?;
+            }
+            return want.write(dir);
+        }
+        match Manifest::read(dir)? {
+            Some(have) => {
+                let diff = have.differences(&want);
+                if !diff.is_empty() {
+                    return Err(BatchError::Invalid(format!(
+                        "{}: holds trials of a different batch ({} differences, directory → \
+                         this run: {}); use --force-new to discard them, or another --out",
+                        dir.display(),
+                        diff.len(),
+                        diff.iter().take(8).cloned().collect::<Vec<_>>().join("; ")
+                    )));
+                }
+                Ok(())
+            }
+            None if std::fs::metadata(&trials).is_ok_and(|m| m.len() > 0) => {
+                Err(BatchError::Invalid(format!(
+                    "{}: has trials.jsonl but no manifest.json (written by an older forkbench?), \
+                     so its settings are unknown; use --force-new to start over",
+                    dir.display()
+                )))
+            }
+            None => want.write(dir),
+        }
+    }
+}
+
+/// Runs (or resumes) a batch into `dir`: one JSON line per finished trial in
+/// `trials.jsonl`, then `summary.json` and `summary.md`. `on_done` sees each finished trial.
+pub fn run_batch(
+    spec: &BatchSpec,
+    dir: &Path,
+    jobs: usize,
+    on_done: &(dyn Fn(&TrialRecord) + Sync),
+) -> Result<Summary, BatchError> {
+    if spec.trials == 0 {
+        return Err(BatchError::Invalid("--trials must be at least 1".into()));
+    }
+    if spec.shard.1 == 0 || spec.shard.0 >= spec.shard.1 {
+        return Err(BatchError::Invalid(format!(
+            "shard {}/{}: the index must be below the shard count",
+            spec.shard.0, spec.shard.1
+        )));
+    }
+    spec.check_names()?;
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let _lock = DirLock::take(dir)?;
+    spec.prepare_dir(dir)?;
+    let path = dir.join("trials.jsonl");
+    let (existing, torn) = read_records_torn(&path)?;
+    check_unique(&existing, &path)?;
+    let done: HashSet<_> = existing.iter().map(TrialRecord::key).collect();
+    let todo: Vec<Job> = spec
+        .jobs()
+        .into_iter()
+        .filter(|j| !done.contains(&spec.key(j)))
+        .collect();
+    // Drop a torn or corrupt last line before appending after it.
+    let raw_ends_clean = std::fs::read(&path).map_or(true, |b| b.is_empty() || b.ends_with(b"\n"));
+    if torn || !raw_ends_clean {
+        rewrite_records(&path, &existing)?;
+    }
+    let file = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .map_err(io(&path))?;
+    let writer = Mutex::new(BufWriter::new(file));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .map_err(|e| BatchError::Invalid(format!("thread pool: {e}")))?;
+    let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
+    pool.install(|| {
+        todo.par_iter().for_each(|j| {
+            let rec = spec.run_job(j);
+            let line = serde_json::to_string(&rec)
+                .unwrap_or_else(|e| format!("{{\"serialisation_error\":\"{e}\"}}"));
+            // Flush per line: a crash or Ctrl-C loses nothing already finished.
+            let mut w = writer
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            if let Err(e) = writeln!(w, "{line}").and_then(|()| w.flush()) {
+                write_error
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner)
+                    .get_or_insert(e);
+            }
+            drop(w);
+            on_done(&rec);
+        });
+    });
+    if let Some(e) = write_error
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+    {
+        return Err(io(&path)(e));
+    }
+    let wanted: HashSet<_> = spec.jobs().iter().map(|j| spec.key(j)).collect();
+    let records: Vec<TrialRecord> = read_records(&path)?
+        .into_iter()
+        .filter(|r| wanted.contains(&r.key()))
+        .collect();
+    let summary = summarize(&records);
+    write_summary(dir, &summary)?;
+    Ok(summary)
+}

@@ -1,0 +1,187 @@
+//! The batch directory on disk: trial records (torn lines, duplicates), finished results, and merging shards.
+
+use std::collections::{BTreeMap, HashSet};
+use std::fs::File;
+use std::io::{BufRead as _, BufReader, BufWriter, Write as _};
+use std::path::{Path, PathBuf};
+
+use super::{BatchError, DirLock, Manifest, Summary, TrialRecord, io, summarize, write_summary};
+
+/// Reads `trials.jsonl`. A torn last line (a crash mid-write) is skipped; any other bad
+/// line is an error naming the file and line.
+pub fn read_records(path: &Path) -> Result<Vec<TrialRecord>, BatchError> {
+    read_records_torn(path).map(|(records, _)| records)
+}
+
+/// [`read_records`], also saying whether a torn last line was skipped.
+pub(super) fn read_records_torn(path: &Path) -> Result<(Vec<TrialRecord>, bool), BatchError> {
+    let file = match File::open(path) {
+        Ok(f) => f,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((Vec::new(), false)),
+        Err(e) => return Err(io(path)(e)),
+    };
+    let lines: Vec<String> = BufReader::new(file)
+        .lines()
+        .collect::<Result<_, _>>()
+        .map_err(io(path))?;
+    let mut out = Vec::with_capacity(lines.len());
+    let last = lines.iter().rposition(|l| !l.trim().is_empty());
+    let mut torn = false;
+    for (i, line) in lines.iter().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        match serde_json::from_str::<TrialRecord>(line) {
+            Ok(r) => out.push(r),
+            Err(_) if Some(i) == last => torn = true, // torn or corrupt final write
+            Err(e) => {
+                return Err(BatchError::Record {
+                    path: path.display().to_string(),
+                    line: i + 1,
+                    message: e.to_string(),
+                });
+            }
+        }
+    }
+    Ok((out, torn))
+}
+
+/// Refuses records that share a trial's key: two writers at once, or a file edited by hand.
+pub(super) fn check_unique(records: &[TrialRecord], path: &Path) -> Result<(), BatchError> {
+    let mut seen = HashSet::new();
+    let dups: Vec<_> = records.iter().filter(|r| !seen.insert(r.key())).collect();
+    if let Some(first) = dups.first() {
+        return Err(BatchError::Invalid(format!(
+            "{}: {} duplicate trial records (first: {:?}); two processes wrote here at once? \
+             Start over with --force-new",
+            path.display(),
+            dups.len(),
+            first.key()
+        )));
+    }
+    Ok(())
+}
+
+/// Rewrites `trials.jsonl` with exactly `records` (dropping a torn last line).
+pub(super) fn rewrite_records(path: &Path, records: &[TrialRecord]) -> Result<(), BatchError> {
+    let mut w = BufWriter::new(File::create(path).map_err(io(path))?);
+    for r in records {
+        let line = serde_json::to_string(r).map_err(|e| BatchError::Invalid(e.to_string()))?;
+        writeln!(w, "{line}").map_err(io(path))?;
+    }
+    w.flush().map_err(io(path))
+}
+
+pub(super) fn remove_if_present(path: &Path) -> Result<(), BatchError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(io(path)(e)),
+        _ => Ok(()),
+    }
+}
+
+/// The summary of a finished batch directory, derived from its `trials.jsonl` (never
+/// from a `summary.json` that may be stale): refuses a directory without a manifest,
+/// with duplicate records, or with fewer trials than its manifest names.
+pub fn load_results(dir: &Path) -> Result<Summary, BatchError> {
+    let m = Manifest::read(dir)?.ok_or_else(|| {
+        BatchError::Invalid(format!(
+            "{}: no manifest.json, so not a forkbench batch directory (or one from an older \
+             version: run the batch again)",
+            dir.display()
+        ))
+    })?;
+    let path = dir.join("trials.jsonl");
+    let records = read_records(&path)?;
+    check_unique(&records, &path)?;
+    let expected = m.expected_trials();
+    if records.len() as u64 != expected || expected == 0 {
+        return Err(BatchError::Invalid(format!(
+            "{}: holds {} of the {expected} trials its manifest names (interrupted?); \
+             resume it with the same batch arguments",
+            dir.display(),
+            records.len()
+        )));
+    }
+    Ok(summarize(&records))
+}
+
+/// Merges the shards of one batch into `out` and summarises. Refuses inputs from
+/// different batches, duplicate or missing shards, unfinished shards, no inputs, and
+/// an `out` that is one of the inputs.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
+    let first = dirs
+        .first()
+        .ok_or_else(|| BatchError::Invalid("merge needs at least one input directory".into()))?;
+    let out_real = std::fs::canonicalize(out).ok();
+    let manifests = dirs
+        .iter()
+        .map(|d| {
+            if out_real.is_some() && std::fs::canonicalize(d).ok() == out_real {
+                return Err(BatchError::Invalid(format!(
+                    "{}: is both an input and --out; merge into a new directory",
+                    d.display()
+                )));
+            }
+            Manifest::read(d)?.ok_or_else(|| {
+                BatchError::Invalid(format!(
+                    "{}: no manifest.json (not a batch directory?)",
+                    d.display()
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let m0 = &manifests[0];
+    let n = m0.shard[1];
+    let mut by_index: BTreeMap<u64, &PathBuf> = BTreeMap::new();
+    for (d, m) in dirs.iter().zip(&manifests) {
+        if !m0.same_batch(m) {
+            let mut theirs = m.clone();
+            theirs.shard[0] = m0.shard[0];
+            return Err(BatchError::Invalid(format!(
+                "{} and {} are shards of different batches ({})",
+                first.display(),
+                d.display(),
+                m0.differences(&theirs)
+                    .into_iter()
+                    .take(8)
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )));
+        }
+        if let Some(other) = by_index.insert(m.shard[0], d) {
+            return Err(BatchError::Invalid(format!(
+                "shard {}/{n} given twice: {} and {}",
+                m.shard[0],
+                other.display(),
+                d.display()
+            )));
+        }
+    }
+    let missing: Vec<String> = (0..n)
+        .filter(|i| !by_index.contains_key(i))
+        .map(|i| i.to_string())
+        .collect();
+    if !missing.is_empty() {
+        return Err(BatchError::Invalid(format!(
+            "shards {} of {n} are missing",
+            missing.join(", ")
+        )));
+    }
+    let mut all = Vec::new();
+    for d in dirs {
+        load_results(d)?; // complete and free of duplicates
+        all.extend(read_records(&d.join("trials.jsonl"))?);
+    }
+    all.sort_by_key(TrialRecord::key);
+    std::fs::create_dir_all(out).map_err(io(out))?;
+    let _lock = DirLock::take(out)?;
+    let path = out.join("trials.jsonl");
+    check_unique(&all, &path)?;
+    let mut merged = m0.clone();
+    merged.shard = [0, 1];
+    merged.write(out)?;
+    rewrite_records(&path, &all)?;
+    let summary = summarize(&all);
+    write_summary(out, &summary)?;
+    Ok(summary)
+}

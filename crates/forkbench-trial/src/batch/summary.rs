@@ -1,0 +1,160 @@
+//! Batch summaries: success rates with Wilson intervals, failure counts and entry errors per scenario × planner.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::{BatchError, TrialRecord, io};
+use crate::outcome::Failure;
+use crate::stats::{Z95, percentile_sorted, wilson};
+
+/// Success statistics of one scenario × planner.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SummaryRow {
+    pub scenario: String,
+    pub planner: String,
+    pub trials: u64,
+    pub successes: u64,
+    pub success_rate: f64,
+    /// Wilson 95 % interval of the success rate.
+    pub ci95_low: f64,
+    pub ci95_high: f64,
+    /// Failed trials by first failed criterion.
+    pub failures: BTreeMap<String, u64>,
+    /// |lateral| and |heading| error at entry, over trials whose forks reached the face.
+    pub lateral_error_mean_m: Option<f64>,
+    pub lateral_error_p95_m: Option<f64>,
+    pub heading_error_mean_rad: Option<f64>,
+    pub heading_error_p95_rad: Option<f64>,
+    /// Sum of trial wall times (CPU-side cost, not elapsed time).
+    pub wall_time_total_s: f64,
+}
+
+/// A batch's summary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    pub trials: u64,
+    pub successes: u64,
+    pub rows: Vec<SummaryRow>,
+}
+
+/// Summarises records; order-independent (values are sorted before any sum).
+pub fn summarize(records: &[TrialRecord]) -> Summary {
+    #[derive(Default)]
+    struct Acc {
+        n: u64,
+        k: u64,
+        failures: BTreeMap<String, u64>,
+        lat: Vec<f64>,
+        head: Vec<f64>,
+        wall: Vec<f64>,
+    }
+    let mut groups: BTreeMap<(String, String), Acc> = BTreeMap::new();
+    for r in records {
+        let o = &r.outcome;
+        let a = groups
+            .entry((o.scenario.clone(), o.planner.clone()))
+            .or_default();
+        a.n += 1;
+        if o.success {
+            a.k += 1;
+        } else {
+            let name = o.failure.map_or("unknown", Failure::name).to_owned();
+            *a.failures.entry(name).or_default() += 1;
+        }
+        if let Some(v) = o.lateral_error_m.filter(|v| v.is_finite()) {
+            a.lat.push(v.abs());
+        }
+        if let Some(v) = o.heading_error_rad.filter(|v| v.is_finite()) {
+            a.head.push(v.abs());
+        }
+        a.wall.push(o.wall_time_ms);
+    }
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    let rows: Vec<SummaryRow> = groups
+        .into_iter()
+        .map(|((scenario, planner), mut a)| {
+            a.lat.sort_by(f64::total_cmp);
+            a.head.sort_by(f64::total_cmp);
+            a.wall.sort_by(f64::total_cmp);
+            let (lo, hi) = wilson(a.k, a.n, Z95);
+            SummaryRow {
+                scenario,
+                planner,
+                trials: a.n,
+                successes: a.k,
+                success_rate: a.k as f64 / a.n as f64,
+                ci95_low: lo,
+                ci95_high: hi,
+                failures: a.failures,
+                lateral_error_mean_m: mean(&a.lat),
+                lateral_error_p95_m: percentile_sorted(&a.lat, 0.95),
+                heading_error_mean_rad: mean(&a.head),
+                heading_error_p95_rad: percentile_sorted(&a.head, 0.95),
+                wall_time_total_s: a.wall.iter().sum::<f64>() / 1e3,
+            }
+        })
+        .collect();
+    Summary {
+        trials: rows.iter().map(|r| r.trials).sum(),
+        successes: rows.iter().map(|r| r.successes).sum(),
+        rows,
+    }
+}
+
+impl Summary {
+    /// The success table as markdown.
+    pub fn markdown(&self) -> String {
+        let mut s = String::from(
+            "| scenario | planner | trials | successes | success rate | 95 % CI (Wilson) | failures | lateral mean / p95 (mm) | heading mean / p95 (°) | trial CPU (s) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        let mm = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.1}", v * 1e3));
+        let deg = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.2}", v.to_degrees()));
+        for r in &self.rows {
+            let failures = if r.failures.is_empty() {
+                "–".to_owned()
+            } else {
+                r.failures
+                    .iter()
+                    .map(|(k, v)| format!("{k} {v}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            s.push_str(&format!(
+                "| {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % | {} | {} / {} | {} / {} | {:.2} |\n",
+                r.scenario,
+                r.planner,
+                r.trials,
+                r.successes,
+                100.0 * r.success_rate,
+                100.0 * r.ci95_low,
+                100.0 * r.ci95_high,
+                failures,
+                mm(r.lateral_error_mean_m),
+                mm(r.lateral_error_p95_m),
+                deg(r.heading_error_mean_rad),
+                deg(r.heading_error_p95_rad),
+                r.wall_time_total_s
+            ));
+        }
+        s.push_str(&format!(
+            "\n{} trials, {} successes ({:.1} %)\n",
+            self.trials,
+            self.successes,
+            100.0 * self.successes as f64 / self.trials.max(1) as f64
+        ));
+        s
+    }
+}
+
+pub(super) fn write_summary(dir: &Path, s: &Summary) -> Result<(), BatchError> {
+    let json = dir.join("summary.json");
+    std::fs::write(
+        &json,
+        serde_json::to_string_pretty(s).map_err(|e| BatchError::Invalid(e.to_string()))? + "\n",
+    )
+    .map_err(io(&json))?;
+    let md = dir.join("summary.md");
+    std::fs::write(&md, s.markdown()).map_err(io(&md))
+}
