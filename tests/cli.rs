@@ -621,3 +621,93 @@ fn corridor_input_errors_are_clear() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+/// Issue 21, defect 11: a scenario or case name cannot steer where recordings go, nor
+/// make the batch fail after its trials ran.
+#[test]
+fn names_cannot_steer_recording_paths() {
+    let base = tmp("names");
+    let _ = std::fs::remove_dir_all(&base);
+    let out = base.join("a/b/out");
+    std::fs::create_dir_all(&out).expect("dir");
+    let text = std::fs::read_to_string(repo_root().join("scenarios/field-test.toml"))
+        .expect("readable")
+        .replace("name = \"field-test\"", "name = \"../../escaped/x\"");
+    let scn = base.join("hostile.toml");
+    std::fs::write(&scn, text).expect("write");
+    let run = forkbench(&[
+        "batch",
+        scn.to_str().expect("utf8"),
+        "--trials",
+        "2",
+        "--record",
+        "all",
+        "--out",
+        out.to_str().expect("utf8"),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(!base.join("a/b/escaped").exists() && !base.join("a/escaped").exists());
+    let files: Vec<_> = std::fs::read_dir(out.join("recordings"))
+        .expect("recordings inside OUT")
+        .map(|e| e.expect("entry").file_name().into_string().expect("utf8"))
+        .collect();
+    assert_eq!(files.len(), 4, "{files:?}");
+    assert!(
+        files.iter().all(|f| f.starts_with("______escaped_x-")),
+        "{files:?}"
+    );
+}
+
+/// Issue 21, defects 12 and 13: one path for both formats is refused; a world that is a
+/// device or a huge file is refused after a bounded read; a directory is not a file.
+#[test]
+fn one_path_for_two_formats_and_unbounded_inputs_are_refused() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let scn = scn.to_str().expect("utf8");
+    let same = tmp("same.out");
+    let s = same.to_str().expect("utf8");
+    let out = forkbench(&[
+        "trial",
+        scn,
+        "--no-noise",
+        "--rrd",
+        s,
+        "--mcap",
+        s,
+        "--force",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("both --rrd and --mcap"));
+    let dir = std::env::temp_dir();
+    let out = forkbench(&[
+        "trial",
+        scn,
+        "--no-noise",
+        "--rrd",
+        dir.to_str().expect("utf8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is a directory"));
+    let text = std::fs::read_to_string(scn).expect("readable");
+    let zero = tmp("zero-world.toml");
+    std::fs::write(&zero, format!("world = \"/dev/zero\"\n{text}")).expect("write");
+    let t0 = std::time::Instant::now();
+    let out = forkbench(&["trial", zero.to_str().expect("utf8"), "--no-noise"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("/dev/zero") && err.contains("larger than"),
+        "{err}"
+    );
+    assert!(t0.elapsed().as_secs() < 20);
+    // A deeply nested value's parse error is bounded, not the whole input echoed back.
+    let deep = tmp("deep.toml");
+    std::fs::write(&deep, format!("x = {}", "[".repeat(200_000))).expect("write");
+    let out = forkbench(&["trial", deep.to_str().expect("utf8"), "--no-noise"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stderr.len() < 10_000, "{} bytes", out.stderr.len());
+}

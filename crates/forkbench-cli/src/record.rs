@@ -27,6 +27,14 @@ pub struct Sinks {
 impl Sinks {
     /// Checks file targets before anything runs, then opens every sink.
     pub fn open(a: &RecordArgs, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
+        if let (Some(r), Some(m)) = (&a.rrd, &a.mcap)
+            && std::path::absolute(r).ok() == std::path::absolute(m).ok()
+        {
+            return Err(LogError::Io {
+                path: r.display().to_string(),
+                message: "given to both --rrd and --mcap; the two formats need two files".into(),
+            });
+        }
         for p in a.rrd.iter().chain(&a.mcap) {
             check_writable(p, a.force)?;
         }
@@ -118,7 +126,12 @@ pub fn record_trial(
 ) -> anyhow::Result<(forkbench_trial::TrialOutcome, PathBuf)> {
     let planner = opts.planner.unwrap_or(scn.planner);
     let seed = opts.seed.unwrap_or(scn.seed);
-    let stem = format!("{}-{}-{}-seed{}", scn.name, case.name, planner, seed);
+    // Names are free text: only letters, digits, '-' and '_' reach the file name, so a
+    // name can neither leave `dir` nor fail the write (the real names are in the files).
+    let stem = safe_file_stem(&format!(
+        "{}-{}-{}-seed{}",
+        scn.name, case.name, planner, seed
+    ));
     let rrd = dir.join(format!("{stem}.rrd"));
     let args = RecordArgs {
         rrd: Some(rrd.clone()),
@@ -131,4 +144,17 @@ pub fn record_trial(
         sinks.record(|rec| forkbench_trial::run_trial_recorded(scn, case, opts, rec));
     written?;
     Ok((out, rrd))
+}
+
+/// `text` with every character other than ASCII letters, digits, '-' and '_' replaced by '_'.
+fn safe_file_stem(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }

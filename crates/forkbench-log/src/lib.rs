@@ -26,6 +26,12 @@ pub enum LogError {
 /// the file is absent unless `force`.
 pub fn check_writable(path: &Path, force: bool) -> Result<(), LogError> {
     let p = path.display().to_string();
+    if path.is_dir() {
+        return Err(LogError::Io {
+            path: p,
+            message: "is a directory; give a file name".into(),
+        });
+    }
     if path.exists() && !force {
         return Err(LogError::Exists { path: p });
     }

@@ -91,17 +91,44 @@ pub struct World {
     pub pallet_slot: Vec<PalletSlot>,
 }
 
+/// Largest scenario or world file read: far above any real one, and a bound on what a
+/// wrong path (a device, a huge file) can make the loader read.
+pub const MAX_INPUT_BYTES: u64 = 4 << 20;
+
+/// Longest parse message passed on: toml quotes the offending input, which for a
+/// pathological file can be most of it.
+const MAX_MESSAGE_CHARS: usize = 2000;
+
 fn read(path: &FsPath) -> Result<String, TrialError> {
-    std::fs::read_to_string(path).map_err(|source| TrialError::Read {
+    use std::io::Read as _;
+    let err = |source| TrialError::Read {
         file: path.display().to_string(),
         source,
-    })
+    };
+    let file = std::fs::File::open(path).map_err(err)?;
+    let mut text = String::new();
+    file.take(MAX_INPUT_BYTES + 1)
+        .read_to_string(&mut text)
+        .map_err(err)?;
+    if text.len() as u64 > MAX_INPUT_BYTES {
+        return Err(TrialError::Parse {
+            file: path.display().to_string(),
+            message: format!("larger than {MAX_INPUT_BYTES} bytes; not a scenario or world file"),
+        });
+    }
+    Ok(text)
 }
 
 fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, TrialError> {
-    toml::from_str(text).map_err(|e| TrialError::Parse {
-        file: file.to_owned(),
-        message: e.to_string().trim_end().to_owned(),
+    toml::from_str(text).map_err(|e| {
+        let mut message = e.to_string().trim_end().to_owned();
+        if message.chars().count() > MAX_MESSAGE_CHARS {
+            message = message.chars().take(MAX_MESSAGE_CHARS).collect::<String>() + " …";
+        }
+        TrialError::Parse {
+            file: file.to_owned(),
+            message,
+        }
     })
 }
 
