@@ -711,3 +711,76 @@ fn one_path_for_two_formats_and_unbounded_inputs_are_refused() {
     assert_eq!(out.status.code(), Some(1));
     assert!(out.stderr.len() < 10_000, "{} bytes", out.stderr.len());
 }
+
+/// Issue 21, defect 8: [sim] and [replan] settings are checked at load (bad input, exit
+/// 1, naming the field), not when a simulator starts.
+#[test]
+fn sim_and_replan_settings_are_checked_at_load() {
+    let text =
+        std::fs::read_to_string(repo_root().join("scenarios/field-test.toml")).expect("readable");
+    for (extra, field) in [
+        ("[sim]\ndt_s = 0\n", "sim.dt_s"),
+        ("[sim]\ndt_s = 1e-9\n", "sim.dt_s"),
+        (
+            "[replan]\nposition_threshold_m = nan\n",
+            "replan.position_threshold_m",
+        ),
+        (
+            "[replan]\nheading_threshold_deg = -1\n",
+            "replan.heading_threshold_deg",
+        ),
+        (
+            "[replan]\nposition_threshold_m = inf\n",
+            "replan.position_threshold_m",
+        ),
+    ] {
+        let f = tmp(&format!("bad-{}.toml", field.replace('.', "-")));
+        std::fs::write(&f, format!("{text}\n{extra}")).expect("write");
+        let t0 = std::time::Instant::now();
+        let out = forkbench(&["trial", f.to_str().expect("utf8"), "--no-noise"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{extra}: {err}");
+        assert!(err.contains(field), "{extra}: {err}");
+        assert!(t0.elapsed().as_secs() < 20, "{extra}");
+    }
+}
+
+/// Issue 21, defect 9: a port that accepts TCP but is no rerun viewer no longer hangs
+/// the run; the outcome is printed and the exit is non-zero.
+#[test]
+fn a_silent_viewer_port_times_out() {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+    let addr = listener.local_addr().expect("addr").to_string();
+    std::thread::spawn(move || {
+        let mut held = Vec::new();
+        for c in listener.incoming().flatten() {
+            held.push(c); // accept and never answer
+        }
+    });
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let t0 = std::time::Instant::now();
+    let out = forkbench(&[
+        "trial",
+        scn.to_str().expect("utf8"),
+        "--no-noise",
+        "--connect",
+        &addr,
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("outcome"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("did not take the recording"));
+    assert!(t0.elapsed().as_secs() < 60, "{:?}", t0.elapsed());
+}
+
+/// Issue 21, defect 10: a goal that needs reversing is refused as unreachable (the
+/// B-spline folded back into a cusp and reported max |κ| = 0).
+#[test]
+fn a_goal_behind_the_truck_is_unreachable_for_the_bspline() {
+    let out = forkbench(&["plan", "bspline", "--start", "0,0,90", "--goal", "0,-5,90"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("reverses direction") && err.contains("cusp"),
+        "{err}"
+    );
+}

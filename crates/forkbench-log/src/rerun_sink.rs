@@ -52,11 +52,14 @@ const PLOTS: [(&str, &[&str]); 5] = [
 ];
 
 /// Where a recording is in its closing.
+/// How long a live viewer may take to accept the recording's last data.
+const VIEWER_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
+
 enum Close {
     Open,
     /// The trial's outcome is logged: this thread flushes the stream and closes it (rerun
     /// writes the file's footer on close).
-    Closing(std::thread::JoinHandle<Option<String>>),
+    Closing(std::sync::mpsc::Receiver<Option<String>>),
     /// Joined (or closed without a thread); later calls log nothing.
     Closed,
 }
@@ -85,6 +88,9 @@ pub struct RerunRecorder {
     last_pallet: Option<Pose2>,
     error: Option<String>,
     close: Close,
+    /// How long closing may wait for the sink: unbounded for a file, bounded for a
+    /// viewer (a port that accepts TCP but is no viewer would otherwise hang the run).
+    close_timeout: Option<std::time::Duration>,
     /// Write errors of the .rrd file, also those found while closing it.
     file_errors: Option<ErrorSlot>,
     /// The truck's pose before the first step, sent with the first columns.
@@ -257,6 +263,10 @@ impl RerunRecorder {
             last_pallet: None,
             error: None,
             close: Close::Open,
+            close_timeout: match target {
+                RerunTarget::File(_) => None,
+                RerunTarget::Spawn | RerunTarget::Connect(_) => Some(VIEWER_TIMEOUT),
+            },
             file_errors,
             truck_start: None,
             first_rows: Vec::new(),
@@ -437,17 +447,19 @@ impl RerunRecorder {
             self.send_cols(entity, &[0.0], Ok(Vec::new()));
         }
         let rec = std::mem::replace(&mut self.rec, rerun::RecordingStream::disabled());
+        let timeout = self.close_timeout.unwrap_or(std::time::Duration::MAX);
+        let (tx, rx) = std::sync::mpsc::channel();
         let closing = std::thread::Builder::new()
             .name("rrd-close".into())
             .spawn(move || {
-                let r = rec.flush_blocking().err().map(|e| e.to_string());
+                let r = rec.flush_with_timeout(timeout).err().map(|e| e.to_string());
                 // Dropping the last handle closes the sink: the footer is written and the
                 // writer thread joined.
                 drop(rec);
-                r
+                let _ = tx.send(r);
             });
         match closing {
-            Ok(h) => self.close = Close::Closing(h),
+            Ok(_) => self.close = Close::Closing(rx),
             Err(e) => self.note::<(), _>(Err(e)),
         }
     }
@@ -456,11 +468,23 @@ impl RerunRecorder {
     /// returns); returns the first logging error, if any.
     pub fn finish(&mut self) -> Result<(), LogError> {
         self.close_async();
-        if let Close::Closing(h) = std::mem::replace(&mut self.close, Close::Closed) {
-            match h.join() {
+        if let Close::Closing(rx) = std::mem::replace(&mut self.close, Close::Closed) {
+            use std::sync::mpsc::RecvTimeoutError;
+            let got = match self.close_timeout {
+                None => rx.recv().map_err(|_| RecvTimeoutError::Disconnected),
+                // Twice the flush's own timeout: dropping the stream may wait too.
+                Some(t) => rx.recv_timeout(2 * t),
+            };
+            match got {
                 Ok(Some(e)) => self.note::<(), _>(Err(e)),
                 Ok(None) => {}
-                Err(_) => self.note::<(), _>(Err("the rerun closing thread panicked")),
+                Err(RecvTimeoutError::Timeout) => self.note::<(), _>(Err(format!(
+                    "the viewer did not take the recording within {} s (is it a rerun viewer?)",
+                    2 * self.close_timeout.map_or(0, |t| t.as_secs())
+                ))),
+                Err(RecvTimeoutError::Disconnected) => {
+                    self.note::<(), _>(Err("the rerun closing thread panicked"))
+                }
             }
         }
         if let Some(e) = self

@@ -513,6 +513,15 @@ pub fn plan(req: &PlanRequest, cfg: &BsplineConfig) -> Result<BsplinePlan, PlanE
         ));
     }
     let path = curve.sample(start, goal, cfg.sample_spacing_m);
+    if let Some(s_m) = crate::find_cusp(&path, req.truck.max_curvature_per_m()) {
+        return Err(PlanError::Unreachable {
+            planner: PlannerKind::Bspline,
+            reason: format!(
+                "the path reverses direction (a cusp {s_m:.2} m along it): the goal needs \
+                 the truck to back up, which a forward pick path cannot"
+            ),
+        });
+    }
     Ok(BsplinePlan {
         l1_m: l1,
         l2_m: l2,

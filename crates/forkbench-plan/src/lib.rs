@@ -197,3 +197,18 @@ pub fn plan(kind: PlannerKind, req: &PlanRequest, cfg: &PlannerConfig) -> Result
         PlannerKind::Spiral => spiral::plan(req, &cfg.spiral).map(SpiralPlan::into_plan),
     }
 }
+
+/// Arc length of the first cusp in a sampled forward path, if any: a heading change
+/// between neighbouring samples far beyond what the curvature limit allows, or a step
+/// that runs against the samples' heading (the path doubles back on itself).
+pub fn find_cusp(path: &Path, max_curvature_per_m: f64) -> Option<f64> {
+    path.samples.windows(2).find_map(|w| {
+        let (a, b) = (&w[0], &w[1]);
+        let ds = b.s_m - a.s_m;
+        let turn = forkbench_core::units::wrap_angle(b.heading_rad - a.heading_rad).abs();
+        let (dx, dy) = (b.x_m - a.x_m, b.y_m - a.y_m);
+        let along = dx * a.heading_rad.cos() + dy * a.heading_rad.sin();
+        let reversed = dx.hypot(dy) > 1e-9 && along < 0.0;
+        (turn > 0.1 + 10.0 * max_curvature_per_m * ds || reversed).then_some(a.s_m)
+    })
+}

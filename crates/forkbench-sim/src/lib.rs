@@ -109,7 +109,8 @@ fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 impl SimConfig {
-    fn validate(&self) -> Result<(), SimError> {
+    /// Checks every setting; scenario loading calls it so bad values fail at load.
+    pub fn validate(&self) -> Result<(), SimError> {
         let fields = [
             ("dt_s", self.dt_s),
             ("tyre_friction", self.tyre_friction),
@@ -131,6 +132,13 @@ impl SimConfig {
                 field: "dt_s",
                 value: self.dt_s,
                 reason: "must be ≤ 0.02 s (50 Hz) for stable tyre impulses",
+            });
+        }
+        if self.dt_s < 1e-3 {
+            return Err(SimError::Config {
+                field: "dt_s",
+                value: self.dt_s,
+                reason: "must be ≥ 0.001 s: a finer step only multiplies the work",
             });
         }
         if !(self.fork_friction.is_finite() && self.fork_friction >= 0.0) {

@@ -91,6 +91,9 @@ pub struct World {
     pub pallet_slot: Vec<PalletSlot>,
 }
 
+/// Longest simulated trial a scenario may ask for: bounds the steps one trial takes.
+pub const MAX_TIMEOUT_S: f64 = 600.0;
+
 /// Largest scenario or world file read: far above any real one, and a bound on what a
 /// wrong path (a device, a huge file) can make the loader read.
 pub const MAX_INPUT_BYTES: u64 = 4 << 20;
@@ -428,8 +431,27 @@ impl Scenario {
                 reason,
             ));
         }
-        if !(f.timeout_s.is_finite() && f.timeout_s > 0.0) {
-            return Err(invalid(file, "timeout_s", "must be a positive finite time"));
+        if !(f.timeout_s.is_finite() && f.timeout_s > 0.0 && f.timeout_s <= MAX_TIMEOUT_S) {
+            return Err(invalid(
+                file,
+                "timeout_s",
+                "must be a positive time of at most 600 s",
+            ));
+        }
+        if let Err(forkbench_sim::SimError::Config { field, reason, .. }) = f.sim.validate() {
+            return Err(invalid(file, &format!("sim.{field}"), reason));
+        }
+        for (name, v) in [
+            ("position_threshold_m", f.replan.position_threshold_m),
+            ("heading_threshold_deg", f.replan.heading_threshold_deg),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(
+                    file,
+                    &format!("replan.{name}"),
+                    "must be a positive finite number (NaN would disable the trigger)",
+                ));
+            }
         }
         let t = &f.tolerances;
         for (name, v) in [
