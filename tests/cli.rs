@@ -784,3 +784,54 @@ fn a_goal_behind_the_truck_is_unreachable_for_the_bspline() {
         "{err}"
     );
 }
+
+/// Issue 21, defect 7 (planning and scenario part): huge finite inputs are refused with
+/// the limit named, at once, instead of exhausting memory or hanging.
+#[test]
+fn huge_finite_inputs_are_refused_with_the_limit_named() {
+    for goal in ["1e9,0,0", "1e20,0,0", "500,0,0"] {
+        let t0 = std::time::Instant::now();
+        let out = forkbench(&["plan", "spiral", "--start", "0,0,0", "--goal", goal]);
+        assert_eq!(out.status.code(), Some(1), "{goal}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("invalid goal") && err.contains(" m"),
+            "{goal}: {err}"
+        );
+        assert!(t0.elapsed().as_secs() < 10, "{goal}");
+    }
+    let cfg = tmp("tiny-spacing.toml");
+    std::fs::write(&cfg, "[bspline]\nsample_spacing_m = 1e-9\n").expect("write");
+    let out = forkbench(&[
+        "plan",
+        "bspline",
+        "--start",
+        "0,0,90",
+        "--goal",
+        "1.5,6.5,105",
+        "--config",
+        cfg.to_str().expect("utf8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("sample_spacing_m"));
+    let text = std::fs::read_to_string(repo_root().join("scenarios/field-test.toml"))
+        .expect("readable")
+        .replace("pallet = { x_m = 1.832533", "pallet = { x_m = 1e9");
+    let far = tmp("far-pallet.toml");
+    std::fs::write(&far, text).expect("write");
+    let out = forkbench(&["trial", far.to_str().expect("utf8"), "--no-noise"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("pallet.x_m") && err.contains("10 km"), "{err}");
+    let out = forkbench(&[
+        "batch",
+        "--trials",
+        "1",
+        "--jobs",
+        "100000",
+        "--out",
+        tmp("jobs").to_str().expect("utf8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("at most 256"));
+}

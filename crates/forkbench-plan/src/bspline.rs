@@ -269,7 +269,9 @@ impl BsplineConfig {
         if self.grid_points < 3 {
             return bad("bspline.grid_points", "must be at least 3");
         }
-        if !(self.sample_spacing_m.is_finite() && self.sample_spacing_m > 0.0) {
+        if !(self.sample_spacing_m.is_finite()
+            && self.sample_spacing_m >= crate::MIN_SAMPLE_SPACING_M)
+        {
             return bad(
                 "bspline.sample_spacing_m",
                 "must be a positive finite length",

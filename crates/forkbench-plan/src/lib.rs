@@ -102,7 +102,28 @@ impl PlanRequest {
                 limit_per_m: limit,
             });
         }
+        for (what, pose) in [("start", &self.start), ("goal", &self.goal)] {
+            if pose.x_m.abs().max(pose.y_m.abs()) > MAX_COORDINATE_M {
+                return Err(PlanError::InvalidInput {
+                    what,
+                    reason: format!(
+                        "({}, {}) m lies beyond ±{MAX_COORDINATE_M} m; a pick planner works \
+                         over metres (this bounds the path and its samples)",
+                        pose.x_m, pose.y_m
+                    ),
+                });
+            }
+        }
         let d = self.start.distance_to(&self.goal);
+        if d > MAX_GOAL_DISTANCE_M {
+            return Err(PlanError::InvalidInput {
+                what: "goal",
+                reason: format!(
+                    "{d:.1} m from the start; pick paths are planned over at most \
+                     {MAX_GOAL_DISTANCE_M} m"
+                ),
+            });
+        }
         if d < MIN_GOAL_DISTANCE_M {
             return Err(PlanError::GoalTooClose {
                 distance_m: d,
@@ -115,6 +136,17 @@ impl PlanRequest {
 
 /// Below this start–goal distance no forward pick path is meaningful.
 pub const MIN_GOAL_DISTANCE_M: f64 = 0.05;
+
+/// Largest |x| or |y| of a start or goal pose: keeps the numbers well inside f64's exact
+/// range for sub-millimetre work.
+pub const MAX_COORDINATE_M: f64 = 1e4;
+
+/// Longest start–goal distance a pick planner takes: bounds the path's length and so
+/// the samples (and memory) one plan can cause.
+pub const MAX_GOAL_DISTANCE_M: f64 = 200.0;
+
+/// Smallest sample spacing: with [`MAX_GOAL_DISTANCE_M`] it bounds a path's samples.
+pub const MIN_SAMPLE_SPACING_M: f64 = 1e-4;
 
 /// Why a plan could not be made. Every variant names the limit that failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -40,9 +40,31 @@ impl PoseDeg {
                 ));
             }
         }
+        for (name, v) in [("x_m", self.x_m), ("y_m", self.y_m)] {
+            if v.abs() > MAX_WORLD_EXTENT_M {
+                return Err(invalid(
+                    file,
+                    &format!("{field}.{name}"),
+                    "lies beyond ±10 km: the world's extent is bounded so one trial's work is",
+                ));
+            }
+        }
+        if self.heading_deg.abs() > 1e4 {
+            return Err(invalid(
+                file,
+                &format!("{field}.heading_deg"),
+                "must lie within ±10000°",
+            ));
+        }
         Ok(())
     }
 }
+
+/// Largest |x| or |y| anywhere in a world or scenario file.
+pub const MAX_WORLD_EXTENT_M: f64 = 1e4;
+
+/// Most cases one scenario file may list.
+pub const MAX_CASES: usize = 10_000;
 
 fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
     TrialError::Invalid {
@@ -153,11 +175,11 @@ impl World {
                 }
                 .check(file, &f)?;
                 for (name, v) in [("length_m", r.length_m), ("width_m", r.width_m)] {
-                    if !(v.is_finite() && v > 0.0) {
+                    if !(v.is_finite() && v > 0.0 && v <= MAX_WORLD_EXTENT_M) {
                         return Err(invalid(
                             file,
                             &format!("{f}.{name}"),
-                            "must be a positive finite length",
+                            "must be a positive length of at most 10 km",
                         ));
                     }
                 }
@@ -520,6 +542,13 @@ impl Scenario {
                     }),
             }
         };
+        if f.case.len() > MAX_CASES {
+            return Err(invalid(
+                file,
+                "case",
+                &format!("{} cases; at most {MAX_CASES} per file", f.case.len()),
+            ));
+        }
         let mut cases = Vec::new();
         let listed: Vec<CaseFile> = if f.case.is_empty() {
             vec![CaseFile {

@@ -94,10 +94,15 @@ impl SpiralConfig {
                 reason: "must be at least 3".into(),
             });
         }
-        if !(self.sample_spacing_m.is_finite() && self.sample_spacing_m > 0.0) {
+        if !(self.sample_spacing_m.is_finite()
+            && self.sample_spacing_m >= crate::MIN_SAMPLE_SPACING_M)
+        {
             return Err(PlanError::InvalidInput {
                 what: "spiral.sample_spacing_m",
-                reason: "must be a positive finite length".into(),
+                reason: format!(
+                    "must be a finite length of at least {} m",
+                    crate::MIN_SAMPLE_SPACING_M
+                ),
             });
         }
         Ok(())

@@ -27,6 +27,9 @@ use crate::outcome::{Failure, TrialOutcome};
 use crate::scenario::Scenario;
 use crate::trial::{TrialOptions, run_trial};
 
+/// Most worker threads a batch starts.
+pub const MAX_JOBS: usize = 256;
+
 /// What a batch runs.
 #[derive(Debug, Clone)]
 pub struct BatchSpec {
@@ -310,6 +313,11 @@ pub fn run_batch(
         return Err(BatchError::Invalid(format!(
             "shard {}/{}: the index must be below the shard count",
             spec.shard.0, spec.shard.1
+        )));
+    }
+    if jobs > MAX_JOBS {
+        return Err(BatchError::Invalid(format!(
+            "--jobs {jobs}: at most {MAX_JOBS} worker threads"
         )));
     }
     spec.check_names()?;
