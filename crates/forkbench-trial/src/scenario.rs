@@ -453,45 +453,7 @@ impl Scenario {
                 reason,
             ));
         }
-        if !(f.timeout_s.is_finite() && f.timeout_s > 0.0 && f.timeout_s <= MAX_TIMEOUT_S) {
-            return Err(invalid(
-                file,
-                "timeout_s",
-                "must be a positive time of at most 600 s",
-            ));
-        }
-        if let Err(forkbench_sim::SimError::Config { field, reason, .. }) = f.sim.validate() {
-            return Err(invalid(file, &format!("sim.{field}"), reason));
-        }
-        for (name, v) in [
-            ("position_threshold_m", f.replan.position_threshold_m),
-            ("heading_threshold_deg", f.replan.heading_threshold_deg),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(invalid(
-                    file,
-                    &format!("replan.{name}"),
-                    "must be a positive finite number (NaN would disable the trigger)",
-                ));
-            }
-        }
-        let t = &f.tolerances;
-        for (name, v) in [
-            ("lateral_m", t.lateral_m),
-            ("heading_deg", t.heading_deg),
-            ("insertion_depth_m", t.insertion_depth_m),
-            ("contact_force_n", t.contact_force_n),
-            ("pallet_displacement_m", t.pallet_displacement_m),
-            ("pallet_rotation_deg", t.pallet_rotation_deg),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(invalid(
-                    file,
-                    &format!("tolerances.{name}"),
-                    "must be a positive finite number",
-                ));
-            }
-        }
+        check_settings(&f, file)?;
         if let Some(b) = &f.estimate_bias {
             b.check(file, "estimate_bias")?;
         }
@@ -515,7 +477,7 @@ impl Scenario {
             PalletKind::Field1200 => PalletSpec::field_1200(),
             PalletKind::Sim1000 => PalletSpec::sim_1000(),
         };
-        if t.insertion_depth_m > pallet.depth_m.min(f.truck.fork_length_m) {
+        if f.tolerances.insertion_depth_m > pallet.depth_m.min(f.truck.fork_length_m) {
             return Err(invalid(
                 file,
                 "tolerances.insertion_depth_m",
@@ -703,6 +665,51 @@ fn check_layout(
             &format!("{field}start"),
             "truck starts overlapping the pallet",
         ));
+    }
+    Ok(())
+}
+
+/// Run settings of a scenario file, checked at load: the trial timeout, [sim], [replan]
+/// and the tolerances.
+fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
+    if !(f.timeout_s.is_finite() && f.timeout_s > 0.0 && f.timeout_s <= MAX_TIMEOUT_S) {
+        return Err(invalid(
+            file,
+            "timeout_s",
+            "must be a positive time of at most 600 s",
+        ));
+    }
+    if let Err(forkbench_sim::SimError::Config { field, reason, .. }) = f.sim.validate() {
+        return Err(invalid(file, &format!("sim.{field}"), reason));
+    }
+    for (name, v) in [
+        ("position_threshold_m", f.replan.position_threshold_m),
+        ("heading_threshold_deg", f.replan.heading_threshold_deg),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(invalid(
+                file,
+                &format!("replan.{name}"),
+                "must be a positive finite number (NaN would disable the trigger)",
+            ));
+        }
+    }
+    let t = &f.tolerances;
+    for (name, v) in [
+        ("lateral_m", t.lateral_m),
+        ("heading_deg", t.heading_deg),
+        ("insertion_depth_m", t.insertion_depth_m),
+        ("contact_force_n", t.contact_force_n),
+        ("pallet_displacement_m", t.pallet_displacement_m),
+        ("pallet_rotation_deg", t.pallet_rotation_deg),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(invalid(
+                file,
+                &format!("tolerances.{name}"),
+                "must be a positive finite number",
+            ));
+        }
     }
     Ok(())
 }

@@ -243,6 +243,25 @@ fn error_outcome(
 }
 
 impl BatchSpec {
+    /// The batch's own arguments: trials, shard, worker threads and unique names.
+    fn check(&self, jobs: usize) -> Result<(), BatchError> {
+        if self.trials == 0 {
+            return Err(BatchError::Invalid("--trials must be at least 1".into()));
+        }
+        if self.shard.1 == 0 || self.shard.0 >= self.shard.1 {
+            return Err(BatchError::Invalid(format!(
+                "shard {}/{}: the index must be below the shard count",
+                self.shard.0, self.shard.1
+            )));
+        }
+        if jobs > MAX_JOBS {
+            return Err(BatchError::Invalid(format!(
+                "--jobs {jobs}: at most {MAX_JOBS} worker threads"
+            )));
+        }
+        self.check_names()
+    }
+
     /// Scenario names key rows and seeds: two scenarios may not share one.
     fn check_names(&self) -> Result<(), BatchError> {
         for (i, a) in self.scenarios.iter().enumerate() {
@@ -306,21 +325,7 @@ pub fn run_batch(
     jobs: usize,
     on_done: &(dyn Fn(&TrialRecord) + Sync),
 ) -> Result<Summary, BatchError> {
-    if spec.trials == 0 {
-        return Err(BatchError::Invalid("--trials must be at least 1".into()));
-    }
-    if spec.shard.1 == 0 || spec.shard.0 >= spec.shard.1 {
-        return Err(BatchError::Invalid(format!(
-            "shard {}/{}: the index must be below the shard count",
-            spec.shard.0, spec.shard.1
-        )));
-    }
-    if jobs > MAX_JOBS {
-        return Err(BatchError::Invalid(format!(
-            "--jobs {jobs}: at most {MAX_JOBS} worker threads"
-        )));
-    }
-    spec.check_names()?;
+    spec.check(jobs)?;
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let _lock = DirLock::take(dir)?;
     spec.prepare_dir(dir)?;
