@@ -835,3 +835,73 @@ fn huge_finite_inputs_are_refused_with_the_limit_named() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("at most 256"));
 }
+
+/// Issue 21, defect 7 (corridor part): a search that would need more than 1e7 states is
+/// refused before it allocates (`--width 3` ran minutes at GBs, `1e6` aborted, `1e308`
+/// printed zero areas).
+#[test]
+fn corridor_work_is_bounded() {
+    for w in ["3", "1e6", "1e308"] {
+        let t0 = std::time::Instant::now();
+        let out = forkbench(&["corridor", "--width", w, "--angle", "90"]);
+        assert_eq!(out.status.code(), Some(1), "width {w}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("width_m") && err.contains("search states"),
+            "{w}: {err}"
+        );
+        assert!(t0.elapsed().as_secs() < 5, "{w}");
+    }
+}
+
+/// Issue 21, message polish: the reason once, the scenario's world field named, --out
+/// that is a file, replay --line 0, and no "NaN m" when planning failed.
+#[test]
+fn error_messages_are_polished() {
+    let out = forkbench(&["trial", "does-not-exist.toml"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("os error 2").count(), 1, "{err}");
+    let text =
+        std::fs::read_to_string(repo_root().join("scenarios/field-test.toml")).expect("readable");
+    let f = tmp("missing-world.toml");
+    std::fs::write(&f, format!("world = \"no-such-world.toml\"\n{text}")).expect("write");
+    let out = forkbench(&["trial", f.to_str().expect("utf8")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("missing-world.toml") && err.contains("`world`"),
+        "{err}"
+    );
+    let file = tmp("out-is-a-file");
+    std::fs::write(&file, "x").expect("write");
+    let out = forkbench(&[
+        "batch",
+        "--trials",
+        "1",
+        "--out",
+        file.to_str().expect("utf8"),
+    ]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is not a directory"));
+    let lines = tmp("lines.jsonl");
+    std::fs::write(&lines, "{}\n").expect("write");
+    let out = forkbench(&["replay", lines.to_str().expect("utf8"), "--line", "0"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("numbered from 1"));
+    let behind = text.replace(
+        "pallet = { x_m = 1.832533, y_m = 14.917769",
+        "pallet = { x_m = 0.505353, y_m = 1.0",
+    );
+    let f = tmp("pallet-behind.toml");
+    std::fs::write(&f, behind).expect("write");
+    let out = forkbench(&["trial", f.to_str().expect("utf8"), "--no-noise"]);
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let shown = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        !shown.contains("NaN") && shown.contains("plan_failed"),
+        "{shown}"
+    );
+}

@@ -331,7 +331,10 @@ pub fn replay(
 ) -> anyhow::Result<bool> {
     let text =
         std::fs::read_to_string(file).with_context(|| format!("reading {}", file.display()))?;
-    let Some(raw) = text.lines().nth(line.saturating_sub(1)) else {
+    if line == 0 {
+        bail!("--line 0: lines are numbered from 1");
+    }
+    let Some(raw) = text.lines().nth(line - 1) else {
         bail!("{}: has no line {line}", file.display());
     };
     let record: TrialRecord = serde_json::from_str(raw)
@@ -358,10 +361,10 @@ pub fn replay(
     )?;
     let (mut out, written) =
         sinks.record(|r| forkbench_trial::run_trial_recorded(scn, case, &opts, r));
-    if let Some(e) = sinks.viewer_error.take() {
+    let viewer_error = sinks.viewer_error.take();
+    if let Some(e) = &viewer_error {
         eprintln!("error: {e} (the trial ran without the viewer)");
     }
-    written.context("writing the recording")?;
     let mut expected = record.outcome.clone();
     (out.wall_time_ms, expected.wall_time_ms) = (0.0, 0.0);
     let same = serde_json::to_value(&out)? == serde_json::to_value(&expected)?;
@@ -382,6 +385,12 @@ pub fn replay(
             "DIFFERS from the recorded outcome"
         }
     ))?;
+    // As for `trial`: the outcome is printed first, then a recording or viewer error
+    // makes the exit status 1.
+    written.context("writing the recording")?;
+    if viewer_error.is_some() {
+        bail!("the requested rerun viewer could not be reached");
+    }
     if !same {
         bail!("the replay did not reproduce the recorded outcome");
     }

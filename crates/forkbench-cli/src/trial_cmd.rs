@@ -90,13 +90,29 @@ pub fn run(
         "heading error entry  {}",
         opt(out.heading_error_rad, 1.0, "rad")
     );
-    let _ = writeln!(s, "final lateral error  {:.4} m", out.final_lateral_error_m);
+    // A trial that failed before driving has no final pose: "–", not "NaN m".
+    let num = |v: f64, digits: usize, unit: &str| {
+        if v.is_finite() {
+            format!("{v:.digits$} {unit}")
+        } else {
+            "–".to_owned()
+        }
+    };
     let _ = writeln!(
         s,
-        "final heading error  {:.5} rad",
-        out.final_heading_error_rad
+        "final lateral error  {}",
+        num(out.final_lateral_error_m, 4, "m")
     );
-    let _ = writeln!(s, "insertion depth      {:.3} m", out.insertion_depth_m);
+    let _ = writeln!(
+        s,
+        "final heading error  {}",
+        num(out.final_heading_error_rad, 5, "rad")
+    );
+    let _ = writeln!(
+        s,
+        "insertion depth      {}",
+        num(out.insertion_depth_m, 3, "m")
+    );
     let _ = writeln!(s, "max steering         {:.4} rad", out.max_steer_rad);
     let _ = writeln!(s, "max contact force    {:.1} N", out.max_contact_force_n);
     let _ = writeln!(

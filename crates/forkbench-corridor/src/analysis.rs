@@ -3,7 +3,7 @@
 use forkbench_core::Pose2;
 
 use crate::bend::{Junction, Vehicle};
-use crate::search::{GRegion, Mode, Resolution};
+use crate::search::{GRegion, Mode, Resolution, Space};
 
 /// Bad corridor-analysis input.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -72,8 +72,47 @@ pub fn check_inputs(
         if junction == Junction::T && a != 90.0 {
             return bad("angle_deg", a, "a T junction turns by 90°");
         }
+        if let Some(w) = width_m
+            && search_states(v, junction, w, a, cell_m) > MAX_SEARCH_STATES
+        {
+            return bad(
+                "width_m",
+                w,
+                "needs more than 1e7 search states (cells × 1° heading layers) at this \
+                 resolution: use a coarser --resolution or a narrower corridor",
+            );
+        }
     }
     Ok(())
+}
+
+/// Most search states (grid cells × heading layers) one analysis may allocate: bounds
+/// its memory (about 20 bytes each) and time.
+pub const MAX_SEARCH_STATES: f64 = 1e7;
+
+/// States a search of this bend at this resolution allocates, in f64 (no overflow for
+/// absurd widths), with 1° heading layers.
+fn search_states(
+    v: &Vehicle,
+    junction: Junction,
+    width_m: f64,
+    angle_deg: f64,
+    cell_m: f64,
+) -> f64 {
+    if width_m.is_nan() || width_m >= 1e4 {
+        return f64::INFINITY;
+    }
+    let res = Resolution {
+        cell_m,
+        heading_rad: 1f64.to_radians(),
+    };
+    let space = Space::new(
+        junction.bend(width_m, angle_deg.to_radians()),
+        *v,
+        Mode::Oblique,
+        res,
+    );
+    space.nx as f64 * space.ny as f64 * (angle_deg + 1.0)
 }
 
 /// Areas claimed passable by circle inflation, and where each is wrong, for one mode.

@@ -19,11 +19,11 @@ pub const SPIRAL_TABLE2_TOML: &str =
 /// A reference table file that could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum TableError {
-    #[error("{file}: {source}")]
+    /// The reason is in the message, not chained as a source: `{:#}` would print it twice.
+    #[error("{file}: {cause}")]
     Parse {
         file: String,
-        #[source]
-        source: toml::de::Error,
+        cause: toml::de::Error,
     },
     #[error("{file}: case {case:?}: field `{field}`: {reason}")]
     Invalid {
@@ -57,9 +57,9 @@ pub struct BsplineCase {
 
 impl BsplineTable {
     pub fn parse(text: &str, file: &str) -> Result<Self, TableError> {
-        let t: Self = toml::from_str(text).map_err(|source| TableError::Parse {
+        let t: Self = toml::from_str(text).map_err(|cause| TableError::Parse {
             file: file.to_owned(),
-            source,
+            cause,
         })?;
         for c in &t.case {
             for (field, v) in [
@@ -203,9 +203,9 @@ pub struct SpiralCase {
 
 impl SpiralTable {
     pub fn parse(text: &str, file: &str) -> Result<Self, TableError> {
-        let t: Self = toml::from_str(text).map_err(|source| TableError::Parse {
+        let t: Self = toml::from_str(text).map_err(|cause| TableError::Parse {
             file: file.to_owned(),
-            source,
+            cause,
         })?;
         for c in &t.case {
             for (field, v) in [

@@ -16,12 +16,9 @@ pub use trial::{TrialOptions, run_trial, run_trial_recorded};
 /// A scenario or world file that cannot be used, with the file and field named.
 #[derive(Debug, thiserror::Error)]
 pub enum TrialError {
-    #[error("{file}: {source}")]
-    Read {
-        file: String,
-        #[source]
-        source: std::io::Error,
-    },
+    /// The reason is in the message, not chained as a source: `{:#}` would print it twice.
+    #[error("{file}: {cause}")]
+    Read { file: String, cause: std::io::Error },
     /// Syntax or type error; toml's message carries line and column.
     #[error("{file}: {message}")]
     Parse { file: String, message: String },

@@ -126,9 +126,9 @@ const MAX_MESSAGE_CHARS: usize = 2000;
 
 fn read(path: &FsPath) -> Result<String, TrialError> {
     use std::io::Read as _;
-    let err = |source| TrialError::Read {
+    let err = |cause| TrialError::Read {
         file: path.display().to_string(),
-        source,
+        cause,
     };
     let file = std::fs::File::open(path).map_err(err)?;
     let mut text = String::new();
@@ -434,7 +434,13 @@ impl Scenario {
     ) -> Result<Self, TrialError> {
         let f: ScenarioFile = parse(text, file)?;
         let world = match &f.world {
-            Some(p) => load_world(p)?,
+            Some(p) => load_world(p).map_err(|e| {
+                invalid(
+                    file,
+                    "world",
+                    &format!("{} could not be loaded: {e}", p.display()),
+                )
+            })?,
             None => World::default(),
         };
         f.truck

@@ -71,9 +71,14 @@ fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
     pallet.to_local(root)
 }
 
-/// Depth of the shallower fork tip past the pallet face.
+/// Depth of the shallower fork tip past the pallet face, at most the fork length. A fork
+/// root that is itself past the face plane (a truck that drove past or away behind the
+/// pallet) inserted nothing: 0.
 fn insertion_depth(pallet: &Pose2, root: &Pose2, truck: &ForkliftSpec) -> f64 {
-    [1.0, -1.0]
+    if pallet.to_local(root).x_m > 0.0 {
+        return 0.0;
+    }
+    let depth = [1.0, -1.0]
         .iter()
         .map(|side| {
             let tip = root.to_world(&Pose2::new(
@@ -83,7 +88,8 @@ fn insertion_depth(pallet: &Pose2, root: &Pose2, truck: &ForkliftSpec) -> f64 {
             ));
             pallet.to_local(&tip).x_m
         })
-        .fold(f64::INFINITY, f64::min)
+        .fold(f64::INFINITY, f64::min);
+    depth.min(truck.fork_length_m)
 }
 
 /// Runs one case of a scenario to its judged outcome.
@@ -490,4 +496,29 @@ fn run_inner<R: Recorder + ?Sized>(
         None
     };
     finish(out, failure)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 21, defect 10: a truck that drove away behind the pallet reported an
+    /// insertion depth of 106 m; depth counts only from the front and is at most the forks.
+    #[test]
+    fn insertion_depth_is_bounded_by_the_forks_and_counted_from_the_front() {
+        let truck = ForkliftSpec::default();
+        let pallet = Pose2::new(0.0, 0.0, 0.0);
+        let at = |x: f64| insertion_depth(&pallet, &Pose2::new(x, 0.0, 0.0), &truck);
+        assert!(
+            (at(-truck.fork_length_m - 0.5) + 0.5).abs() < 1e-12,
+            "short of the face"
+        );
+        assert!(
+            (at(-truck.fork_length_m + 0.8) - 0.8).abs() < 1e-12,
+            "0.8 m in"
+        );
+        assert!(at(-0.01) <= truck.fork_length_m);
+        assert_eq!(at(0.5), 0.0, "root past the face");
+        assert_eq!(at(105.0), 0.0, "drove away behind the pallet");
+    }
 }

@@ -51,12 +51,9 @@ pub struct BatchSpec {
 /// Why a batch could not run or be read.
 #[derive(Debug, thiserror::Error)]
 pub enum BatchError {
-    #[error("{path}: {source}")]
-    Io {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
+    /// The reason is in the message, not chained as a source: `{:#}` would print it twice.
+    #[error("{path}: {cause}")]
+    Io { path: String, cause: std::io::Error },
     #[error("{path}:{line}: {message}")]
     Record {
         path: String,
@@ -68,9 +65,9 @@ pub enum BatchError {
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> BatchError + '_ {
-    move |source| BatchError::Io {
+    move |cause| BatchError::Io {
         path: path.display().to_string(),
-        source,
+        cause,
     }
 }
 
@@ -326,6 +323,12 @@ pub fn run_batch(
     on_done: &(dyn Fn(&TrialRecord) + Sync),
 ) -> Result<Summary, BatchError> {
     spec.check(jobs)?;
+    if dir.exists() && !dir.is_dir() {
+        return Err(BatchError::Invalid(format!(
+            "{}: exists and is not a directory (--out names a directory)",
+            dir.display()
+        )));
+    }
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let _lock = DirLock::take(dir)?;
     spec.prepare_dir(dir)?;
