@@ -55,10 +55,16 @@ pub fn run(
         crate::emit(&format!("{text}\n"))?;
         return finish(out.success);
     }
+    // A trial that failed before driving has no final pose: "–", not "NaN m".
+    let num = |v: f64, digits: usize, unit: &str| {
+        if v.is_finite() {
+            format!("{v:.digits$} {unit}")
+        } else {
+            "–".to_owned()
+        }
+    };
     let opt = |v: Option<f64>, scale: f64, unit: &str| {
-        v.map_or("never entered".to_owned(), |v| {
-            format!("{:.4} {unit}", v * scale)
-        })
+        v.map_or("never entered".to_owned(), |v| num(v * scale, 4, unit))
     };
     let verdict = match (&out.failure, out.success) {
         (_, true) => "SUCCESS".to_owned(),
@@ -90,14 +96,6 @@ pub fn run(
         "heading error entry  {}",
         opt(out.heading_error_rad, 1.0, "rad")
     );
-    // A trial that failed before driving has no final pose: "–", not "NaN m".
-    let num = |v: f64, digits: usize, unit: &str| {
-        if v.is_finite() {
-            format!("{v:.digits$} {unit}")
-        } else {
-            "–".to_owned()
-        }
-    };
     let _ = writeln!(
         s,
         "final lateral error  {}",

@@ -1,44 +1,23 @@
 //! Plan time of both planners over the papers' Table 2 scenarios, and of the spiral over the random goals of its optimality test (issue targets: spiral median ≤ 150 µs, max ≤ 1 ms).
 
+#[path = "../tests/common/reference.rs"]
+#[allow(dead_code)]
+mod reference;
+
 use criterion::{Criterion, criterion_group, criterion_main};
-use forkbench_core::{ForkliftSpec, Pose2};
+use forkbench_core::ForkliftSpec;
 use forkbench_plan::reproduce::{BsplineTable, SpiralTable};
 use forkbench_plan::{BsplineConfig, PlanRequest, SpiralConfig, bspline, spiral};
-use serde::Deserialize;
 use std::hint::black_box;
 
-#[derive(Deserialize)]
-struct Reference {
-    goals: Vec<Goal>,
-}
-
-#[derive(Deserialize)]
-struct Goal {
-    name: String,
-    goal_x_m: f64,
-    goal_y_m: f64,
-    goal_heading_rad: f64,
-    start_curvature_per_m: f64,
-    length_window: bool,
-    cost: Option<f64>,
-}
-
-/// The random and holdout goals of `tests/spiral_optimal.rs` that have a feasible spiral in the
-/// paper's window (the planner's default).
+/// The random and holdout goals of `tests/spiral_optimal.rs` that have a feasible spiral
+/// in the paper's window (the planner's default).
 fn random_goals() -> Vec<(String, PlanRequest)> {
-    let r: Reference = serde_json::from_str(include_str!("../tests/data/spiral_reference.json"))
-        .expect("reference parses");
-    r.goals
+    reference::reference()
+        .goals
         .into_iter()
         .filter(|g| g.length_window && g.cost.is_some() && !g.name.starts_with("row"))
-        .map(|g| {
-            let mut req = PlanRequest::new(
-                Pose2::new(0.0, 0.0, 0.0),
-                Pose2::new(g.goal_x_m, g.goal_y_m, g.goal_heading_rad),
-            );
-            req.start_curvature_per_m = g.start_curvature_per_m;
-            (g.name.replace(' ', "/"), req)
-        })
+        .map(|g| (g.name.replace(' ', "/"), g.request()))
         .collect()
 }
 

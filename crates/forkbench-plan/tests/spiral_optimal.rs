@@ -1,49 +1,18 @@
 //! The spiral planner's cost against an independent optimiser (scipy SLSQP over all five coefficients and the length, `tools/spiral_reference.py`): within 1 % on every goal the reference solves, in the paper's window and the wide one.
 
-use forkbench_core::{ForkliftSpec, Pose2};
-use forkbench_plan::PlanRequest;
+#[path = "common/reference.rs"]
+mod common;
+
+use common::reference;
+use forkbench_core::ForkliftSpec;
 use forkbench_plan::spiral::{self, SpiralConfig, SpiralProblem, window_bound};
-use serde::Deserialize;
-
-#[derive(Debug, Deserialize)]
-struct Reference {
-    kappa_max_per_m: f64,
-    goals: Vec<Goal>,
-}
-
-#[derive(Debug, Deserialize)]
-struct Goal {
-    name: String,
-    goal_x_m: f64,
-    goal_y_m: f64,
-    goal_heading_rad: f64,
-    start_curvature_per_m: f64,
-    length_window: bool,
-    window: [f64; 2],
-    cost: Option<f64>,
-    sf: Option<f64>,
-}
-
-fn reference() -> Reference {
-    let text = include_str!("data/spiral_reference.json");
-    serde_json::from_str(text).expect("tests/data/spiral_reference.json parses")
-}
-
-fn request(g: &Goal) -> PlanRequest {
-    let mut req = PlanRequest::new(
-        Pose2::new(0.0, 0.0, 0.0),
-        Pose2::new(g.goal_x_m, g.goal_y_m, g.goal_heading_rad),
-    );
-    req.start_curvature_per_m = g.start_curvature_per_m;
-    req
-}
 
 #[test]
 fn reference_solves_the_same_problem() {
     let r = reference();
     assert!((r.kappa_max_per_m - ForkliftSpec::default().max_curvature_per_m()).abs() < 1e-12);
     for g in &r.goals {
-        let prob = SpiralProblem::from_request(&request(g), 0.0);
+        let prob = SpiralProblem::from_request(&g.request(), 0.0);
         let (lo, hi) = prob.length_window(g.length_window);
         assert!(
             (lo - g.window[0]).abs() < 1e-12 && (hi - g.window[1]).abs() < 1e-12,
@@ -65,7 +34,7 @@ fn cost_is_within_one_percent_of_the_independent_optimum() {
             enforce_length_window: g.length_window,
             ..SpiralConfig::default()
         };
-        let req = request(g);
+        let req = g.request();
         let res = spiral::plan(&req, &cfg);
         let Some(ref_cost) = g.cost else {
             // The reference found nothing: a plan we do return must still be feasible.
