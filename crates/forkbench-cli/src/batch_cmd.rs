@@ -311,9 +311,6 @@ fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
         let Ok(case) = scn.case(&r.outcome.case) else {
             continue;
         };
-        if r.pallet_noise_scale != spec.pallet_noise_scale {
-            continue; // a record from an earlier run with other settings
-        }
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         crate::record::record_trial(scn, case, &r.options(), &dir)?;
         n += 1;

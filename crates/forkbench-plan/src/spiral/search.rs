@@ -8,6 +8,16 @@ use crate::numeric::brent_min;
 /// One solved length: (s_f, [b, c], cost, max normalised |κ|).
 pub(super) type Candidate = (f64, [f64; 2], f64, f64);
 
+/// The candidate of a solution (b, c) at length `sf`: its cost and largest |κ|.
+fn candidate(p: &SpiralProblem, sf: f64, bc: [f64; 2]) -> Candidate {
+    (
+        sf,
+        bc,
+        p.cost(bc[0], bc[1], sf),
+        p.max_abs_curvature(bc[0], bc[1], sf),
+    )
+}
+
 /// The search over lengths: each grid length keeps the least-cost solution any start or
 /// any neighbour's solution reached, then the best bracket is refined.
 pub(super) struct LengthSearch<'a> {
@@ -15,7 +25,8 @@ pub(super) struct LengthSearch<'a> {
     lo: f64,
     hi: f64,
     sfs: Vec<f64>,
-    /// Gaps between grid lengths whose fold was already looked for.
+    /// Per gap between grid lengths and direction, whether the curve was already
+    /// followed across it.
     folds_tried: Vec<[bool; 2]>,
     /// Solutions found at folds (s_f free).
     folds: Vec<Candidate>,
@@ -105,8 +116,8 @@ impl<'a> LengthSearch<'a> {
         best
     }
 
-    /// Fresh starts at every grid length, then continuation sweeps down and up until no
-    /// length improves: a branch found at one length is followed across the whole
+    /// Fresh starts at every sixth grid length and the longest (at all of them if none
+    /// solves), then continuation sweeps down and up until no length improves: a branch found at one length is followed across the whole
     /// window (through folds), so the cheapest branch wins wherever it was first reached
     /// (e.g. only near the fold at the short end, while its cost keeps falling toward
     /// the long end).
@@ -206,8 +217,7 @@ impl<'a> LengthSearch<'a> {
             Trace::Reached(q) => Some((i, self.solve(self.sfs[i], &[[q[0], q[1]]])?)),
             Trace::Turned { fold, back } => {
                 let [b, c, sf] = fold;
-                self.folds
-                    .push((sf, [b, c], p.cost(b, c, sf), p.max_abs_curvature(b, c, sf)));
+                self.folds.push(candidate(p, sf, [b, c]));
                 Some((j, self.solve(prev.0, &[[back[0], back[1]]])?))
             }
         }
@@ -235,13 +245,7 @@ impl<'a> LengthSearch<'a> {
             let (bc, s) =
                 self.prob
                     .solve_free(self.prob.fit_bc(sf, profile), sf, self.lo, self.hi)?;
-            let p = self.prob;
-            Some((
-                s,
-                bc,
-                p.cost(bc[0], bc[1], s),
-                p.max_abs_curvature(bc[0], bc[1], s),
-            ))
+            Some(candidate(self.prob, s, bc))
         })
     }
 
@@ -251,12 +255,12 @@ impl<'a> LengthSearch<'a> {
         self.newton_solves += 1;
         match self.prob.solve_bc(c.0, c.1, Rule::Final) {
             Some(bc) => {
-                let p = self.prob;
-                let max_k = p.max_abs_curvature(bc[0], bc[1], c.0);
-                let polished = (c.0, bc, p.cost(bc[0], bc[1], c.0), max_k);
+                let polished = candidate(self.prob, c.0, bc);
                 // Polishing moves (b, c) by ~1e-9: the same spiral, unless Newton fell
                 // onto another branch, which must not replace the chosen one.
-                if (polished.2 - c.2).abs() <= 1e-6 * (1.0 + c.2) && max_k <= p.kappa_limit {
+                if (polished.2 - c.2).abs() <= 1e-6 * (1.0 + c.2)
+                    && polished.3 <= self.prob.kappa_limit
+                {
                     polished
                 } else {
                     c

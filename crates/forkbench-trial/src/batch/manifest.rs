@@ -105,11 +105,12 @@ impl Manifest {
         out
     }
 
-    /// The same batch but for the shard index (what shards of one batch share).
-    pub fn same_batch(&self, other: &Manifest) -> bool {
+    /// Where two manifests differ other than in the shard index: empty for shards of one
+    /// batch.
+    pub fn batch_differences(&self, other: &Manifest) -> Vec<String> {
         let mut o = other.clone();
         o.shard[0] = self.shard[0];
-        self.differences(&o).is_empty()
+        self.differences(&o)
     }
 
     fn comparable(&self) -> Value {

@@ -90,6 +90,12 @@ pub fn load_results(dir: &Path) -> Result<Summary, BatchError> {
             dir.display()
         ))
     })?;
+    Ok(summarize(&complete_records(dir, &m)?))
+}
+
+/// The records of `dir`, refused unless they are exactly the trials manifest `m` names
+/// (no duplicates, none missing).
+fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchError> {
     let path = dir.join("trials.jsonl");
     let records = read_records(&path)?;
     check_unique(&records, &path)?;
@@ -102,7 +108,7 @@ pub fn load_results(dir: &Path) -> Result<Summary, BatchError> {
             records.len()
         )));
     }
-    Ok(summarize(&records))
+    Ok(records)
 }
 
 /// Merges the shards of one batch into `out` and summarises. Refuses inputs from
@@ -134,18 +140,13 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
     let n = m0.shard[1];
     let mut by_index: BTreeMap<u64, &PathBuf> = BTreeMap::new();
     for (d, m) in dirs.iter().zip(&manifests) {
-        if !m0.same_batch(m) {
-            let mut theirs = m.clone();
-            theirs.shard[0] = m0.shard[0];
+        let diff = m0.batch_differences(m);
+        if !diff.is_empty() {
             return Err(BatchError::Invalid(format!(
                 "{} and {} are shards of different batches ({})",
                 first.display(),
                 d.display(),
-                m0.differences(&theirs)
-                    .into_iter()
-                    .take(8)
-                    .collect::<Vec<_>>()
-                    .join("; ")
+                diff.into_iter().take(8).collect::<Vec<_>>().join("; ")
             )));
         }
         if let Some(other) = by_index.insert(m.shard[0], d) {
@@ -168,9 +169,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
         )));
     }
     let mut all = Vec::new();
-    for d in dirs {
-        load_results(d)?; // complete and free of duplicates
-        all.extend(read_records(&d.join("trials.jsonl"))?);
+    for (d, m) in dirs.iter().zip(&manifests) {
+        all.extend(complete_records(d, m)?);
     }
     all.sort_by_key(TrialRecord::key);
     std::fs::create_dir_all(out).map_err(io(out))?;
