@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context as _, bail};
-use forkbench_plan::PlannerKind;
 use forkbench_trial::batch::{self, Baseline, BatchSpec, Summary, TrialRecord};
 use forkbench_trial::{Scenario, defaults};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -16,7 +15,8 @@ pub struct BatchArgs {
     pub scenarios: Vec<PathBuf>,
     pub trials: u64,
     pub seed: u64,
-    pub planners: Vec<PlannerKind>,
+    pub planners: Vec<String>,
+    pub trackers: Vec<String>,
     pub jobs: usize,
     pub shard: Option<String>,
     pub out: PathBuf,
@@ -127,6 +127,7 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
     let mut spec = BatchSpec {
         scenarios,
         planners: a.planners.clone(),
+        trackers: a.trackers.clone(),
         trials: a.trials,
         seed: a.seed,
         shard,
@@ -351,11 +352,9 @@ pub fn replay(
         })?;
     let case = scn.case(&record.outcome.case)?;
     let opts = record.options();
-    let planner = opts.planner.unwrap_or(scn.planner);
-    let mut sinks = crate::record::Sinks::open(
-        rec,
-        crate::record::metadata(&scn.name, &case.name, planner.name(), record.outcome.seed),
-    )?;
+    let run = scn.resolve(&opts)?;
+    let mut sinks =
+        crate::record::Sinks::open(rec, crate::record::metadata(&scn.name, &case.name, &run))?;
     let (mut out, written) =
         sinks.record(|r| forkbench_trial::run_trial_recorded(scn, case, &opts, r));
     let viewer_error = sinks.viewer_error.take();
@@ -366,10 +365,11 @@ pub fn replay(
     (out.wall_time_ms, expected.wall_time_ms) = (0.0, 0.0);
     let same = serde_json::to_value(&out)? == serde_json::to_value(&expected)?;
     crate::emit(&format!(
-        "replayed {} / case {} / {} / seed {}: {} ({})\n",
+        "replayed {} / case {} / {} / {} / seed {}: {} ({})\n",
         out.scenario,
         out.case,
         out.planner,
+        out.tracker,
         out.seed,
         if out.success {
             "SUCCESS".to_owned()

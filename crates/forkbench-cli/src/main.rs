@@ -14,7 +14,6 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 use clap::{Parser, Subcommand, ValueEnum};
 use forkbench_core::{ForkliftSpec, Pose2};
-use forkbench_plan::PlannerKind;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -27,27 +26,12 @@ struct Cli {
     command: Command,
 }
 
-/// Planner names as the CLI spells them.
+/// The papers' tables `reproduce` knows.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum ReproduceArg {
     Bspline,
     Spiral,
     Corridor,
-}
-
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-enum PlannerArg {
-    Bspline,
-    Spiral,
-}
-
-impl From<PlannerArg> for PlannerKind {
-    fn from(p: PlannerArg) -> Self {
-        match p {
-            PlannerArg::Bspline => PlannerKind::Bspline,
-            PlannerArg::Spiral => PlannerKind::Spiral,
-        }
-    }
 }
 
 /// Recording targets of one trial.
@@ -94,7 +78,8 @@ enum RecordWhich {
 enum Command {
     /// Plan one pick path from a start pose to a pallet pose.
     Plan {
-        planner: PlannerArg,
+        /// Planner kind (bspline, spiral, external, or one a library user registered).
+        planner: String,
         /// Start pose of the fork root: x_m,y_m,heading_deg
         #[arg(long, value_parser = parse_pose, allow_hyphen_values = true)]
         start: Pose2,
@@ -107,7 +92,8 @@ enum Command {
         /// Forklift spec overrides (TOML with fields of ForkliftSpec).
         #[arg(long)]
         truck: Option<PathBuf>,
-        /// Planner settings (TOML with [bspline] and [spiral] tables).
+        /// Planner settings: a TOML file with the keys of a scenario's [planner] table
+        /// (without `kind`).
         #[arg(long)]
         config: Option<PathBuf>,
         /// Spiral: search lengths outside the paper's window 1 + θ²/5 ≤ s_f ≤ 2 + θ²/5.
@@ -129,9 +115,12 @@ enum Command {
         /// Seed of every random draw (default: the scenario's).
         #[arg(long)]
         seed: Option<u64>,
-        /// Planner (default: the scenario's).
+        /// Planner by name: the scenario's own or a registered kind (default: the scenario's).
         #[arg(long)]
-        planner: Option<PlannerArg>,
+        planner: Option<String>,
+        /// Tracker by name: the scenario's own or a registered kind (default: the scenario's).
+        #[arg(long)]
+        tracker: Option<String>,
         /// Turn off NAV350 and pallet-estimate noise.
         #[arg(long)]
         no_noise: bool,
@@ -159,19 +148,23 @@ enum Command {
         #[command(flatten)]
         record: RecordFlags,
     },
-    /// Monte-Carlo batch over scenarios × cases × planners × trials (default: the embedded scenario set).
+    /// Monte-Carlo batch over scenarios × cases × planners × trackers × trials (default: the embedded scenario set).
     Batch {
         /// Scenario files (default: the embedded field-test, rack-pick and Table 2 sets).
         scenarios: Vec<PathBuf>,
-        /// Trials per scenario × case × planner.
+        /// Trials per scenario × case × planner × tracker.
         #[arg(long, default_value_t = 20)]
         trials: u64,
         /// Batch seed; each trial's seed derives from it and the trial's identity.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Planners to run every case with (default: each scenario's own).
+        /// Planners to run every case with, by name: a scenario's own or a registered kind
+        /// (default: each scenario's own).
         #[arg(long, num_args = 1..)]
-        planner: Vec<PlannerArg>,
+        planner: Vec<String>,
+        /// Trackers to run every case with, by name (default: each scenario's own).
+        #[arg(long, num_args = 1..)]
+        tracker: Vec<String>,
         /// Worker threads.
         #[arg(long, default_value_t = 2)]
         jobs: usize,
@@ -320,6 +313,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             trials,
             seed,
             planner,
+            tracker,
             jobs,
             shard,
             out,
@@ -334,7 +328,8 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             scenarios,
             trials,
             seed,
-            planners: planner.into_iter().map(Into::into).collect(),
+            planners: planner,
+            trackers: tracker,
             jobs,
             shard,
             out,
@@ -369,6 +364,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             case,
             seed,
             planner,
+            tracker,
             no_noise,
             pallet_noise_scale,
             replan,
@@ -377,7 +373,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         } => {
             let opts = trial_cmd::options(
                 seed,
-                planner.map(Into::into),
+                (planner, tracker),
                 no_noise,
                 pallet_noise_scale,
                 replan,
@@ -406,24 +402,25 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             plot,
         } => {
             let truck = load_truck(truck.as_ref())?;
-            let mut cfg = match &config {
+            let mut settings = match &config {
                 Some(p) => {
                     let text = std::fs::read_to_string(p)
                         .with_context(|| format!("reading {}", p.display()))?;
                     toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?
                 }
-                None => forkbench_plan::PlannerConfig::default(),
+                None => forkbench_core::Settings::new(),
             };
             if no_length_window {
-                cfg.spiral.enforce_length_window = false;
+                settings.insert("enforce_length_window".into(), false.into());
             }
             plan_cmd::run(plan_cmd::PlanArgs {
-                planner: planner.into(),
+                planner,
+                settings,
+                config_dir: config.as_deref().map(forkbench_plan::external::dir_of),
                 start,
                 goal,
                 start_curvature_per_m: start_curvature,
                 truck,
-                cfg,
                 json,
                 plot,
             })
@@ -435,14 +432,12 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             json,
             plot,
         } => match what {
-            ReproduceArg::Bspline | ReproduceArg::Spiral => {
-                let planner = if matches!(what, ReproduceArg::Bspline) {
-                    PlannerKind::Bspline
-                } else {
-                    PlannerKind::Spiral
-                };
-                reproduce_cmd::run(planner, table.as_deref(), json, plot.as_deref())
-            }
+            ReproduceArg::Bspline | ReproduceArg::Spiral => reproduce_cmd::run(
+                matches!(what, ReproduceArg::Bspline),
+                table.as_deref(),
+                json,
+                plot.as_deref(),
+            ),
             ReproduceArg::Corridor => {
                 if table.is_some() {
                     anyhow::bail!("--table: reproduce corridor has no reference table file");

@@ -5,41 +5,45 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use forkbench_core::{ForkliftSpec, Pose2};
-use forkbench_plan::{PlanParams, PlanRequest, PlannerConfig, PlannerKind};
+use forkbench_core::Settings;
+use forkbench_plan::{PlanParams, PlanRequest};
+use forkbench_trial::{ComponentSpec, Registry, Role};
 use serde_json::json;
 
 use crate::plot;
 
 #[derive(Debug)]
 pub struct PlanArgs {
-    pub planner: PlannerKind,
+    /// A registered planner kind.
+    pub planner: String,
+    /// Its settings (the keys of a scenario's [planner] table).
+    pub settings: Settings,
+    /// Where an external planner's command runs: the settings file's directory.
+    pub config_dir: Option<PathBuf>,
     pub start: Pose2,
     pub goal: Pose2,
     pub start_curvature_per_m: f64,
     pub truck: ForkliftSpec,
-    pub cfg: PlannerConfig,
     pub json: bool,
     pub plot: Option<PathBuf>,
 }
 
 pub fn run(a: PlanArgs) -> anyhow::Result<()> {
-    let req = PlanRequest {
-        start: a.start,
-        goal: a.goal,
-        start_curvature_per_m: a.start_curvature_per_m,
-        truck: a.truck.clone(),
-    };
+    let mut req = PlanRequest::new(a.start, a.goal);
+    req.start_curvature_per_m = a.start_curvature_per_m;
+    req.truck = a.truck.clone();
+    let mut spec = ComponentSpec::of_kind(Role::Planner, &a.planner);
+    spec.settings = a.settings.clone();
+    spec.dir = a.config_dir.clone().unwrap_or_else(|| PathBuf::from("."));
+    let mut planner = Registry::shared()
+        .planner(&spec)
+        .map_err(|e| anyhow::anyhow!("planner {:?}: {e}", a.planner))?;
     let t0 = Instant::now();
-    let plan = forkbench_plan::plan(a.planner, &req, &a.cfg)?;
+    let plan = planner.plan(&req)?;
     let solve_time_us = t0.elapsed().as_secs_f64() * 1e6;
     let m = plan.path.metrics(&a.start, &a.goal, &a.truck);
     if let Some(file) = &a.plot {
-        let polygon = match &plan.params {
-            PlanParams::Bspline {
-                control_points_m, ..
-            } => Some(control_points_m.to_vec()),
-            PlanParams::Spiral(_) => None,
-        };
+        let polygon = plan.control_polygon_m.clone();
         let title = format!("{} plan", a.planner);
         plot::draw_plans(
             file,
@@ -55,7 +59,7 @@ pub fn run(a: PlanArgs) -> anyhow::Result<()> {
     if a.json {
         let pose = |p: &Pose2| json!({"x_m": p.x_m, "y_m": p.y_m, "heading_rad": p.heading_rad});
         let out = json!({
-            "planner": a.planner.name(),
+            "planner": a.planner,
             "start": pose(&a.start),
             "goal": pose(&a.goal),
             "start_curvature_per_m": a.start_curvature_per_m,
@@ -86,6 +90,10 @@ pub fn run(a: PlanArgs) -> anyhow::Result<()> {
             );
             let _ = writeln!(s, "scale R, mirrored    {:.4} m, {}", p.scale_m, p.mirrored);
             let _ = writeln!(s, "cost ∫½κ² (norm.)    {:.6}", plan.cost);
+        }
+        PlanParams::Other(info) => {
+            let _ = writeln!(s, "planner info         {info}");
+            let _ = writeln!(s, "cost                 {:.6}", plan.cost);
         }
     }
     let _ = writeln!(s, "length               {:.4} m", m.length_m);

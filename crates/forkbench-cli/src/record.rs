@@ -99,12 +99,17 @@ impl Sinks {
 }
 
 /// Metadata record of a trial's MCAP file.
-pub fn metadata(scenario: &str, case: &str, planner: &str, seed: u64) -> BTreeMap<String, String> {
+pub fn metadata(
+    scenario: &str,
+    case: &str,
+    run: &forkbench_trial::Resolved,
+) -> BTreeMap<String, String> {
     BTreeMap::from([
         ("scenario".to_owned(), scenario.to_owned()),
         ("case".to_owned(), case.to_owned()),
-        ("planner".to_owned(), planner.to_owned()),
-        ("seed".to_owned(), seed.to_string()),
+        ("planner".to_owned(), run.planner.name.clone()),
+        ("tracker".to_owned(), run.tracker.name.clone()),
+        ("seed".to_owned(), run.seed.to_string()),
         (
             "forkbench_version".to_owned(),
             env!("CARGO_PKG_VERSION").to_owned(),
@@ -117,20 +122,20 @@ pub fn metadata(scenario: &str, case: &str, planner: &str, seed: u64) -> BTreeMa
     ])
 }
 
-/// Re-runs one trial of a scenario into `<dir>/<scenario>-<case>-<planner>-seed<seed>.{rrd,mcap}`.
+/// Re-runs one trial of a scenario into
+/// `<dir>/<scenario>-<case>-<planner>-<tracker>-seed<seed>.{rrd,mcap}`.
 pub fn record_trial(
     scn: &forkbench_trial::Scenario,
     case: &forkbench_trial::Case,
     opts: &forkbench_trial::TrialOptions,
     dir: &std::path::Path,
 ) -> anyhow::Result<(forkbench_trial::TrialOutcome, PathBuf)> {
-    let planner = opts.planner.unwrap_or(scn.planner);
-    let seed = opts.seed.unwrap_or(scn.seed);
+    let run = scn.resolve(opts)?;
     // Names are free text: only letters, digits, '-' and '_' reach the file name, so a
     // name can neither leave `dir` nor fail the write (the real names are in the files).
     let stem = safe_file_stem(&format!(
-        "{}-{}-{}-seed{}",
-        scn.name, case.name, planner, seed
+        "{}-{}-{}-{}-seed{}",
+        scn.name, case.name, run.planner.name, run.tracker.name, run.seed
     ));
     let rrd = dir.join(format!("{stem}.rrd"));
     let args = RecordArgs {
@@ -139,7 +144,7 @@ pub fn record_trial(
         force: true,
         ..RecordArgs::default()
     };
-    let mut sinks = Sinks::open(&args, metadata(&scn.name, &case.name, planner.name(), seed))?;
+    let mut sinks = Sinks::open(&args, metadata(&scn.name, &case.name, &run))?;
     let (out, written) =
         sinks.record(|rec| forkbench_trial::run_trial_recorded(scn, case, opts, rec));
     written?;

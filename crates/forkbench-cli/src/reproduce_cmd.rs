@@ -6,7 +6,7 @@ use std::path::Path as FsPath;
 use anyhow::Context as _;
 use forkbench_core::ForkliftSpec;
 use forkbench_plan::reproduce::{BsplineTable, SpiralTable, reproduce_bspline, reproduce_spiral};
-use forkbench_plan::{BsplineConfig, Plan, PlanParams, PlannerKind, SpiralConfig};
+use forkbench_plan::{BsplineConfig, Plan, SpiralConfig};
 use serde_json::json;
 
 use crate::plot;
@@ -21,7 +21,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 pub fn run(
-    planner: PlannerKind,
+    bspline: bool,
     table: Option<&FsPath>,
     json: bool,
     plot_file: Option<&FsPath>,
@@ -29,8 +29,9 @@ pub fn run(
     let truck = ForkliftSpec::default();
     let read =
         |p: &FsPath| std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()));
-    let (text, plans) = match planner {
-        PlannerKind::Bspline => {
+    let planner = if bspline { "bspline" } else { "spiral" };
+    let (text, plans) = match bspline {
+        true => {
             let t = match table {
                 Some(p) => BsplineTable::parse(&read(p)?, &p.display().to_string())?,
                 None => BsplineTable::embedded(),
@@ -48,7 +49,7 @@ pub fn run(
                     .collect::<Vec<_>>(),
             )
         }
-        PlannerKind::Spiral => {
+        false => {
             let t = match table {
                 Some(p) => SpiralTable::parse(&read(p)?, &p.display().to_string())?,
                 None => SpiralTable::embedded(),
@@ -73,12 +74,7 @@ pub fn run(
             .map(|(name, p): &(String, Plan)| plot::Series {
                 label: format!("#{name}"),
                 path: &p.path,
-                control_polygon: match &p.params {
-                    PlanParams::Bspline {
-                        control_points_m, ..
-                    } if plans.len() == 1 => Some(control_points_m.to_vec()),
-                    _ => None,
-                },
+                control_polygon: p.control_polygon_m.clone().filter(|_| plans.len() == 1),
             })
             .collect();
         plot::draw_plans(

@@ -3,7 +3,6 @@
 use std::path::Path;
 
 use anyhow::Context as _;
-use forkbench_plan::PlannerKind;
 use forkbench_trial::{Scenario, TrialOptions};
 
 pub fn run(
@@ -28,13 +27,13 @@ pub fn run(
                 .join(", ")
         ),
     };
-    let planner = opts.planner.unwrap_or(scn.planner);
-    let seed = opts.seed.unwrap_or(scn.seed);
+    // Unknown planner or tracker names stop here, before any recording file is made.
+    let run = scn.resolve(opts)?;
     // File targets are checked before the run; a viewer that cannot be reached is
     // reported and the trial runs anyway.
     let mut sinks = crate::record::Sinks::open(
         rec,
-        crate::record::metadata(&scn.name, &case.name, planner.name(), seed),
+        crate::record::metadata(&scn.name, &case.name, &run),
     )?;
     let (out, written) = sinks.record(|r| forkbench_trial::run_trial_recorded(&scn, case, opts, r));
     let viewer_error = sinks.viewer_error.take();
@@ -126,10 +125,10 @@ pub fn run(
     finish(out.success)
 }
 
-/// Planner override from the CLI.
+/// Trial options from the CLI: seed, (planner, tracker) names, noise and replanning.
 pub fn options(
     seed: Option<u64>,
-    planner: Option<PlannerKind>,
+    (planner, tracker): (Option<String>, Option<String>),
     no_noise: bool,
     pallet_noise_scale: Option<f64>,
     replan: bool,
@@ -142,6 +141,7 @@ pub fn options(
     Ok(TrialOptions {
         seed,
         planner,
+        tracker,
         no_noise,
         pallet_noise_scale,
         replan: replan.then_some(true),

@@ -1,10 +1,15 @@
 //! Shared vocabulary of forkbench: poses, units, the forklift and pallet specs, sampled paths.
 
+pub mod geometry;
+pub mod pallet;
 pub mod path;
+pub mod settings;
 pub mod pose;
 pub mod units;
 pub mod vehicle;
 
+pub use pallet::PalletSpec;
 pub use path::{Path, PathMetrics, PathSample};
 pub use pose::{Pose2, PoseParseError};
+pub use settings::{Settings, SettingsError};
 pub use vehicle::{ForkliftSpec, SpecError};

@@ -71,6 +71,23 @@ impl ForkliftSpec {
         1.0 / self.max_curvature_per_m()
     }
 
+    /// Centre pose of the chassis for a fork-root pose (the chassis ends at the fork root).
+    pub fn chassis_centre(&self, root: &crate::Pose2) -> crate::Pose2 {
+        root.to_world(&crate::Pose2::new(-self.body_length_m / 2.0, 0.0, 0.0))
+    }
+
+    /// Lateral offsets of the left and right fork centre lines from the truck's axis.
+    pub fn fork_offsets_m(&self) -> [f64; 2] {
+        [self.fork_spacing_m / 2.0, -self.fork_spacing_m / 2.0]
+    }
+
+    /// Poses of the left and right forks' points `along_m` ahead of the fork root (0: the
+    /// root, `fork_length_m`: the tips).
+    pub fn fork_points(&self, root: &crate::Pose2, along_m: f64) -> [crate::Pose2; 2] {
+        self.fork_offsets_m()
+            .map(|y| root.to_world(&crate::Pose2::new(along_m, y, 0.0)))
+    }
+
     /// Equivalent steering angle that yields the given path curvature: arctan(L κ).
     pub fn steer_for_curvature(&self, curvature_per_m: f64) -> f64 {
         (self.wheelbase_m * curvature_per_m).atan()

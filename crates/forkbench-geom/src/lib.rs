@@ -32,11 +32,7 @@ impl Footprint {
 
     /// The four corners (world frame) for a reference pose, counter-clockwise from front left.
     pub fn corners(&self, reference: &Pose2) -> [[f64; 2]; 4] {
-        let c = self.centre(reference);
-        let (s, co) = c.heading_rad.sin_cos();
-        let (hl, hw) = (self.length_m / 2.0, self.width_m / 2.0);
-        [[hl, hw], [-hl, hw], [-hl, -hw], [hl, -hw]]
-            .map(|[x, y]| [c.x_m + co * x - s * y, c.y_m + s * x + co * y])
+        forkbench_core::geometry::rect_corners(&self.centre(reference), self.length_m, self.width_m)
     }
 }
 

@@ -6,7 +6,8 @@ mod rrd_file;
 
 use std::path::Path;
 
-use forkbench_core::Pose2;
+use forkbench_core::geometry::rect_outline;
+use forkbench_core::{PalletSpec, Pose2};
 
 pub use mcap_sink::McapRecorder;
 pub use rerun_sink::{RerunRecorder, RerunTarget};
@@ -58,49 +59,27 @@ pub fn check_writable(path: &Path, force: bool) -> Result<(), LogError> {
         })
 }
 
-/// Corners of a rectangle given by its centre pose and full sizes, closed (5 points).
-pub(crate) fn rect_corners(centre: &Pose2, length_m: f64, width_m: f64) -> [[f64; 2]; 5] {
-    let (hl, hw) = (length_m / 2.0, width_m / 2.0);
-    let c = [[hl, hw], [-hl, hw], [-hl, -hw], [hl, -hw], [hl, hw]];
-    c.map(|[x, y]| {
-        let p = centre.to_world(&Pose2::new(x, y, 0.0));
-        [p.x_m, p.y_m]
-    })
-}
-
 /// Outlines of the truck at a fork-root pose: chassis and the two forks.
 pub(crate) fn truck_outlines(
     truck: &forkbench_core::ForkliftSpec,
     root: &Pose2,
 ) -> Vec<[[f64; 2]; 5]> {
-    let chassis = root.to_world(&Pose2::new(-truck.body_length_m / 2.0, 0.0, 0.0));
-    let mut v = vec![rect_corners(
-        &chassis,
+    let mut v = vec![rect_outline(
+        &truck.chassis_centre(root),
         truck.body_length_m,
         truck.body_width_m,
     )];
-    for side in [1.0, -1.0] {
-        let f = root.to_world(&Pose2::new(
-            truck.fork_length_m / 2.0,
-            side * truck.fork_spacing_m / 2.0,
-            0.0,
-        ));
-        v.push(rect_corners(&f, truck.fork_length_m, truck.fork_width_m));
+    for f in truck.fork_points(root, truck.fork_length_m / 2.0) {
+        v.push(rect_outline(&f, truck.fork_length_m, truck.fork_width_m));
     }
     v
 }
 
 /// Outlines of the pallet's stringers at its face pose.
-pub(crate) fn pallet_outlines(
-    pallet: &forkbench_sim::PalletSpec,
-    face: &Pose2,
-) -> Vec<[[f64; 2]; 5]> {
+pub(crate) fn pallet_outlines(pallet: &PalletSpec, face: &Pose2) -> Vec<[[f64; 2]; 5]> {
     pallet
-        .stringer_offsets_m()
+        .stringer_centres(face)
         .iter()
-        .map(|y| {
-            let c = face.to_world(&Pose2::new(pallet.depth_m / 2.0, *y, 0.0));
-            rect_corners(&c, pallet.depth_m, pallet.stringer_width_m())
-        })
+        .map(|c| rect_outline(c, pallet.depth_m, pallet.stringer_width_m()))
         .collect()
 }

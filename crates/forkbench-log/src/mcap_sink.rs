@@ -12,7 +12,8 @@ use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
 use serde::Serialize;
 use serde_json::json;
 
-use crate::{LogError, pallet_outlines, rect_corners, truck_outlines};
+use crate::{LogError, pallet_outlines, truck_outlines};
+use forkbench_core::geometry::rect_outline;
 
 /// Topics, schemas and how often they are written.
 const CHANNELS: [(&str, &str, &str); 9] = [
@@ -647,7 +648,7 @@ impl Recorder for McapRecorder {
                     0.0,
                     &format!("obstacle/{i}"),
                     vec![line(
-                        &rect_corners(&o.centre, o.length_m, o.width_m),
+                        &rect_outline(&o.centre, o.length_m, o.width_m),
                         [0.5, 0.5, 0.5, 1.0],
                         0.03,
                     )],

@@ -7,7 +7,8 @@ use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
 use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TimeSeriesView, Vertical};
 
 use crate::rrd_file::{ErrorSlot, Prefix, RrdFileSink};
-use crate::{LogError, pallet_outlines, rect_corners, truck_outlines};
+use crate::{LogError, pallet_outlines, truck_outlines};
+use forkbench_core::geometry::rect_outline;
 
 /// Where the recording goes.
 #[derive(Debug, Clone, PartialEq)]
@@ -525,7 +526,7 @@ impl Recorder for RerunRecorder {
         let obstacles: Vec<[[f64; 2]; 5]> = s
             .obstacles
             .iter()
-            .map(|o| rect_corners(&o.centre, o.length_m, o.width_m))
+            .map(|o| rect_outline(&o.centre, o.length_m, o.width_m))
             .collect();
         if !obstacles.is_empty() {
             let strips: Vec<Vec<[f32; 2]>> = obstacles.iter().map(|c| strip(c)).collect();

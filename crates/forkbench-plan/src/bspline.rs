@@ -4,7 +4,7 @@ use forkbench_core::{Path, PathSample, Pose2};
 use serde::{Deserialize, Serialize};
 
 use crate::numeric::max_abs_on_interval;
-use crate::{Plan, PlanError, PlanParams, PlanRequest, PlannerKind};
+use crate::{Plan, PlanError, PlanParams, PlanRequest};
 
 /// Settings of the B-spline planner.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -233,7 +233,7 @@ pub struct BsplinePlan {
 impl BsplinePlan {
     pub fn into_plan(self) -> Plan {
         Plan {
-            planner: PlannerKind::Bspline,
+            planner: "bspline".into(),
             params: PlanParams::Bspline {
                 l1_m: self.l1_m,
                 l2_m: self.l2_m,
@@ -241,6 +241,7 @@ impl BsplinePlan {
             },
             cost: self.max_abs_curvature_per_m,
             path: self.path,
+            control_polygon_m: Some(self.control_points_m.to_vec()),
         }
     }
 }
@@ -251,7 +252,7 @@ pub fn max_abs_curvature_for(start: &Pose2, goal: &Pose2, l1_m: f64, l2_m: f64) 
 }
 
 impl BsplineConfig {
-    fn validate(&self) -> Result<(), PlanError> {
+    pub(crate) fn validate(&self) -> Result<(), PlanError> {
         let bad = |what, reason: &str| {
             Err(PlanError::InvalidInput {
                 what,
@@ -476,7 +477,7 @@ pub fn plan(req: &PlanRequest, cfg: &BsplineConfig) -> Result<BsplinePlan, PlanE
     seeds.truncate(3);
     if seeds.is_empty() {
         return Err(PlanError::Unreachable {
-            planner: PlannerKind::Bspline,
+            planner: "bspline".into(),
             reason: format!(
                 "every control polygon with handles in [{lo:.3}, {hi:.3}] m folds back into a cusp"
             ),
@@ -502,14 +503,14 @@ pub fn plan(req: &PlanRequest, cfg: &BsplineConfig) -> Result<BsplinePlan, PlanE
     let max_k = curve.max_abs_curvature_per_m();
     if !max_k.is_finite() {
         return Err(PlanError::Unreachable {
-            planner: PlannerKind::Bspline,
+            planner: "bspline".into(),
             reason: "the best control polygon still has a cusp".into(),
         });
     }
     // κ ≤ κ_max and arctan(L κ) ≤ α_max are the same bound; check it once.
     if max_k > req.truck.max_curvature_per_m() {
         return Err(PlanError::curvature(
-            PlannerKind::Bspline,
+            "bspline",
             max_k,
             &req.truck,
         ));
@@ -517,7 +518,7 @@ pub fn plan(req: &PlanRequest, cfg: &BsplineConfig) -> Result<BsplinePlan, PlanE
     let path = curve.sample(start, goal, cfg.sample_spacing_m);
     if let Some(s_m) = crate::find_cusp(&path, req.truck.max_curvature_per_m()) {
         return Err(PlanError::Unreachable {
-            planner: PlannerKind::Bspline,
+            planner: "bspline".into(),
             reason: format!(
                 "the path reverses direction (a cusp {s_m:.2} m along it): the goal needs \
                  the truck to back up, which a forward pick path cannot"

@@ -1,54 +1,19 @@
 //! Pallet-pick path planners: cubic B-spline (Lü et al. 2019) and quartic polynomial spiral (Shen et al. 2022).
 
 pub mod bspline;
+pub mod external;
 pub mod numeric;
+mod planner;
 pub mod reproduce;
 pub mod spiral;
 
+use forkbench_core::geometry::Obstacle;
 use forkbench_core::{ForkliftSpec, Path, Pose2};
 use serde::{Deserialize, Serialize};
 
 pub use bspline::{BsplineConfig, BsplinePlan};
+pub use planner::{BsplinePlanner, Planner, SpiralPlanner};
 pub use spiral::{SpiralConfig, SpiralParams, SpiralPlan};
-
-/// Which local planner to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum PlannerKind {
-    Bspline,
-    Spiral,
-}
-
-impl PlannerKind {
-    pub const ALL: [PlannerKind; 2] = [PlannerKind::Bspline, PlannerKind::Spiral];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            PlannerKind::Bspline => "bspline",
-            PlannerKind::Spiral => "spiral",
-        }
-    }
-}
-
-impl std::fmt::Display for PlannerKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for PlannerKind {
-    type Err = PlanError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "bspline" => Ok(PlannerKind::Bspline),
-            "spiral" => Ok(PlannerKind::Spiral),
-            other => Err(PlanError::InvalidInput {
-                what: "planner",
-                reason: format!("unknown planner {other:?} (expected bspline or spiral)"),
-            }),
-        }
-    }
-}
 
 /// What to plan: a forward path of the fork root from `start` to `goal`.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,6 +24,11 @@ pub struct PlanRequest {
     /// always starts at zero curvature and ignores it.
     pub start_curvature_per_m: f64,
     pub truck: ForkliftSpec,
+    /// Racks and walls of the world, for planners that avoid obstacles (the pick planners
+    /// ignore them; the trial checks every plan's swept body against them).
+    pub obstacles: Vec<Obstacle>,
+    /// The trial's seed, for planners that draw random numbers.
+    pub seed: u64,
 }
 
 impl PlanRequest {
@@ -68,6 +38,8 @@ impl PlanRequest {
             goal,
             start_curvature_per_m: 0.0,
             truck: ForkliftSpec::default(),
+            obstacles: Vec::new(),
+            seed: 0,
         }
     }
 
@@ -167,23 +139,24 @@ pub enum PlanError {
          (steering {needed_steer_rad:.4} rad > α_max {limit_steer_rad:.4} rad)"
     )]
     CurvatureLimit {
-        planner: PlannerKind,
+        planner: String,
         needed_per_m: f64,
         limit_per_m: f64,
         needed_steer_rad: f64,
         limit_steer_rad: f64,
     },
     #[error("{planner} cannot reach the goal: {reason}")]
-    Unreachable {
-        planner: PlannerKind,
-        reason: String,
-    },
+    Unreachable { planner: String, reason: String },
+    /// The planner misbehaved or returned a path that breaks the contract (external
+    /// planners: a crash, a hang, bad JSON, a path off the start or goal).
+    #[error("{planner}: {reason}")]
+    Rejected { planner: String, reason: String },
 }
 
 impl PlanError {
-    pub(crate) fn curvature(planner: PlannerKind, needed_per_m: f64, truck: &ForkliftSpec) -> Self {
+    pub(crate) fn curvature(planner: &str, needed_per_m: f64, truck: &ForkliftSpec) -> Self {
         PlanError::CurvatureLimit {
-            planner,
+            planner: planner.to_owned(),
             needed_per_m,
             limit_per_m: truck.max_curvature_per_m(),
             needed_steer_rad: truck.steer_for_curvature(needed_per_m),
@@ -202,32 +175,21 @@ pub enum PlanParams {
         control_points_m: [[f64; 2]; 6],
     },
     Spiral(SpiralParams),
+    /// A planner outside the workspace: whatever it reported about its plan.
+    Other(serde_json::Value),
 }
 
 /// A planned path with the planner's parameters and objective value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
-    pub planner: PlannerKind,
+    /// Name of the planner that made it.
+    pub planner: String,
     pub params: PlanParams,
     /// The planner's own objective: max |κ| (m⁻¹) for bspline, normalised ∫½κ² for spiral.
     pub cost: f64,
     pub path: Path,
-}
-
-/// Settings of both planners (each keeps its own defaults).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct PlannerConfig {
-    pub bspline: BsplineConfig,
-    pub spiral: SpiralConfig,
-}
-
-/// Plans with the chosen planner.
-pub fn plan(kind: PlannerKind, req: &PlanRequest, cfg: &PlannerConfig) -> Result<Plan, PlanError> {
-    match kind {
-        PlannerKind::Bspline => bspline::plan(req, &cfg.bspline).map(BsplinePlan::into_plan),
-        PlannerKind::Spiral => spiral::plan(req, &cfg.spiral).map(SpiralPlan::into_plan),
-    }
+    /// A control polygon the recorder draws beside the path (the B-spline's), if any.
+    pub control_polygon_m: Option<Vec<[f64; 2]>>,
 }
 
 /// Arc length of the first cusp in a sampled forward path, if any: a heading change

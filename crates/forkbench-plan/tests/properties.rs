@@ -1,7 +1,29 @@
 //! Property tests: random feasible and infeasible goals never panic or yield NaN; Ok plans end exactly at the goal.
 
 use forkbench_core::{ForkliftSpec, Pose2};
-use forkbench_plan::{PlanError, PlanRequest, PlannerConfig, PlannerKind, plan};
+use forkbench_plan::{BsplinePlanner, Plan, PlanError, PlanRequest, Planner, SpiralPlanner};
+
+/// The two published planners, through the `Planner` trait with the papers' settings.
+#[derive(Debug, Clone, Copy)]
+enum PlannerKind {
+    Bspline,
+    Spiral,
+}
+
+impl PlannerKind {
+    const ALL: [PlannerKind; 2] = [PlannerKind::Bspline, PlannerKind::Spiral];
+}
+
+/// Default settings of both (a stand-in for per-planner configuration).
+#[derive(Debug, Default)]
+struct PlannerConfig;
+
+fn plan(kind: PlannerKind, req: &PlanRequest, _: &PlannerConfig) -> Result<Plan, PlanError> {
+    match kind {
+        PlannerKind::Bspline => BsplinePlanner::default().plan(req),
+        PlannerKind::Spiral => SpiralPlanner::default().plan(req),
+    }
+}
 use proptest::prelude::*;
 
 fn check(kind: PlannerKind, req: &PlanRequest, endpoint_tol_m: f64) -> Result<(), TestCaseError> {
@@ -79,7 +101,7 @@ proptest! {
         req.start_curvature_per_m = k0;
         for kind in PlannerKind::ALL {
             let p = plan(kind, &req, &PlannerConfig::default());
-            prop_assert!(p.is_ok(), "{kind} failed on a typical pick: {:?}", p.err());
+            prop_assert!(p.is_ok(), "{kind:?} failed on a typical pick: {:?}", p.err());
         }
         check(PlannerKind::Bspline, &req, 1e-9)?;
         check(PlannerKind::Spiral, &req, 1e-3)?;
@@ -131,7 +153,7 @@ fn sharp_goal_names_the_curvature_limit() {
                 e,
                 PlanError::CurvatureLimit { .. } | PlanError::Unreachable { .. }
             ),
-            "{kind}: {text}"
+            "{kind:?}: {text}"
         );
         if let PlanError::CurvatureLimit { .. } = e {
             assert!(text.contains("κ_max 1.0630 m⁻¹"), "{text}");

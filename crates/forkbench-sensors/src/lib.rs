@@ -13,6 +13,50 @@ fn normal<R: Rng + ?Sized>(rng: &mut R, sigma: f64) -> f64 {
     sigma * z
 }
 
+/// A localisation sensor: pose fixes of the fork root as the controller receives them.
+pub trait Localizer: Send {
+    fn name(&self) -> &str;
+
+    /// Advances to time `t_s` with the true pose; returns the newest fix delivered by
+    /// then, if any. Draws only from `rng`.
+    fn update(&mut self, t_s: f64, truth: &Pose2, rng: &mut dyn Rng) -> Option<Pose2>;
+}
+
+/// A pallet-pose estimator (camera, laser): a noisy pallet face pose at a range.
+pub trait PalletEstimator: Send {
+    fn name(&self) -> &str;
+
+    /// One estimate of the pallet face pose seen from `range_m`. Draws only from `rng`.
+    fn estimate(&self, truth: &Pose2, range_m: f64, rng: &mut dyn Rng) -> Pose2;
+
+    /// Ranges (fork root to the estimated face) at which the trial asks for a new estimate.
+    fn reestimate_at_m(&self) -> Vec<f64>;
+}
+
+impl Localizer for Nav350 {
+    fn name(&self) -> &str {
+        "nav350"
+    }
+
+    fn update(&mut self, t_s: f64, truth: &Pose2, rng: &mut dyn Rng) -> Option<Pose2> {
+        Nav350::update(self, t_s, truth, rng)
+    }
+}
+
+impl PalletEstimator for PalletEstimateConfig {
+    fn name(&self) -> &str {
+        "range_scaled_gaussian"
+    }
+
+    fn estimate(&self, truth: &Pose2, range_m: f64, rng: &mut dyn Rng) -> Pose2 {
+        PalletEstimateConfig::estimate(self, truth, range_m, rng)
+    }
+
+    fn reestimate_at_m(&self) -> Vec<f64> {
+        self.reestimate_at_m.clone()
+    }
+}
+
 /// SICK NAV350: pose fixes at a fixed rate with zero-mean Gaussian noise and a latency.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

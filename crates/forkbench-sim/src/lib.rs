@@ -1,12 +1,12 @@
 //! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers, fixed racks.
 
-mod pallet;
 
 use forkbench_core::{ForkliftSpec, Pose2};
 use rapier2d::prelude::*;
 use serde::{Deserialize, Serialize};
 
-pub use pallet::PalletSpec;
+pub use forkbench_core::PalletSpec;
+pub use forkbench_core::geometry::Obstacle;
 
 /// Standard gravity, for tyre and floor normal loads (the plane itself has no gravity).
 const G_MPS2: f64 = 9.81;
@@ -42,13 +42,6 @@ impl Default for SimConfig {
     }
 }
 
-/// A fixed rectangle (rack upright, rack bay, wall) in the world frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Obstacle {
-    pub centre: Pose2,
-    pub length_m: f64,
-    pub width_m: f64,
-}
 
 /// Why a world could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -1,7 +1,24 @@
-//! Path tracking for a rear-steered forklift: pure pursuit on the fork root, a speed profile, odometry prediction.
+//! Path tracking for a rear-steered forklift: the `Tracker` trait, pure pursuit, regulated pure pursuit, odometry prediction.
 
 mod predictor;
 mod pursuit;
+mod regulated;
+mod tracker;
 
 pub use predictor::PosePredictor;
 pub use pursuit::{Command, PurePursuit, TrackerConfig};
+pub use regulated::{RegulatedConfig, RegulatedPurePursuit};
+pub use tracker::{Tracker, TrackerInput};
+
+use forkbench_core::settings::{self, Settings, SettingsError};
+
+impl PurePursuit {
+    /// From a scenario's `[tracker]` table: [`TrackerConfig`]'s fields.
+    pub fn from_settings(s: &Settings) -> Result<Self, SettingsError> {
+        let cfg: TrackerConfig = settings::parse(s)?;
+        if let Some((f, why)) = cfg.invalid_field() {
+            return Err(SettingsError::field(f, why));
+        }
+        Ok(Self::with_config(cfg))
+    }
+}

@@ -4,6 +4,8 @@ use forkbench_core::units::wrap_angle;
 use forkbench_core::{ForkliftSpec, Path, Pose2};
 use serde::{Deserialize, Serialize};
 
+use crate::{Tracker, TrackerInput};
+
 /// Tracker settings (SI units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -116,21 +118,39 @@ impl PurePursuit {
         &self.path
     }
 
+    /// A tracker with no path yet: [`Tracker::reset`] gives it one.
+    pub fn with_config(cfg: TrackerConfig) -> Self {
+        Self::new(Path::default(), cfg, 0.0)
+    }
+
+    /// Look-ahead distance at this speed.
+    fn lookahead_m(&self, speed_mps: f64) -> f64 {
+        match self.cfg.lookahead_gain_s {
+            Some(k) => (k * speed_mps.abs()).max(self.cfg.min_lookahead_m),
+            None => self.cfg.lookahead_m,
+        }
+    }
+
     /// Steering and speed for the (measured or predicted) fork-root pose.
     pub fn command(&mut self, root: &Pose2, speed_mps: f64, truck: &ForkliftSpec) -> Command {
+        let ld = self.lookahead_m(speed_mps);
+        let Some(g) = self.geometry(root, ld, truck) else {
+            return stopped(root);
+        };
+        let cruise = self.cfg.cruise_speed_mps.min(truck.max_speed_mps);
+        let mut speed = cruise;
+        if g.remaining_m < self.cfg.approach_distance_m {
+            speed = speed.min(self.cfg.approach_speed_mps);
+        }
+        g.command(stop_profile(speed, self.cfg.decel_mps2, g.remaining_m))
+    }
+
+    /// Where the path is, relative to the truck: closest sample, look-ahead point, the
+    /// pursuit arc. `None` without a path.
+    pub(crate) fn geometry(&mut self, root: &Pose2, ld: f64, truck: &ForkliftSpec) -> Option<Geometry> {
         let pose = &root.to_world(&Pose2::new(-self.root_ahead_m, 0.0, 0.0));
         let n = self.path.samples.len();
-        let Some(last) = self.path.samples.last().copied() else {
-            return Command {
-                speed_mps: 0.0,
-                steer_rad: 0.0,
-                lookahead_point: [pose.x_m, pose.y_m],
-                cross_track_m: 0.0,
-                remaining_m: 0.0,
-                path_curvature_per_m: 0.0,
-                done: true,
-            };
-        };
+        let last = self.path.samples.last().copied()?;
         // Closest sample, searched forward from the last progress over a bounded window.
         let d2 = |i: usize| {
             let p = &self.path.samples[i];
@@ -158,11 +178,6 @@ impl PurePursuit {
         } else {
             self.path.length_m() - near.s_m - along
         };
-
-        let ld = match self.cfg.lookahead_gain_s {
-            Some(k) => (k * speed_mps.abs()).max(self.cfg.min_lookahead_m),
-            None => self.cfg.lookahead_m,
-        };
         // Look-ahead point: first sample at least ld away; past the end, a point on the
         // goal heading's extension keeps the forks aligned with the pocket.
         let mut target = None;
@@ -187,35 +202,78 @@ impl PurePursuit {
         let vy = target[1] - pose.y_m;
         let dist = vx.hypot(vy).max(1e-6);
         let eta = wrap_angle(vy.atan2(vx) - pose.heading_rad);
-        let curvature = 2.0 * eta.sin() / dist;
+        let arc_curvature_per_m = 2.0 * eta.sin() / dist;
         let steer_rad = truck
-            .steer_for_curvature(curvature)
+            .steer_for_curvature(arc_curvature_per_m)
             .clamp(-truck.max_steer_rad, truck.max_steer_rad);
-
-        let done = remaining_m <= 0.002;
-        let cruise = self.cfg.cruise_speed_mps.min(truck.max_speed_mps);
-        let mut speed = cruise;
-        if remaining_m < self.cfg.approach_distance_m {
-            speed = speed.min(self.cfg.approach_speed_mps);
-        }
-        // Stop at the goal: v ≤ √(2 a d), with a small floor so the last millimetres close.
-        speed = speed.min(
-            (2.0 * self.cfg.decel_mps2 * remaining_m.max(0.0))
-                .sqrt()
-                .max(0.02),
-        );
-        if done {
-            speed = 0.0;
-        }
-        Command {
-            speed_mps: speed,
-            steer_rad,
-            lookahead_point: target,
+        Some(Geometry {
+            target,
             cross_track_m,
             remaining_m,
             path_curvature_per_m: near.curvature_per_m,
+            arc_curvature_per_m,
+            steer_rad,
+        })
+    }
+}
+
+/// The pursuit geometry at one tick, before a speed is chosen.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Geometry {
+    pub target: [f64; 2],
+    pub cross_track_m: f64,
+    pub remaining_m: f64,
+    pub path_curvature_per_m: f64,
+    /// Curvature of the arc through the look-ahead point.
+    pub arc_curvature_per_m: f64,
+    pub steer_rad: f64,
+}
+
+impl Geometry {
+    /// The command at `speed_mps` (zero once the goal is reached).
+    pub fn command(&self, speed_mps: f64) -> Command {
+        let done = self.remaining_m <= 0.002;
+        Command {
+            speed_mps: if done { 0.0 } else { speed_mps },
+            steer_rad: self.steer_rad,
+            lookahead_point: self.target,
+            cross_track_m: self.cross_track_m,
+            remaining_m: self.remaining_m,
+            path_curvature_per_m: self.path_curvature_per_m,
             done,
         }
+    }
+}
+
+/// Stop at the goal: v ≤ √(2 a d), with a small floor so the last millimetres close.
+pub(crate) fn stop_profile(speed_mps: f64, decel_mps2: f64, remaining_m: f64) -> f64 {
+    speed_mps.min((2.0 * decel_mps2 * remaining_m.max(0.0)).sqrt().max(0.02))
+}
+
+/// The command without a path: stand still, done.
+pub(crate) fn stopped(root: &Pose2) -> Command {
+    Command {
+        speed_mps: 0.0,
+        steer_rad: 0.0,
+        lookahead_point: [root.x_m, root.y_m],
+        cross_track_m: 0.0,
+        remaining_m: 0.0,
+        path_curvature_per_m: 0.0,
+        done: true,
+    }
+}
+
+impl Tracker for PurePursuit {
+    fn name(&self) -> &str {
+        "pure_pursuit"
+    }
+
+    fn reset(&mut self, path: &Path, truck: &ForkliftSpec) {
+        *self = Self::new(path.clone(), self.cfg.clone(), truck.fork_root_ahead_of_front_axle_m);
+    }
+
+    fn command(&mut self, state: &TrackerInput) -> Command {
+        PurePursuit::command(self, &state.pose, state.speed_mps, state.truck)
     }
 }
 

@@ -1,6 +1,7 @@
-//! One pick trial end to end: scenario and world files, noisy estimate → plan → pure pursuit in rapier2d → judged outcome.
+//! One pick trial end to end: scenario and world files, noisy estimate → plan → tracker in rapier2d → judged outcome, with components from a registry.
 
 pub mod batch;
+pub mod components;
 pub mod defaults;
 pub mod outcome;
 pub mod recorder;
@@ -10,8 +11,9 @@ pub mod trial;
 
 pub use outcome::{Failure, TrialOutcome};
 pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord, Tee};
+pub use components::{ComponentSpec, Registry, Role};
 pub use scenario::{Case, PoseDeg, Scenario, Tolerances, World};
-pub use trial::{TrialOptions, run_trial, run_trial_recorded};
+pub use trial::{Resolved, TrialOptions, run_trial, run_trial_recorded};
 
 /// A scenario or world file that cannot be used, with the file and field named.
 #[derive(Debug, thiserror::Error)]

@@ -51,6 +51,9 @@ pub struct TrialOutcome {
     pub scenario: String,
     pub case: String,
     pub planner: String,
+    /// Records written before trackers were pluggable have none: pure pursuit.
+    #[serde(default = "default_tracker")]
+    pub tracker: String,
     pub seed: u64,
     pub noise: bool,
     pub success: bool,
@@ -82,11 +85,18 @@ pub struct TrialOutcome {
 
 impl TrialOutcome {
     /// A not-yet-judged outcome: nothing measured (NaN where a value would be), no failure.
-    pub fn blank(scenario: &str, case: &str, planner: &str, seed: u64, noise: bool) -> Self {
+    pub fn blank(
+        scenario: &str,
+        case: &str,
+        (planner, tracker): (&str, &str),
+        seed: u64,
+        noise: bool,
+    ) -> Self {
         Self {
             scenario: scenario.to_owned(),
             case: case.to_owned(),
             planner: planner.to_owned(),
+            tracker: tracker.to_owned(),
             seed,
             noise,
             success: false,
@@ -108,6 +118,19 @@ impl TrialOutcome {
             wall_time_ms: 0.0,
         }
     }
+}
+
+impl TrialOutcome {
+    /// Marks the trial failed on `failure` with its detail.
+    pub fn fail(&mut self, failure: Failure, detail: String) {
+        self.success = false;
+        self.failure = Some(failure);
+        self.failure_detail = Some(detail);
+    }
+}
+
+fn default_tracker() -> String {
+    "pure_pursuit".to_owned()
 }
 
 /// NaN (a trial that never ran far enough to measure) is written as JSON null and read back.

@@ -4,13 +4,14 @@ use std::path::{Path as FsPath, PathBuf};
 
 use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_geom::{Footprint, Obstacles};
-use forkbench_plan::PlannerKind;
+use std::sync::Arc;
+
 use forkbench_sensors::{Nav350Config, PalletEstimateConfig};
 use forkbench_sim::{Obstacle, PalletSpec, SimConfig};
-use forkbench_track::TrackerConfig;
 use serde::{Deserialize, Serialize};
 
 use crate::TrialError;
+use crate::components::{ComponentSpec, Registry, Role};
 
 /// A pose as written in files: metres and degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -335,7 +336,8 @@ struct ScenarioFile {
     description: String,
     /// World file, relative to this scenario file; none is an open floor.
     world: Option<PathBuf>,
-    planner: PlannerKind,
+    /// `planner = "bspline"` or a `[planner]` table with `kind` and its settings.
+    planner: toml::Spanned<toml::Value>,
     #[serde(default)]
     seed: u64,
     #[serde(default = "default_pallet_kind")]
@@ -348,8 +350,8 @@ struct ScenarioFile {
     validate_paths: bool,
     #[serde(default)]
     truck: ForkliftSpec,
-    #[serde(default)]
-    tracker: TrackerConfig,
+    /// A `[tracker]` table: `kind` (default pure pursuit) and its settings.
+    tracker: Option<toml::Spanned<toml::Value>>,
     #[serde(default)]
     sim: SimConfig,
     #[serde(default)]
@@ -388,14 +390,17 @@ pub struct Scenario {
     pub file: String,
     pub name: String,
     pub description: String,
-    pub planner: PlannerKind,
+    pub planner: ComponentSpec,
+    pub tracker: ComponentSpec,
+    /// Builds the components this scenario names (and any a run asks for by name).
+    #[serde(skip)]
+    pub registry: Arc<Registry>,
     pub seed: u64,
     pub pallet: PalletSpec,
     pub timeout_s: f64,
     /// Plans whose swept truck body hits a rack or wall count as `plan_failed`.
     pub validate_paths: bool,
     pub truck: ForkliftSpec,
-    pub tracker: TrackerConfig,
     pub sim: SimConfig,
     pub noise: NoiseFile,
     pub replan: ReplanFile,
@@ -420,14 +425,61 @@ pub struct Case {
 
 impl Scenario {
     pub fn load(path: &FsPath) -> Result<Self, TrialError> {
-        let file = path.display().to_string();
-        let text = read(path)?;
-        let dir = path.parent().unwrap_or(FsPath::new("."));
-        Self::parse(&text, &file, |world| World::load(&dir.join(world)))
+        Self::load_with(path, Registry::shared())
     }
 
-    /// Parses scenario text; `load_world` resolves the `world` path.
+    /// Loads with a registry that may hold the caller's own components.
+    pub fn load_with(path: &FsPath, registry: Arc<Registry>) -> Result<Self, TrialError> {
+        let file = path.display().to_string();
+        let text = read(path)?;
+        let dir = forkbench_plan::external::dir_of(path);
+        let world_dir = dir.clone();
+        let parsed = Self::parse(&text, &file, |world| World::load(&world_dir.join(world)));
+        parsed.and_then(|s| s.with_components(&text, registry, dir))
+    }
+
+    /// Parses scenario text; `load_world` resolves the `world` path. Components are built
+    /// from the built-in registry, external commands run in the working directory.
     pub fn parse(
+        text: &str,
+        file: &str,
+        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
+    ) -> Result<Self, TrialError> {
+        let s = Self::parse_layout(text, file, load_world)?;
+        s.with_components(text, Registry::shared(), PathBuf::from("."))
+    }
+
+    /// Reads the `[planner]` and `[tracker]` tables against `registry`; errors name the
+    /// file, line and field.
+    fn with_components(
+        mut self,
+        text: &str,
+        registry: Arc<Registry>,
+        dir: PathBuf,
+    ) -> Result<Self, TrialError> {
+        let f: ScenarioFile = parse(text, &self.file)?;
+        let pure_pursuit = Some("pure_pursuit");
+        let planner = Some(&f.planner);
+        for (role, value, default_kind) in [
+            (Role::Planner, planner, None),
+            (Role::Tracker, f.tracker.as_ref(), pure_pursuit),
+        ] {
+            let spec = match value {
+                Some(v) => ComponentSpec::from_value(role, v.get_ref(), default_kind, dir.clone())
+                    .and_then(|spec| registry.check(&spec).map(|()| spec))
+                    .map_err(|e| component_error(&self.file, text, role, v.span(), &e))?,
+                None => ComponentSpec::of_kind(role, "pure_pursuit"),
+            };
+            match role {
+                Role::Planner => self.planner = spec,
+                Role::Tracker => self.tracker = spec,
+            }
+        }
+        self.registry = registry;
+        Ok(self)
+    }
+
+    fn parse_layout(
         text: &str,
         file: &str,
         load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
@@ -446,9 +498,6 @@ impl Scenario {
         f.truck
             .validate()
             .map_err(|e| invalid(file, &format!("truck.{}", e.field), e.reason))?;
-        if let Some((field, reason)) = f.tracker.invalid_field() {
-            return Err(invalid(file, &format!("tracker.{field}"), reason));
-        }
         if let Some((field, reason)) = f.noise.nav350.invalid_field() {
             return Err(invalid(file, &format!("noise.nav350.{field}"), reason));
         }
@@ -562,13 +611,14 @@ impl Scenario {
             file: file.to_owned(),
             name: f.name,
             description: f.description,
-            planner: f.planner,
+            planner: ComponentSpec::of_kind(Role::Planner, "bspline"),
+            tracker: ComponentSpec::of_kind(Role::Tracker, "pure_pursuit"),
+            registry: Registry::shared(),
             seed: f.seed,
             pallet,
             timeout_s: f.timeout_s,
             validate_paths: f.validate_paths,
             truck: f.truck,
-            tracker: f.tracker,
             sim: f.sim,
             noise: f.noise,
             replan: f.replan,
@@ -718,4 +768,36 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
         }
     }
     Ok(())
+}
+
+/// A component table's error at the line of the offending key (or of the table).
+fn component_error(
+    file: &str,
+    text: &str,
+    role: Role,
+    span: std::ops::Range<usize>,
+    e: &forkbench_core::SettingsError,
+) -> TrialError {
+    let region = text.get(span.clone()).unwrap_or("");
+    let key_at = e.field.as_deref().and_then(|k| {
+        let mut at = 0;
+        region.split_inclusive('\n').find_map(|l| {
+            let here = at;
+            at += l.len();
+            let t = l.trim_start();
+            let key = t.split(['=', ' ', '\t']).next().unwrap_or("");
+            (key == k || key.trim_matches('"') == k).then_some(here)
+        })
+    });
+    let offset = span.start + key_at.unwrap_or(0);
+    let line = text[..offset.min(text.len())].matches('\n').count() + 1;
+    let field = match &e.field {
+        Some(f) => format!("{role}.{f}"),
+        None => role.to_string(),
+    };
+    TrialError::Invalid {
+        file: format!("{file}:{line}"),
+        field,
+        reason: e.reason.clone(),
+    }
 }

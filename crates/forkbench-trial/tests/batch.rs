@@ -2,7 +2,6 @@
 
 use std::path::{Path, PathBuf};
 
-use forkbench_plan::PlannerKind;
 use forkbench_trial::batch::{self, Baseline, BatchSpec, TrialRecord};
 use forkbench_trial::{Failure, Scenario};
 
@@ -21,6 +20,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, seed: u64) -> BatchSpec {
     BatchSpec {
         scenarios,
         planners: vec![],
+        trackers: vec![],
         trials,
         seed,
         shard: (0, 1),
@@ -102,7 +102,7 @@ fn a_crashed_batch_resumes_without_losing_or_repeating_trials() {
 #[test]
 fn a_panicking_trial_becomes_an_error_outcome() {
     let s = scenario("field-test.toml");
-    let out = batch::guarded(&s, "default", PlannerKind::Bspline, 99, || {
+    let out = batch::guarded(&s, "default", ("bspline", "pure_pursuit"), 99, || {
         panic!("solver exploded")
     });
     assert_eq!(out.failure, Some(Failure::Error));

@@ -11,7 +11,7 @@ use forkbench_core::{Path, PathSample, Pose2};
 use serde::{Deserialize, Serialize};
 
 use crate::numeric::sin_cos;
-use crate::{Plan, PlanError, PlanParams, PlanRequest, PlannerKind};
+use crate::{Plan, PlanError, PlanParams, PlanRequest};
 use search::LengthSearch;
 
 /// Settings of the spiral planner.
@@ -78,16 +78,17 @@ pub struct SpiralPlan {
 impl SpiralPlan {
     pub fn into_plan(self) -> Plan {
         Plan {
-            planner: PlannerKind::Spiral,
+            planner: "spiral".into(),
             params: PlanParams::Spiral(self.params),
             cost: self.cost,
             path: self.path,
+            control_polygon_m: None,
         }
     }
 }
 
 impl SpiralConfig {
-    fn validate(&self) -> Result<(), PlanError> {
+    pub(crate) fn validate(&self) -> Result<(), PlanError> {
         if self.length_grid_points < 3 {
             return Err(PlanError::InvalidInput {
                 what: "spiral.length_grid_points",
@@ -124,10 +125,10 @@ pub fn plan(req: &PlanRequest, cfg: &SpiralConfig) -> Result<SpiralPlan, PlanErr
     let mut search = LengthSearch::new(&prob, (lo, hi), m);
     let (sf, [bb, cc], cost, max_k) = search.run().map_err(|least_k| {
         if least_k.is_finite() {
-            PlanError::curvature(PlannerKind::Spiral, least_k / prob.scale_m, &req.truck)
+            PlanError::curvature("spiral", least_k / prob.scale_m, &req.truck)
         } else {
             PlanError::Unreachable {
-                planner: PlannerKind::Spiral,
+                planner: "spiral".into(),
                 reason: format!(
                     "no quartic spiral of normalised length {lo:.3}–{hi:.3} reaches the goal"
                 ),

@@ -20,6 +20,9 @@ pub struct Baseline {
 pub struct BaselineRow {
     pub scenario: String,
     pub planner: String,
+    /// Baselines made before trackers were pluggable have none: pure pursuit.
+    #[serde(default = "super::summary::pure_pursuit")]
+    pub tracker: String,
     pub trials: u64,
     pub successes: u64,
 }
@@ -34,6 +37,7 @@ impl Baseline {
                 .map(|r| BaselineRow {
                     scenario: r.scenario.clone(),
                     planner: r.planner.clone(),
+                    tracker: r.tracker.clone(),
                     trials: r.trials,
                     successes: r.successes,
                 })
@@ -57,13 +61,15 @@ impl Baseline {
         for (i, r) in b.rows.iter().enumerate() {
             if let Some(j) = b.rows[..i]
                 .iter()
-                .position(|o| o.scenario == r.scenario && o.planner == r.planner)
+                .position(|o| o.key() == r.key())
             {
                 return Err(BatchError::Invalid(format!(
-                    "{}: rows[{i}] repeats rows[{j}] ({} / {}); each scenario × planner once",
+                    "{}: rows[{i}] repeats rows[{j}] ({} / {} / {}); each scenario × planner × \
+                     tracker once",
                     path.display(),
                     r.scenario,
-                    r.planner
+                    r.planner,
+                    r.tracker
                 )));
             }
             if r.trials == 0 || r.successes > r.trials {
@@ -81,11 +87,18 @@ impl Baseline {
     }
 }
 
+impl BaselineRow {
+    fn key(&self) -> (&str, &str, &str) {
+        (&self.scenario, &self.planner, &self.tracker)
+    }
+}
+
 /// One compared row.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RegressRow {
     pub scenario: String,
     pub planner: String,
+    pub tracker: String,
     pub baseline_rate: f64,
     pub now_rate: Option<f64>,
     pub now_trials: u64,
@@ -110,7 +123,7 @@ pub fn regress(
             let r = now
                 .rows
                 .iter()
-                .find(|r| r.scenario == b.scenario && r.planner == b.planner);
+                .find(|r| (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str()) == b.key());
             let base_rate = b.successes as f64 / b.trials as f64;
             let (now_rate, n, p, verdict) = match r {
                 None => (None, 0, None, "missing"),
@@ -130,6 +143,7 @@ pub fn regress(
             RegressRow {
                 scenario: b.scenario.clone(),
                 planner: b.planner.clone(),
+                tracker: b.tracker.clone(),
                 baseline_rate: base_rate,
                 now_rate,
                 now_trials: n,
@@ -144,7 +158,7 @@ pub fn regress(
 /// The regression report as markdown.
 pub fn regress_markdown(rows: &[RegressRow], alpha: f64) -> String {
     let mut s = String::from(
-        "| scenario | planner | baseline | now | difference | p (one-sided drop) | verdict |\n|---|---|---|---|---|---|---|\n",
+        "| scenario | planner | tracker | baseline | now | difference | p (one-sided drop) | verdict |\n|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let now = r.now_rate.map_or("–".to_owned(), |v| {
@@ -155,9 +169,10 @@ pub fn regress_markdown(rows: &[RegressRow], alpha: f64) -> String {
         });
         let p = r.p_value.map_or("–".to_owned(), |p| format!("{p:.4}"));
         s.push_str(&format!(
-            "| {} | {} | {:.1} % | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {:.1} % | {} | {} | {} | {} |\n",
             r.scenario,
             r.planner,
+            r.tracker,
             100.0 * r.baseline_rate,
             now,
             diff,

@@ -20,6 +20,9 @@ pub struct Manifest {
     pub shard: [u64; 2],
     /// Planners every case ran with; empty = each scenario's own.
     pub planners: Vec<String>,
+    /// Trackers every case ran with; empty = each scenario's own.
+    #[serde(default)]
+    pub trackers: Vec<String>,
     pub pallet_noise_scale: Option<f64>,
     pub replan: Option<bool>,
     pub scenarios: Vec<ScenarioEntry>,
@@ -65,7 +68,8 @@ impl Manifest {
             seed: spec.seed,
             trials: spec.trials,
             shard: [spec.shard.0, spec.shard.1],
-            planners: spec.planners.iter().map(|p| p.name().to_owned()).collect(),
+            planners: spec.planners.clone(),
+            trackers: spec.trackers.clone(),
             pallet_noise_scale: spec.pallet_noise_scale,
             replan: spec.replan,
             scenarios,

@@ -1,4 +1,4 @@
-//! Monte-Carlo batches: scenario × case × planner × trial, in parallel, streamed to JSON lines, summarised, compared.
+//! Monte-Carlo batches: scenario × case × planner × tracker × trial, in parallel, streamed to JSON lines, summarised, compared.
 
 use std::collections::HashSet;
 use std::fs::OpenOptions;
@@ -6,7 +6,6 @@ use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use std::sync::Mutex;
 
-use forkbench_plan::PlannerKind;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -34,9 +33,11 @@ pub const MAX_JOBS: usize = 256;
 #[derive(Debug, Clone)]
 pub struct BatchSpec {
     pub scenarios: Vec<Scenario>,
-    /// Planners to run every case with; empty = each scenario's own planner.
-    pub planners: Vec<PlannerKind>,
-    /// Trials per scenario × case × planner.
+    /// Planners to run every case with, by name; empty = each scenario's own planner.
+    pub planners: Vec<String>,
+    /// Trackers to run every case with, by name; empty = each scenario's own tracker.
+    pub trackers: Vec<String>,
+    /// Trials per scenario × case × planner × tracker.
     pub trials: u64,
     pub seed: u64,
     /// This shard's index and the shard count (0/1 = everything).
@@ -89,7 +90,8 @@ impl TrialRecord {
     pub fn options(&self) -> TrialOptions {
         TrialOptions {
             seed: Some(self.outcome.seed),
-            planner: self.outcome.planner.parse().ok(),
+            planner: Some(self.outcome.planner.clone()),
+            tracker: Some(self.outcome.tracker.clone()),
             no_noise: !self.outcome.noise,
             pallet_noise_scale: self.pallet_noise_scale,
             replan: self.replan,
@@ -97,19 +99,24 @@ impl TrialRecord {
     }
 }
 
+/// Identity of one trial in a batch: scenario, case, planner, tracker, trial index.
+pub type TrialKey = (String, String, String, String, u64);
+
 impl TrialRecord {
-    pub fn key(&self) -> (String, String, String, u64) {
+    pub fn key(&self) -> TrialKey {
         (
             self.outcome.scenario.clone(),
             self.outcome.case.clone(),
             self.outcome.planner.clone(),
+            self.outcome.tracker.clone(),
             self.trial,
         )
     }
 }
 
 /// Seed of one trial from its identity alone, so results do not depend on `--jobs`,
-/// sharding or order (FNV-1a over the key, finished with SplitMix64).
+/// sharding or order (FNV-1a over the key, finished with SplitMix64). The tracker is not
+/// part of it: trackers compared in one batch see the same noise draws.
 pub fn trial_seed(batch_seed: u64, scenario: &str, case: &str, planner: &str, trial: u64) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut eat = |bytes: &[u8]| {
@@ -136,7 +143,8 @@ pub fn trial_seed(batch_seed: u64, scenario: &str, case: &str, planner: &str, tr
 pub struct Job {
     pub scenario: usize,
     pub case: usize,
-    pub planner: PlannerKind,
+    pub planner: String,
+    pub tracker: String,
     pub trial: u64,
 }
 
@@ -146,19 +154,16 @@ impl BatchSpec {
         let mut out = Vec::new();
         let mut k: u64 = 0;
         for (si, s) in self.scenarios.iter().enumerate() {
-            let planners = if self.planners.is_empty() {
-                vec![s.planner]
-            } else {
-                self.planners.clone()
-            };
+            let (planners, trackers) = self.components_of(s);
             for ci in 0..s.cases.len() {
-                for &p in &planners {
+                for (p, tr) in planners.iter().flat_map(|p| trackers.iter().map(move |t| (p, t))) {
                     for t in 0..self.trials {
                         if k % self.shard.1 == self.shard.0 {
                             out.push(Job {
                                 scenario: si,
                                 case: ci,
-                                planner: p,
+                                planner: p.clone(),
+                                tracker: tr.clone(),
                                 trial: t,
                             });
                         }
@@ -170,12 +175,28 @@ impl BatchSpec {
         out
     }
 
-    fn key(&self, j: &Job) -> (String, String, String, u64) {
+    /// The planner and tracker names a scenario runs with in this batch.
+    fn components_of(&self, s: &Scenario) -> (Vec<String>, Vec<String>) {
+        let or_own = |list: &Vec<String>, own: &str| {
+            if list.is_empty() {
+                vec![own.to_owned()]
+            } else {
+                list.clone()
+            }
+        };
+        (
+            or_own(&self.planners, &s.planner.name),
+            or_own(&self.trackers, &s.tracker.name),
+        )
+    }
+
+    fn key(&self, j: &Job) -> TrialKey {
         let s = &self.scenarios[j.scenario];
         (
             s.name.clone(),
             s.cases[j.case].name.clone(),
-            j.planner.name().to_owned(),
+            j.planner.clone(),
+            j.tracker.clone(),
             j.trial,
         )
     }
@@ -184,15 +205,17 @@ impl BatchSpec {
     pub fn run_job(&self, j: &Job) -> TrialRecord {
         let s = &self.scenarios[j.scenario];
         let case = &s.cases[j.case];
-        let seed = trial_seed(self.seed, &s.name, &case.name, j.planner.name(), j.trial);
+        let seed = trial_seed(self.seed, &s.name, &case.name, &j.planner, j.trial);
         let opts = TrialOptions {
             seed: Some(seed),
-            planner: Some(j.planner),
+            planner: Some(j.planner.clone()),
+            tracker: Some(j.tracker.clone()),
             no_noise: false,
             pallet_noise_scale: self.pallet_noise_scale,
             replan: self.replan,
         };
-        let outcome = guarded(s, &case.name, j.planner, seed, || run_trial(s, case, &opts));
+        let names = (j.planner.as_str(), j.tracker.as_str());
+        let outcome = guarded(s, &case.name, names, seed, || run_trial(s, case, &opts));
         TrialRecord {
             trial: j.trial,
             pallet_noise_scale: self.pallet_noise_scale,
@@ -206,7 +229,7 @@ impl BatchSpec {
 pub fn guarded(
     s: &Scenario,
     case: &str,
-    planner: PlannerKind,
+    names: (&str, &str),
     seed: u64,
     f: impl FnOnce() -> TrialOutcome,
 ) -> TrialOutcome {
@@ -219,7 +242,7 @@ pub fn guarded(
         error_outcome(
             s,
             case,
-            planner,
+            names,
             seed,
             format!("trial panicked (seed {seed}): {message}"),
         )
@@ -229,13 +252,12 @@ pub fn guarded(
 fn error_outcome(
     s: &Scenario,
     case: &str,
-    planner: PlannerKind,
+    names: (&str, &str),
     seed: u64,
     detail: String,
 ) -> TrialOutcome {
-    let mut out = TrialOutcome::blank(&s.name, case, planner.name(), seed, s.noise.enabled);
-    out.failure = Some(Failure::Error);
-    out.failure_detail = Some(detail);
+    let mut out = TrialOutcome::blank(&s.name, case, names, seed, s.noise.enabled);
+    out.fail(Failure::Error, detail);
     out
 }
 
@@ -256,7 +278,24 @@ impl BatchSpec {
                 "--jobs {jobs}: at most {MAX_JOBS} worker threads"
             )));
         }
-        self.check_names()
+        self.check_names()?;
+        self.check_components()
+    }
+
+    /// Every planner and tracker name must resolve in every scenario, before any trial runs.
+    fn check_components(&self) -> Result<(), BatchError> {
+        for s in &self.scenarios {
+            let (planners, trackers) = self.components_of(s);
+            for p in &planners {
+                s.component(crate::Role::Planner, Some(p))
+                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
+            }
+            for t in &trackers {
+                s.component(crate::Role::Tracker, Some(t))
+                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
+            }
+        }
+        Ok(())
     }
 
     /// Scenario names key rows and seeds: two scenarios may not share one.

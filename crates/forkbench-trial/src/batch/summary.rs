@@ -1,4 +1,4 @@
-//! Batch summaries: success rates with Wilson intervals, failure counts and entry errors per scenario × planner.
+//! Batch summaries: success rates with Wilson intervals, failure counts and entry errors per scenario × planner × tracker.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -9,11 +9,14 @@ use super::{BatchError, TrialRecord, io};
 use crate::outcome::Failure;
 use crate::stats::{Z95, percentile_sorted, wilson};
 
-/// Success statistics of one scenario × planner.
+/// Success statistics of one scenario × planner × tracker.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SummaryRow {
     pub scenario: String,
     pub planner: String,
+    /// Summaries written before trackers were pluggable have none: pure pursuit.
+    #[serde(default = "pure_pursuit")]
+    pub tracker: String,
     pub trials: u64,
     pub successes: u64,
     pub success_rate: f64,
@@ -50,11 +53,11 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
         head: Vec<f64>,
         wall: Vec<f64>,
     }
-    let mut groups: BTreeMap<(String, String), Acc> = BTreeMap::new();
+    let mut groups: BTreeMap<(String, String, String), Acc> = BTreeMap::new();
     for r in records {
         let o = &r.outcome;
         let a = groups
-            .entry((o.scenario.clone(), o.planner.clone()))
+            .entry((o.scenario.clone(), o.planner.clone(), o.tracker.clone()))
             .or_default();
         a.n += 1;
         if o.success {
@@ -74,7 +77,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     let rows: Vec<SummaryRow> = groups
         .into_iter()
-        .map(|((scenario, planner), mut a)| {
+        .map(|((scenario, planner, tracker), mut a)| {
             a.lat.sort_by(f64::total_cmp);
             a.head.sort_by(f64::total_cmp);
             a.wall.sort_by(f64::total_cmp);
@@ -82,6 +85,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
             SummaryRow {
                 scenario,
                 planner,
+                tracker,
                 trials: a.n,
                 successes: a.k,
                 success_rate: a.k as f64 / a.n as f64,
@@ -107,7 +111,7 @@ impl Summary {
     /// The success table as markdown.
     pub fn markdown(&self) -> String {
         let mut s = String::from(
-            "| scenario | planner | trials | successes | success rate | 95 % CI (Wilson) | failures | lateral mean / p95 (mm) | heading mean / p95 (°) | trial CPU (s) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+            "| scenario | planner | tracker | trials | successes | success rate | 95 % CI (Wilson) | failures | lateral mean / p95 (mm) | heading mean / p95 (°) | trial CPU (s) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         let mm = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.1}", v * 1e3));
         let deg = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.2}", v.to_degrees()));
@@ -122,9 +126,10 @@ impl Summary {
                     .join(", ")
             };
             s.push_str(&format!(
-                "| {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % | {} | {} / {} | {} / {} | {:.2} |\n",
+                "| {} | {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % | {} | {} / {} | {} / {} | {:.2} |\n",
                 r.scenario,
                 r.planner,
+                r.tracker,
                 r.trials,
                 r.successes,
                 100.0 * r.success_rate,
@@ -146,6 +151,10 @@ impl Summary {
         ));
         s
     }
+}
+
+pub(super) fn pure_pursuit() -> String {
+    "pure_pursuit".to_owned()
 }
 
 pub(super) fn write_summary(dir: &Path, s: &Summary) -> Result<(), BatchError> {

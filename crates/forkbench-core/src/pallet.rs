@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::Pose2;
+
 /// A two-pocket pallet seen from above at fork height: three stringers along its depth.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -50,6 +52,12 @@ impl PalletSpec {
     pub fn pocket_offsets_m(&self) -> [f64; 2] {
         let o = self.stringer_width_m() / 2.0 + self.pocket_width_m / 2.0;
         [o, -o]
+    }
+
+    /// Centre poses of the three stringers for a pallet whose face centre is at `face`.
+    pub fn stringer_centres(&self, face: &Pose2) -> [Pose2; 3] {
+        self.stringer_offsets_m()
+            .map(|y| face.to_world(&Pose2::new(self.depth_m / 2.0, y, 0.0)))
     }
 
     pub fn validate(&self) -> Result<(), String> {

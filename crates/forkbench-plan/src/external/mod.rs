@@ -1,0 +1,139 @@
+//! Planners in any language: a child process speaking newline-delimited JSON (docs/external-planner.md).
+
+mod check;
+mod process;
+pub mod protocol;
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use forkbench_core::settings::{self, Settings, SettingsError};
+use serde::Deserialize;
+
+pub use check::{ENDPOINT_TOLERANCE_M, ENDPOINT_TOLERANCE_RAD, MAX_SPACING_M, path_violation};
+pub use process::dir_of;
+use process::{Process, clip};
+use protocol::{RequestMsg, ResponseMsg, to_path};
+
+use crate::{Plan, PlanError, PlanParams, PlanRequest, Planner};
+
+/// Longest answer time a scenario may allow a planner.
+pub const MAX_TIMEOUT_S: f64 = 600.0;
+
+/// Settings of `[planner] kind = "external"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExternalConfig {
+    /// Program and arguments, run in the directory of the file that names them.
+    pub command: Vec<String>,
+    /// Longest wait for the hello and for each plan; past it the process is stopped and
+    /// the trial's plan fails.
+    #[serde(default = "default_timeout")]
+    pub timeout_s: f64,
+}
+
+fn default_timeout() -> f64 {
+    10.0
+}
+
+/// A planner process per worker thread, started on first use and restarted after it
+/// misbehaves. Keyed by command and directory.
+type Pool = HashMap<(Vec<String>, PathBuf), (Process, u64)>;
+
+thread_local! {
+    static POOL: RefCell<Pool> = RefCell::new(HashMap::new());
+}
+
+/// An external planner, as configured; the process lives in this thread's pool.
+#[derive(Debug, Clone)]
+pub struct ExternalPlanner {
+    cfg: ExternalConfig,
+    dir: PathBuf,
+}
+
+impl ExternalPlanner {
+    /// From a `[planner]` table; `dir` is where the command runs.
+    pub fn from_settings(s: &Settings, dir: PathBuf) -> Result<Self, SettingsError> {
+        let cfg: ExternalConfig = settings::parse(s)?;
+        if cfg.command.is_empty() || cfg.command[0].trim().is_empty() {
+            return Err(SettingsError::field(
+                "command",
+                "must name a program: [\"python3\", \"planner.py\"]",
+            ));
+        }
+        if !(cfg.timeout_s.is_finite() && cfg.timeout_s > 0.0 && cfg.timeout_s <= MAX_TIMEOUT_S) {
+            return Err(SettingsError::field(
+                "timeout_s",
+                format!("must lie in (0, {MAX_TIMEOUT_S}] s"),
+            ));
+        }
+        Ok(Self { cfg, dir })
+    }
+
+    fn timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.cfg.timeout_s)
+    }
+
+    /// One request on a (possibly new) process; the process goes back to the pool only
+    /// when the exchange kept to the protocol.
+    fn request(&self, req: &PlanRequest) -> Result<ResponseMsg, String> {
+        let key = (self.cfg.command.clone(), self.dir.clone());
+        let taken = POOL.with(|p| p.borrow_mut().remove(&key));
+        let (mut proc, id) = match taken {
+            Some(p) => p,
+            None => (Process::start(&self.cfg.command, &self.dir, self.timeout())?, 0),
+        };
+        let line = serde_json::to_string(&RequestMsg::new(id, req)).map_err(|e| e.to_string())?;
+        let answer = proc.exchange(&line, self.timeout())?;
+        let msg: ResponseMsg = serde_json::from_str(&answer)
+            .map_err(|e| format!("invalid JSON in the answer ({e}): {:?}", clip(&answer)))?;
+        let got = match &msg {
+            ResponseMsg::Path { id, .. } | ResponseMsg::Error { id, .. } => *id,
+        };
+        if got != id {
+            return Err(format!("answered request {got}, expected {id}"));
+        }
+        POOL.with(|p| p.borrow_mut().insert(key, (proc, id + 1)));
+        Ok(msg)
+    }
+}
+
+impl Planner for ExternalPlanner {
+    fn name(&self) -> &str {
+        "external"
+    }
+
+    fn plan(&mut self, req: &PlanRequest) -> Result<Plan, PlanError> {
+        let name = self.name().to_owned();
+        let rejected = |reason: String| PlanError::Rejected {
+            planner: name.clone(),
+            reason,
+        };
+        match self.request(req).map_err(rejected)? {
+            ResponseMsg::Error { message, .. } => Err(PlanError::Unreachable {
+                planner: name,
+                reason: clip(&message),
+            }),
+            ResponseMsg::Path {
+                samples,
+                cost,
+                info,
+                ..
+            } => {
+                let path = to_path(&samples);
+                if let Some(why) = path_violation(&path, req) {
+                    return Err(rejected(why));
+                }
+                Ok(Plan {
+                    planner: name,
+                    params: PlanParams::Other(info.unwrap_or(serde_json::Value::Null)),
+                    cost: cost.unwrap_or(f64::NAN),
+                    path,
+                    control_polygon_m: None,
+                })
+            }
+        }
+    }
+}

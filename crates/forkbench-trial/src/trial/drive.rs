@@ -1,0 +1,158 @@
+//! Drive stage: each control tick (fix, replan check, tracker command, physics step, record) until stopped or timed out.
+
+use forkbench_core::Pose2;
+use forkbench_core::units::wrap_angle;
+use forkbench_track::{Command, TrackerInput};
+
+use super::judge::{in_pallet_frame, insertion_depth};
+use super::setup::Trial;
+use crate::recorder::{Level, Recorder, StepRecord};
+
+impl Trial<'_> {
+    /// Drives until the tracker reports the goal reached and the truck stands, or the
+    /// scenario's time limit. Err: the state went non-finite.
+    pub(super) fn drive<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), String> {
+        // Re-estimate ranges still ahead of the truck, nearest last.
+        let start_range = self.first_fix.distance_to(&self.pallet_est);
+        let mut reestimates: Vec<f64> = self
+            .estimator
+            .reestimate_at_m()
+            .into_iter()
+            .filter(|r| *r < start_range)
+            .collect();
+        reestimates.sort_by(|a, b| b.total_cmp(a));
+        while self.sim.time_s() < self.scn.timeout_s {
+            let truth = self.sim.fork_root_pose();
+            let fix = self.localizer.update(self.sim.time_s(), &truth, &mut self.nav_rng);
+            if let Some(fix) = fix {
+                self.predictor.fix(fix);
+            }
+            let pose = self.predictor.pose().unwrap_or(self.first_fix);
+            if !(pose.is_finite() && truth.is_finite()) {
+                return Err(format!("non-finite state at t = {:.3} s", self.sim.time_s()));
+            }
+            if self.run.replan
+                && reestimates
+                    .first()
+                    .is_some_and(|r| pose.distance_to(&self.pallet_est) <= *r)
+            {
+                reestimates.remove(0);
+                self.reestimate(&pose, rec);
+            }
+            let cmd = self.tracker.command(&TrackerInput {
+                t_s: self.sim.time_s(),
+                pose,
+                speed_mps: self.sim.speed_mps(),
+                steer_rad: self.sim.steer_rad(),
+                truck: &self.scn.truck,
+            });
+            if cmd.done && self.sim.speed_mps().abs() < 0.01 {
+                self.timed_out = false;
+                break;
+            }
+            self.step(&cmd, fix, pose, rec);
+        }
+        Ok(())
+    }
+
+    /// One physics step under `cmd`, its record, and the entry check.
+    fn step<R: Recorder + ?Sized>(&mut self, cmd: &Command, fix: Option<Pose2>, pose: Pose2, rec: &mut R) {
+        let truck = &self.scn.truck;
+        self.sim.step(cmd.speed_mps, cmd.steer_rad);
+        self.predictor.propagate(
+            self.sim.speed_mps(),
+            self.sim.steer_rad(),
+            truck.wheelbase_m,
+            truck.fork_root_ahead_of_front_axle_m,
+            self.sim.dt_s(),
+        );
+        self.out.max_steer_rad = self.out.max_steer_rad.max(self.sim.steer_rad().abs());
+        if self.sim.obstacle_contact() && !self.collision {
+            rec.event(self.sim.time_s(), Level::Error, "truck touched a rack or wall");
+        }
+        self.collision |= self.sim.obstacle_contact();
+        rec.step(&StepRecord {
+            t_s: self.sim.time_s(),
+            truth: self.sim.fork_root_pose(),
+            fix,
+            estimate: pose,
+            pallet: self.sim.pallet_pose(),
+            pallet_estimate: self.pallet_est,
+            steer_cmd_rad: cmd.steer_rad,
+            steer_rad: self.sim.steer_rad(),
+            speed_cmd_mps: cmd.speed_mps,
+            speed_mps: self.sim.speed_mps(),
+            lookahead: cmd.lookahead_point,
+            cross_track_m: cmd.cross_track_m,
+            path_curvature_per_m: cmd.path_curvature_per_m,
+            contact_force_n: self.sim.fork_contact_force_n(),
+        });
+        self.check_entry(rec);
+    }
+
+    /// Contact force before full depth, and the entry errors once the tips cross the face
+    /// plane within the face (not beside the pallet).
+    fn check_entry<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
+        let root = self.sim.fork_root_pose();
+        let pallet_now = self.sim.pallet_pose();
+        let depth = insertion_depth(&pallet_now, &root, &self.scn.truck);
+        if depth < self.insertion_m - 0.01 {
+            self.out.max_contact_force_n = self.out.max_contact_force_n.max(self.sim.fork_contact_force_n());
+        }
+        let local = in_pallet_frame(&pallet_now, &root);
+        if self.out.lateral_error_m.is_none() && depth >= 0.0 && local.y_m.abs() < self.scn.pallet.width_m / 2.0 {
+            self.out.lateral_error_m = Some(local.y_m);
+            self.out.heading_error_rad = Some(local.heading_rad);
+            rec.event(
+                self.sim.time_s(),
+                Level::Info,
+                &format!(
+                    "fork entry: {:.4} m lateral, {:.4} rad heading",
+                    local.y_m, local.heading_rad
+                ),
+            );
+        }
+    }
+
+    /// A new pallet estimate at a re-estimate range; replans when it moved past the
+    /// thresholds. A refused replan keeps the old plan: the truck cannot turn onto the new goal.
+    fn reestimate<R: Recorder + ?Sized>(&mut self, pose: &Pose2, rec: &mut R) {
+        let range = pose.distance_to(&self.pallet_est);
+        let truth = self.sim.pallet_pose();
+        let new_est = self.estimate(&truth, range);
+        let moved = new_est.distance_to(&self.pallet_est);
+        let turned = wrap_angle(new_est.heading_rad - self.pallet_est.heading_rad).abs();
+        let limits = &self.scn.replan;
+        if moved <= limits.position_threshold_m && turned <= limits.heading_threshold_deg.to_radians() {
+            return;
+        }
+        let t = self.sim.time_s();
+        let k0 = self.sim.steer_rad().tan() / self.scn.truck.wheelbase_m;
+        let replan = self
+            .plan_from(*pose, k0, &new_est)
+            .and_then(|p| match self.clash(&p.path) {
+                Some(why) => Err(why),
+                None => Ok(p),
+            });
+        match replan {
+            Ok(p) => {
+                rec.plan(t, self.out.replans + 1, &p.path, p.control_polygon_m.as_deref());
+                rec.event(
+                    t,
+                    Level::Info,
+                    &format!(
+                        "replan at {range:.2} m: estimate moved {moved:.3} m, {:.2}°",
+                        turned.to_degrees()
+                    ),
+                );
+                self.tracker.reset(&p.path, &self.scn.truck);
+                self.pallet_est = new_est;
+                self.out.replans += 1;
+            }
+            Err(e) => {
+                rec.event(t, Level::Warn, &format!("replan refused, keeping the old plan: {e}"));
+                self.out.replans_failed += 1;
+            }
+        }
+    }
+}

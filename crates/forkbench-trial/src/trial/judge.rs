@@ -1,0 +1,168 @@
+//! Judge stage: final errors, pallet displacement, and the first failed criterion in check order.
+
+use forkbench_core::units::wrap_angle;
+use forkbench_core::{ForkliftSpec, Pose2};
+use rand_chacha::ChaCha8Rng;
+
+use super::setup::Trial;
+use crate::outcome::{Failure, TrialOutcome};
+
+/// The pallet pose moved by a draw of N(0, σ) per axis in its own frame, truncated at 3σ.
+pub(super) fn jitter(pallet: &Pose2, sigma: &Pose2, rng: &mut ChaCha8Rng) -> Pose2 {
+    if sigma.x_m == 0.0 && sigma.y_m == 0.0 && sigma.heading_rad == 0.0 {
+        return *pallet;
+    }
+    let mut draw = |s: f64| {
+        let z: f64 = rand::RngExt::sample(rng, rand_distr::StandardNormal);
+        s * z.clamp(-3.0, 3.0)
+    };
+    let d = Pose2::new(draw(sigma.x_m), draw(sigma.y_m), draw(sigma.heading_rad));
+    pallet.to_world(&d)
+}
+
+/// Fork-root pose in the pallet frame: x < 0 before the face, y the lateral offset.
+pub(super) fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
+    pallet.to_local(root)
+}
+
+/// Depth of the shallower fork tip past the pallet face, at most the fork length. A fork
+/// root that is itself past the face plane (a truck that drove past or away behind the
+/// pallet) inserted nothing: 0.
+pub(super) fn insertion_depth(pallet: &Pose2, root: &Pose2, truck: &ForkliftSpec) -> f64 {
+    if pallet.to_local(root).x_m > 0.0 {
+        return 0.0;
+    }
+    let depth = truck
+        .fork_points(root, truck.fork_length_m)
+        .iter()
+        .map(|tip| pallet.to_local(tip).x_m)
+        .fold(f64::INFINITY, f64::min);
+    depth.min(truck.fork_length_m)
+}
+
+impl Trial<'_> {
+    /// Final measurements and the verdict.
+    pub(super) fn judge(mut self) -> TrialOutcome {
+        let truck = &self.scn.truck;
+        let out = &mut self.out;
+        out.sim_time_s = self.sim.time_s();
+        let root = self.sim.fork_root_pose();
+        let pallet_now = self.sim.pallet_pose();
+        let local = in_pallet_frame(&pallet_now, &root);
+        out.final_lateral_error_m = local.y_m;
+        out.final_heading_error_rad = local.heading_rad;
+        out.insertion_depth_m = insertion_depth(&pallet_now, &root, truck);
+        out.pallet_displacement_m = pallet_now.distance_to(&self.pallet0);
+        out.pallet_rotation_rad = wrap_angle(pallet_now.heading_rad - self.pallet0.heading_rad);
+        let pockets = self.scn.pallet.pocket_offsets_m();
+        let worst_pocket_miss = truck
+            .fork_points(&root, truck.fork_length_m / 2.0)
+            .iter()
+            .zip(pockets)
+            // Lateral position of the fork's middle in the pallet frame, against its pocket.
+            .map(|(mid, py)| (pallet_now.to_local(mid).y_m - py).abs())
+            .fold(0.0, f64::max);
+        let verdict = verdict(&self, worst_pocket_miss);
+        match verdict {
+            Some((f, why)) => self.out.fail(f, why),
+            None => self.out.success = true,
+        }
+        self.out
+    }
+}
+
+/// The first failed criterion, in check order, with its value and limit.
+fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
+    let (out, tol, truck) = (&t.out, &t.scn.tolerances, &t.scn.truck);
+    let clearance = (t.scn.pallet.pocket_width_m - truck.fork_width_m) / 2.0;
+    if t.collision {
+        return Some((Failure::Collision, "truck touched a rack or wall".to_owned()));
+    }
+    if out.max_contact_force_n > tol.contact_force_n {
+        return Some((
+            Failure::ContactForce,
+            format!(
+                "fork–pallet contact {:.0} N > {:.0} N before full depth",
+                out.max_contact_force_n, tol.contact_force_n
+            ),
+        ));
+    }
+    if out.pallet_displacement_m > tol.pallet_displacement_m
+        || out.pallet_rotation_rad.abs() > tol.pallet_rotation_deg.to_radians()
+    {
+        return Some((
+            Failure::PalletDisplaced,
+            format!(
+                "pallet moved {:.3} m and turned {:.2}° (limits {} m, {}°)",
+                out.pallet_displacement_m,
+                out.pallet_rotation_rad.to_degrees(),
+                tol.pallet_displacement_m,
+                tol.pallet_rotation_deg
+            ),
+        ));
+    }
+    if let Some(e) = out.lateral_error_m.filter(|e| e.abs() > tol.lateral_m) {
+        return Some((
+            Failure::LateralError,
+            format!("{e:.3} m off the pocket centre line at entry (limit {} m)", tol.lateral_m),
+        ));
+    }
+    if let Some(e) = out.heading_error_rad.filter(|e| e.abs() > tol.heading_deg.to_radians()) {
+        return Some((
+            Failure::HeadingError,
+            format!(
+                "{:.2}° off the pallet axis at entry (limit {}°)",
+                e.to_degrees(),
+                tol.heading_deg
+            ),
+        ));
+    }
+    if t.timed_out {
+        return Some((
+            Failure::Timeout,
+            format!("not stopped at the goal after {} s", t.scn.timeout_s),
+        ));
+    }
+    if out.insertion_depth_m < tol.insertion_depth_m {
+        return Some((
+            Failure::InsertionDepth,
+            format!(
+                "forks {:.3} m deep (required {} m)",
+                out.insertion_depth_m, tol.insertion_depth_m
+            ),
+        ));
+    }
+    (worst_pocket_miss > clearance).then(|| {
+        (
+            Failure::ForkOutsidePocket,
+            format!(
+                "a fork is {worst_pocket_miss:.3} m from its pocket centre (clearance {clearance:.4} m)"
+            ),
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 21, defect 10: a truck that drove away behind the pallet reported an
+    /// insertion depth of 106 m; depth counts only from the front and is at most the forks.
+    #[test]
+    fn insertion_depth_is_bounded_by_the_forks_and_counted_from_the_front() {
+        let truck = ForkliftSpec::default();
+        let pallet = Pose2::new(0.0, 0.0, 0.0);
+        let at = |x: f64| insertion_depth(&pallet, &Pose2::new(x, 0.0, 0.0), &truck);
+        assert!(
+            (at(-truck.fork_length_m - 0.5) + 0.5).abs() < 1e-12,
+            "short of the face"
+        );
+        assert!(
+            (at(-truck.fork_length_m + 0.8) - 0.8).abs() < 1e-12,
+            "0.8 m in"
+        );
+        assert!(at(-0.01) <= truck.fork_length_m);
+        assert_eq!(at(0.5), 0.0, "root past the face");
+        assert_eq!(at(105.0), 0.0, "drove away behind the pallet");
+    }
+}

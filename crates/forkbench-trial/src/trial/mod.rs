@@ -1,0 +1,157 @@
+//! One pick trial as named stages: setup, plan, drive (with replans), judge.
+
+mod drive;
+mod judge;
+mod plan;
+mod setup;
+
+use std::time::Instant;
+
+use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
+
+use crate::components::{ComponentSpec, Role};
+use crate::outcome::{Failure, TrialOutcome};
+use crate::recorder::{Level, NoRecorder, Recorder};
+use crate::scenario::{Case, Scenario};
+use crate::TrialError;
+
+pub use setup::Trial;
+
+/// Per-run choices on top of the scenario file.
+#[derive(Debug, Clone, Default)]
+pub struct TrialOptions {
+    pub seed: Option<u64>,
+    /// Planner by name: the scenario's own (by its name) or a registered kind.
+    pub planner: Option<String>,
+    /// Tracker by name, resolved the same way.
+    pub tracker: Option<String>,
+    /// Turn off NAV350 and pallet-estimate noise.
+    pub no_noise: bool,
+    /// Override of the pallet-estimate σ scale (0 = perfect estimate, NAV350 noise kept).
+    pub pallet_noise_scale: Option<f64>,
+    /// Force replanning on new pallet estimates on or off.
+    pub replan: Option<bool>,
+}
+
+/// Gap between the fork tips and the pallet face at the end of the approach curve.
+pub const APPROACH_GAP_M: f64 = 0.3;
+
+/// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
+/// (negative: before it).
+pub fn goal_for(face: &Pose2, truck: &ForkliftSpec, insertion_m: f64) -> Pose2 {
+    face.to_world(&Pose2::new(insertion_m - truck.fork_length_m, 0.0, 0.0))
+}
+
+/// Depth the fork tips reach aimed at: 5 cm short of the pallet back (or the fork length).
+pub fn target_insertion_m(truck: &ForkliftSpec, pallet: &PalletSpec) -> f64 {
+    pallet.depth_m.min(truck.fork_length_m) - 0.05
+}
+
+/// Everything a trial runs with, resolved once from the scenario and the options.
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    pub seed: u64,
+    pub planner: ComponentSpec,
+    pub tracker: ComponentSpec,
+    pub noise: bool,
+    pub replan: bool,
+    pub pallet_estimate: forkbench_sensors::PalletEstimateConfig,
+}
+
+impl Scenario {
+    /// The component a run names: the scenario's own when the name is its name, else a
+    /// registered kind with default settings (checked by building it once).
+    pub fn component(&self, role: Role, name: Option<&str>) -> Result<ComponentSpec, TrialError> {
+        let own = match role {
+            Role::Planner => &self.planner,
+            Role::Tracker => &self.tracker,
+        };
+        let Some(name) = name.filter(|n| *n != own.name) else {
+            return Ok(own.clone());
+        };
+        let spec = ComponentSpec::of_kind(role, name);
+        self.registry.check(&spec).map_err(|e| TrialError::Invalid {
+            file: self.file.clone(),
+            field: role.to_string(),
+            reason: format!(
+                "{name:?} is neither this scenario's {role} ({:?}) nor a {role} kind usable \
+                 with default settings: {e}",
+                own.name
+            ),
+        })?;
+        Ok(spec)
+    }
+
+    /// Resolves a run's options against this scenario: the one place defaults meet overrides.
+    pub fn resolve(&self, opts: &TrialOptions) -> Result<Resolved, TrialError> {
+        let mut pallet_estimate = self.noise.pallet_estimate.clone();
+        if let Some(s) = opts.pallet_noise_scale {
+            pallet_estimate.scale = s;
+        }
+        Ok(Resolved {
+            seed: opts.seed.unwrap_or(self.seed),
+            planner: self.component(Role::Planner, opts.planner.as_deref())?,
+            tracker: self.component(Role::Tracker, opts.tracker.as_deref())?,
+            noise: self.noise.enabled && !opts.no_noise,
+            replan: opts.replan.unwrap_or(self.replan.enabled),
+            pallet_estimate,
+        })
+    }
+}
+
+/// Runs one case of a scenario to its judged outcome.
+pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutcome {
+    run_trial_recorded(scn, case, opts, &mut NoRecorder)
+}
+
+/// Runs one case and reports every step to `rec`.
+pub fn run_trial_recorded<R: Recorder + ?Sized>(
+    scn: &Scenario,
+    case: &Case,
+    opts: &TrialOptions,
+    rec: &mut R,
+) -> TrialOutcome {
+    let wall = Instant::now();
+    let mut out = match scn.resolve(opts) {
+        Ok(run) => run_stages(scn, case, &run, rec),
+        Err(e) => {
+            let names = (
+                opts.planner.as_deref().unwrap_or(&scn.planner.name),
+                opts.tracker.as_deref().unwrap_or(&scn.tracker.name),
+            );
+            let seed = opts.seed.unwrap_or(scn.seed);
+            let mut out = TrialOutcome::blank(&scn.name, &case.name, names, seed, false);
+            out.fail(Failure::Error, e.to_string());
+            out
+        }
+    };
+    out.wall_time_ms = wall.elapsed().as_secs_f64() * 1e3;
+    rec.outcome(out.sim_time_s, &out);
+    out
+}
+
+fn run_stages<R: Recorder + ?Sized>(
+    scn: &Scenario,
+    case: &Case,
+    run: &Resolved,
+    rec: &mut R,
+) -> TrialOutcome {
+    let mut trial = match Trial::setup(scn, case, run, rec) {
+        Ok(t) => t,
+        Err(out) => return *out,
+    };
+    let path = match trial.first_plan(rec) {
+        Ok(p) => p,
+        Err((failure, why)) => {
+            trial.out.fail(failure, why);
+            return trial.out;
+        }
+    };
+    trial.tracker.reset(&path, &scn.truck);
+    if let Err(why) = trial.drive(rec) {
+        rec.event(trial.sim.time_s(), Level::Error, &why);
+        trial.out.fail(Failure::Error, why);
+        return trial.out;
+    }
+    trial.judge()
+}

@@ -1,0 +1,146 @@
+//! Setup stage: the simulated world, sensors with their own random streams, the components, the first fix and estimate.
+
+use forkbench_core::Pose2;
+use forkbench_plan::Planner;
+use forkbench_sensors::{Localizer, PalletEstimator};
+use forkbench_sim::Sim;
+use forkbench_track::{PosePredictor, Tracker};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use super::judge::jitter;
+use super::{Resolved, target_insertion_m};
+use crate::outcome::{Failure, TrialOutcome};
+use crate::recorder::{Level, Recorder, SceneInfo};
+use crate::scenario::{Case, Scenario};
+
+/// Independent random streams per sensor, so changing one sensor's settings does not
+/// change the other's draws.
+fn stream(seed: u64, salt: u64) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(seed ^ salt.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
+
+/// A trial in progress: its world, sensors, components and what it has measured so far.
+pub struct Trial<'a> {
+    pub(super) scn: &'a Scenario,
+    pub(super) run: &'a Resolved,
+    pub(super) out: TrialOutcome,
+    pub(super) sim: Sim,
+    pub(super) planner: Box<dyn Planner>,
+    pub(super) tracker: Box<dyn Tracker>,
+    pub(super) localizer: Box<dyn Localizer>,
+    pub(super) estimator: Box<dyn PalletEstimator>,
+    pub(super) nav_rng: ChaCha8Rng,
+    pub(super) est_rng: ChaCha8Rng,
+    pub(super) predictor: PosePredictor,
+    pub(super) first_fix: Pose2,
+    /// The pallet pose the current plan aims at.
+    pub(super) pallet_est: Pose2,
+    /// Depth the forks are driven to past the face.
+    pub(super) insertion_m: f64,
+    pub(super) obstacles: Vec<forkbench_sim::Obstacle>,
+    /// Pallet pose before the truck moved: displacement is measured from it.
+    pub(super) pallet0: Pose2,
+    pub(super) collision: bool,
+    pub(super) timed_out: bool,
+}
+
+impl std::fmt::Debug for Trial<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Trial").field("out", &self.out).finish_non_exhaustive()
+    }
+}
+
+impl<'a> Trial<'a> {
+    /// Builds the world and components and takes the first fix and pallet estimate. A
+    /// world that cannot be built ends the trial here, as an `error` outcome.
+    pub fn setup<R: Recorder + ?Sized>(
+        scn: &'a Scenario,
+        case: &Case,
+        run: &'a Resolved,
+        rec: &mut R,
+    ) -> Result<Self, Box<TrialOutcome>> {
+        let names = (run.planner.name.as_str(), run.tracker.name.as_str());
+        let mut out = TrialOutcome::blank(&scn.name, &case.name, names, run.seed, run.noise);
+        let mut fail = |out: &mut TrialOutcome, why: String| {
+            rec.event(0.0, Level::Error, &why);
+            out.fail(Failure::Error, why);
+        };
+        let components = scn
+            .registry
+            .planner(&run.planner)
+            .and_then(|p| Ok((p, scn.registry.tracker(&run.tracker)?)));
+        let (planner, tracker) = match components {
+            Ok(c) => c,
+            Err(e) => {
+                fail(&mut out, format!("building the components: {e}"));
+                return Err(Box::new(out));
+            }
+        };
+        // Per-trial jitter of where the pallet really stands (its own random stream).
+        let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(run.seed, 3));
+        let obstacles = scn.world.obstacles();
+        let sim = Sim::new(&scn.truck, &case.start, &scn.pallet, &true_pallet, &obstacles, &scn.sim);
+        let sim = match sim {
+            Ok(s) => s,
+            Err(e) => {
+                fail(&mut out, e.to_string());
+                return Err(Box::new(out));
+            }
+        };
+        rec.scene(&SceneInfo {
+            scenario: &scn.name,
+            case: &case.name,
+            planner: &run.planner.name,
+            seed: run.seed,
+            truck: &scn.truck,
+            pallet: &scn.pallet,
+            pallet_pose: true_pallet,
+            obstacles: &obstacles,
+            start: case.start,
+        });
+        let pallet0 = sim.pallet_pose();
+        let mut trial = Trial {
+            scn,
+            run,
+            out,
+            sim,
+            planner,
+            tracker,
+            localizer: scn.registry.localizer(&scn.noise.nav350, run.noise),
+            estimator: scn.registry.estimator(&run.pallet_estimate),
+            nav_rng: stream(run.seed, 1),
+            est_rng: stream(run.seed, 2),
+            predictor: PosePredictor::new(),
+            first_fix: case.start,
+            pallet_est: true_pallet,
+            insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
+            obstacles,
+            pallet0,
+            collision: false,
+            timed_out: true,
+        };
+        trial.first_fix_and_estimate(case, &true_pallet);
+        Ok(trial)
+    }
+
+    fn first_fix_and_estimate(&mut self, case: &Case, true_pallet: &Pose2) {
+        let truth = self.sim.fork_root_pose();
+        let fix = self.localizer.update(0.0, &truth, &mut self.nav_rng);
+        self.first_fix = fix.unwrap_or(case.start);
+        self.predictor.fix(self.first_fix);
+        let range = self.first_fix.distance_to(true_pallet);
+        self.pallet_est = self.estimate(true_pallet, range);
+    }
+
+    /// A pallet estimate seen from `range_m`: the scenario's fixed bias, then the
+    /// estimator's noise (none with noise off, which draws nothing).
+    pub(super) fn estimate(&mut self, truth: &Pose2, range_m: f64) -> Pose2 {
+        let biased = truth.to_world(&self.scn.estimate_bias);
+        if self.run.noise {
+            self.estimator.estimate(&biased, range_m, &mut self.est_rng)
+        } else {
+            biased
+        }
+    }
+}
