@@ -38,7 +38,12 @@ impl BsplinePlanner {
                 ));
             }
         };
-        let cfg: BsplineConfig = settings::parse(&s)?;
+        let cfg: BsplineConfig = settings::parse(&s).map_err(|mut e| {
+            if e.reason.contains("expected one of") {
+                e.reason.push_str(", `relax_handles_near_goal`");
+            }
+            e
+        })?;
         cfg.validate().map_err(|e| settings_error(&e))?;
         Ok(Self {
             cfg,

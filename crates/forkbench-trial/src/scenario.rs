@@ -778,7 +778,15 @@ fn component_error(
     span: std::ops::Range<usize>,
     e: &forkbench_core::SettingsError,
 ) -> TrialError {
-    let region = text.get(span.clone()).unwrap_or("");
+    // A table's span may cover only its header: search on to the next table header.
+    let rest = text.get(span.start..).unwrap_or("");
+    let end = rest
+        .match_indices('\n')
+        .map(|(i, _)| i + 1)
+        .find(|&i| rest[i..].trim_start().starts_with('['))
+        .unwrap_or(rest.len())
+        .max(span.len().min(rest.len()));
+    let region = &rest[..end];
     let key_at = e.field.as_deref().and_then(|k| {
         let mut at = 0;
         region.split_inclusive('\n').find_map(|l| {

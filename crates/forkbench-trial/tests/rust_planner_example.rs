@@ -1,0 +1,54 @@
+//! The Rust planner of `examples/rust_planner.rs`, registered with one line, runs in a
+//! trial and a batch beside the built-in planners.
+
+#[path = "../../../examples/rust_planner.rs"]
+mod rust_planner;
+
+use std::path::Path;
+use std::sync::Arc;
+
+use forkbench_trial::batch::{BatchSpec, run_batch};
+use forkbench_trial::{Scenario, TrialOptions, run_trial};
+
+fn field_test() -> Scenario {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/field-test.toml");
+    Scenario::load_with(&file, Arc::new(rust_planner::registry())).expect("loads")
+}
+
+#[test]
+fn the_example_planner_runs_in_a_trial_and_a_batch() {
+    let scn = field_test();
+    let opts = TrialOptions {
+        planner: Some("bezier".into()),
+        no_noise: true,
+        ..TrialOptions::default()
+    };
+    let out = run_trial(&scn, &scn.cases[0], &opts);
+    assert_eq!(out.planner, "bezier");
+    assert!(out.success, "{:?}", out.failure_detail);
+
+    let dir = std::env::temp_dir().join(format!("forkbench-rust-planner-{}", std::process::id()));
+    let spec = BatchSpec {
+        scenarios: vec![scn],
+        planners: vec!["bezier".into(), "bspline".into()],
+        trackers: vec!["pure_pursuit".into(), "regulated_pure_pursuit".into()],
+        trials: 3,
+        seed: 2,
+        shard: (0, 1),
+        pallet_noise_scale: None,
+        replan: None,
+        force_new: true,
+    };
+    let summary = run_batch(&spec, &dir, 2, &|_| {}).expect("batch");
+    let rows: Vec<_> = summary.rows.iter().map(|r| (r.planner.as_str(), r.tracker.as_str())).collect();
+    assert_eq!(
+        rows,
+        [
+            ("bezier", "pure_pursuit"),
+            ("bezier", "regulated_pure_pursuit"),
+            ("bspline", "pure_pursuit"),
+            ("bspline", "regulated_pure_pursuit")
+        ]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
