@@ -35,7 +35,10 @@ impl BezierPlanner {
     pub fn from_settings(s: &Settings) -> Result<Self, SettingsError> {
         let p: BezierPlanner = settings::parse(s)?;
         if !(p.handle_fraction > 0.0 && p.handle_fraction < 1.0) {
-            return Err(SettingsError::field("handle_fraction", "must lie in (0, 1)"));
+            return Err(SettingsError::field(
+                "handle_fraction",
+                "must lie in (0, 1)",
+            ));
         }
         Ok(p)
     }
@@ -52,12 +55,22 @@ impl Planner for BezierPlanner {
         let h = self.handle_fraction * a.distance_to(&b);
         let p = [
             [a.x_m, a.y_m],
-            [a.x_m + h * a.heading_rad.cos(), a.y_m + h * a.heading_rad.sin()],
-            [b.x_m - h * b.heading_rad.cos(), b.y_m - h * b.heading_rad.sin()],
+            [
+                a.x_m + h * a.heading_rad.cos(),
+                a.y_m + h * a.heading_rad.sin(),
+            ],
+            [
+                b.x_m - h * b.heading_rad.cos(),
+                b.y_m - h * b.heading_rad.sin(),
+            ],
             [b.x_m, b.y_m],
         ];
         let path = sample(&p, 0.01);
-        let worst = path.samples.iter().map(|s| s.curvature_per_m.abs()).fold(0.0, f64::max);
+        let worst = path
+            .samples
+            .iter()
+            .map(|s| s.curvature_per_m.abs())
+            .fold(0.0, f64::max);
         if worst > req.truck.max_curvature_per_m() {
             return Err(PlanError::Unreachable {
                 planner: "bezier".into(),
@@ -79,7 +92,12 @@ fn sample(p: &[[f64; 2]; 4], spacing_m: f64) -> PlanPath {
     let at = |u: f64| {
         let v = 1.0 - u;
         let w = [v * v * v, 3.0 * v * v * u, 3.0 * v * u * u, u * u * u];
-        let d1 = [-3.0 * v * v, 3.0 * v * v - 6.0 * u * v, 6.0 * u * v - 3.0 * u * u, 3.0 * u * u];
+        let d1 = [
+            -3.0 * v * v,
+            3.0 * v * v - 6.0 * u * v,
+            6.0 * u * v - 3.0 * u * u,
+            3.0 * u * u,
+        ];
         let d2 = [6.0 * v, 6.0 * u - 12.0 * v, 6.0 * v - 12.0 * u, 6.0 * u];
         let comb = |c: [f64; 4], k: usize| (0..4).map(|i| c[i] * p[i][k]).sum::<f64>();
         let (x1, y1, x2, y2) = (comb(d1, 0), comb(d1, 1), comb(d2, 0), comb(d2, 1));
@@ -105,7 +123,8 @@ fn sample(p: &[[f64; 2]; 4], spacing_m: f64) -> PlanPath {
     }
     // Headings unwrapped, as every forkbench path has them.
     for i in 1..samples.len() {
-        let d = forkbench_core::units::wrap_angle(samples[i].heading_rad - samples[i - 1].heading_rad);
+        let d =
+            forkbench_core::units::wrap_angle(samples[i].heading_rad - samples[i - 1].heading_rad);
         samples[i].heading_rad = samples[i - 1].heading_rad + d;
     }
     PlanPath { samples }
@@ -113,13 +132,18 @@ fn sample(p: &[[f64; 2]; 4], spacing_m: f64) -> PlanPath {
 
 /// The built-in components plus this planner: the one line that adds it.
 pub fn registry() -> Registry {
-    Registry::builtin().with_planner("bezier", |s, _| Ok(Box::new(BezierPlanner::from_settings(s)?)))
+    Registry::builtin().with_planner("bezier", |s, _| {
+        Ok(Box::new(BezierPlanner::from_settings(s)?))
+    })
 }
 
 #[allow(dead_code)]
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let scn = Scenario::load_with(&root.join("scenarios/field-test.toml"), Arc::new(registry()))?;
+    let scn = Scenario::load_with(
+        &root.join("scenarios/field-test.toml"),
+        Arc::new(registry()),
+    )?;
     let spec = BatchSpec {
         scenarios: vec![scn],
         planners: vec!["bezier".into(), "bspline".into()],

@@ -371,7 +371,8 @@ fn batch_writes_results_and_regress_gates_them() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(
-        String::from_utf8_lossy(&out.stdout).contains("| field-test | bspline | 4 | 4 | 100.0 % |")
+        String::from_utf8_lossy(&out.stdout)
+            .contains("| field-test | bspline | pure_pursuit | 4 | 4 | 100.0 % |")
     );
     for f in ["trials.jsonl", "summary.json", "summary.md"] {
         assert!(out_dir.join(f).exists(), "{f}");
@@ -420,9 +421,22 @@ fn batch_input_errors_are_clear() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(message), "{extra:?}: {err}");
     }
-    let out = forkbench(&["batch", scn, "--planner", "rrt"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("rrt"));
+    // Planner names resolve at run time (a scenario's own or a registered kind): an
+    // unknown one is refused before any trial, naming the known kinds.
+    let out = forkbench(&[
+        "batch",
+        scn,
+        "--planner",
+        "rrt",
+        "--out",
+        "/nonexistent-dir-never-written",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("unknown planner \"rrt\" (known: bspline, external, spiral)"),
+        "{err}"
+    );
     let bad = tmp("bad-baseline.json");
     std::fs::write(&bad, "{ not json").expect("write");
     let out = forkbench(&["regress", "--baseline", bad.to_str().expect("utf8"), "."]);
@@ -505,7 +519,7 @@ fn batch_records_failures_and_replay_reproduces_a_trial() {
     assert!(
         files
             .iter()
-            .all(|f| f.starts_with("field-test-default-bspline-seed")),
+            .all(|f| f.starts_with("field-test-default-bspline-pure_pursuit-seed")),
         "{files:?}"
     );
     let jsonl = dir.join("trials.jsonl");

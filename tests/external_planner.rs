@@ -62,8 +62,19 @@ fn the_python_planner_sits_beside_the_built_in_ones_in_batch_and_regress() {
     let dir = tmp("batch");
     let d = dir.to_str().expect("utf-8");
     ok(&forkbench(&[
-        "batch", SCENARIO, "--planner", "quintic", "bspline", "spiral", "--trials", "6",
-        "--record", "none", "--out", d, "--force-new",
+        "batch",
+        SCENARIO,
+        "--planner",
+        "quintic",
+        "bspline",
+        "spiral",
+        "--trials",
+        "6",
+        "--record",
+        "none",
+        "--out",
+        d,
+        "--force-new",
     ]));
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("summary.json")).expect("summary"))
@@ -80,7 +91,8 @@ fn the_python_planner_sits_beside_the_built_in_ones_in_batch_and_regress() {
     ok(&forkbench(&["baseline", d, "--out", b]));
     let text = ok(&forkbench(&["regress", "--baseline", b, d]));
     assert!(
-        text.lines().any(|l| l.contains("| quintic | pure_pursuit |") && l.contains("| ok |")),
+        text.lines()
+            .any(|l| l.contains("| quintic | pure_pursuit |") && l.contains("| ok |")),
         "{text}"
     );
 }

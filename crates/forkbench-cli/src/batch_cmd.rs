@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context as _, bail};
-use forkbench_trial::batch::{self, Baseline, BatchSpec, Summary, TrialRecord};
+use forkbench_trial::batch::{self, Baseline, BatchSpec, RecordChoice, Summary, TrialRecord};
 use forkbench_trial::{Scenario, defaults};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -24,8 +24,7 @@ pub struct BatchArgs {
     pub pallet_noise_scale: Option<f64>,
     pub replan: bool,
     pub sweep: Option<String>,
-    pub record_failures: bool,
-    pub record_successes: bool,
+    pub record: RecordChoice,
     pub max_recordings: usize,
     pub force_new: bool,
 }
@@ -124,7 +123,7 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
     {
         bail!("--pallet-noise-scale {s}: must be a finite number ≥ 0");
     }
-    let mut spec = BatchSpec {
+    let spec = BatchSpec {
         scenarios,
         planners: a.planners.clone(),
         trackers: a.trackers.clone(),
@@ -158,12 +157,10 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
     };
     let values = parse_sweep(sweep)?;
     let mut points: Vec<(f64, Summary)> = Vec::new();
-    for v in values {
-        spec.pallet_noise_scale = Some(v);
-        let dir = a.out.join(format!("pallet_noise-{v}"));
-        points.push((v, run_one(&spec, &dir, a.jobs)?));
+    for p in batch::sweep_points(&spec, &a.out, &values) {
+        points.push((p.pallet_noise, run_one(&p.spec, &p.dir, a.jobs)?));
     }
-    let text = sweep_report(&points);
+    let text = batch::sweep_markdown(&points);
     std::fs::write(a.out.join("sweep.md"), &text)
         .with_context(|| format!("writing {}", a.out.display()))?;
     let json: Vec<_> = points
@@ -191,36 +188,6 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
         "{text}\nwritten: {}/sweep.md, sweep.json, sweep-<planner>.png\n",
         a.out.display()
     ))
-}
-
-fn sweep_report(points: &[(f64, Summary)]) -> String {
-    let mut s = String::from(
-        "| scenario | planner | pallet noise scale | trials | success rate | 95 % CI |\n|---|---|---|---|---|---|\n",
-    );
-    let mut rows: Vec<(String, String, f64, u64, f64, f64, f64)> = Vec::new();
-    for (v, sum) in points {
-        for r in &sum.rows {
-            rows.push((
-                r.scenario.clone(),
-                r.planner.clone(),
-                *v,
-                r.trials,
-                r.success_rate,
-                r.ci95_low,
-                r.ci95_high,
-            ));
-        }
-    }
-    rows.sort_by(|a, b| (&a.0, &a.1).cmp(&(&b.0, &b.1)).then(a.2.total_cmp(&b.2)));
-    for (sc, p, v, n, rate, lo, hi) in rows {
-        s.push_str(&format!(
-            "| {sc} | {p} | {v} | {n} | {:.1} % | {:.1}–{:.1} % |\n",
-            100.0 * rate,
-            100.0 * lo,
-            100.0 * hi
-        ));
-    }
-    s
 }
 
 pub fn merge(dirs: &[PathBuf], out: &Path, json: bool) -> anyhow::Result<()> {
@@ -289,34 +256,19 @@ pub fn regress(
     Ok(!failed)
 }
 
-/// Re-runs the batch's failed (or all) trials with recording; trials are deterministic,
-/// so the recording is the trial that ran.
+/// Records the trials the library picks (failures, or all) as .rrd and .mcap.
 fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
-    if !a.record_failures && !a.record_successes {
+    if a.record == RecordChoice::None {
         return Ok(0);
     }
-    let mut records = batch::read_records(&a.out.join("trials.jsonl"))?;
-    records.sort_by_key(TrialRecord::key);
+    let records = batch::read_records(&a.out.join("trials.jsonl"))?;
+    let jobs = batch::trials_to_record(spec, &records, a.record, a.max_recordings);
     let dir = a.out.join("recordings");
-    let mut n = 0;
-    for r in records {
-        if n >= a.max_recordings {
-            break;
-        }
-        if r.outcome.success && !a.record_successes {
-            continue;
-        }
-        let Some(scn) = spec.scenarios.iter().find(|s| s.name == r.outcome.scenario) else {
-            continue;
-        };
-        let Ok(case) = scn.case(&r.outcome.case) else {
-            continue;
-        };
+    for j in &jobs {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        crate::record::record_trial(scn, case, &r.options(), &dir)?;
-        n += 1;
+        crate::record::record_trial(j.scenario, j.case, &j.options, &dir)?;
     }
-    Ok(n)
+    Ok(jobs.len())
 }
 
 /// `forkbench replay`: re-runs one trial from its JSON line, records it, and checks that

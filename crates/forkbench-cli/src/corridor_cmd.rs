@@ -3,24 +3,15 @@
 use std::fmt::Write as _;
 use std::path::Path as FsPath;
 
-use forkbench_core::ForkliftSpec;
 use forkbench_corridor::{
-    GRegion, Junction, Mode, Resolution, Vehicle, check_inputs, compare, min_width_m,
-    oblique_min_width_m, validate,
+    CorridorQuery, CorridorRun, GRegion, Junction, Mode, Vehicle, WidthRow as Row, analyse,
+    compare, validate,
 };
 use plotters::prelude::*;
 
 use crate::plot::{COLORS, err, to_file};
 
-/// The paper's AMV (Lc 0.56 m, Wc 0.40 m).
-pub fn amv() -> Vehicle {
-    Vehicle {
-        length_m: 0.56,
-        width_m: 0.40,
-        kinematic_ahead_m: 0.0,
-        min_radius_m: 0.0,
-    }
-}
+pub use forkbench_corridor::amv;
 
 /// Parses "0.56x0.40" (metres).
 pub fn parse_vehicle(text: &str) -> Result<Vehicle, String> {
@@ -71,25 +62,6 @@ pub fn parse_sweep(text: &str) -> Result<Angles, String> {
     }
 }
 
-fn modes_for(v: &Vehicle) -> Vec<Mode> {
-    if v.min_radius_m > 0.0 {
-        Mode::ALL.to_vec()
-    } else {
-        Mode::ALL[..4].to_vec()
-    }
-}
-
-#[derive(serde::Serialize)]
-struct Row {
-    angle_deg: f64,
-    mode: Mode,
-    min_width_m: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    g_area_m2: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    closed_form_m: Option<f64>,
-}
-
 /// Options of one `corridor` run.
 #[derive(Debug)]
 pub struct Args<'a> {
@@ -103,40 +75,13 @@ pub struct Args<'a> {
 }
 
 pub fn run(a: &Args) -> anyhow::Result<()> {
-    check_inputs(&a.vehicle, a.junction, a.width_m, &a.angles_deg, a.cell_m)?;
-    let res = Resolution {
+    let CorridorRun { rows, regions } = analyse(&CorridorQuery {
+        vehicle: a.vehicle,
+        junction: a.junction,
+        width_m: a.width_m,
+        angles_deg: a.angles_deg.clone(),
         cell_m: a.cell_m,
-        heading_rad: 1f64.to_radians(),
-    };
-    let modes = modes_for(&a.vehicle);
-    let mut rows = Vec::new();
-    let mut regions = Vec::new();
-    for &deg in &a.angles_deg {
-        let th = deg.to_radians();
-        for &mode in &modes {
-            let w = min_width_m(
-                &a.vehicle,
-                mode,
-                a.junction,
-                th,
-                res,
-                20.0 * a.vehicle.circumscribed_m(),
-            );
-            let g = a
-                .width_m
-                .map(|w| GRegion::compute(a.junction.bend(w, th), a.vehicle, mode, res));
-            rows.push(Row {
-                angle_deg: deg,
-                mode,
-                min_width_m: w,
-                g_area_m2: g.as_ref().map(GRegion::area_m2),
-                closed_form_m: (mode == Mode::Oblique).then(|| oblique_min_width_m(&a.vehicle, th)),
-            });
-            if let Some(g) = g {
-                regions.push((deg, g));
-            }
-        }
-    }
+    })?;
     if let Some(p) = a.plot {
         if a.width_m.is_some() && a.angles_deg.len() == 1 {
             plot_regions(p, &a.vehicle, &regions)?;
@@ -205,58 +150,34 @@ pub fn run(a: &Args) -> anyhow::Result<()> {
     crate::emit(&out)
 }
 
-/// `reproduce corridor`: the paper's AMV and the A30 truck over bend angles.
+/// `reproduce corridor`: the library's sections (the paper's AMV, then the A30 truck).
 pub fn reproduce(json: bool, plot: Option<&FsPath>) -> anyhow::Result<()> {
-    let v = amv();
-    let worst = (v.length_m / v.width_m).atan().to_degrees();
-    let mut angles = vec![15.0, 30.0, 45.0, worst, 60.0, 75.0, 90.0];
-    angles.sort_by(f64::total_cmp);
+    let worst = forkbench_corridor::reproduce::worst_oblique_angle_deg(&amv());
     if !json {
         crate::emit(&format!(
-            "# Quan & Wang 2021, corridor bends\n\nThe paper's equations 1–3 and Table 1 are not in its text; oblique translation has a closed form (Lc·sin θ + Wc·cos θ), the rest is searched. Worst angle for oblique translation: arctan(Lc/Wc) = {worst:.2}°.\n\n## AMV 0.56 × 0.40 m\n\n"
+            "# Quan & Wang 2021, corridor bends\n\nThe paper's equations 1–3 and Table 1 are not in its text; oblique translation has a closed form (Lc·sin θ + Wc·cos θ), the rest is searched. Worst angle for oblique translation: arctan(Lc/Wc) = {worst:.2}°.\n"
         ))?;
     }
-    run(&Args {
-        vehicle: v,
-        junction: Junction::L,
-        width_m: None,
-        angles_deg: angles.clone(),
-        cell_m: 0.01,
-        plot,
-        json,
-    })?;
-    if !json {
-        let truck = Vehicle::forklift(&ForkliftSpec::default());
-        let section = |vehicle, junction, width_m, angles_deg: &[f64], cell_m| Args {
-            vehicle,
-            junction,
-            width_m,
-            angles_deg: angles_deg.to_vec(),
-            cell_m,
-            plot: None,
-            json: false,
-        };
-        for (title, args) in [
-            (
-                "AMV G regions at W = 0.60 m, θ = 90°",
-                section(v, Junction::L, Some(0.60), &[90.0], 0.01),
-            ),
-            (
-                "AMV turning from the stem of a T junction, W = 0.60 m",
-                section(v, Junction::T, Some(0.60), &[90.0], 0.01),
-            ),
-            (
-                "A30 truck body 2.45 × 1.2 m (r_min 0.94 m about the front axle)",
-                section(truck, Junction::L, None, &[30.0, 60.0, 90.0], 0.03),
-            ),
-            (
-                "A30 G regions at W = 2.6 m, θ = 90° (5 cm cells)",
-                section(truck, Junction::L, Some(2.6), &[90.0], 0.05),
-            ),
-        ] {
-            crate::emit(&format!("\n## {title}\n\n"))?;
-            run(&args)?;
+    // JSON and the plot cover the first section (the paper's AMV); text shows them all.
+    for (i, (title, q)) in forkbench_corridor::reproduce::reproduction()
+        .into_iter()
+        .enumerate()
+    {
+        if json && i > 0 {
+            break;
         }
+        if !json {
+            crate::emit(&format!("\n## {title}\n\n"))?;
+        }
+        run(&Args {
+            vehicle: q.vehicle,
+            junction: q.junction,
+            width_m: q.width_m,
+            angles_deg: q.angles_deg,
+            cell_m: q.cell_m,
+            plot: if i == 0 { plot } else { None },
+            json,
+        })?;
     }
     Ok(())
 }

@@ -337,8 +337,11 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             pallet_noise_scale,
             replan,
             sweep,
-            record_failures: record != RecordWhich::None,
-            record_successes: record == RecordWhich::All,
+            record: match record {
+                RecordWhich::None => forkbench_trial::batch::RecordChoice::None,
+                RecordWhich::Failures => forkbench_trial::batch::RecordChoice::Failures,
+                RecordWhich::All => forkbench_trial::batch::RecordChoice::All,
+            },
             max_recordings,
             force_new,
         })

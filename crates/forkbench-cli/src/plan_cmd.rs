@@ -4,8 +4,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_core::Settings;
+use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_plan::{PlanParams, PlanRequest};
 use forkbench_trial::{ComponentSpec, Registry, Role};
 use serde_json::json;

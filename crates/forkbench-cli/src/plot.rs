@@ -269,25 +269,27 @@ where
         .y_desc("success rate (%)")
         .draw()
         .map_err(err)?;
-    let mut scenarios: Vec<String> = points
+    // One series per scenario × tracker of this planner.
+    let mut series: Vec<(String, String)> = points
         .iter()
         .flat_map(|(_, s)| {
             s.rows
                 .iter()
                 .filter(|r| r.planner == planner)
-                .map(|r| r.scenario.clone())
+                .map(|r| (r.scenario.clone(), r.tracker.clone()))
         })
         .collect();
-    scenarios.sort();
-    scenarios.dedup();
-    for (i, sc) in scenarios.iter().enumerate() {
+    series.sort();
+    series.dedup();
+    let several_trackers = series.iter().any(|(_, t)| *t != series[0].1);
+    for (i, (sc, tr)) in series.iter().enumerate() {
         let color = COLORS[i % COLORS.len()];
         let pts: Vec<(f64, f64, f64, f64)> = points
             .iter()
             .filter_map(|(v, s)| {
                 s.rows
                     .iter()
-                    .find(|r| &r.scenario == sc && r.planner == planner)
+                    .find(|r| &r.scenario == sc && &r.tracker == tr && r.planner == planner)
                     .map(|r| {
                         (
                             *v,
@@ -304,7 +306,11 @@ where
                 color.stroke_width(2),
             ))
             .map_err(err)?
-            .label(sc.clone())
+            .label(if several_trackers {
+                format!("{sc} / {tr}")
+            } else {
+                sc.clone()
+            })
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
             });

@@ -31,10 +31,8 @@ pub fn run(
     let run = scn.resolve(opts)?;
     // File targets are checked before the run; a viewer that cannot be reached is
     // reported and the trial runs anyway.
-    let mut sinks = crate::record::Sinks::open(
-        rec,
-        crate::record::metadata(&scn.name, &case.name, &run),
-    )?;
+    let mut sinks =
+        crate::record::Sinks::open(rec, crate::record::metadata(&scn.name, &case.name, &run))?;
     let (out, written) = sinks.record(|r| forkbench_trial::run_trial_recorded(&scn, case, opts, r));
     let viewer_error = sinks.viewer_error.take();
     if let Some(e) = &viewer_error {

@@ -43,7 +43,10 @@ mod tests {
         let c = rect_corners(&Pose2::new(1.0, 2.0, std::f64::consts::FRAC_PI_2), 4.0, 2.0);
         let want = [[0.0, 4.0], [0.0, 0.0], [2.0, 0.0], [2.0, 4.0]];
         for (a, b) in c.iter().zip(want) {
-            assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12, "{c:?}");
+            assert!(
+                (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12,
+                "{c:?}"
+            );
         }
     }
 }

@@ -3,8 +3,8 @@
 pub mod geometry;
 pub mod pallet;
 pub mod path;
-pub mod settings;
 pub mod pose;
+pub mod settings;
 pub mod units;
 pub mod vehicle;
 

@@ -43,7 +43,10 @@ pub fn parse<T: DeserializeOwned>(settings: &Settings) -> Result<T, SettingsErro
 /// Refuses every key of `settings`: for components that take none.
 pub fn none(settings: &Settings) -> Result<(), SettingsError> {
     match settings.keys().next() {
-        Some(k) => Err(SettingsError::field(k, "unknown field: this component takes no settings")),
+        Some(k) => Err(SettingsError::field(
+            k,
+            "unknown field: this component takes no settings",
+        )),
         None => Ok(()),
     }
 }

@@ -509,11 +509,7 @@ pub fn plan(req: &PlanRequest, cfg: &BsplineConfig) -> Result<BsplinePlan, PlanE
     }
     // κ ≤ κ_max and arctan(L κ) ≤ α_max are the same bound; check it once.
     if max_k > req.truck.max_curvature_per_m() {
-        return Err(PlanError::curvature(
-            "bspline",
-            max_k,
-            &req.truck,
-        ));
+        return Err(PlanError::curvature("bspline", max_k, &req.truck));
     }
     let path = curve.sample(start, goal, cfg.sample_spacing_m);
     if let Some(s_m) = crate::find_cusp(&path, req.truck.max_curvature_per_m()) {

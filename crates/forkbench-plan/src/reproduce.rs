@@ -10,11 +10,9 @@ use crate::spiral::{self, SpiralConfig, SpiralProblem};
 use crate::{Plan, PlanError, PlanRequest};
 
 /// The B-spline reference table as shipped in `scenarios/reference/bspline-table2.toml`.
-pub const BSPLINE_TABLE2_TOML: &str =
-    include_str!("../../../scenarios/reference/bspline-table2.toml");
+pub const BSPLINE_TABLE2_TOML: &str = include_str!("../data/reference/bspline-table2.toml");
 /// The spiral reference table as shipped in `scenarios/reference/spiral-table2.toml`.
-pub const SPIRAL_TABLE2_TOML: &str =
-    include_str!("../../../scenarios/reference/spiral-table2.toml");
+pub const SPIRAL_TABLE2_TOML: &str = include_str!("../data/reference/spiral-table2.toml");
 
 /// A reference table file that could not be read.
 #[derive(Debug, thiserror::Error)]

@@ -14,11 +14,8 @@ impl PlannerKind {
     const ALL: [PlannerKind; 2] = [PlannerKind::Bspline, PlannerKind::Spiral];
 }
 
-/// Default settings of both (a stand-in for per-planner configuration).
-#[derive(Debug, Default)]
-struct PlannerConfig;
-
-fn plan(kind: PlannerKind, req: &PlanRequest, _: &PlannerConfig) -> Result<Plan, PlanError> {
+/// Plans with the papers' default settings.
+fn plan(kind: PlannerKind, req: &PlanRequest) -> Result<Plan, PlanError> {
     match kind {
         PlannerKind::Bspline => BsplinePlanner::default().plan(req),
         PlannerKind::Spiral => SpiralPlanner::default().plan(req),
@@ -27,7 +24,7 @@ fn plan(kind: PlannerKind, req: &PlanRequest, _: &PlannerConfig) -> Result<Plan,
 use proptest::prelude::*;
 
 fn check(kind: PlannerKind, req: &PlanRequest, endpoint_tol_m: f64) -> Result<(), TestCaseError> {
-    match plan(kind, req, &PlannerConfig::default()) {
+    match plan(kind, req) {
         Ok(p) => {
             prop_assert!(p.path.is_finite(), "NaN in path");
             prop_assert!(p.path.samples.len() >= 2);
@@ -100,7 +97,7 @@ proptest! {
         let mut req = PlanRequest::new(start, goal);
         req.start_curvature_per_m = k0;
         for kind in PlannerKind::ALL {
-            let p = plan(kind, &req, &PlannerConfig::default());
+            let p = plan(kind, &req);
             prop_assert!(p.is_ok(), "{kind:?} failed on a typical pick: {:?}", p.err());
         }
         check(PlannerKind::Bspline, &req, 1e-9)?;
@@ -111,22 +108,21 @@ proptest! {
 #[test]
 fn non_finite_and_degenerate_inputs_are_refused() {
     let ok = Pose2::new(0.0, 0.0, 0.0);
-    let cfg = PlannerConfig::default();
     for kind in PlannerKind::ALL {
         let req = PlanRequest::new(ok, Pose2::new(f64::NAN, 1.0, 0.0));
         assert!(matches!(
-            plan(kind, &req, &cfg),
+            plan(kind, &req),
             Err(PlanError::InvalidInput { what: "goal", .. })
         ));
         let req = PlanRequest::new(ok, Pose2::new(0.01, 0.0, 0.0));
         assert!(matches!(
-            plan(kind, &req, &cfg),
+            plan(kind, &req),
             Err(PlanError::GoalTooClose { .. })
         ));
         let mut req = PlanRequest::new(ok, Pose2::new(6.0, 0.0, 0.0));
         req.start_curvature_per_m = 2.0;
         assert!(matches!(
-            plan(kind, &req, &cfg),
+            plan(kind, &req),
             Err(PlanError::StartCurvature { .. })
         ));
         let mut req = PlanRequest::new(ok, Pose2::new(6.0, 0.0, 0.0));
@@ -135,7 +131,7 @@ fn non_finite_and_degenerate_inputs_are_refused() {
             ..ForkliftSpec::default()
         };
         assert!(matches!(
-            plan(kind, &req, &cfg),
+            plan(kind, &req),
             Err(PlanError::InvalidInput { what: "truck", .. })
         ));
     }
@@ -146,7 +142,7 @@ fn sharp_goal_names_the_curvature_limit() {
     // 1 m ahead and 1.5 m to the side, turned 90°: needs far more than κ_max.
     let req = PlanRequest::new(Pose2::new(0.0, 0.0, 0.0), Pose2::new(1.0, 1.5, -1.5));
     for kind in PlannerKind::ALL {
-        let e = plan(kind, &req, &PlannerConfig::default()).expect_err("infeasible");
+        let e = plan(kind, &req).expect_err("infeasible");
         let text = e.to_string();
         assert!(
             matches!(
@@ -168,9 +164,8 @@ fn mirrored_goals_give_mirrored_spirals() {
     left.start_curvature_per_m = 0.1;
     let mut right = PlanRequest::new(start, Pose2::new(6.0, -1.0, -0.3));
     right.start_curvature_per_m = -0.1;
-    let cfg = PlannerConfig::default();
-    let l = plan(PlannerKind::Spiral, &left, &cfg).expect("feasible");
-    let r = plan(PlannerKind::Spiral, &right, &cfg).expect("feasible");
+    let l = plan(PlannerKind::Spiral, &left).expect("feasible");
+    let r = plan(PlannerKind::Spiral, &right).expect("feasible");
     assert!((l.cost - r.cost).abs() < 1e-9);
     for (a, b) in l.path.samples.iter().zip(&r.path.samples) {
         assert!(
@@ -191,7 +186,7 @@ fn large_turn_spiral_endpoint_is_exact() {
     );
     let mut req = PlanRequest::new(start, goal);
     req.start_curvature_per_m = -0.654_394_592_948_561_6;
-    let p = plan(PlannerKind::Spiral, &req, &PlannerConfig::default()).expect("feasible");
+    let p = plan(PlannerKind::Spiral, &req).expect("feasible");
     let m = p.path.metrics(&start, &goal, &req.truck);
     assert!(
         m.endpoint_position_error_m < 1e-6,
@@ -211,8 +206,7 @@ fn symmetric_lane_change_spiral_is_found() {
             Pose2::new(5.0, 1.254_866_699_262_767_5, 0.0),
         );
         req.start_curvature_per_m = k0;
-        let p = plan(PlannerKind::Spiral, &req, &PlannerConfig::default())
-            .unwrap_or_else(|e| panic!("k0 = {k0}: {e}"));
+        let p = plan(PlannerKind::Spiral, &req).unwrap_or_else(|e| panic!("k0 = {k0}: {e}"));
         let m = p.path.metrics(&req.start, &req.goal, &req.truck);
         assert!(
             m.endpoint_position_error_m < 1e-6,

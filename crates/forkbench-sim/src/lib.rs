@@ -1,6 +1,5 @@
 //! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers, fixed racks.
 
-
 use forkbench_core::{ForkliftSpec, Pose2};
 use rapier2d::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -41,7 +40,6 @@ impl Default for SimConfig {
         }
     }
 }
-
 
 /// Why a world could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -147,7 +147,12 @@ impl PurePursuit {
 
     /// Where the path is, relative to the truck: closest sample, look-ahead point, the
     /// pursuit arc. `None` without a path.
-    pub(crate) fn geometry(&mut self, root: &Pose2, ld: f64, truck: &ForkliftSpec) -> Option<Geometry> {
+    pub(crate) fn geometry(
+        &mut self,
+        root: &Pose2,
+        ld: f64,
+        truck: &ForkliftSpec,
+    ) -> Option<Geometry> {
         let pose = &root.to_world(&Pose2::new(-self.root_ahead_m, 0.0, 0.0));
         let n = self.path.samples.len();
         let last = self.path.samples.last().copied()?;
@@ -269,7 +274,11 @@ impl Tracker for PurePursuit {
     }
 
     fn reset(&mut self, path: &Path, truck: &ForkliftSpec) {
-        *self = Self::new(path.clone(), self.cfg.clone(), truck.fork_root_ahead_of_front_axle_m);
+        *self = Self::new(
+            path.clone(),
+            self.cfg.clone(),
+            truck.fork_root_ahead_of_front_axle_m,
+        );
     }
 
     fn command(&mut self, state: &TrackerInput) -> Command {

@@ -118,7 +118,8 @@ impl Tracker for RegulatedPurePursuit {
 
     fn command(&mut self, input: &TrackerInput) -> Command {
         let c = &self.cfg;
-        let ld = (c.lookahead_time_s * input.speed_mps.abs()).clamp(c.min_lookahead_m, c.max_lookahead_m);
+        let ld = (c.lookahead_time_s * input.speed_mps.abs())
+            .clamp(c.min_lookahead_m, c.max_lookahead_m);
         let Some(g) = self.pursuit.geometry(&input.pose, ld, input.truck) else {
             return crate::pursuit::stopped(&input.pose);
         };
@@ -153,7 +154,7 @@ mod tests {
         let tight = rpp.speed(1.0, 10.0, &truck);
         let approach = rpp.speed(0.0, 1.0, &truck);
         assert!((open - 0.8).abs() < 1e-12, "{open}");
-        assert!(tight < 0.5 && tight >= 0.25, "{tight}");
+        assert!((0.25..0.5).contains(&tight), "{tight}");
         assert!(approach < open && approach >= 0.15, "{approach}");
     }
 
@@ -161,7 +162,13 @@ mod tests {
     fn follows_a_straight_path_to_its_end() {
         let truck = ForkliftSpec::default();
         let mut rpp = RegulatedPurePursuit::new(RegulatedConfig::default());
-        rpp.reset(&straight(5.0), &ForkliftSpec { fork_root_ahead_of_front_axle_m: 0.0, ..truck.clone() });
+        rpp.reset(
+            &straight(5.0),
+            &ForkliftSpec {
+                fork_root_ahead_of_front_axle_m: 0.0,
+                ..truck.clone()
+            },
+        );
         let input = |x: f64, y: f64, v: f64| TrackerInput {
             t_s: 0.0,
             pose: Pose2::new(x, y, 0.0),
@@ -169,7 +176,10 @@ mod tests {
             steer_rad: 0.0,
             truck: &truck,
         };
-        assert!(rpp.command(&input(1.0, 0.2, 0.5)).steer_rad < 0.0, "steers back");
+        assert!(
+            rpp.command(&input(1.0, 0.2, 0.5)).steer_rad < 0.0,
+            "steers back"
+        );
         let end = rpp.command(&input(4.999, 0.0, 0.05));
         assert!(end.done && end.speed_mps == 0.0);
     }

@@ -8,30 +8,30 @@ use crate::scenario::{Scenario, World};
 const SCENARIOS: [(&str, &str); 4] = [
     (
         "scenarios/field-test.toml",
-        include_str!("../../../scenarios/field-test.toml"),
+        include_str!("../data/scenarios/field-test.toml"),
     ),
     (
         "scenarios/rack-pick.toml",
-        include_str!("../../../scenarios/rack-pick.toml"),
+        include_str!("../data/scenarios/rack-pick.toml"),
     ),
     (
         "scenarios/bspline-table2.toml",
-        include_str!("../../../scenarios/bspline-table2.toml"),
+        include_str!("../data/scenarios/bspline-table2.toml"),
     ),
     (
         "scenarios/spiral-table2.toml",
-        include_str!("../../../scenarios/spiral-table2.toml"),
+        include_str!("../data/scenarios/spiral-table2.toml"),
     ),
 ];
 
 const WORLDS: [(&str, &str); 2] = [
     (
         "open-floor.toml",
-        include_str!("../../../worlds/open-floor.toml"),
+        include_str!("../data/worlds/open-floor.toml"),
     ),
     (
         "rack-bay.toml",
-        include_str!("../../../worlds/rack-bay.toml"),
+        include_str!("../data/worlds/rack-bay.toml"),
     ),
 ];
 

@@ -9,9 +9,9 @@ pub mod scenario;
 pub mod stats;
 pub mod trial;
 
+pub use components::{ComponentSpec, Registry, Role};
 pub use outcome::{Failure, TrialOutcome};
 pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord, Tee};
-pub use components::{ComponentSpec, Registry, Role};
 pub use scenario::{Case, PoseDeg, Scenario, Tolerances, World};
 pub use trial::{Resolved, TrialOptions, run_trial, run_trial_recorded};
 

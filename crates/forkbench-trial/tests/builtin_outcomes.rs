@@ -73,7 +73,9 @@ fn built_in_outcomes_are_identical_to_the_records_before_the_change() {
     let mut differing = Vec::new();
     for v in &got {
         let k = key(v);
-        let w = want.get(&k).unwrap_or_else(|| panic!("no committed record for {k:?}"));
+        let w = want
+            .get(&k)
+            .unwrap_or_else(|| panic!("no committed record for {k:?}"));
         if w != v {
             differing.push(k);
         }

@@ -20,7 +20,10 @@ fn error(body: &str) -> String {
 #[test]
 fn old_scenario_files_keep_working() {
     let s = parse("planner = \"spiral\"\n[tracker]\nlookahead_m = 0.9\n").expect("old form");
-    assert_eq!((s.planner.kind.as_str(), s.planner.name.as_str()), ("spiral", "spiral"));
+    assert_eq!(
+        (s.planner.kind.as_str(), s.planner.name.as_str()),
+        ("spiral", "spiral")
+    );
     assert_eq!(s.tracker.kind, "pure_pursuit");
     assert_eq!(s.tracker.settings.get("lookahead_m"), Some(&0.9.into()));
 }
@@ -40,24 +43,44 @@ fn tables_name_the_kind_a_name_and_settings() {
 #[test]
 fn unknown_kinds_and_settings_name_file_line_and_field() {
     let e = error("[planner]\nkind = \"bspline\"\ngrid_points = 8\nmin_handel_m = 1.0\n");
-    assert!(e.starts_with("c.toml:7: field `planner.min_handel_m`"), "{e}");
+    assert!(
+        e.starts_with("c.toml:7: field `planner.min_handel_m`"),
+        "{e}"
+    );
     let e = error("planner = \"bspline\"\n[tracker]\nkind = \"stanley\"\n");
     assert!(e.starts_with("c.toml:6: field `tracker.kind`"), "{e}");
     assert!(e.contains("pure_pursuit, regulated_pure_pursuit"), "{e}");
     let e = error("planner = \"bspline\"\n[tracker]\ncruise_speed_mps = -1\n");
-    assert!(e.starts_with("c.toml:6: field `tracker.cruise_speed_mps`"), "{e}");
+    assert!(
+        e.starts_with("c.toml:6: field `tracker.cruise_speed_mps`"),
+        "{e}"
+    );
     let e = error("[planner]\nkind = \"external\"\n");
     assert!(e.contains("field `planner.command`"), "{e}");
     let e = error("[planner]\ngrid_points = 8\n");
-    assert!(e.contains("field `planner.kind`") && e.contains("missing"), "{e}");
+    assert!(
+        e.contains("field `planner.kind`") && e.contains("missing"),
+        "{e}"
+    );
 }
 
 #[test]
 fn a_run_names_the_scenarios_own_component_or_a_registered_kind() {
     let s = parse("[planner]\nkind = \"bspline\"\nname = \"mine\"\n").expect("loads");
     use forkbench_trial::Role;
-    assert_eq!(s.component(Role::Planner, Some("mine")).expect("own").kind, "bspline");
-    assert_eq!(s.component(Role::Planner, Some("spiral")).expect("kind").kind, "spiral");
-    let e = s.component(Role::Planner, Some("nope")).expect_err("unknown").to_string();
+    assert_eq!(
+        s.component(Role::Planner, Some("mine")).expect("own").kind,
+        "bspline"
+    );
+    assert_eq!(
+        s.component(Role::Planner, Some("spiral"))
+            .expect("kind")
+            .kind,
+        "spiral"
+    );
+    let e = s
+        .component(Role::Planner, Some("nope"))
+        .expect_err("unknown")
+        .to_string();
     assert!(e.contains("unknown planner \"nope\""), "{e}");
 }

@@ -40,7 +40,11 @@ fn the_example_planner_runs_in_a_trial_and_a_batch() {
         force_new: true,
     };
     let summary = run_batch(&spec, &dir, 2, &|_| {}).expect("batch");
-    let rows: Vec<_> = summary.rows.iter().map(|r| (r.planner.as_str(), r.tracker.as_str())).collect();
+    let rows: Vec<_> = summary
+        .rows
+        .iter()
+        .map(|r| (r.planner.as_str(), r.tracker.as_str()))
+        .collect();
     assert_eq!(
         rows,
         [

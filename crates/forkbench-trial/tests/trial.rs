@@ -193,7 +193,7 @@ fn bad_scenarios_are_rejected_with_file_line_and_field() {
     );
     assert!(e.contains("overlapping the pallet"), "{e}");
     let e = parse_err(&base.replace("bspline", "rrt"));
-    assert!(e.contains("rrt") && e.contains("line 2"), "{e}");
+    assert!(e.contains("rrt") && e.contains("bad.toml:2:"), "{e}");
     let e = parse_err(&format!("{base}[tolerances]\ninsertion_depth_m = 1.5\n"));
     assert!(e.contains("tolerances.insertion_depth_m"), "{e}");
 }

@@ -26,7 +26,9 @@ pub fn path_violation(path: &Path, req: &PlanRequest) -> Option<String> {
             .iter()
             .all(|v| v.is_finite())
     }) {
-        return Some(format!("sample {i} has a non-finite value (NaN or infinity)"));
+        return Some(format!(
+            "sample {i} has a non-finite value (NaN or infinity)"
+        ));
     }
     spacing_violation(path)
         .or_else(|| endpoint_violation(path, req))
@@ -57,7 +59,11 @@ fn spacing_violation(path: &Path) -> Option<String> {
 fn endpoint_violation(path: &Path, req: &PlanRequest) -> Option<String> {
     let ends = [
         ("start", path.samples[0].pose(), req.start),
-        ("goal", path.samples[path.samples.len() - 1].pose(), req.goal),
+        (
+            "goal",
+            path.samples[path.samples.len() - 1].pose(),
+            req.goal,
+        ),
     ];
     ends.iter().find_map(|(what, got, want)| {
         let off = got.distance_to(want);
@@ -66,7 +72,11 @@ fn endpoint_violation(path: &Path, req: &PlanRequest) -> Option<String> {
             format!(
                 "the path does not {} the {what}: {off:.3} m and {:.2}° off (tolerance \
                  {ENDPOINT_TOLERANCE_M} m, {:.1}°)",
-                if *what == "start" { "start at" } else { "end at" },
+                if *what == "start" {
+                    "start at"
+                } else {
+                    "end at"
+                },
                 turn.to_degrees(),
                 ENDPOINT_TOLERANCE_RAD.to_degrees()
             )

@@ -83,18 +83,27 @@ impl ExternalPlanner {
         let taken = POOL.with(|p| p.borrow_mut().remove(&key));
         let (mut proc, id) = match taken {
             Some(p) => p,
-            None => (Process::start(&self.cfg.command, &self.dir, self.timeout())?, 0),
+            None => (
+                Process::start(&self.cfg.command, &self.dir, self.timeout())?,
+                0,
+            ),
         };
         let line = serde_json::to_string(&RequestMsg::new(id, req)).map_err(|e| e.to_string())?;
         let answer = proc.exchange(&line, self.timeout())?;
         let msg: ResponseMsg = serde_json::from_str(&answer).map_err(|e| {
             // Python's json writes NaN and Infinity, which JSON has no numbers for.
-            let hint = if ["NaN", "Infinity", "null"].iter().any(|t| answer.contains(t)) {
+            let hint = if ["NaN", "Infinity", "null"]
+                .iter()
+                .any(|t| answer.contains(t))
+            {
                 "; a non-finite value (NaN, Infinity) in the path?"
             } else {
                 ""
             };
-            format!("invalid JSON in the answer ({e}{hint}): {:?}", clip(&answer))
+            format!(
+                "invalid JSON in the answer ({e}{hint}): {:?}",
+                clip(&answer)
+            )
         })?;
         let got = match &msg {
             ResponseMsg::Path { id, .. } | ResponseMsg::Error { id, .. } => *id,

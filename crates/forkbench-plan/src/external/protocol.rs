@@ -118,13 +118,15 @@ pub fn to_path(samples: &[[f64; 5]]) -> Path {
     Path {
         samples: samples
             .iter()
-            .map(|&[s_m, x_m, y_m, heading_rad, curvature_per_m]| PathSample {
-                s_m,
-                x_m,
-                y_m,
-                heading_rad,
-                curvature_per_m,
-            })
+            .map(
+                |&[s_m, x_m, y_m, heading_rad, curvature_per_m]| PathSample {
+                    s_m,
+                    x_m,
+                    y_m,
+                    heading_rad,
+                    curvature_per_m,
+                },
+            )
             .collect(),
     }
 }

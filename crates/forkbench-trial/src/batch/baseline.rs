@@ -59,10 +59,7 @@ impl Baseline {
             )));
         }
         for (i, r) in b.rows.iter().enumerate() {
-            if let Some(j) = b.rows[..i]
-                .iter()
-                .position(|o| o.key() == r.key())
-            {
+            if let Some(j) = b.rows[..i].iter().position(|o| o.key() == r.key()) {
                 return Err(BatchError::Invalid(format!(
                     "{}: rows[{i}] repeats rows[{j}] ({} / {} / {}); each scenario × planner × \
                      tracker once",
@@ -116,42 +113,41 @@ pub fn regress(
     floor: Option<f64>,
 ) -> (Vec<RegressRow>, bool) {
     let mut failed = false;
-    let rows = base
-        .rows
-        .iter()
-        .map(|b| {
-            let r = now
-                .rows
-                .iter()
-                .find(|r| (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str()) == b.key());
-            let base_rate = b.successes as f64 / b.trials as f64;
-            let (now_rate, n, p, verdict) = match r {
-                None => (None, 0, None, "missing"),
-                Some(r) => {
-                    let p = drop_p_value(b.successes, b.trials, r.successes, r.trials);
-                    let v = if p < alpha {
-                        "drop"
-                    } else if floor.is_some_and(|f| r.success_rate < f) {
-                        "below_floor"
-                    } else {
-                        "ok"
-                    };
-                    (Some(r.success_rate), r.trials, Some(p), v)
+    let rows =
+        base.rows
+            .iter()
+            .map(|b| {
+                let r = now.rows.iter().find(|r| {
+                    (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str()) == b.key()
+                });
+                let base_rate = b.successes as f64 / b.trials as f64;
+                let (now_rate, n, p, verdict) = match r {
+                    None => (None, 0, None, "missing"),
+                    Some(r) => {
+                        let p = drop_p_value(b.successes, b.trials, r.successes, r.trials);
+                        let v = if p < alpha {
+                            "drop"
+                        } else if floor.is_some_and(|f| r.success_rate < f) {
+                            "below_floor"
+                        } else {
+                            "ok"
+                        };
+                        (Some(r.success_rate), r.trials, Some(p), v)
+                    }
+                };
+                failed |= verdict != "ok";
+                RegressRow {
+                    scenario: b.scenario.clone(),
+                    planner: b.planner.clone(),
+                    tracker: b.tracker.clone(),
+                    baseline_rate: base_rate,
+                    now_rate,
+                    now_trials: n,
+                    p_value: p,
+                    verdict: verdict.to_owned(),
                 }
-            };
-            failed |= verdict != "ok";
-            RegressRow {
-                scenario: b.scenario.clone(),
-                planner: b.planner.clone(),
-                tracker: b.tracker.clone(),
-                baseline_rate: base_rate,
-                now_rate,
-                now_trials: n,
-                p_value: p,
-                verdict: verdict.to_owned(),
-            }
-        })
-        .collect();
+            })
+            .collect();
     (rows, failed)
 }
 

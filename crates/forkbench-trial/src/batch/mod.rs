@@ -13,11 +13,15 @@ mod baseline;
 mod manifest;
 mod store;
 mod summary;
+mod sweep;
 
 pub use baseline::{Baseline, BaselineRow, RegressRow, regress, regress_markdown};
 pub use manifest::{DirLock, Manifest};
 pub use store::{load_results, merge, read_records};
 pub use summary::{Summary, SummaryRow, summarize};
+pub use sweep::{
+    RecordChoice, RecordJob, SweepPoint, sweep_markdown, sweep_points, trials_to_record,
+};
 
 use store::{check_unique, read_records_torn, remove_if_present, rewrite_records};
 use summary::write_summary;
@@ -156,7 +160,10 @@ impl BatchSpec {
         for (si, s) in self.scenarios.iter().enumerate() {
             let (planners, trackers) = self.components_of(s);
             for ci in 0..s.cases.len() {
-                for (p, tr) in planners.iter().flat_map(|p| trackers.iter().map(move |t| (p, t))) {
+                for (p, tr) in planners
+                    .iter()
+                    .flat_map(|p| trackers.iter().map(move |t| (p, t)))
+                {
                     for t in 0..self.trials {
                         if k % self.shard.1 == self.shard.0 {
                             out.push(Job {

@@ -29,7 +29,8 @@ pub type TrackerCtor = Ctor<Box<dyn Tracker>>;
 /// Builds the localisation sensor from the scenario's NAV350 settings (noise on or off).
 pub type LocalizerCtor = Arc<dyn Fn(&Nav350Config, bool) -> Box<dyn Localizer> + Send + Sync>;
 /// Builds the pallet-pose estimator from the scenario's estimate settings.
-pub type EstimatorCtor = Arc<dyn Fn(&PalletEstimateConfig) -> Box<dyn PalletEstimator> + Send + Sync>;
+pub type EstimatorCtor =
+    Arc<dyn Fn(&PalletEstimateConfig) -> Box<dyn PalletEstimator> + Send + Sync>;
 
 /// Planners and trackers by name, and the sensor models.
 #[derive(Clone)]
@@ -53,12 +54,18 @@ impl Registry {
     /// The components forkbench ships. A new one is one line here.
     pub fn builtin() -> Self {
         Self::sensors_only()
-            .with_planner("bspline", |s, _| Ok(Box::new(BsplinePlanner::from_settings(s)?)))
-            .with_planner("spiral", |s, _| Ok(Box::new(SpiralPlanner::from_settings(s)?)))
+            .with_planner("bspline", |s, _| {
+                Ok(Box::new(BsplinePlanner::from_settings(s)?))
+            })
+            .with_planner("spiral", |s, _| {
+                Ok(Box::new(SpiralPlanner::from_settings(s)?))
+            })
             .with_planner("external", |s, cx| {
                 Ok(Box::new(ExternalPlanner::from_settings(s, cx.dir.clone())?))
             })
-            .with_tracker("pure_pursuit", |s, _| Ok(Box::new(PurePursuit::from_settings(s)?)))
+            .with_tracker("pure_pursuit", |s, _| {
+                Ok(Box::new(PurePursuit::from_settings(s)?))
+            })
             .with_tracker("regulated_pure_pursuit", |s, _| {
                 Ok(Box::new(RegulatedPurePursuit::from_settings(s)?))
             })

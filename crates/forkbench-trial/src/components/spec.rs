@@ -62,7 +62,9 @@ impl ComponentSpec {
         dir: PathBuf,
     ) -> Result<Self, SettingsError> {
         let mut settings = match value {
-            toml::Value::String(kind) => Settings::from_iter([("kind".to_owned(), kind.as_str().into())]),
+            toml::Value::String(kind) => {
+                Settings::from_iter([("kind".to_owned(), kind.as_str().into())])
+            }
             toml::Value::Table(t) => t.clone(),
             _ => {
                 return Err(SettingsError {

@@ -23,13 +23,18 @@ impl Trial<'_> {
         reestimates.sort_by(|a, b| b.total_cmp(a));
         while self.sim.time_s() < self.scn.timeout_s {
             let truth = self.sim.fork_root_pose();
-            let fix = self.localizer.update(self.sim.time_s(), &truth, &mut self.nav_rng);
+            let fix = self
+                .localizer
+                .update(self.sim.time_s(), &truth, &mut self.nav_rng);
             if let Some(fix) = fix {
                 self.predictor.fix(fix);
             }
             let pose = self.predictor.pose().unwrap_or(self.first_fix);
             if !(pose.is_finite() && truth.is_finite()) {
-                return Err(format!("non-finite state at t = {:.3} s", self.sim.time_s()));
+                return Err(format!(
+                    "non-finite state at t = {:.3} s",
+                    self.sim.time_s()
+                ));
             }
             if self.run.replan
                 && reestimates
@@ -56,7 +61,13 @@ impl Trial<'_> {
     }
 
     /// One physics step under `cmd`, its record, and the entry check.
-    fn step<R: Recorder + ?Sized>(&mut self, cmd: &Command, fix: Option<Pose2>, pose: Pose2, rec: &mut R) {
+    fn step<R: Recorder + ?Sized>(
+        &mut self,
+        cmd: &Command,
+        fix: Option<Pose2>,
+        pose: Pose2,
+        rec: &mut R,
+    ) {
         let truck = &self.scn.truck;
         self.sim.step(cmd.speed_mps, cmd.steer_rad);
         self.predictor.propagate(
@@ -68,7 +79,11 @@ impl Trial<'_> {
         );
         self.out.max_steer_rad = self.out.max_steer_rad.max(self.sim.steer_rad().abs());
         if self.sim.obstacle_contact() && !self.collision {
-            rec.event(self.sim.time_s(), Level::Error, "truck touched a rack or wall");
+            rec.event(
+                self.sim.time_s(),
+                Level::Error,
+                "truck touched a rack or wall",
+            );
         }
         self.collision |= self.sim.obstacle_contact();
         rec.step(&StepRecord {
@@ -97,10 +112,16 @@ impl Trial<'_> {
         let pallet_now = self.sim.pallet_pose();
         let depth = insertion_depth(&pallet_now, &root, &self.scn.truck);
         if depth < self.insertion_m - 0.01 {
-            self.out.max_contact_force_n = self.out.max_contact_force_n.max(self.sim.fork_contact_force_n());
+            self.out.max_contact_force_n = self
+                .out
+                .max_contact_force_n
+                .max(self.sim.fork_contact_force_n());
         }
         let local = in_pallet_frame(&pallet_now, &root);
-        if self.out.lateral_error_m.is_none() && depth >= 0.0 && local.y_m.abs() < self.scn.pallet.width_m / 2.0 {
+        if self.out.lateral_error_m.is_none()
+            && depth >= 0.0
+            && local.y_m.abs() < self.scn.pallet.width_m / 2.0
+        {
             self.out.lateral_error_m = Some(local.y_m);
             self.out.heading_error_rad = Some(local.heading_rad);
             rec.event(
@@ -123,7 +144,9 @@ impl Trial<'_> {
         let moved = new_est.distance_to(&self.pallet_est);
         let turned = wrap_angle(new_est.heading_rad - self.pallet_est.heading_rad).abs();
         let limits = &self.scn.replan;
-        if moved <= limits.position_threshold_m && turned <= limits.heading_threshold_deg.to_radians() {
+        if moved <= limits.position_threshold_m
+            && turned <= limits.heading_threshold_deg.to_radians()
+        {
             return;
         }
         let t = self.sim.time_s();
@@ -136,7 +159,12 @@ impl Trial<'_> {
             });
         match replan {
             Ok(p) => {
-                rec.plan(t, self.out.replans + 1, &p.path, p.control_polygon_m.as_deref());
+                rec.plan(
+                    t,
+                    self.out.replans + 1,
+                    &p.path,
+                    p.control_polygon_m.as_deref(),
+                );
                 rec.event(
                     t,
                     Level::Info,
@@ -150,7 +178,11 @@ impl Trial<'_> {
                 self.out.replans += 1;
             }
             Err(e) => {
-                rec.event(t, Level::Warn, &format!("replan refused, keeping the old plan: {e}"));
+                rec.event(
+                    t,
+                    Level::Warn,
+                    &format!("replan refused, keeping the old plan: {e}"),
+                );
                 self.out.replans_failed += 1;
             }
         }

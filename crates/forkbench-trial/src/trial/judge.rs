@@ -76,7 +76,10 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
     let (out, tol, truck) = (&t.out, &t.scn.tolerances, &t.scn.truck);
     let clearance = (t.scn.pallet.pocket_width_m - truck.fork_width_m) / 2.0;
     if t.collision {
-        return Some((Failure::Collision, "truck touched a rack or wall".to_owned()));
+        return Some((
+            Failure::Collision,
+            "truck touched a rack or wall".to_owned(),
+        ));
     }
     if out.max_contact_force_n > tol.contact_force_n {
         return Some((
@@ -104,10 +107,16 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
     if let Some(e) = out.lateral_error_m.filter(|e| e.abs() > tol.lateral_m) {
         return Some((
             Failure::LateralError,
-            format!("{e:.3} m off the pocket centre line at entry (limit {} m)", tol.lateral_m),
+            format!(
+                "{e:.3} m off the pocket centre line at entry (limit {} m)",
+                tol.lateral_m
+            ),
         ));
     }
-    if let Some(e) = out.heading_error_rad.filter(|e| e.abs() > tol.heading_deg.to_radians()) {
+    if let Some(e) = out
+        .heading_error_rad
+        .filter(|e| e.abs() > tol.heading_deg.to_radians())
+    {
         return Some((
             Failure::HeadingError,
             format!(

@@ -9,11 +9,11 @@ use std::time::Instant;
 
 use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
 
+use crate::TrialError;
 use crate::components::{ComponentSpec, Role};
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
-use crate::TrialError;
 
 pub use setup::Trial;
 
@@ -70,15 +70,17 @@ impl Scenario {
             return Ok(own.clone());
         };
         let spec = ComponentSpec::of_kind(role, name);
-        self.registry.check(&spec).map_err(|e| TrialError::Invalid {
-            file: self.file.clone(),
-            field: role.to_string(),
-            reason: format!(
-                "{name:?} is neither this scenario's {role} ({:?}) nor a {role} kind usable \
+        self.registry
+            .check(&spec)
+            .map_err(|e| TrialError::Invalid {
+                file: self.file.clone(),
+                field: role.to_string(),
+                reason: format!(
+                    "{name:?} is neither this scenario's {role} ({:?}) nor a {role} kind usable \
                  with default settings: {e}",
-                own.name
-            ),
-        })?;
+                    own.name
+                ),
+            })?;
         Ok(spec)
     }
 

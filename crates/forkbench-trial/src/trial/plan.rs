@@ -18,7 +18,12 @@ impl Trial<'_> {
     /// Plans from `pose` (path curvature `curvature`) to the pre-entry pose of `est`. The
     /// planner's curve ends aligned with the pockets, tips just short of the face (the
     /// papers' P_dest); the forks then go in straight to the target depth.
-    pub(super) fn plan_from(&mut self, pose: Pose2, curvature: f64, est: &Pose2) -> Result<Plan, String> {
+    pub(super) fn plan_from(
+        &mut self,
+        pose: Pose2,
+        curvature: f64,
+        est: &Pose2,
+    ) -> Result<Plan, String> {
         let truck = &self.scn.truck;
         let mut req = PlanRequest::new(pose, goal_for(est, truck, -APPROACH_GAP_M));
         req.truck = truck.clone();
@@ -26,7 +31,8 @@ impl Trial<'_> {
         req.obstacles = self.obstacles.clone();
         req.seed = self.run.seed;
         let mut plan = self.planner.plan(&req).map_err(|e| e.to_string())?;
-        plan.path.extend_straight(APPROACH_GAP_M + self.insertion_m, 0.01);
+        plan.path
+            .extend_straight(APPROACH_GAP_M + self.insertion_m, 0.01);
         Ok(plan)
     }
 

@@ -47,7 +47,9 @@ pub struct Trial<'a> {
 
 impl std::fmt::Debug for Trial<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Trial").field("out", &self.out).finish_non_exhaustive()
+        f.debug_struct("Trial")
+            .field("out", &self.out)
+            .finish_non_exhaustive()
     }
 }
 
@@ -80,7 +82,14 @@ impl<'a> Trial<'a> {
         // Per-trial jitter of where the pallet really stands (its own random stream).
         let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(run.seed, 3));
         let obstacles = scn.world.obstacles();
-        let sim = Sim::new(&scn.truck, &case.start, &scn.pallet, &true_pallet, &obstacles, &scn.sim);
+        let sim = Sim::new(
+            &scn.truck,
+            &case.start,
+            &scn.pallet,
+            &true_pallet,
+            &obstacles,
+            &scn.sim,
+        );
         let sim = match sim {
             Ok(s) => s,
             Err(e) => {
