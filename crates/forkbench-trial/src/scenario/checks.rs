@@ -1,0 +1,243 @@
+//! Checks of a scenario at load: run settings, value ranges, and the layout of every case (no overlaps at the start).
+
+use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
+use forkbench_geom::{Footprint, Obstacles};
+
+use super::file::{CaseFile, PalletPlacement, ScenarioFile};
+use super::{Case, MAX_CASES, MAX_TIMEOUT_S, World, invalid};
+use crate::TrialError;
+
+/// The truck body's footprint referenced to the fork root: the chassis ends there (forks
+/// excluded, since they are meant to enter the pallet).
+pub fn truck_footprint(truck: &ForkliftSpec) -> Footprint {
+    Footprint {
+        length_m: truck.body_length_m,
+        width_m: truck.body_width_m,
+        centre_ahead_m: -truck.body_length_m / 2.0,
+    }
+}
+
+/// The pallet's footprint referenced to its face centre.
+pub fn pallet_footprint(pallet: &PalletSpec) -> Footprint {
+    Footprint {
+        length_m: pallet.depth_m,
+        width_m: pallet.width_m,
+        centre_ahead_m: pallet.depth_m / 2.0,
+    }
+}
+
+/// Layouts may touch (a pallet against a rack's back, a truck parked flush to a wall):
+/// footprints are shrunk by this on every side before the overlap test.
+const LAYOUT_TOLERANCE_M: f64 = 1e-3;
+
+fn shrunk(fp: Footprint) -> Footprint {
+    Footprint {
+        length_m: fp.length_m - 2.0 * LAYOUT_TOLERANCE_M,
+        width_m: fp.width_m - 2.0 * LAYOUT_TOLERANCE_M,
+        ..fp
+    }
+}
+
+fn check_layout(
+    case: &Case,
+    truck: &ForkliftSpec,
+    pallet: &PalletSpec,
+    world: &World,
+    file: &str,
+    field: &str,
+) -> Result<(), TrialError> {
+    let (obstacles, labels) = world.footprint_obstacles();
+    let (pallet_fp, truck_fp) = (
+        shrunk(pallet_footprint(pallet)),
+        shrunk(truck_footprint(truck)),
+    );
+    if let Some(i) = obstacles.hit(&pallet_fp, &case.pallet) {
+        return Err(invalid(
+            file,
+            &format!("{field}pallet"),
+            &format!("pallet overlaps {}", labels[i]),
+        ));
+    }
+    if let Some(i) = obstacles.hit(&truck_fp, &case.start) {
+        return Err(invalid(
+            file,
+            &format!("{field}start"),
+            &format!("truck starts inside {}", labels[i]),
+        ));
+    }
+    let mut pallet_only = Obstacles::new();
+    pallet_only.add_rect(
+        &pallet_fp.centre(&case.pallet),
+        pallet_fp.length_m,
+        pallet_fp.width_m,
+    );
+    if pallet_only.collides(&truck_fp, &case.start) {
+        return Err(invalid(
+            file,
+            &format!("{field}start"),
+            "truck starts overlapping the pallet",
+        ));
+    }
+    Ok(())
+}
+
+/// Run settings of a scenario file, checked at load: the trial timeout, [sim], [replan]
+/// and the tolerances.
+fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
+    if !(f.timeout_s.is_finite() && f.timeout_s > 0.0 && f.timeout_s <= MAX_TIMEOUT_S) {
+        return Err(invalid(
+            file,
+            "timeout_s",
+            "must be a positive time of at most 600 s",
+        ));
+    }
+    if let Err(forkbench_sim::SimError::Config { field, reason, .. }) = f.sim.validate() {
+        return Err(invalid(file, &format!("sim.{field}"), reason));
+    }
+    for (name, v) in [
+        ("position_threshold_m", f.replan.position_threshold_m),
+        ("heading_threshold_deg", f.replan.heading_threshold_deg),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(invalid(
+                file,
+                &format!("replan.{name}"),
+                "must be a positive finite number (NaN would disable the trigger)",
+            ));
+        }
+    }
+    let t = &f.tolerances;
+    for (name, v) in [
+        ("lateral_m", t.lateral_m),
+        ("heading_deg", t.heading_deg),
+        ("insertion_depth_m", t.insertion_depth_m),
+        ("contact_force_n", t.contact_force_n),
+        ("pallet_displacement_m", t.pallet_displacement_m),
+        ("pallet_rotation_deg", t.pallet_rotation_deg),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(invalid(
+                file,
+                &format!("tolerances.{name}"),
+                "must be a positive finite number",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Value ranges of the truck, sensors, run settings, estimate bias and pallet jitter.
+pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
+    f.truck
+        .validate()
+        .map_err(|e| invalid(file, &format!("truck.{}", e.field), e.reason))?;
+    if let Some((field, reason)) = f.noise.nav350.invalid_field() {
+        return Err(invalid(file, &format!("noise.nav350.{field}"), reason));
+    }
+    if let Some((field, reason)) = f.noise.pallet_estimate.invalid_field() {
+        return Err(invalid(
+            file,
+            &format!("noise.pallet_estimate.{field}"),
+            reason,
+        ));
+    }
+    check_settings(f, file)?;
+    if let Some(b) = &f.estimate_bias {
+        b.check(file, "estimate_bias")?;
+    }
+    if let Some(j) = &f.pallet_jitter {
+        j.check(file, "pallet_jitter")?;
+        for (name, v) in [
+            ("x_m", j.x_m),
+            ("y_m", j.y_m),
+            ("heading_deg", j.heading_deg),
+        ] {
+            if v < 0.0 {
+                return Err(invalid(
+                    file,
+                    &format!("pallet_jitter.{name}"),
+                    "a standard deviation must be ≥ 0",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Where a placement puts the pallet: its pose, or the world's slot of that name.
+fn place(p: &PalletPlacement, world: &World, file: &str, field: &str) -> Result<Pose2, TrialError> {
+    match p {
+        PalletPlacement::Pose(pd) => {
+            pd.check(file, field)?;
+            Ok(pd.to_pose())
+        }
+        PalletPlacement::Slot { slot } => world
+            .pallet_slot
+            .iter()
+            .find(|s| &s.name == slot)
+            .map(|s| Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()))
+            .ok_or_else(|| {
+                invalid(
+                    file,
+                    &format!("{field}.slot"),
+                    &format!("world has no pallet slot {slot:?}"),
+                )
+            }),
+    }
+}
+
+/// The cases (or the one `default` case), each with its start and pallet resolved and
+/// its layout checked; names unique.
+pub(super) fn resolve_cases(
+    f: &ScenarioFile,
+    world: &World,
+    pallet: &PalletSpec,
+    file: &str,
+) -> Result<Vec<Case>, TrialError> {
+    if f.case.len() > MAX_CASES {
+        return Err(invalid(
+            file,
+            "case",
+            &format!("{} cases; at most {MAX_CASES} per file", f.case.len()),
+        ));
+    }
+    let default = [CaseFile {
+        name: "default".into(),
+        start: None,
+        pallet: None,
+    }];
+    let listed: &[CaseFile] = if f.case.is_empty() { &default } else { &f.case };
+    let mut cases: Vec<Case> = Vec::new();
+    for (i, c) in listed.iter().enumerate() {
+        let field = if f.case.is_empty() {
+            String::new()
+        } else {
+            format!("case[{i}].")
+        };
+        let start = c
+            .start
+            .or(f.start)
+            .ok_or_else(|| invalid(file, &format!("{field}start"), "missing"))?;
+        start.check(file, &format!("{field}start"))?;
+        let placement = c
+            .pallet
+            .as_ref()
+            .or(f.pallet.as_ref())
+            .ok_or_else(|| invalid(file, &format!("{field}pallet"), "missing"))?;
+        let case = Case {
+            name: c.name.clone(),
+            start: start.to_pose(),
+            pallet: place(placement, world, file, &format!("{field}pallet"))?,
+        };
+        check_layout(&case, &f.truck, pallet, world, file, &field)?;
+        if cases.iter().any(|k| k.name == case.name) {
+            return Err(invalid(
+                file,
+                &format!("{field}name"),
+                "duplicate case name",
+            ));
+        }
+        cases.push(case);
+    }
+    Ok(cases)
+}

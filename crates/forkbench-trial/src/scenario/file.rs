@@ -1,0 +1,162 @@
+//! The scenario file as written: its tables and their defaults, before validation.
+
+use std::path::PathBuf;
+
+use forkbench_core::ForkliftSpec;
+use forkbench_sensors::{Nav350Config, PalletEstimateConfig};
+use forkbench_sim::SimConfig;
+use serde::{Deserialize, Serialize};
+
+use super::PoseDeg;
+
+/// Where the pallet stands: a pose, or a slot of the world.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PalletPlacement {
+    Slot { slot: String },
+    Pose(PoseDeg),
+}
+
+/// Which pallet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PalletKind {
+    /// 1.2 × 1.2 m, 0.405 m pockets (the field test).
+    #[serde(rename = "field-1200")]
+    Field1200,
+    /// 1.0 × 1.0 m (the papers' simulations).
+    #[serde(rename = "sim-1000")]
+    Sim1000,
+}
+
+/// Success tolerances of a pick.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Tolerances {
+    /// Fork-root offset from the pocket centre line at entry.
+    pub lateral_m: f64,
+    pub heading_deg: f64,
+    /// Required fork insertion (tips past the pallet face).
+    pub insertion_depth_m: f64,
+    /// Fork–pallet contact force allowed before full depth.
+    pub contact_force_n: f64,
+    pub pallet_displacement_m: f64,
+    pub pallet_rotation_deg: f64,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Self {
+            // 0.15 m forks in 0.405 m pockets leave ±0.1275 m; keep a margin for the
+            // heading error's contribution along the fork.
+            lateral_m: 0.10,
+            heading_deg: 3.0,
+            insertion_depth_m: 1.0,
+            contact_force_n: 200.0,
+            pallet_displacement_m: 0.02,
+            pallet_rotation_deg: 1.0,
+        }
+    }
+}
+
+/// Sensor noise settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseFile {
+    pub enabled: bool,
+    pub nav350: Nav350Config,
+    pub pallet_estimate: PalletEstimateConfig,
+}
+
+impl Default for NoiseFile {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            nav350: Nav350Config::default(),
+            pallet_estimate: PalletEstimateConfig::default(),
+        }
+    }
+}
+
+/// Replanning when a new pallet estimate arrives.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ReplanFile {
+    /// Off reproduces the papers: plan once from the first estimate.
+    pub enabled: bool,
+    pub position_threshold_m: f64,
+    pub heading_threshold_deg: f64,
+}
+
+impl Default for ReplanFile {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            position_threshold_m: 0.02,
+            heading_threshold_deg: 1.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct CaseFile {
+    pub(super) name: String,
+    pub(super) start: Option<PoseDeg>,
+    pub(super) pallet: Option<PalletPlacement>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ScenarioFile {
+    pub(super) name: String,
+    #[serde(default)]
+    pub(super) description: String,
+    /// World file, relative to this scenario file; none is an open floor.
+    pub(super) world: Option<PathBuf>,
+    /// `planner = "bspline"` or a `[planner]` table with `kind` and its settings.
+    pub(super) planner: toml::Spanned<toml::Value>,
+    #[serde(default)]
+    pub(super) seed: u64,
+    #[serde(default = "default_pallet_kind")]
+    pub(super) pallet_kind: PalletKind,
+    #[serde(default = "default_timeout")]
+    pub(super) timeout_s: f64,
+    /// Refuse plans (and replans) whose swept truck body hits a rack or wall; off lets a
+    /// colliding plan be driven, to study the collision itself.
+    #[serde(default = "default_true")]
+    pub(super) validate_paths: bool,
+    #[serde(default)]
+    pub(super) truck: ForkliftSpec,
+    /// A `[tracker]` table: `kind` (default pure pursuit) and its settings.
+    pub(super) tracker: Option<toml::Spanned<toml::Value>>,
+    #[serde(default)]
+    pub(super) sim: SimConfig,
+    #[serde(default)]
+    pub(super) noise: NoiseFile,
+    #[serde(default)]
+    pub(super) replan: ReplanFile,
+    #[serde(default)]
+    pub(super) tolerances: Tolerances,
+    /// Fixed error of every pallet estimate, in the pallet frame (a miscalibrated camera);
+    /// kept with `--no-noise`, since it is not random.
+    pub(super) estimate_bias: Option<PoseDeg>,
+    /// Monte-Carlo jitter of the true pallet pose: σ per axis in the pallet frame,
+    /// drawn per trial (truncated at 3σ).
+    pub(super) pallet_jitter: Option<PoseDeg>,
+    pub(super) start: Option<PoseDeg>,
+    pub(super) pallet: Option<PalletPlacement>,
+    #[serde(default)]
+    pub(super) case: Vec<CaseFile>,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+fn default_pallet_kind() -> PalletKind {
+    PalletKind::Field1200
+}
+
+fn default_timeout() -> f64 {
+    120.0
+}

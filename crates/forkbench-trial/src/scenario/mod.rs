@@ -1,0 +1,285 @@
+//! Scenario and world files (TOML, unknown fields rejected), validated into SI-unit cases before any simulation.
+
+mod checks;
+mod file;
+mod world;
+
+use std::path::{Path as FsPath, PathBuf};
+use std::sync::Arc;
+
+use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
+use forkbench_sim::SimConfig;
+use serde::Serialize;
+
+use crate::TrialError;
+use crate::components::{ComponentSpec, Registry, Role};
+
+pub use checks::{pallet_footprint, truck_footprint};
+pub use file::{NoiseFile, PalletKind, PalletPlacement, ReplanFile, Tolerances};
+pub use world::{MAX_WORLD_EXTENT_M, PalletSlot, PoseDeg, RectFile, World};
+
+use checks::{check_values, resolve_cases};
+use file::ScenarioFile;
+
+/// Most cases one scenario file may list.
+pub const MAX_CASES: usize = 10_000;
+
+pub(crate) fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
+    TrialError::Invalid {
+        file: file.to_owned(),
+        field: field.to_owned(),
+        reason: reason.to_owned(),
+    }
+}
+
+/// Longest simulated trial a scenario may ask for: bounds the steps one trial takes.
+pub const MAX_TIMEOUT_S: f64 = 600.0;
+
+/// Largest scenario or world file read: far above any real one, and a bound on what a
+/// wrong path (a device, a huge file) can make the loader read.
+pub const MAX_INPUT_BYTES: u64 = 4 << 20;
+
+/// Longest parse message passed on: toml quotes the offending input, which for a
+/// pathological file can be most of it.
+const MAX_MESSAGE_CHARS: usize = 2000;
+
+pub(crate) fn read(path: &FsPath) -> Result<String, TrialError> {
+    use std::io::Read as _;
+    let err = |cause| TrialError::Read {
+        file: path.display().to_string(),
+        cause,
+    };
+    let file = std::fs::File::open(path).map_err(err)?;
+    let mut text = String::new();
+    file.take(MAX_INPUT_BYTES + 1)
+        .read_to_string(&mut text)
+        .map_err(err)?;
+    if text.len() as u64 > MAX_INPUT_BYTES {
+        return Err(TrialError::Parse {
+            file: path.display().to_string(),
+            message: format!("larger than {MAX_INPUT_BYTES} bytes; not a scenario or world file"),
+        });
+    }
+    Ok(text)
+}
+
+pub(crate) fn parse<T: serde::de::DeserializeOwned>(
+    text: &str,
+    file: &str,
+) -> Result<T, TrialError> {
+    toml::from_str(text).map_err(|e| {
+        let mut message = e.to_string().trim_end().to_owned();
+        if message.chars().count() > MAX_MESSAGE_CHARS {
+            message = message.chars().take(MAX_MESSAGE_CHARS).collect::<String>() + " …";
+        }
+        TrialError::Parse {
+            file: file.to_owned(),
+            message,
+        }
+    })
+}
+
+/// A loaded, validated scenario file (serialisable: a batch's manifest records it whole).
+#[derive(Debug, Clone, Serialize)]
+pub struct Scenario {
+    pub file: String,
+    pub name: String,
+    pub description: String,
+    pub planner: ComponentSpec,
+    pub tracker: ComponentSpec,
+    /// Builds the components this scenario names (and any a run asks for by name).
+    #[serde(skip)]
+    pub registry: Arc<Registry>,
+    pub seed: u64,
+    pub pallet: PalletSpec,
+    pub timeout_s: f64,
+    /// Plans whose swept truck body hits a rack or wall count as `plan_failed`.
+    pub validate_paths: bool,
+    pub truck: ForkliftSpec,
+    pub sim: SimConfig,
+    pub noise: NoiseFile,
+    pub replan: ReplanFile,
+    pub tolerances: Tolerances,
+    /// Fixed pallet-estimate error in the pallet frame.
+    pub estimate_bias: Pose2,
+    /// σ of the per-trial jitter of the true pallet pose (pallet frame; heading in rad).
+    pub pallet_jitter: Pose2,
+    pub world: World,
+    pub cases: Vec<Case>,
+}
+
+/// One start/pallet geometry of a scenario.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Case {
+    pub name: String,
+    /// Fork-root start pose.
+    pub start: Pose2,
+    /// Pallet front-face centre, heading into the pallet.
+    pub pallet: Pose2,
+}
+
+impl Scenario {
+    pub fn load(path: &FsPath) -> Result<Self, TrialError> {
+        Self::load_with(path, Registry::shared())
+    }
+
+    /// Loads with a registry that may hold the caller's own components.
+    pub fn load_with(path: &FsPath, registry: Arc<Registry>) -> Result<Self, TrialError> {
+        let file = path.display().to_string();
+        let text = read(path)?;
+        let dir = forkbench_plan::external::dir_of(path);
+        let layout = Self::parse_layout(&text, &file, |world| World::load(&dir.join(world)))?;
+        layout.with_components(&text, registry, dir)
+    }
+
+    /// Parses scenario text; `load_world` resolves the `world` path. Components are built
+    /// from the built-in registry, external commands run in the working directory.
+    pub fn parse(
+        text: &str,
+        file: &str,
+        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
+    ) -> Result<Self, TrialError> {
+        let s = Self::parse_layout(text, file, load_world)?;
+        s.with_components(text, Registry::shared(), PathBuf::from("."))
+    }
+
+    /// Reads the `[planner]` and `[tracker]` tables against `registry`; errors name the
+    /// file, line and field.
+    fn with_components(
+        mut self,
+        text: &str,
+        registry: Arc<Registry>,
+        dir: PathBuf,
+    ) -> Result<Self, TrialError> {
+        let f: ScenarioFile = parse(text, &self.file)?;
+        let pure_pursuit = Some("pure_pursuit");
+        let planner = Some(&f.planner);
+        for (role, value, default_kind) in [
+            (Role::Planner, planner, None),
+            (Role::Tracker, f.tracker.as_ref(), pure_pursuit),
+        ] {
+            let spec = match value {
+                Some(v) => ComponentSpec::from_value(role, v.get_ref(), default_kind, dir.clone())
+                    .and_then(|spec| registry.check(&spec).map(|()| spec))
+                    .map_err(|e| component_error(&self.file, text, role, v.span(), &e))?,
+                None => ComponentSpec::of_kind(role, "pure_pursuit"),
+            };
+            match role {
+                Role::Planner => self.planner = spec,
+                Role::Tracker => self.tracker = spec,
+            }
+        }
+        self.registry = registry;
+        Ok(self)
+    }
+
+    /// Everything but the components: world, truck, sensors, settings and cases.
+    fn parse_layout(
+        text: &str,
+        file: &str,
+        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
+    ) -> Result<Self, TrialError> {
+        let f: ScenarioFile = parse(text, file)?;
+        let world = match &f.world {
+            Some(p) => load_world(p).map_err(|e| {
+                invalid(
+                    file,
+                    "world",
+                    &format!("{} could not be loaded: {e}", p.display()),
+                )
+            })?,
+            None => World::default(),
+        };
+        check_values(&f, file)?;
+        let pallet = match f.pallet_kind {
+            PalletKind::Field1200 => PalletSpec::field_1200(),
+            PalletKind::Sim1000 => PalletSpec::sim_1000(),
+        };
+        if f.tolerances.insertion_depth_m > pallet.depth_m.min(f.truck.fork_length_m) {
+            return Err(invalid(
+                file,
+                "tolerances.insertion_depth_m",
+                "deeper than the pallet or the forks allow",
+            ));
+        }
+        let cases = resolve_cases(&f, &world, &pallet, file)?;
+        let zero = Pose2::new(0.0, 0.0, 0.0);
+        Ok(Scenario {
+            file: file.to_owned(),
+            name: f.name,
+            description: f.description,
+            planner: ComponentSpec::of_kind(Role::Planner, "bspline"),
+            tracker: ComponentSpec::of_kind(Role::Tracker, "pure_pursuit"),
+            registry: Registry::shared(),
+            seed: f.seed,
+            pallet,
+            timeout_s: f.timeout_s,
+            validate_paths: f.validate_paths,
+            truck: f.truck,
+            sim: f.sim,
+            noise: f.noise,
+            replan: f.replan,
+            tolerances: f.tolerances,
+            estimate_bias: f.estimate_bias.map_or(zero, PoseDeg::to_pose),
+            pallet_jitter: f.pallet_jitter.map_or(zero, PoseDeg::to_pose),
+            world,
+            cases,
+        })
+    }
+
+    pub fn case(&self, name: &str) -> Result<&Case, TrialError> {
+        self.cases
+            .iter()
+            .find(|c| c.name == name)
+            .ok_or_else(|| TrialError::UnknownCase {
+                file: self.file.clone(),
+                case: name.to_owned(),
+                known: self
+                    .cases
+                    .iter()
+                    .map(|c| c.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    }
+}
+
+/// A component table's error at the line of the offending key (or of the table).
+fn component_error(
+    file: &str,
+    text: &str,
+    role: Role,
+    span: std::ops::Range<usize>,
+    e: &forkbench_core::SettingsError,
+) -> TrialError {
+    // A table's span may cover only its header: search on to the next table header.
+    let rest = text.get(span.start..).unwrap_or("");
+    let end = rest
+        .match_indices('\n')
+        .map(|(i, _)| i + 1)
+        .find(|&i| rest[i..].trim_start().starts_with('['))
+        .unwrap_or(rest.len())
+        .max(span.len().min(rest.len()));
+    let region = &rest[..end];
+    let key_at = e.field.as_deref().and_then(|k| {
+        let mut at = 0;
+        region.split_inclusive('\n').find_map(|l| {
+            let here = at;
+            at += l.len();
+            let t = l.trim_start();
+            let key = t.split(['=', ' ', '\t']).next().unwrap_or("");
+            (key == k || key.trim_matches('"') == k).then_some(here)
+        })
+    });
+    let offset = span.start + key_at.unwrap_or(0);
+    let line = text[..offset.min(text.len())].matches('\n').count() + 1;
+    let field = match &e.field {
+        Some(f) => format!("{role}.{f}"),
+        None => role.to_string(),
+    };
+    TrialError::Invalid {
+        file: format!("{file}:{line}"),
+        field,
+        reason: e.reason.clone(),
+    }
+}

@@ -1,0 +1,175 @@
+//! World files (racks, walls, pallet slots) and poses as files write them (metres, degrees).
+
+use std::path::Path as FsPath;
+
+use forkbench_core::Pose2;
+use forkbench_geom::Obstacles;
+use forkbench_sim::Obstacle;
+use serde::{Deserialize, Serialize};
+
+use super::{invalid, parse, read};
+use crate::TrialError;
+
+/// A pose as written in files: metres and degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseDeg {
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_deg: f64,
+}
+
+impl PoseDeg {
+    pub fn to_pose(self) -> Pose2 {
+        Pose2::new(self.x_m, self.y_m, self.heading_deg.to_radians())
+    }
+
+    pub(super) fn check(&self, file: &str, field: &str) -> Result<(), TrialError> {
+        for (name, v) in [
+            ("x_m", self.x_m),
+            ("y_m", self.y_m),
+            ("heading_deg", self.heading_deg),
+        ] {
+            if !v.is_finite() {
+                return Err(invalid(
+                    file,
+                    &format!("{field}.{name}"),
+                    "must be a finite number",
+                ));
+            }
+        }
+        for (name, v) in [("x_m", self.x_m), ("y_m", self.y_m)] {
+            if v.abs() > MAX_WORLD_EXTENT_M {
+                return Err(invalid(
+                    file,
+                    &format!("{field}.{name}"),
+                    "lies beyond ±10 km: the world's extent is bounded so one trial's work is",
+                ));
+            }
+        }
+        if self.heading_deg.abs() > 1e4 {
+            return Err(invalid(
+                file,
+                &format!("{field}.heading_deg"),
+                "must lie within ±10000°",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Largest |x| or |y| anywhere in a world or scenario file.
+pub const MAX_WORLD_EXTENT_M: f64 = 1e4;
+
+/// A fixed rectangle in a world file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RectFile {
+    #[serde(default)]
+    pub name: String,
+    pub x_m: f64,
+    pub y_m: f64,
+    #[serde(default)]
+    pub heading_deg: f64,
+    pub length_m: f64,
+    pub width_m: f64,
+}
+
+/// A named place a pallet can stand (face centre, heading into the pallet).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PalletSlot {
+    pub name: String,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_deg: f64,
+}
+
+/// A warehouse layout.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct World {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default)]
+    pub rack: Vec<RectFile>,
+    #[serde(default)]
+    pub wall: Vec<RectFile>,
+    #[serde(default)]
+    pub pallet_slot: Vec<PalletSlot>,
+}
+
+impl World {
+    pub fn load(path: &FsPath) -> Result<Self, TrialError> {
+        let file = path.display().to_string();
+        Self::parse(&read(path)?, &file)
+    }
+
+    pub fn parse(text: &str, file: &str) -> Result<Self, TrialError> {
+        let w: World = parse(text, file)?;
+        for (kind, list) in [("rack", &w.rack), ("wall", &w.wall)] {
+            for (i, r) in list.iter().enumerate() {
+                let f = format!("{kind}[{i}]");
+                PoseDeg {
+                    x_m: r.x_m,
+                    y_m: r.y_m,
+                    heading_deg: r.heading_deg,
+                }
+                .check(file, &f)?;
+                for (name, v) in [("length_m", r.length_m), ("width_m", r.width_m)] {
+                    if !(v.is_finite() && v > 0.0 && v <= MAX_WORLD_EXTENT_M) {
+                        return Err(invalid(
+                            file,
+                            &format!("{f}.{name}"),
+                            "must be a positive length of at most 10 km",
+                        ));
+                    }
+                }
+            }
+        }
+        for (i, s) in w.pallet_slot.iter().enumerate() {
+            PoseDeg {
+                x_m: s.x_m,
+                y_m: s.y_m,
+                heading_deg: s.heading_deg,
+            }
+            .check(file, &format!("pallet_slot[{i}]"))?;
+        }
+        Ok(w)
+    }
+
+    /// Racks and walls for the footprint checker, with a label per obstacle for messages.
+    pub fn footprint_obstacles(&self) -> (Obstacles, Vec<String>) {
+        let mut obstacles = Obstacles::new();
+        let mut labels = Vec::new();
+        for (kind, list) in [("rack", &self.rack), ("wall", &self.wall)] {
+            for r in list {
+                obstacles.add_rect(
+                    &Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
+                    r.length_m,
+                    r.width_m,
+                );
+                labels.push(if r.name.is_empty() {
+                    kind.to_owned()
+                } else {
+                    format!("{kind} {:?}", r.name)
+                });
+            }
+        }
+        (obstacles, labels)
+    }
+
+    /// Racks and walls as simulator obstacles.
+    pub fn obstacles(&self) -> Vec<Obstacle> {
+        self.rack
+            .iter()
+            .chain(&self.wall)
+            .map(|r| Obstacle {
+                centre: Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
+                length_m: r.length_m,
+                width_m: r.width_m,
+            })
+            .collect()
+    }
+}
