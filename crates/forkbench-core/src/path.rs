@@ -60,6 +60,22 @@ impl Path {
         })
     }
 
+    /// A straight path of `length_m` from `start` along its heading, samples at most
+    /// `spacing_m` apart.
+    pub fn straight(start: &Pose2, length_m: f64, spacing_m: f64) -> Path {
+        let mut p = Path {
+            samples: vec![PathSample {
+                s_m: 0.0,
+                x_m: start.x_m,
+                y_m: start.y_m,
+                heading_rad: start.heading_rad,
+                curvature_per_m: 0.0,
+            }],
+        };
+        p.extend_straight(length_m, spacing_m);
+        p
+    }
+
     /// Appends a straight segment of `length_m` along the last sample's heading, with
     /// samples at most `spacing_m` apart (e.g. the fork insertion after an approach curve).
     pub fn extend_straight(&mut self, length_m: f64, spacing_m: f64) {

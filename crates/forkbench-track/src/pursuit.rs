@@ -289,20 +289,9 @@ impl Tracker for PurePursuit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use forkbench_core::PathSample;
 
     fn straight(len: f64) -> Path {
-        let mut p = Path {
-            samples: vec![PathSample {
-                s_m: 0.0,
-                x_m: 0.0,
-                y_m: 0.0,
-                heading_rad: 0.0,
-                curvature_per_m: 0.0,
-            }],
-        };
-        p.extend_straight(len, 0.01);
-        p
+        Path::straight(&Pose2::new(0.0, 0.0, 0.0), len, 0.01)
     }
 
     #[test]

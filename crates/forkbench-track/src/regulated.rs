@@ -30,9 +30,9 @@ pub struct RegulatedConfig {
 impl Default for RegulatedConfig {
     fn default() -> Self {
         Self {
-            lookahead_time_s: 1.2,
+            lookahead_time_s: 0.9,
             min_lookahead_m: 0.5,
-            max_lookahead_m: 1.2,
+            max_lookahead_m: 0.8,
             cruise_speed_mps: 0.8,
             regulated_min_radius_m: 2.5,
             regulated_min_speed_mps: 0.25,
@@ -130,20 +130,10 @@ impl Tracker for RegulatedPurePursuit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use forkbench_core::{PathSample, Pose2};
+    use forkbench_core::Pose2;
 
     fn straight(len: f64) -> Path {
-        let mut p = Path {
-            samples: vec![PathSample {
-                s_m: 0.0,
-                x_m: 0.0,
-                y_m: 0.0,
-                heading_rad: 0.0,
-                curvature_per_m: 0.0,
-            }],
-        };
-        p.extend_straight(len, 0.01);
-        p
+        Path::straight(&Pose2::new(0.0, 0.0, 0.0), len, 0.01)
     }
 
     #[test]
