@@ -19,6 +19,7 @@ pub struct BatchArgs {
     pub trackers: Vec<String>,
     pub jobs: usize,
     pub shard: Option<String>,
+    pub shard_count: Option<u64>,
     pub out: PathBuf,
     pub json: bool,
     pub pallet_noise_scale: Option<f64>,
@@ -27,24 +28,6 @@ pub struct BatchArgs {
     pub record: RecordChoice,
     pub max_recordings: usize,
     pub force_new: bool,
-}
-
-fn parse_shard(text: &str) -> anyhow::Result<(u64, u64)> {
-    let (i, n) = text
-        .split_once('/')
-        .with_context(|| format!("--shard {text:?}: expected I/N, e.g. 0/4"))?;
-    let i: u64 = i
-        .trim()
-        .parse()
-        .with_context(|| format!("--shard {text:?}: index {i:?} is not a whole number"))?;
-    let n: u64 = n
-        .trim()
-        .parse()
-        .with_context(|| format!("--shard {text:?}: count {n:?} is not a whole number"))?;
-    if n == 0 || i >= n {
-        bail!("--shard {text:?}: the index must be below the count (0 ≤ I < N)");
-    }
-    Ok((i, n))
 }
 
 /// `--sweep pallet_noise=0,0.5,1`: the knob and its values.
@@ -109,12 +92,16 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
             .map(|p| Scenario::load(p))
             .collect::<Result<_, _>>()?
     };
-    let shard = a
-        .shard
-        .as_deref()
-        .map(parse_shard)
-        .transpose()?
-        .unwrap_or((0, 1));
+    let shard = match a.shard.as_deref() {
+        Some(text) => {
+            let arg = batch::parse_shard(text, a.shard_count)?;
+            batch::resolve_shard(arg, &|k| std::env::var(k).ok())?
+        }
+        None if a.shard_count.is_some() => bail!("--shard-count goes with --shard auto"),
+        None => (0, 1),
+    };
+    let out = batch::shard_dir(&a.out, shard);
+    let a = BatchArgs { out, ..a };
     if a.trials == 0 {
         bail!("--trials must be at least 1");
     }
@@ -191,7 +178,7 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
 }
 
 pub fn merge(dirs: &[PathBuf], out: &Path, json: bool) -> anyhow::Result<()> {
-    let s = batch::merge(dirs, out)?;
+    let s = batch::merge(&batch::merge_inputs(dirs)?, out)?;
     if json {
         return crate::emit(&format!("{}\n", serde_json::to_string(&s)?));
     }

@@ -168,9 +168,14 @@ enum Command {
         /// Worker threads.
         #[arg(long, default_value_t = 2)]
         jobs: usize,
-        /// Run only shard I of N (I/N, 0-based); combine shards with `forkbench merge`.
+        /// Run only shard I of N (I/N, 0-based), or `auto`: from a Slurm job array
+        /// (SLURM_ARRAY_TASK_*) or a Kubernetes Indexed Job (JOB_COMPLETION_INDEX with
+        /// --shard-count). Shard I of N writes OUT/shard-I-of-N/; `forkbench merge OUT`.
         #[arg(long)]
         shard: Option<String>,
+        /// Shard count for `--shard auto` under Kubernetes (its Job's completions).
+        #[arg(long)]
+        shard_count: Option<u64>,
         /// Output directory (trials.jsonl, summary.json, summary.md).
         #[arg(long, default_value = "recordings/batch")]
         out: PathBuf,
@@ -196,7 +201,8 @@ enum Command {
         #[arg(long)]
         force_new: bool,
     },
-    /// Combine shard outputs into one summary.
+    /// Combine shard outputs into one summary: shard directories, or the --out of a
+    /// sharded batch (its shard-I-of-N directories).
     Merge {
         dirs: Vec<PathBuf>,
         #[arg(long)]
@@ -316,6 +322,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             tracker,
             jobs,
             shard,
+            shard_count,
             out,
             json,
             pallet_noise_scale,
@@ -332,6 +339,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             trackers: tracker,
             jobs,
             shard,
+            shard_count,
             out,
             json,
             pallet_noise_scale,

@@ -11,12 +11,14 @@ use serde::{Deserialize, Serialize};
 
 mod baseline;
 mod manifest;
+mod shard;
 mod store;
 mod summary;
 mod sweep;
 
 pub use baseline::{Baseline, BaselineRow, RegressRow, regress, regress_markdown};
 pub use manifest::{DirLock, Manifest};
+pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_results, merge, read_records};
 pub use summary::{Summary, SummaryRow, summarize};
 pub use sweep::{
