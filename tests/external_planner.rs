@@ -68,6 +68,9 @@ fn the_python_planner_sits_beside_the_built_in_ones_in_batch_and_regress() {
         "quintic",
         "bspline",
         "spiral",
+        "--tracker",
+        "pure_pursuit",
+        "regulated_pure_pursuit",
         "--trials",
         "6",
         "--record",
@@ -85,14 +88,23 @@ fn the_python_planner_sits_beside_the_built_in_ones_in_batch_and_regress() {
         .iter()
         .map(|r| r["planner"].as_str().expect("planner"))
         .collect();
-    assert_eq!(planners, ["bspline", "quintic", "spiral"]);
+    // Rows are scenario × planner × tracker.
+    assert_eq!(
+        planners,
+        [
+            "bspline", "bspline", "quintic", "quintic", "spiral", "spiral"
+        ]
+    );
     let base = tmp("baseline.json");
     let b = base.to_str().expect("utf-8");
     ok(&forkbench(&["baseline", d, "--out", b]));
     let text = ok(&forkbench(&["regress", "--baseline", b, d]));
-    assert!(
-        text.lines()
-            .any(|l| l.contains("| quintic | pure_pursuit |") && l.contains("| ok |")),
-        "{text}"
-    );
+    for tracker in ["pure_pursuit", "regulated_pure_pursuit"] {
+        let row = format!("| quintic | {tracker} |");
+        assert!(
+            text.lines()
+                .any(|l| l.contains(&row) && l.contains("| ok |")),
+            "{text}"
+        );
+    }
 }

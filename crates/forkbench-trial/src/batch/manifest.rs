@@ -132,13 +132,13 @@ impl Manifest {
 
     /// Trials this manifest's batch (this shard of it) runs.
     pub fn expected_trials(&self) -> u64 {
-        let planners = self.planners.len().max(1) as u64;
+        let components = (self.planners.len().max(1) * self.trackers.len().max(1)) as u64;
         let total: u64 = self
             .scenarios
             .iter()
             .map(|s| {
                 let cases = s.settings.get("cases").and_then(Value::as_array);
-                cases.map_or(0, |c| c.len() as u64) * planners * self.trials
+                cases.map_or(0, |c| c.len() as u64) * components * self.trials
             })
             .sum();
         let [i, n] = self.shard;
