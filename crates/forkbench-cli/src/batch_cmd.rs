@@ -9,25 +9,110 @@ use forkbench_trial::batch::{self, Baseline, BatchSpec, RecordChoice, Summary, T
 use forkbench_trial::{Scenario, defaults};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// Batch arguments after parsing.
-#[derive(Debug)]
+/// Which batch trials to record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RecordWhich {
+    Failures,
+    All,
+    None,
+}
+
+impl From<RecordWhich> for RecordChoice {
+    fn from(r: RecordWhich) -> Self {
+        match r {
+            RecordWhich::None => RecordChoice::None,
+            RecordWhich::Failures => RecordChoice::Failures,
+            RecordWhich::All => RecordChoice::All,
+        }
+    }
+}
+
+/// `forkbench batch`.
+#[derive(Debug, Clone, clap::Args)]
 pub struct BatchArgs {
+    /// Scenario files (default: the embedded field-test, rack-pick and Table 2 sets).
     pub scenarios: Vec<PathBuf>,
+    /// Trials per scenario × case × planner × tracker.
+    #[arg(long, default_value_t = 20)]
     pub trials: u64,
+    /// Batch seed; each trial's seed derives from it and the trial's identity.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Planners to run every case with, by name: a scenario's own or a registered kind
+    /// (default: each scenario's own).
+    #[arg(long = "planner", num_args = 1..)]
     pub planners: Vec<String>,
+    /// Trackers to run every case with, by name (default: each scenario's own).
+    #[arg(long = "tracker", num_args = 1..)]
     pub trackers: Vec<String>,
+    /// Worker threads.
+    #[arg(long, default_value_t = 2)]
     pub jobs: usize,
+    /// Run only shard I of N (I/N, 0-based), or `auto`: from a Slurm job array
+    /// (SLURM_ARRAY_TASK_*) or a Kubernetes Indexed Job (JOB_COMPLETION_INDEX with
+    /// --shard-count). Shard I of N writes OUT/shard-I-of-N/; `forkbench merge OUT`.
+    #[arg(long)]
     pub shard: Option<String>,
+    /// Shard count for `--shard auto` (a Kubernetes Job's completions; with Slurm, makes
+    /// the array task ID the shard index so one index can be resubmitted alone).
+    #[arg(long)]
     pub shard_count: Option<u64>,
+    /// Output directory (trials.jsonl, summary.json, summary.md).
+    #[arg(long, default_value = "recordings/batch")]
     pub out: PathBuf,
+    #[arg(long)]
     pub json: bool,
+    /// Scale of the pallet-estimate σ for every trial.
+    #[arg(long, allow_hyphen_values = true)]
     pub pallet_noise_scale: Option<f64>,
+    /// Re-estimate the pallet and replan on the way in.
+    #[arg(long)]
     pub replan: bool,
+    /// Sweep a noise knob, e.g. pallet_noise=0,0.5,1,1.5,2 (table and plot per planner).
+    #[arg(long)]
     pub sweep: Option<String>,
-    pub record: RecordChoice,
+    /// Which trials to record as .rrd and .mcap under OUT/recordings/.
+    #[arg(long, value_enum, default_value_t = RecordWhich::Failures)]
+    pub record: RecordWhich,
+    /// At most this many recordings (the first in job order).
+    #[arg(long, default_value_t = 20)]
     pub max_recordings: usize,
+    /// Discard what OUT holds from a batch with other settings and start over
+    /// (without it such a directory is refused, naming the differences).
+    #[arg(long)]
     pub force_new: bool,
+    /// Also write the results as JUnit XML to FILE: a test case per scenario × planner ×
+    /// tracker, failing below --floor.
+    #[arg(long)]
+    pub junit: Option<PathBuf>,
+    /// Success-rate floor (0–1) for the --junit cases.
+    #[arg(long, requires = "junit")]
+    pub floor: Option<f64>,
+    /// Also write OUT/trials.csv: one row per trial, flat columns in SI units.
+    #[arg(long)]
+    pub csv: bool,
+    /// Also write OUT/report.html (see `forkbench report`).
+    #[arg(long)]
+    pub report: bool,
+}
+
+/// `forkbench regress`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RegressArgs {
+    #[arg(long)]
+    pub baseline: PathBuf,
+    pub results: PathBuf,
+    /// Significance level of the one-sided two-proportion test.
+    #[arg(long, default_value_t = 0.05)]
+    pub alpha: f64,
+    /// Absolute floor on every row's success rate (0–1).
+    #[arg(long)]
+    pub floor: Option<f64>,
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the verdicts as JUnit XML to FILE (a failing case per dropped row).
+    #[arg(long)]
+    pub junit: Option<PathBuf>,
 }
 
 /// `--sweep pallet_noise=0,0.5,1`: the knob and its values.
@@ -83,7 +168,9 @@ fn run_one(spec: &BatchSpec, dir: &Path, jobs: usize) -> anyhow::Result<Summary>
     Ok(summary)
 }
 
-pub fn run(a: BatchArgs) -> anyhow::Result<()> {
+/// The batch spec the arguments describe, and the arguments with OUT resolved to this
+/// shard's directory.
+fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     let scenarios: Vec<Scenario> = if a.scenarios.is_empty() {
         defaults::default_scenarios()?
     } else {
@@ -110,6 +197,11 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
     {
         bail!("--pallet-noise-scale {s}: must be a finite number ≥ 0");
     }
+    if let Some(f) = a.floor
+        && !(0.0..=1.0).contains(&f)
+    {
+        bail!("--floor {f}: must be a success rate between 0 and 1");
+    }
     let spec = BatchSpec {
         scenarios,
         planners: a.planners.clone(),
@@ -121,30 +213,62 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
         replan: a.replan.then_some(true),
         force_new: a.force_new,
     };
-    let Some(sweep) = &a.sweep else {
-        let t0 = std::time::Instant::now();
-        let summary = run_one(&spec, &a.out, a.jobs)?;
-        let elapsed = t0.elapsed().as_secs_f64();
-        let recorded = record_batch(&spec, &a)?;
-        if a.json {
-            return crate::emit(&format!("{}\n", serde_json::to_string(&summary)?));
+    Ok((spec, a))
+}
+
+pub fn run(a: BatchArgs) -> anyhow::Result<()> {
+    let (spec, a) = prepare(a)?;
+    if let Some(sweep) = &a.sweep {
+        return run_sweep(&spec, &a, sweep);
+    }
+    let t0 = std::time::Instant::now();
+    let summary = run_one(&spec, &a.out, a.jobs)?;
+    let elapsed = t0.elapsed().as_secs_f64();
+    let recorded = record_batch(&spec, &a)?;
+    let extras = write_extras(&summary, &a)?;
+    if a.json {
+        return crate::emit(&format!("{}\n", serde_json::to_string(&summary)?));
+    }
+    crate::emit(&format!(
+        "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md{extras}){}\n",
+        summary.markdown(),
+        elapsed,
+        a.jobs,
+        a.out.display(),
+        if recorded > 0 {
+            format!("; {recorded} trials recorded in recordings/")
+        } else {
+            String::new()
         }
-        return crate::emit(&format!(
-            "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md){}\n",
-            summary.markdown(),
-            elapsed,
-            a.jobs,
-            a.out.display(),
-            if recorded > 0 {
-                format!("; {recorded} trials recorded in recordings/")
-            } else {
-                String::new()
-            }
-        ));
-    };
+    ))
+}
+
+/// The outputs asked for beside the results (CSV, JUnit, HTML report), named for the
+/// closing line.
+fn write_extras(summary: &Summary, a: &BatchArgs) -> anyhow::Result<String> {
+    let mut written = String::new();
+    if a.csv {
+        let records = batch::read_records(&a.out.join("trials.jsonl"))?;
+        batch::write_csv(&records, &a.out.join("trials.csv"))?;
+        written.push_str(", trials.csv");
+    }
+    if let Some(file) = &a.junit {
+        let cases = batch::junit::batch_cases(summary, a.floor);
+        let xml = batch::junit::junit_xml("forkbench batch", &cases, summary.provenance.as_ref());
+        std::fs::write(file, xml).with_context(|| format!("writing {}", file.display()))?;
+        written.push_str(&format!(", JUnit {}", file.display()));
+    }
+    if a.report {
+        crate::report::write(&a.out, None)?;
+        written.push_str(", report.html");
+    }
+    Ok(written)
+}
+
+fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()> {
     let values = parse_sweep(sweep)?;
     let mut points: Vec<(f64, Summary)> = Vec::new();
-    for p in batch::sweep_points(&spec, &a.out, &values) {
+    for p in batch::sweep_points(spec, &a.out, &values) {
         points.push((p.pallet_noise, run_one(&p.spec, &p.dir, a.jobs)?));
     }
     let text = batch::sweep_markdown(&points);
@@ -167,6 +291,9 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
     for p in &planners {
         let file = a.out.join(format!("sweep-{p}.png"));
         crate::plot::draw_sweep(&file, p, &points)?;
+    }
+    if a.report {
+        crate::report::write(&a.out, None)?;
     }
     if a.json {
         return crate::emit(&format!("{}\n", serde_json::to_string(&json)?));
@@ -206,33 +333,38 @@ pub fn baseline(dir: &Path, out: &Path) -> anyhow::Result<()> {
 }
 
 /// Returns whether the gate passed.
-pub fn regress(
-    baseline: &Path,
-    dir: &Path,
-    alpha: f64,
-    floor: Option<f64>,
-    json: bool,
-) -> anyhow::Result<bool> {
-    if !(alpha > 0.0 && alpha < 1.0) {
-        bail!("--alpha {alpha}: must lie strictly between 0 and 1");
+pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
+    if !(a.alpha > 0.0 && a.alpha < 1.0) {
+        bail!("--alpha {}: must lie strictly between 0 and 1", a.alpha);
     }
-    if let Some(f) = floor
+    if let Some(f) = a.floor
         && !(0.0..=1.0).contains(&f)
     {
         bail!("--floor {f}: must be a success rate between 0 and 1");
     }
-    let b = Baseline::load(baseline)?;
-    let s = load_summary(dir)?;
-    let (rows, failed) = batch::regress(&b, &s, alpha, floor);
-    if json {
+    let b = Baseline::load(&a.baseline)?;
+    let s = load_summary(&a.results)?;
+    // A baseline made with other tolerances or sensors is not comparable row for row.
+    let changed =
+        batch::Manifest::read(&a.results)?.map_or_else(Vec::new, |m| b.setting_differences(&m));
+    for c in &changed {
+        eprintln!("warning: scenario settings differ from the baseline's batch: {c}");
+    }
+    let (rows, failed) = batch::regress(&b, &s, a.alpha, a.floor);
+    if let Some(file) = &a.junit {
+        let cases = batch::junit::regress_cases(&rows, a.alpha, a.floor);
+        let xml = batch::junit::junit_xml("forkbench regress", &cases, s.provenance.as_ref());
+        std::fs::write(file, xml).with_context(|| format!("writing {}", file.display()))?;
+    }
+    if a.json {
         crate::emit(&format!(
             "{}\n",
-            serde_json::json!({"passed": !failed, "alpha": alpha, "floor": floor, "rows": rows})
+            serde_json::json!({"passed": !failed, "alpha": a.alpha, "floor": a.floor, "rows": rows, "setting_differences": changed})
         ))?;
     } else {
         crate::emit(&format!(
             "{}\n{}\n",
-            batch::regress_markdown(&rows, alpha),
+            batch::regress_markdown(&rows, a.alpha),
             if failed {
                 "REGRESSION: at least one row dropped"
             } else {
@@ -245,11 +377,12 @@ pub fn regress(
 
 /// Records the trials the library picks (failures, or all) as .rrd and .mcap.
 fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
-    if a.record == RecordChoice::None {
+    let choice = RecordChoice::from(a.record);
+    if choice == RecordChoice::None {
         return Ok(0);
     }
     let records = batch::read_records(&a.out.join("trials.jsonl"))?;
-    let jobs = batch::trials_to_record(spec, &records, a.record, a.max_recordings);
+    let jobs = batch::trials_to_record(spec, &records, choice, a.max_recordings);
     let dir = a.out.join("recordings");
     for j in &jobs {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -5,6 +5,7 @@ mod corridor_cmd;
 mod plan_cmd;
 mod plot;
 mod record;
+mod report;
 mod reproduce_cmd;
 mod trial_cmd;
 
@@ -64,14 +65,6 @@ impl RecordFlags {
             force: self.force,
         }
     }
-}
-
-/// Which batch trials to record.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum RecordWhich {
-    Failures,
-    All,
-    None,
 }
 
 #[derive(Debug, Subcommand)]
@@ -149,58 +142,7 @@ enum Command {
         record: RecordFlags,
     },
     /// Monte-Carlo batch over scenarios × cases × planners × trackers × trials (default: the embedded scenario set).
-    Batch {
-        /// Scenario files (default: the embedded field-test, rack-pick and Table 2 sets).
-        scenarios: Vec<PathBuf>,
-        /// Trials per scenario × case × planner × tracker.
-        #[arg(long, default_value_t = 20)]
-        trials: u64,
-        /// Batch seed; each trial's seed derives from it and the trial's identity.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Planners to run every case with, by name: a scenario's own or a registered kind
-        /// (default: each scenario's own).
-        #[arg(long, num_args = 1..)]
-        planner: Vec<String>,
-        /// Trackers to run every case with, by name (default: each scenario's own).
-        #[arg(long, num_args = 1..)]
-        tracker: Vec<String>,
-        /// Worker threads.
-        #[arg(long, default_value_t = 2)]
-        jobs: usize,
-        /// Run only shard I of N (I/N, 0-based), or `auto`: from a Slurm job array
-        /// (SLURM_ARRAY_TASK_*) or a Kubernetes Indexed Job (JOB_COMPLETION_INDEX with
-        /// --shard-count). Shard I of N writes OUT/shard-I-of-N/; `forkbench merge OUT`.
-        #[arg(long)]
-        shard: Option<String>,
-        /// Shard count for `--shard auto` under Kubernetes (its Job's completions).
-        #[arg(long)]
-        shard_count: Option<u64>,
-        /// Output directory (trials.jsonl, summary.json, summary.md).
-        #[arg(long, default_value = "recordings/batch")]
-        out: PathBuf,
-        #[arg(long)]
-        json: bool,
-        /// Scale of the pallet-estimate σ for every trial.
-        #[arg(long, allow_hyphen_values = true)]
-        pallet_noise_scale: Option<f64>,
-        /// Re-estimate the pallet and replan on the way in.
-        #[arg(long)]
-        replan: bool,
-        /// Sweep a noise knob, e.g. pallet_noise=0,0.5,1,1.5,2 (table and plot per planner).
-        #[arg(long)]
-        sweep: Option<String>,
-        /// Which trials to record as .rrd and .mcap under OUT/recordings/.
-        #[arg(long, value_enum, default_value_t = RecordWhich::Failures)]
-        record: RecordWhich,
-        /// At most this many recordings (the first in job order).
-        #[arg(long, default_value_t = 20)]
-        max_recordings: usize,
-        /// Discard what OUT holds from a batch with other settings and start over
-        /// (without it such a directory is refused, naming the differences).
-        #[arg(long)]
-        force_new: bool,
-    },
+    Batch(batch_cmd::BatchArgs),
     /// Combine shard outputs into one summary: shard directories, or the --out of a
     /// sharded batch (its shard-I-of-N directories).
     Merge {
@@ -217,18 +159,16 @@ enum Command {
         out: PathBuf,
     },
     /// Compare results with a baseline; exit 1 on a significant drop.
-    Regress {
+    Regress(batch_cmd::RegressArgs),
+    /// Write a self-contained HTML report of a batch (or sweep) directory: DIR/report.html.
+    Report {
+        dir: PathBuf,
+        /// Compare with this baseline, a verdict per row.
         #[arg(long)]
-        baseline: PathBuf,
-        results: PathBuf,
-        /// Significance level of the one-sided two-proportion test.
-        #[arg(long, default_value_t = 0.05)]
-        alpha: f64,
-        /// Absolute floor on every row's success rate (0–1).
+        baseline: Option<PathBuf>,
+        /// Write the page here instead of DIR/report.html.
         #[arg(long)]
-        floor: Option<f64>,
-        #[arg(long)]
-        json: bool,
+        out: Option<PathBuf>,
     },
     /// Corridor bends: minimum width per turning mode and angle, and G regions at a width.
     Corridor {
@@ -314,60 +254,20 @@ enum Done {
 
 fn run(cli: Cli) -> anyhow::Result<Done> {
     match cli.command {
-        Command::Batch {
-            scenarios,
-            trials,
-            seed,
-            planner,
-            tracker,
-            jobs,
-            shard,
-            shard_count,
-            out,
-            json,
-            pallet_noise_scale,
-            replan,
-            sweep,
-            record,
-            max_recordings,
-            force_new,
-        } => batch_cmd::run(batch_cmd::BatchArgs {
-            scenarios,
-            trials,
-            seed,
-            planners: planner,
-            trackers: tracker,
-            jobs,
-            shard,
-            shard_count,
-            out,
-            json,
-            pallet_noise_scale,
-            replan,
-            sweep,
-            record: match record {
-                RecordWhich::None => forkbench_trial::batch::RecordChoice::None,
-                RecordWhich::Failures => forkbench_trial::batch::RecordChoice::Failures,
-                RecordWhich::All => forkbench_trial::batch::RecordChoice::All,
-            },
-            max_recordings,
-            force_new,
-        })
-        .map(|()| Done::Ok),
+        Command::Batch(args) => batch_cmd::run(args).map(|()| Done::Ok),
+        Command::Report { dir, baseline, out } => {
+            let out = out.unwrap_or_else(|| dir.join("report.html"));
+            let page = report::write_to(&dir, baseline.as_deref(), &out)?;
+            emit(&format!("report written to {}\n", page.display())).map(|()| Done::Ok)
+        }
         Command::Merge { dirs, out, json } => {
             batch_cmd::merge(&dirs, &out, json).map(|()| Done::Ok)
         }
         Command::Baseline { results, out } => {
             batch_cmd::baseline(&results, &out).map(|()| Done::Ok)
         }
-        Command::Regress {
-            baseline,
-            results,
-            alpha,
-            floor,
-            json,
-        } => {
-            let ok = batch_cmd::regress(&baseline, &results, alpha, floor, json)?;
+        Command::Regress(args) => {
+            let ok = batch_cmd::regress(&args)?;
             Ok(if ok { Done::Ok } else { Done::Regressed })
         }
         Command::Trial {

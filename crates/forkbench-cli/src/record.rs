@@ -152,7 +152,7 @@ pub fn record_trial(
 }
 
 /// `text` with every character other than ASCII letters, digits, '-' and '_' replaced by '_'.
-fn safe_file_stem(text: &str) -> String {
+pub fn safe_file_stem(text: &str) -> String {
     text.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || c == '-' || c == '_' {

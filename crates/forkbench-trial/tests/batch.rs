@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use forkbench_trial::batch::{self, Baseline, BatchSpec, TrialRecord};
+use forkbench_trial::batch::{self, Baseline, BatchSpec, TrialRecord, junit};
 use forkbench_trial::{Failure, Scenario};
 
 fn scenario(name: &str) -> Scenario {
@@ -40,10 +40,13 @@ fn records(dir: &Path) -> Vec<TrialRecord> {
     v
 }
 
+/// The numbers of a summary: without wall times and provenance (host, times, arguments),
+/// the only things that may differ between equal runs.
 fn without_wall(mut s: batch::Summary) -> batch::Summary {
     for r in &mut s.rows {
         r.wall_time_total_s = 0.0;
     }
+    s.provenance = None;
     s
 }
 
@@ -158,6 +161,11 @@ fn regress_fails_on_a_degraded_tracker_and_passes_unchanged_code() {
     .expect("runs");
     let (rows, failed) = batch::regress(&baseline, &same, 0.01, None);
     assert!(!failed, "{}", batch::regress_markdown(&rows, 0.01));
+    let xml = junit::junit_xml("regress", &junit::regress_cases(&rows, 0.01, None), None);
+    assert!(
+        xml.contains("tests=\"1\" failures=\"0\"") && !xml.contains("<failure"),
+        "{xml}"
+    );
 
     // Steering actuator 16× too slow: the truck cannot follow the curve.
     let mut slow = scenario("field-test.toml");
@@ -167,6 +175,20 @@ fn regress_fails_on_a_degraded_tracker_and_passes_unchanged_code() {
     let (rows, failed) = batch::regress(&baseline, &worse, 0.01, None);
     assert!(failed, "{}", batch::regress_markdown(&rows, 0.01));
     assert_eq!(rows[0].verdict, "drop");
+    // The JUnit file fails that row with the numbers a reviewer needs.
+    let xml = junit::junit_xml("regress", &junit::regress_cases(&rows, 0.01, None), None);
+    let r = &rows[0];
+    for part in [
+        "failures=\"1\"".to_owned(),
+        "<testcase name=\"field-test / bspline / pure_pursuit\"".to_owned(),
+        "significant drop in fork-entry success".to_owned(),
+        format!("baseline {:.1} %", 100.0 * r.baseline_rate),
+        format!("now {:.1} % (n=120)", 100.0 * r.now_rate.expect("rate")),
+        format!("p = {:.4}", r.p_value.expect("p")),
+        "α = 0.01".to_owned(),
+    ] {
+        assert!(xml.contains(&part), "{part} missing from\n{xml}");
+    }
 }
 
 #[test]
@@ -310,7 +332,14 @@ fn results_come_from_a_complete_trials_file_and_baselines_have_rows() {
     let summary = batch::run_batch(&s, &d, 1, &|_| {}).expect("runs");
     // A stale summary.json is never read: results come from trials.jsonl.
     std::fs::write(d.join("summary.json"), "{\"stale\": true}").expect("write");
-    assert_eq!(batch::load_results(&d).expect("complete"), summary);
+    let loaded = batch::load_results(&d).expect("complete");
+    assert!(
+        loaded.provenance.is_none(),
+        "the stale file's provenance is not taken"
+    );
+    let mut expected = summary.clone();
+    expected.provenance = None;
+    assert_eq!(loaded, expected);
     // An interrupted directory is refused.
     let text = std::fs::read_to_string(d.join("trials.jsonl")).expect("written");
     let kept: Vec<&str> = text.lines().take(2).collect();

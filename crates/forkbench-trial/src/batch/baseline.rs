@@ -13,6 +13,9 @@ use crate::stats::drop_p_value;
 pub struct Baseline {
     pub description: String,
     pub rows: Vec<BaselineRow>,
+    /// The provenance of the results it was made from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<super::Provenance>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -42,7 +45,16 @@ impl Baseline {
                     successes: r.successes,
                 })
                 .collect(),
+            provenance: s.provenance.clone(),
         }
+    }
+
+    /// Scenarios whose resolved settings (tolerances, truck, sensors, cases) differ between
+    /// this baseline's batch and `now`'s: their rows do not compare like for like.
+    pub fn setting_differences(&self, now: &super::Manifest) -> Vec<String> {
+        self.provenance
+            .as_ref()
+            .map_or_else(Vec::new, |p| super::scenario_differences(&p.manifest, now))
     }
 
     pub fn load(path: &Path) -> Result<Self, BatchError> {

@@ -149,7 +149,7 @@ impl Manifest {
     }
 }
 
-fn diff_values(path: &str, a: &Value, b: &Value, out: &mut Vec<String>) {
+pub(super) fn diff_values(path: &str, a: &Value, b: &Value, out: &mut Vec<String>) {
     match (a, b) {
         (Value::Object(x), Value::Object(y)) => {
             let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();

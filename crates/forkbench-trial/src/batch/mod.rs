@@ -10,14 +10,19 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod baseline;
+mod export;
+pub mod junit;
 mod manifest;
+mod provenance;
 mod shard;
 mod store;
 mod summary;
 mod sweep;
 
 pub use baseline::{Baseline, BaselineRow, RegressRow, regress, regress_markdown};
+pub use export::write_csv;
 pub use manifest::{DirLock, Manifest};
+pub use provenance::{Provenance, rfc3339, scenario_differences};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_results, merge, read_records};
 pub use summary::{Summary, SummaryRow, summarize};
@@ -371,6 +376,7 @@ pub fn run_batch(
     on_done: &(dyn Fn(&TrialRecord) + Sync),
 ) -> Result<Summary, BatchError> {
     spec.check(jobs)?;
+    let started = std::time::SystemTime::now();
     if dir.exists() && !dir.is_dir() {
         return Err(BatchError::Invalid(format!(
             "{}: exists and is not a directory (--out names a directory)",
@@ -435,7 +441,8 @@ pub fn run_batch(
         .into_iter()
         .filter(|r| wanted.contains(&r.key()))
         .collect();
-    let summary = summarize(&records);
+    let mut summary = summarize(&records);
+    summary.provenance = Some(Provenance::collect(Manifest::of(spec)?, jobs, started));
     write_summary(dir, &summary)?;
     Ok(summary)
 }

@@ -90,7 +90,17 @@ pub fn load_results(dir: &Path) -> Result<Summary, BatchError> {
             dir.display()
         ))
     })?;
-    Ok(summarize(&complete_records(dir, &m)?))
+    let mut summary = summarize(&complete_records(dir, &m)?);
+    summary.provenance = written_provenance(dir);
+    Ok(summary)
+}
+
+/// The provenance the batch wrote into its `summary.json`, if any (informative: the
+/// numbers always come from `trials.jsonl`).
+fn written_provenance(dir: &Path) -> Option<super::Provenance> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let s: Summary = serde_json::from_str(&text).ok()?;
+    s.provenance
 }
 
 /// The records of `dir`, refused unless they are exactly the trials manifest `m` names
@@ -181,7 +191,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
     merged.shard = [0, 1];
     merged.write(out)?;
     rewrite_records(&path, &all)?;
-    let summary = summarize(&all);
+    let mut summary = summarize(&all);
+    // The merge's own provenance (this host, now); each shard's stays in its directory.
+    let now = std::time::SystemTime::now();
+    summary.provenance = Some(super::Provenance::collect(merged, 1, now));
     write_summary(out, &summary)?;
     Ok(summary)
 }

@@ -40,6 +40,9 @@ pub struct Summary {
     pub trials: u64,
     pub successes: u64,
     pub rows: Vec<SummaryRow>,
+    /// How, where and with what the batch ran (absent in summaries derived from records alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<super::Provenance>,
 }
 
 /// Summarises records; order-independent (values are sorted before any sum).
@@ -104,6 +107,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
         trials: rows.iter().map(|r| r.trials).sum(),
         successes: rows.iter().map(|r| r.successes).sum(),
         rows,
+        provenance: None,
     }
 }
 

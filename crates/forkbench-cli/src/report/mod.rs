@@ -1,0 +1,108 @@
+//! `forkbench report`: one self-contained HTML page per batch directory (tables, SVG plots, recordings, provenance).
+
+mod sections;
+mod svg;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use forkbench_trial::batch::{self, Baseline, Manifest, Summary};
+
+const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1300px;color:#222}\
+h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccc}\
+table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #ccc;padding:3px 7px;font-size:13px;text-align:left}\
+th{background:#f3f3f3}.ok{color:#1a7f37;font-weight:bold}.bad{color:#c62828;font-weight:bold}.warn{color:#b26a00}\
+pre{font-size:11px;background:#f7f7f7;padding:6px;overflow:auto}svg{display:block;margin:10px 0}";
+
+/// Writes `dir/report.html` (or `out`) for a batch directory or a sweep's; with a
+/// baseline, the comparison and its verdicts. Returns the page's path.
+pub fn write(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<PathBuf> {
+    write_to(dir, baseline, &dir.join("report.html"))
+}
+
+pub fn write_to(dir: &Path, baseline: Option<&Path>, out: &Path) -> anyhow::Result<PathBuf> {
+    let body = if dir.join("sweep.json").is_file() {
+        sweep_body(dir)?
+    } else {
+        batch_body(dir, baseline)?
+    };
+    let page = format!(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>forkbench report: {0}</title><style>{STYLE}</style></head><body><h1>forkbench report: {0}</h1>{body}</body></html>\n",
+        svg::esc(&dir.display().to_string())
+    );
+    std::fs::write(out, page).with_context(|| format!("writing {}", out.display()))?;
+    Ok(out.to_path_buf())
+}
+
+fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
+    let summary: Summary = batch::load_results(dir)?;
+    let records = batch::read_records(&dir.join("trials.jsonl"))?;
+    let manifest = Manifest::read(dir)?.context("no manifest.json")?;
+    let mut h = format!(
+        "<p><b>{} trials, {} successes ({:.1} %)</b></p>",
+        summary.trials,
+        summary.successes,
+        100.0 * summary.successes as f64 / summary.trials.max(1) as f64
+    );
+    if let Some(b) = baseline {
+        let base = Baseline::load(b)?;
+        let (rows, failed) = batch::regress(&base, &summary, 0.05, None);
+        let verdict = if failed {
+            "<span class=\"bad\">REGRESSION</span>"
+        } else {
+            "<span class=\"ok\">no significant drop</span>"
+        };
+        h.push_str(&format!(
+            "<h2>Against the baseline {}: {verdict}</h2>",
+            svg::esc(&b.display().to_string())
+        ));
+        h.push_str(&sections::baseline_comparison(
+            &rows,
+            0.05,
+            &base.setting_differences(&manifest),
+        ));
+    }
+    h.push_str("<h2>Success per scenario × planner × tracker</h2>");
+    h.push_str(&sections::success_table(&summary));
+    h.push_str("<h2>Failures by first failed criterion</h2>");
+    h.push_str(&sections::failure_breakdown(&summary));
+    let maps = sections::heatmaps(&manifest, &records);
+    if !maps.is_empty() {
+        h.push_str("<h2>Success over lateral offset × pallet angle</h2>");
+        h.push_str(&maps);
+    }
+    h.push_str("<h2>Entry errors (trials whose forks reached the face)</h2>");
+    h.push_str(&sections::error_distributions(&manifest, &records));
+    h.push_str("<h2>Failed trials</h2>");
+    h.push_str(&sections::failed_trials(dir, &records));
+    h.push_str("<h2>Provenance</h2>");
+    h.push_str(&sections::provenance(summary.provenance.as_ref()));
+    Ok(h)
+}
+
+fn sweep_body(dir: &Path) -> anyhow::Result<String> {
+    let path = dir.join("sweep.json");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let raw: Vec<serde_json::Value> =
+        serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
+    let points: Vec<(f64, Summary)> = raw
+        .into_iter()
+        .map(|v| {
+            let x = v["pallet_noise"].as_f64().unwrap_or(f64::NAN);
+            serde_json::from_value(v["summary"].clone()).map(|s| (x, s))
+        })
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{}: not a sweep", path.display()))?;
+    let mut h = String::from("<h2>Success vs pallet-estimate noise</h2>");
+    h.push_str(&sections::sweep(&points));
+    for (v, s) in &points {
+        h.push_str(&format!("<h2>Pallet noise scale {v}</h2>"));
+        h.push_str(&sections::success_table(s));
+    }
+    h.push_str("<h2>Provenance (first point)</h2>");
+    h.push_str(&sections::provenance(
+        points.first().and_then(|p| p.1.provenance.as_ref()),
+    ));
+    Ok(h)
+}

@@ -1,0 +1,357 @@
+//! The report's sections as HTML fragments: tables, failure breakdown, heatmaps, error distributions, sweep, failed trials, provenance.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::Path;
+
+use forkbench_trial::batch::{Manifest, Provenance, RegressRow, Summary, TrialRecord};
+use serde_json::Value;
+
+use super::svg::{self, esc};
+
+fn pct(v: f64) -> String {
+    format!("{:.1} %", 100.0 * v)
+}
+
+fn row_label(scenario: &str, planner: &str, tracker: &str) -> String {
+    format!("{scenario} / {planner} / {tracker}")
+}
+
+/// The success table with Wilson intervals.
+pub fn success_table(s: &Summary) -> String {
+    let mut h = String::from(
+        "<table><tr><th>scenario</th><th>planner</th><th>tracker</th><th>trials</th><th>successes</th><th>success rate</th><th>95 % CI (Wilson)</th><th>lateral mean / p95 (mm)</th><th>heading mean / p95 (°)</th></tr>",
+    );
+    let mm = |v: Option<f64>| v.map_or("–".into(), |v| format!("{:.1}", v * 1e3));
+    let deg = |v: Option<f64>| v.map_or("–".into(), |v| format!("{:.2}", v.to_degrees()));
+    for r in &s.rows {
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}–{}</td><td>{} / {}</td><td>{} / {}</td></tr>",
+            esc(&r.scenario),
+            esc(&r.planner),
+            esc(&r.tracker),
+            r.trials,
+            r.successes,
+            pct(r.success_rate),
+            pct(r.ci95_low),
+            pct(r.ci95_high),
+            mm(r.lateral_error_mean_m),
+            mm(r.lateral_error_p95_m),
+            deg(r.heading_error_mean_rad),
+            deg(r.heading_error_p95_rad)
+        );
+    }
+    h + "</table>"
+}
+
+/// Successes and failures by first failed criterion, one bar per row.
+pub fn failure_breakdown(s: &Summary) -> String {
+    let mut kinds: Vec<String> = vec!["success".into()];
+    let mut found: BTreeSet<String> = BTreeSet::new();
+    for r in &s.rows {
+        found.extend(r.failures.keys().cloned());
+    }
+    kinds.extend(found);
+    let rows: Vec<(String, Vec<(String, u64)>)> = s
+        .rows
+        .iter()
+        .map(|r| {
+            let mut segs = vec![("success".to_owned(), r.successes)];
+            segs.extend(r.failures.iter().map(|(k, n)| (k.clone(), *n)));
+            (row_label(&r.scenario, &r.planner, &r.tracker), segs)
+        })
+        .collect();
+    svg::stacked_bars("failures", &rows, &kinds)
+}
+
+/// (goal lateral offset D in cm, right positive; pallet angle θ in °) of each case, as the
+/// papers' Table 2 gives them: the pre-entry goal (fork tips 0.3 m before the face) in
+/// the start pose's frame, from the manifest's resolved cases and truck.
+fn case_geometry(settings: &Value) -> BTreeMap<String, (f64, f64)> {
+    let pose = |v: &Value| {
+        let g = |k: &str| v.get(k).and_then(Value::as_f64).unwrap_or(0.0);
+        forkbench_core::Pose2::new(g("x_m"), g("y_m"), g("heading_rad"))
+    };
+    let fork_m = settings["truck"]["fork_length_m"].as_f64().unwrap_or(0.0);
+    let cases = settings.get("cases").and_then(Value::as_array).cloned().unwrap_or_default();
+    cases
+        .iter()
+        .map(|c| {
+            let (start, face) = (pose(&c["start"]), pose(&c["pallet"]));
+            let back = fork_m + forkbench_trial::trial::APPROACH_GAP_M;
+            let goal = face.to_world(&forkbench_core::Pose2::new(-back, 0.0, 0.0));
+            let local = start.to_local(&goal);
+            let name = c["name"].as_str().unwrap_or("").to_owned();
+            let lateral_cm = (-local.y_m * 100.0).round();
+            let angle_deg = (local.heading_rad.to_degrees() * 10.0).round() / 10.0;
+            (name, (lateral_cm, angle_deg))
+        })
+        .collect()
+}
+
+/// Success over lateral offset × pallet angle, per scenario (with at least 4 cases) and
+/// planner × tracker.
+pub fn heatmaps(manifest: &Manifest, records: &[TrialRecord]) -> String {
+    let mut h = String::new();
+    for sc in manifest.scenarios.iter().filter(|s| {
+        s.settings
+            .get("cases")
+            .and_then(Value::as_array)
+            .is_some_and(|c| c.len() >= 4)
+    }) {
+        let geo = case_geometry(&sc.settings);
+        let mut cells: BTreeMap<(String, String), BTreeMap<(i64, i64), (u64, u64)>> =
+            BTreeMap::new();
+        for r in records.iter().filter(|r| r.outcome.scenario == sc.name) {
+            let Some(&(lat, ang)) = geo.get(&r.outcome.case) else {
+                continue;
+            };
+            let key = ((lat) as i64, (ang * 10.0) as i64);
+            let c = cells
+                .entry((r.outcome.planner.clone(), r.outcome.tracker.clone()))
+                .or_default()
+                .entry(key)
+                .or_default();
+            c.0 += u64::from(r.outcome.success);
+            c.1 += 1;
+        }
+        for ((planner, tracker), grid) in &cells {
+            let xs: Vec<i64> = grid
+                .keys()
+                .map(|k| k.0)
+                .collect::<BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            let ys: Vec<i64> = grid
+                .keys()
+                .map(|k| k.1)
+                .collect::<BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            let xf: Vec<f64> = xs.iter().map(|x| *x as f64).collect();
+            let yf: Vec<f64> = ys.iter().map(|y| *y as f64 / 10.0).collect();
+            let cell = |i: usize, j: usize| grid.get(&(xs[i], ys[j])).copied();
+            let id = format!("heatmap-{}-{planner}-{tracker}", sc.name);
+            let title = format!("{}: {planner} / {tracker}", sc.name);
+            h.push_str(&svg::heatmap(
+                &id,
+                &title,
+                &xf,
+                &yf,
+                &cell,
+                ("goal lateral offset D (cm, right +)", "pallet angle θ (°)"),
+            ));
+        }
+    }
+    h
+}
+
+/// |lateral| and |heading| error at entry per planner × tracker, with the tolerances.
+pub fn error_distributions(manifest: &Manifest, records: &[TrialRecord]) -> String {
+    let tol = |k: &str| {
+        manifest
+            .scenarios
+            .first()
+            .and_then(|s| s.settings.get("tolerances"))
+            .and_then(|t| t.get(k))
+            .and_then(Value::as_f64)
+            .unwrap_or(0.0)
+    };
+    let mut lat: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut head: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for r in records {
+        let key = format!("{} / {}", r.outcome.planner, r.outcome.tracker);
+        if let Some(v) = r.outcome.lateral_error_m {
+            lat.entry(key.clone()).or_default().push(v.abs() * 1e3);
+        }
+        if let Some(v) = r.outcome.heading_error_rad {
+            head.entry(key).or_default().push(v.abs().to_degrees());
+        }
+    }
+    let lat: Vec<_> = lat.into_iter().collect();
+    let head: Vec<_> = head.into_iter().collect();
+    svg::histogram(
+        "errors-lateral",
+        "|lateral error| at entry",
+        &lat,
+        (tol("lateral_m") * 1e3, "mm"),
+        "|lateral error| (mm)",
+    ) + &svg::histogram(
+        "errors-heading",
+        "|heading error| at entry",
+        &head,
+        (tol("heading_deg"), "°"),
+        "|heading error| (°)",
+    )
+}
+
+/// Failed trials: reason, and links to their recordings where the batch wrote them.
+pub fn failed_trials(dir: &Path, records: &[TrialRecord]) -> String {
+    let rec_dir = dir.join("recordings");
+    let mut h = String::from(
+        "<table><tr><th>scenario</th><th>case</th><th>planner / tracker</th><th>trial</th><th>failure</th><th>recording</th></tr>",
+    );
+    let mut failed: Vec<&TrialRecord> = records.iter().filter(|r| !r.outcome.success).collect();
+    failed.sort_by_key(|r| r.key());
+    let shown = failed.len().min(200);
+    for r in &failed[..shown] {
+        let o = &r.outcome;
+        let stem = crate::record::safe_file_stem(&format!(
+            "{}-{}-{}-{}-seed{}",
+            o.scenario, o.case, o.planner, o.tracker, o.seed
+        ));
+        let links: Vec<String> = ["rrd", "mcap"]
+            .iter()
+            .filter(|ext| rec_dir.join(format!("{stem}.{ext}")).is_file())
+            .map(|ext| format!("<a href=\"recordings/{}.{ext}\">.{ext}</a>", esc(&stem)))
+            .collect();
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td><b>{}</b>: {}</td><td>{}</td></tr>",
+            esc(&o.scenario),
+            esc(&o.case),
+            esc(&o.planner),
+            esc(&o.tracker),
+            r.trial,
+            o.failure.map_or("?", |f| f.name()),
+            esc(o.failure_detail.as_deref().unwrap_or("")),
+            if links.is_empty() {
+                "–".to_owned()
+            } else {
+                links.join(" ")
+            }
+        );
+    }
+    let _ = write!(
+        h,
+        "</table><p>{} failed trials{}.</p>",
+        failed.len(),
+        if shown < failed.len() {
+            format!(", the first {shown} listed")
+        } else {
+            String::new()
+        }
+    );
+    h
+}
+
+/// The comparison with a baseline, a verdict per row.
+pub fn baseline_comparison(rows: &[RegressRow], alpha: f64, differences: &[String]) -> String {
+    let mut h = String::new();
+    if !differences.is_empty() {
+        h.push_str("<p class=\"warn\">The baseline's batch had other scenario settings (not comparable row for row):</p><ul>");
+        for d in differences {
+            let _ = write!(h, "<li>{}</li>", esc(d));
+        }
+        h.push_str("</ul>");
+    }
+    h.push_str("<table><tr><th>scenario / planner / tracker</th><th>baseline</th><th>now</th><th>p (one-sided drop)</th><th>verdict</th></tr>");
+    for r in rows {
+        let class = if r.verdict == "ok" { "ok" } else { "bad" };
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{class}\">{}</td></tr>",
+            esc(&row_label(&r.scenario, &r.planner, &r.tracker)),
+            pct(r.baseline_rate),
+            r.now_rate.map_or("missing".into(), |v| format!(
+                "{} (n={})",
+                pct(v),
+                r.now_trials
+            )),
+            r.p_value.map_or("–".into(), |p| format!("{p:.4}")),
+            esc(&r.verdict)
+        );
+    }
+    let _ = write!(
+        h,
+        "</table><p>α = {alpha}: a row fails on p &lt; α or when missing.</p>"
+    );
+    h
+}
+
+/// The provenance block: who ran what, where, when; every scenario's resolved settings.
+pub fn provenance(p: Option<&Provenance>) -> String {
+    let Some(p) = p else {
+        return "<p>No provenance recorded (results from an older forkbench).</p>".into();
+    };
+    let m = &p.manifest;
+    let mut h = String::from("<table class=\"kv\">");
+    let items = [
+        ("forkbench", p.forkbench_version.clone()),
+        (
+            "git commit",
+            p.git_commit
+                .clone()
+                .unwrap_or_else(|| "not built from a checkout".into()),
+        ),
+        ("host", p.host.clone()),
+        (
+            "CPU",
+            format!(
+                "{} ({} cores, {} worker threads)",
+                p.cpu_model, p.cores, p.jobs
+            ),
+        ),
+        (
+            "started / finished (UTC)",
+            format!("{} / {}", p.started_at, p.finished_at),
+        ),
+        ("command", p.arguments.join(" ")),
+        (
+            "batch",
+            format!(
+                "seed {}, {} trials per row and case, shard {}/{}, planners {:?}, trackers {:?}, pallet noise {:?}, replan {:?}",
+                m.seed,
+                m.trials,
+                m.shard[0],
+                m.shard[1],
+                m.planners,
+                m.trackers,
+                m.pallet_noise_scale,
+                m.replan
+            ),
+        ),
+    ];
+    for (k, v) in items {
+        let _ = write!(h, "<tr><th>{k}</th><td>{}</td></tr>", esc(&v));
+    }
+    h.push_str("</table>");
+    for s in &m.scenarios {
+        let text = serde_json::to_string_pretty(&s.settings).unwrap_or_default();
+        let _ = write!(
+            h,
+            "<details><summary>scenario {} ({}), settings {}</summary><pre>{}</pre></details>",
+            esc(&s.name),
+            esc(&s.file),
+            esc(&s.settings_hash),
+            esc(&text)
+        );
+    }
+    h
+}
+
+/// Success against the pallet-estimate σ scale, a line per scenario × planner × tracker.
+pub fn sweep(points: &[(f64, Summary)]) -> String {
+    let mut series: BTreeMap<String, Vec<(f64, f64, f64, f64)>> = BTreeMap::new();
+    for (v, s) in points {
+        for r in &s.rows {
+            series
+                .entry(row_label(&r.scenario, &r.planner, &r.tracker))
+                .or_default()
+                .push((
+                    *v,
+                    100.0 * r.success_rate,
+                    100.0 * r.ci95_low,
+                    100.0 * r.ci95_high,
+                ));
+        }
+    }
+    let series: Vec<_> = series.into_iter().collect();
+    svg::lines(
+        "sweep",
+        "fork-entry success vs pallet-estimate noise",
+        &series,
+        "pallet-estimate σ scale (1 = the papers' sensor)",
+    )
+}

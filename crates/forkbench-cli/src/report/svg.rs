@@ -1,0 +1,349 @@
+//! Hand-written inline SVG charts for the HTML report: stacked bars, heatmaps, histograms, lines.
+
+use std::fmt::Write as _;
+
+/// Colours fixed by meaning (failure kinds, series), readable on white.
+pub const PALETTE: [&str; 10] = [
+    "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+    "#bcbd22", "#17becf",
+];
+
+pub fn esc(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn open(id: &str, w: f64, h: f64) -> String {
+    format!(
+        "<svg data-plot=\"{}\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" font-family=\"sans-serif\" font-size=\"12\">",
+        esc(id)
+    )
+}
+
+/// One horizontal bar per row, split into segments (kind, count); a legend of kinds.
+pub fn stacked_bars(id: &str, rows: &[(String, Vec<(String, u64)>)], kinds: &[String]) -> String {
+    let (label_w, bar_w, row_h) = (330.0, 420.0, 22.0);
+    let h = 40.0 + row_h * rows.len() as f64 + 22.0 * kinds.len().div_ceil(4) as f64;
+    let mut s = open(id, label_w + bar_w + 80.0, h);
+    let total_max = rows
+        .iter()
+        .map(|(_, segs)| segs.iter().map(|(_, n)| *n).sum::<u64>())
+        .max()
+        .unwrap_or(1)
+        .max(1) as f64;
+    for (i, (label, segs)) in rows.iter().enumerate() {
+        let y = 10.0 + row_h * i as f64;
+        let _ = write!(
+            s,
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>",
+            label_w - 8.0,
+            y + 14.0,
+            esc(label)
+        );
+        let mut x = label_w;
+        for (kind, n) in segs {
+            let w = bar_w * *n as f64 / total_max;
+            let c = PALETTE[kinds.iter().position(|k| k == kind).unwrap_or(0) % PALETTE.len()];
+            let _ = write!(
+                s,
+                "<rect x=\"{x:.1}\" y=\"{y}\" width=\"{w:.1}\" height=\"16\" fill=\"{c}\"><title>{}: {n}</title></rect>",
+                esc(kind)
+            );
+            x += w;
+        }
+        let n: u64 = segs.iter().map(|(_, n)| n).sum();
+        let _ = write!(
+            s,
+            "<text x=\"{:.1}\" y=\"{}\">{n}</text>",
+            x + 4.0,
+            y + 13.0
+        );
+    }
+    let y0 = 20.0 + row_h * rows.len() as f64;
+    for (i, k) in kinds.iter().enumerate() {
+        let (x, y) = (
+            label_w + 140.0 * (i % 4) as f64 - 200.0,
+            y0 + 22.0 * (i / 4) as f64,
+        );
+        let c = PALETTE[i % PALETTE.len()];
+        let _ = write!(
+            s,
+            "<rect x=\"{x}\" y=\"{y}\" width=\"12\" height=\"12\" fill=\"{c}\"/><text x=\"{}\" y=\"{}\">{}</text>",
+            x + 16.0,
+            y + 11.0,
+            esc(k)
+        );
+    }
+    s + "</svg>"
+}
+
+/// Success rate per (x, y) cell: green at 100 %, red at 0 %, the count in the cell.
+pub fn heatmap(
+    id: &str,
+    title: &str,
+    xs: &[f64],
+    ys: &[f64],
+    cell: &dyn Fn(usize, usize) -> Option<(u64, u64)>,
+    (x_label, y_label): (&str, &str),
+) -> String {
+    let (cw, ch, left, top) = (56.0, 30.0, 70.0, 40.0);
+    let (w, h) = (
+        left + cw * xs.len() as f64 + 20.0,
+        top + ch * ys.len() as f64 + 50.0,
+    );
+    let mut s = open(id, w, h);
+    let _ = write!(
+        s,
+        "<text x=\"{left}\" y=\"16\" font-weight=\"bold\">{}</text>",
+        esc(title)
+    );
+    for (j, yv) in ys.iter().enumerate() {
+        let y = top + ch * j as f64;
+        let _ = write!(
+            s,
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{yv}</text>",
+            left - 6.0,
+            y + 19.0
+        );
+        for (i, _) in xs.iter().enumerate() {
+            let x = left + cw * i as f64;
+            let Some((k, n)) = cell(i, j) else { continue };
+            let r = k as f64 / n.max(1) as f64;
+            let colour = format!(
+                "rgb({},{},90)",
+                (220.0 * (1.0 - r)) as u8 + 30,
+                (180.0 * r) as u8 + 40
+            );
+            let _ = write!(
+                s,
+                "<rect x=\"{x}\" y=\"{y}\" width=\"{}\" height=\"{}\" fill=\"{colour}\"><title>{k}/{n}</title></rect><text x=\"{}\" y=\"{}\" text-anchor=\"middle\" fill=\"white\">{:.0}%</text>",
+                cw - 2.0,
+                ch - 2.0,
+                x + cw / 2.0,
+                y + 19.0,
+                100.0 * r
+            );
+        }
+    }
+    let yb = top + ch * ys.len() as f64;
+    for (i, xv) in xs.iter().enumerate() {
+        let _ = write!(
+            s,
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{xv}</text>",
+            left + cw * i as f64 + cw / 2.0,
+            yb + 16.0
+        );
+    }
+    let _ = write!(
+        s,
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text><text x=\"12\" y=\"{}\" transform=\"rotate(-90 12 {})\" text-anchor=\"middle\">{}</text>",
+        left + cw * xs.len() as f64 / 2.0,
+        yb + 36.0,
+        esc(x_label),
+        top + ch * ys.len() as f64 / 2.0,
+        top + ch * ys.len() as f64 / 2.0,
+        esc(y_label)
+    );
+    s + "</svg>"
+}
+
+/// A tick label with the digits its size needs.
+fn tick(v: f64) -> String {
+    match v.abs() {
+        a if a >= 10.0 || a == 0.0 => format!("{v:.0}"),
+        a if a >= 1.0 => format!("{v:.1}"),
+        _ => format!("{v:.3}"),
+    }
+}
+
+/// Axes with ticks for a `w` × `h` plot area at (`left`, `top`), x in [x0, x1], y in [y0, y1].
+#[allow(clippy::too_many_arguments)]
+fn axes(
+    s: &mut String,
+    (left, top, w, h): (f64, f64, f64, f64),
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+    x_label: &str,
+    y_label: &str,
+) {
+    let _ = write!(
+        s,
+        "<rect x=\"{left}\" y=\"{top}\" width=\"{w}\" height=\"{h}\" fill=\"none\" stroke=\"#444\"/>"
+    );
+    for i in 0..=4 {
+        let f = i as f64 / 4.0;
+        let (x, y) = (left + w * f, top + h * (1.0 - f));
+        let _ = write!(
+            s,
+            "<line x1=\"{left}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>",
+            left + w,
+            left - 4.0,
+            y + 4.0,
+            tick(y0 + (y1 - y0) * f)
+        );
+        let _ = write!(
+            s,
+            "<text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">{}</text>",
+            top + h + 16.0,
+            tick(x0 + (x1 - x0) * f)
+        );
+    }
+    let _ = write!(
+        s,
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text><text x=\"14\" y=\"{}\" transform=\"rotate(-90 14 {})\" text-anchor=\"middle\">{}</text>",
+        left + w / 2.0,
+        top + h + 34.0,
+        esc(x_label),
+        top + h / 2.0,
+        top + h / 2.0,
+        esc(y_label)
+    );
+}
+
+/// Histograms (step outlines, one colour per series) of values, with a tolerance line.
+pub fn histogram(
+    id: &str,
+    title: &str,
+    series: &[(String, Vec<f64>)],
+    (tolerance, unit): (f64, &str),
+    x_label: &str,
+) -> String {
+    let (left, top, w, h) = (70.0, 30.0, 560.0, 220.0);
+    let x1 = series
+        .iter()
+        .flat_map(|(_, v)| v.iter().copied())
+        .fold(tolerance * 1.2, f64::max)
+        .max(1e-9);
+    let bins = 30;
+    let counts: Vec<Vec<f64>> = series
+        .iter()
+        .map(|(_, v)| {
+            let mut c = vec![0.0; bins];
+            for x in v {
+                c[((x / x1 * bins as f64) as usize).min(bins - 1)] += 1.0 / v.len().max(1) as f64;
+            }
+            c
+        })
+        .collect();
+    let y1 = counts
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0, f64::max)
+        .max(1e-9);
+    let mut s = open(id, left + w + 240.0, top + h + 50.0);
+    let _ = write!(
+        s,
+        "<text x=\"{left}\" y=\"18\" font-weight=\"bold\">{}</text>",
+        esc(title)
+    );
+    axes(
+        &mut s,
+        (left, top, w, h),
+        (0.0, x1),
+        (0.0, y1),
+        x_label,
+        "fraction of trials",
+    );
+    for (k, c) in counts.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
+        let mut d = format!("M{left},{}", top + h);
+        for (i, v) in c.iter().enumerate() {
+            let (xa, xb, y) = (
+                left + w * i as f64 / bins as f64,
+                left + w * (i + 1) as f64 / bins as f64,
+                top + h * (1.0 - v / y1),
+            );
+            let _ = write!(d, " L{xa:.1},{y:.1} L{xb:.1},{y:.1}");
+        }
+        let _ = write!(
+            s,
+            "<path d=\"{d} L{},{}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"2\"/>",
+            left + w,
+            top + h
+        );
+        let _ = write!(
+            s,
+            "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"3\" fill=\"{colour}\"/><text x=\"{}\" y=\"{}\">{}</text>",
+            left + w + 12.0,
+            top + 10.0 + 18.0 * k as f64,
+            left + w + 28.0,
+            top + 14.0 + 18.0 * k as f64,
+            esc(&series[k].0)
+        );
+    }
+    let xt = left + w * tolerance / x1;
+    let _ = write!(
+        s,
+        "<line data-tolerance=\"{tolerance}\" x1=\"{xt:.1}\" x2=\"{xt:.1}\" y1=\"{top}\" y2=\"{}\" stroke=\"#000\" stroke-dasharray=\"6 4\" stroke-width=\"1.5\"/><text x=\"{:.1}\" y=\"{}\">tolerance {tolerance} {unit}</text>",
+        top + h,
+        xt + 4.0,
+        top + 12.0
+    );
+    s + "</svg>"
+}
+
+/// Lines of (x, y, low, high) points with error bars; y in [0, 100] %.
+pub fn lines(
+    id: &str,
+    title: &str,
+    series: &[(String, Vec<(f64, f64, f64, f64)>)],
+    x_label: &str,
+) -> String {
+    let (left, top, w, h) = (70.0, 30.0, 560.0, 260.0);
+    let x1 = series
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|q| q.0))
+        .fold(0.0, f64::max)
+        .max(1e-9);
+    let mut s = open(id, left + w + 320.0, top + h + 50.0);
+    let _ = write!(
+        s,
+        "<text x=\"{left}\" y=\"18\" font-weight=\"bold\">{}</text>",
+        esc(title)
+    );
+    axes(
+        &mut s,
+        (left, top, w, h),
+        (0.0, x1),
+        (0.0, 100.0),
+        x_label,
+        "success rate (%)",
+    );
+    let px = |x: f64| left + w * x / x1;
+    let py = |y: f64| top + h * (1.0 - y / 100.0);
+    for (k, (label, pts)) in series.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
+        let d: Vec<String> = pts
+            .iter()
+            .map(|p| format!("{:.1},{:.1}", px(p.0), py(p.1)))
+            .collect();
+        let _ = write!(
+            s,
+            "<polyline points=\"{}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"2\"/>",
+            d.join(" ")
+        );
+        for p in pts {
+            let _ = write!(
+                s,
+                "<line x1=\"{0:.1}\" x2=\"{0:.1}\" y1=\"{1:.1}\" y2=\"{2:.1}\" stroke=\"{colour}\"/><circle cx=\"{0:.1}\" cy=\"{3:.1}\" r=\"3\" fill=\"{colour}\"/>",
+                px(p.0),
+                py(p.2),
+                py(p.3),
+                py(p.1)
+            );
+        }
+        let _ = write!(
+            s,
+            "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"3\" fill=\"{colour}\"/><text x=\"{}\" y=\"{}\">{}</text>",
+            left + w + 12.0,
+            top + 10.0 + 18.0 * k as f64,
+            left + w + 28.0,
+            top + 14.0 + 18.0 * k as f64,
+            esc(label)
+        );
+    }
+    s + "</svg>"
+}

@@ -1,0 +1,84 @@
+//! Trial records as CSV: one row per trial, flat columns in SI units, for pandas, polars or R.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::{BatchError, TrialRecord, io};
+
+/// One CSV row (column names carry their units).
+#[derive(Debug, Serialize)]
+struct Row<'a> {
+    scenario: &'a str,
+    case: &'a str,
+    planner: &'a str,
+    tracker: &'a str,
+    trial: u64,
+    seed: u64,
+    noise: bool,
+    replan: Option<bool>,
+    pallet_noise_scale: Option<f64>,
+    success: bool,
+    failure: &'a str,
+    failure_detail: &'a str,
+    lateral_error_m: Option<f64>,
+    heading_error_rad: Option<f64>,
+    final_lateral_error_m: Option<f64>,
+    final_heading_error_rad: Option<f64>,
+    insertion_depth_m: Option<f64>,
+    max_steer_rad: f64,
+    max_contact_force_n: f64,
+    pallet_displacement_m: f64,
+    pallet_rotation_rad: f64,
+    replans: u32,
+    replans_failed: u32,
+    path_length_m: f64,
+    sim_time_s: f64,
+    wall_time_ms: f64,
+}
+
+/// Writes `records` to `path` as CSV (sorted by trial key); a value not measured (the
+/// trial ended before it) is an empty cell.
+pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError> {
+    let mut sorted: Vec<&TrialRecord> = records.iter().collect();
+    sorted.sort_by_key(|r| r.key());
+    let mut w = csv::Writer::from_path(path).map_err(|e| csv_error(path, e))?;
+    let finite = |v: f64| v.is_finite().then_some(v);
+    for r in sorted {
+        let o = &r.outcome;
+        w.serialize(Row {
+            scenario: &o.scenario,
+            case: &o.case,
+            planner: &o.planner,
+            tracker: &o.tracker,
+            trial: r.trial,
+            seed: o.seed,
+            noise: o.noise,
+            replan: r.replan,
+            pallet_noise_scale: r.pallet_noise_scale,
+            success: o.success,
+            failure: o.failure.map_or("", |f| f.name()),
+            failure_detail: o.failure_detail.as_deref().unwrap_or(""),
+            lateral_error_m: o.lateral_error_m,
+            heading_error_rad: o.heading_error_rad,
+            final_lateral_error_m: finite(o.final_lateral_error_m),
+            final_heading_error_rad: finite(o.final_heading_error_rad),
+            insertion_depth_m: finite(o.insertion_depth_m),
+            max_steer_rad: o.max_steer_rad,
+            max_contact_force_n: o.max_contact_force_n,
+            pallet_displacement_m: o.pallet_displacement_m,
+            pallet_rotation_rad: o.pallet_rotation_rad,
+            replans: o.replans,
+            replans_failed: o.replans_failed,
+            path_length_m: o.path_length_m,
+            sim_time_s: o.sim_time_s,
+            wall_time_ms: o.wall_time_ms,
+        })
+        .map_err(|e| csv_error(path, e))?;
+    }
+    w.flush().map_err(io(path))
+}
+
+fn csv_error(path: &Path, e: csv::Error) -> BatchError {
+    BatchError::Invalid(format!("{}: writing CSV: {e}", path.display()))
+}

@@ -1,0 +1,156 @@
+//! JUnit XML (the schema GitLab, GitHub Actions and Jenkins read): one test case per result row.
+
+use super::{Provenance, RegressRow, Summary};
+
+/// One test case: a result row, failed with a message or passed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Case {
+    pub name: String,
+    pub classname: String,
+    /// (short message, full text) of a failure.
+    pub failure: Option<(String, String)>,
+}
+
+fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            // XML 1.0 has no other control characters.
+            c if (c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r') => out.push(' '),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// A `<testsuites>` document with one suite of `cases`, and provenance as properties.
+pub fn junit_xml(suite: &str, cases: &[Case], provenance: Option<&Provenance>) -> String {
+    let failures = cases.iter().filter(|c| c.failure.is_some()).count();
+    let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    x.push_str(&format!(
+        "<testsuites name=\"forkbench\" tests=\"{}\" failures=\"{failures}\" errors=\"0\">\n",
+        cases.len()
+    ));
+    let (host, stamp) = provenance.map_or((String::new(), String::new()), |p| {
+        (
+            format!(" hostname=\"{}\"", escape(&p.host)),
+            format!(" timestamp=\"{}\"", escape(&p.finished_at)),
+        )
+    });
+    x.push_str(&format!(
+        "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{failures}\" errors=\"0\" skipped=\"0\"{host}{stamp}>\n",
+        escape(suite),
+        cases.len()
+    ));
+    if let Some(p) = provenance {
+        x.push_str("    <properties>\n");
+        let props = [
+            ("forkbench_version", p.forkbench_version.clone()),
+            ("git_commit", p.git_commit.clone().unwrap_or_default()),
+            ("seed", p.manifest.seed.to_string()),
+            ("trials", p.manifest.trials.to_string()),
+            ("cpu_model", p.cpu_model.clone()),
+            ("jobs", p.jobs.to_string()),
+        ];
+        for (k, v) in props {
+            x.push_str(&format!(
+                "      <property name=\"{k}\" value=\"{}\"/>\n",
+                escape(&v)
+            ));
+        }
+        x.push_str("    </properties>\n");
+    }
+    for c in cases {
+        let head = format!(
+            "    <testcase name=\"{}\" classname=\"{}\"",
+            escape(&c.name),
+            escape(&c.classname)
+        );
+        match &c.failure {
+            None => x.push_str(&format!("{head}/>\n")),
+            Some((message, text)) => x.push_str(&format!(
+                "{head}>\n      <failure type=\"forkbench.regression\" message=\"{}\">{}</failure>\n    </testcase>\n",
+                escape(message),
+                escape(text)
+            )),
+        }
+    }
+    x.push_str("  </testsuite>\n</testsuites>\n");
+    x
+}
+
+fn case_name(scenario: &str, planner: &str, tracker: &str) -> (String, String) {
+    (
+        format!("{scenario} / {planner} / {tracker}"),
+        format!("forkbench.{scenario}"),
+    )
+}
+
+/// `regress` as JUnit: a case per baseline row, failing on a significant drop, a rate
+/// below the floor, or a missing row, with the numbers in the message.
+pub fn regress_cases(rows: &[RegressRow], alpha: f64, floor: Option<f64>) -> Vec<Case> {
+    rows.iter()
+        .map(|r| {
+            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker);
+            let now = r.now_rate.map_or("missing".to_owned(), |v| {
+                format!("{:.1} % (n={})", 100.0 * v, r.now_trials)
+            });
+            let p = r.p_value.map_or("–".to_owned(), |p| format!("{p:.4}"));
+            let floor_text = floor.map_or(String::new(), |f| format!(", floor {:.1} %", 100.0 * f));
+            let numbers = format!(
+                "baseline {:.1} %, now {now}, p = {p} (one-sided drop), α = {alpha}{floor_text}",
+                100.0 * r.baseline_rate
+            );
+            let failure = (r.verdict != "ok").then(|| {
+                let what = match r.verdict.as_str() {
+                    "drop" => "significant drop in fork-entry success",
+                    "below_floor" => "success rate below the floor",
+                    "missing" => "row missing from the results",
+                    _ => "failed",
+                };
+                (format!("{what}: {numbers}"), numbers.clone())
+            });
+            Case {
+                name,
+                classname,
+                failure,
+            }
+        })
+        .collect()
+}
+
+/// A batch as JUnit: a case per row, failing when its success rate is below `floor`
+/// (every case passes without a floor, and reports its rate).
+pub fn batch_cases(summary: &Summary, floor: Option<f64>) -> Vec<Case> {
+    summary
+        .rows
+        .iter()
+        .map(|r| {
+            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker);
+            let numbers = format!(
+                "success {:.1} % ({} of {}, 95 % CI {:.1}–{:.1} %)",
+                100.0 * r.success_rate,
+                r.successes,
+                r.trials,
+                100.0 * r.ci95_low,
+                100.0 * r.ci95_high
+            );
+            let failure = floor.filter(|f| r.success_rate < *f).map(|f| {
+                (
+                    format!("{numbers} is below the floor {:.1} %", 100.0 * f),
+                    numbers.clone(),
+                )
+            });
+            Case {
+                name,
+                classname,
+                failure,
+            }
+        })
+        .collect()
+}
