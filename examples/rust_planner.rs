@@ -153,6 +153,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         shard: (0, 1),
         pallet_noise_scale: None,
         replan: None,
+        compare_replanning: false,
         force_new: true,
     };
     let summary = run_batch(&spec, &root.join("recordings/rust-planner"), 2, &|_| {})?;

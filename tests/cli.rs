@@ -355,6 +355,7 @@ fn batch_writes_results_and_regress_gates_them() {
     let out_dir = tmp("batch");
     let _ = std::fs::remove_dir_all(&out_dir);
     let dir = out_dir.to_str().expect("utf8");
+    let junit = tmp("batch-junit.xml");
     let out = forkbench(&[
         "batch",
         scn,
@@ -364,6 +365,12 @@ fn batch_writes_results_and_regress_gates_them() {
         "0",
         "--out",
         dir,
+        "--csv",
+        "--report",
+        "--junit",
+        junit.to_str().expect("utf8"),
+        "--floor",
+        "0.9",
     ]);
     assert!(
         out.status.success(),
@@ -372,11 +379,52 @@ fn batch_writes_results_and_regress_gates_them() {
     );
     assert!(
         String::from_utf8_lossy(&out.stdout)
-            .contains("| field-test | bspline | pure_pursuit | 4 | 4 | 100.0 % |")
+            .contains("| field-test | bspline | pure_pursuit | plan once | 4 | 4 | 100.0 % |")
     );
-    for f in ["trials.jsonl", "summary.json", "summary.md"] {
+    for f in [
+        "trials.jsonl",
+        "summary.json",
+        "summary.md",
+        "trials.csv",
+        "report.html",
+    ] {
         assert!(out_dir.join(f).exists(), "{f}");
     }
+    // CSV: a header with SI-unit columns and one row per trial.
+    let csv = std::fs::read_to_string(out_dir.join("trials.csv")).expect("csv");
+    assert!(
+        csv.starts_with("scenario,case,planner,tracker,trial,seed,"),
+        "{csv}"
+    );
+    assert!(
+        csv.lines()
+            .next()
+            .is_some_and(|h| h.contains("lateral_error_m"))
+    );
+    assert_eq!(csv.lines().count(), 5);
+    // JUnit: one passing case (100 % ≥ the 90 % floor) and the provenance as properties.
+    let xml = std::fs::read_to_string(&junit).expect("junit");
+    assert!(xml.contains("tests=\"1\" failures=\"0\""), "{xml}");
+    assert!(
+        xml.contains("<property name=\"seed\" value=\"1\"/>"),
+        "{xml}"
+    );
+    // Provenance: the summary says what ran, where and when.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).expect("s"))
+            .expect("json");
+    let p = &summary["provenance"];
+    for k in [
+        "forkbench_version",
+        "host",
+        "cpu_model",
+        "started_at",
+        "finished_at",
+        "arguments",
+    ] {
+        assert!(!p[k].is_null(), "provenance.{k}: {p}");
+    }
+    assert_eq!(p["manifest"]["scenarios"][0]["name"], "field-test");
     let base = tmp("base.json");
     assert!(
         forkbench(&["baseline", dir, "--out", base.to_str().expect("utf8")])
@@ -389,6 +437,28 @@ fn batch_writes_results_and_regress_gates_them() {
         Some(0),
         "{}",
         String::from_utf8_lossy(&ok.stdout)
+    );
+    // A tighter tolerance is not a regression: regress says the settings differ.
+    let tight = tmp("tight.toml");
+    let text = std::fs::read_to_string(repo_root().join("scenarios/field-test.toml")).expect("r");
+    std::fs::write(&tight, text + "\n[tolerances]\nlateral_m = 0.05\n").expect("write");
+    let tight_dir = tmp("tight-batch");
+    let _ = std::fs::remove_dir_all(&tight_dir);
+    let td = tight_dir.to_str().expect("utf8");
+    let args = [
+        "batch",
+        tight.to_str().expect("utf8"),
+        "--trials",
+        "4",
+        "--out",
+        td,
+    ];
+    assert!(forkbench(&args).status.success());
+    let warned = forkbench(&["regress", "--baseline", base.to_str().expect("utf8"), td]);
+    let err = String::from_utf8_lossy(&warned.stderr);
+    assert!(
+        err.contains("warning: scenario settings differ from the baseline's batch: field-test: tolerances.lateral_m"),
+        "{err}"
     );
     // A baseline claiming 100 of 100 against 4 of 4 is no drop; one claiming a row that
     // was never run is a failure.

@@ -27,6 +27,14 @@ impl From<RecordWhich> for RecordChoice {
     }
 }
 
+/// Which replanning modes a batch runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Modes {
+    Scenario,
+    Replan,
+    Both,
+}
+
 /// `forkbench batch`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BatchArgs {
@@ -65,9 +73,13 @@ pub struct BatchArgs {
     /// Scale of the pallet-estimate σ for every trial.
     #[arg(long, allow_hyphen_values = true)]
     pub pallet_noise_scale: Option<f64>,
-    /// Re-estimate the pallet and replan on the way in.
-    #[arg(long)]
+    /// Re-estimate the pallet and replan on the way in (short for --modes replan).
+    #[arg(long, conflicts_with = "modes")]
     pub replan: bool,
+    /// Replanning modes: each scenario's own setting, replan always, or both side by side
+    /// with the same seeds (default: both for the embedded scenarios, else scenario).
+    #[arg(long, value_enum)]
+    pub modes: Option<Modes>,
     /// Sweep a noise knob, e.g. pallet_noise=0,0.5,1,1.5,2 (table and plot per planner).
     #[arg(long)]
     pub sweep: Option<String>,
@@ -202,6 +214,12 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     {
         bail!("--floor {f}: must be a success rate between 0 and 1");
     }
+    let modes = match (a.replan, a.modes) {
+        (true, _) => Modes::Replan,
+        (false, Some(m)) => m,
+        (false, None) if a.scenarios.is_empty() => Modes::Both,
+        (false, None) => Modes::Scenario,
+    };
     let spec = BatchSpec {
         scenarios,
         planners: a.planners.clone(),
@@ -210,7 +228,8 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         seed: a.seed,
         shard,
         pallet_noise_scale: a.pallet_noise_scale,
-        replan: a.replan.then_some(true),
+        replan: (modes == Modes::Replan).then_some(true),
+        compare_replanning: modes == Modes::Both,
         force_new: a.force_new,
     };
     Ok((spec, a))

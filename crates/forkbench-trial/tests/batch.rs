@@ -26,6 +26,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, seed: u64) -> BatchSpec {
         shard: (0, 1),
         pallet_noise_scale: None,
         replan: Some(true),
+        compare_replanning: false,
         force_new: false,
     }
 }
@@ -180,7 +181,7 @@ fn regress_fails_on_a_degraded_tracker_and_passes_unchanged_code() {
     let r = &rows[0];
     for part in [
         "failures=\"1\"".to_owned(),
-        "<testcase name=\"field-test / bspline / pure_pursuit\"".to_owned(),
+        "<testcase name=\"field-test / bspline / pure_pursuit / replan\"".to_owned(),
         "significant drop in fork-entry success".to_owned(),
         format!("baseline {:.1} %", 100.0 * r.baseline_rate),
         format!("now {:.1} % (n=120)", 100.0 * r.now_rate.expect("rate")),

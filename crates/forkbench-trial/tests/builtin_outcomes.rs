@@ -46,6 +46,7 @@ fn run(replan: Option<bool>) -> Vec<Value> {
         shard: (0, 1),
         pallet_noise_scale: None,
         replan,
+        compare_replanning: false,
         force_new: false,
     };
     run_batch(&spec, &dir, 2, &|_| {}).expect("batch runs");
@@ -58,7 +59,9 @@ fn run(replan: Option<bool>) -> Vec<Value> {
             let m = v.as_object_mut().expect("object");
             m.remove("wall_time_ms");
             assert_eq!(m.remove("tracker"), Some(Value::from("pure_pursuit")));
-            m.entry("replan").or_insert(Value::Bool(false));
+            // Records now always carry the mode they ran in; the committed ones carry the
+            // batch's override (absent when none).
+            m.insert("replan".into(), Value::Bool(replan.unwrap_or(false)));
             v
         })
         .collect()

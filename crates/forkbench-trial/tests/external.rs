@@ -90,6 +90,7 @@ fn a_crashed_planner_is_restarted_and_the_batch_goes_on() {
         shard: (0, 1),
         pallet_noise_scale: Some(0.0),
         replan: None,
+        compare_replanning: false,
         force_new: false,
     };
     // One worker: the first trial's process crashes, the next trials get a new one.

@@ -37,6 +37,7 @@ fn the_example_planner_runs_in_a_trial_and_a_batch() {
         shard: (0, 1),
         pallet_noise_scale: None,
         replan: None,
+        compare_replanning: false,
         force_new: true,
     };
     let summary = run_batch(&spec, &dir, 2, &|_| {}).expect("batch");

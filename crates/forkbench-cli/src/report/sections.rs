@@ -4,7 +4,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use forkbench_trial::batch::{Manifest, Provenance, RegressRow, Summary, TrialRecord};
+use forkbench_trial::batch::{self, Manifest, Provenance, RegressRow, Summary, TrialRecord};
 use serde_json::Value;
 
 use super::svg::{self, esc};
@@ -13,24 +13,31 @@ fn pct(v: f64) -> String {
     format!("{:.1} %", 100.0 * v)
 }
 
-fn row_label(scenario: &str, planner: &str, tracker: &str) -> String {
-    format!("{scenario} / {planner} / {tracker}")
+fn row_label(scenario: &str, planner: &str, tracker: &str, replan: Option<bool>) -> String {
+    match replan {
+        Some(m) => format!(
+            "{scenario} / {planner} / {tracker} / {}",
+            batch::mode_name(m)
+        ),
+        None => format!("{scenario} / {planner} / {tracker}"),
+    }
 }
 
 /// The success table with Wilson intervals.
 pub fn success_table(s: &Summary) -> String {
     let mut h = String::from(
-        "<table><tr><th>scenario</th><th>planner</th><th>tracker</th><th>trials</th><th>successes</th><th>success rate</th><th>95 % CI (Wilson)</th><th>lateral mean / p95 (mm)</th><th>heading mean / p95 (°)</th></tr>",
+        "<table><tr><th>scenario</th><th>planner</th><th>tracker</th><th>mode</th><th>trials</th><th>successes</th><th>success rate</th><th>95 % CI (Wilson)</th><th>lateral mean / p95 (mm)</th><th>heading mean / p95 (°)</th></tr>",
     );
     let mm = |v: Option<f64>| v.map_or("–".into(), |v| format!("{:.1}", v * 1e3));
     let deg = |v: Option<f64>| v.map_or("–".into(), |v| format!("{:.2}", v.to_degrees()));
     for r in &s.rows {
         let _ = write!(
             h,
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}–{}</td><td>{} / {}</td><td>{} / {}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}–{}</td><td>{} / {}</td><td>{} / {}</td></tr>",
             esc(&r.scenario),
             esc(&r.planner),
             esc(&r.tracker),
+            batch::mode_name(r.replan),
             r.trials,
             r.successes,
             pct(r.success_rate),
@@ -59,7 +66,10 @@ pub fn failure_breakdown(s: &Summary) -> String {
         .map(|r| {
             let mut segs = vec![("success".to_owned(), r.successes)];
             segs.extend(r.failures.iter().map(|(k, n)| (k.clone(), *n)));
-            (row_label(&r.scenario, &r.planner, &r.tracker), segs)
+            (
+                row_label(&r.scenario, &r.planner, &r.tracker, Some(r.replan)),
+                segs,
+            )
         })
         .collect();
     svg::stacked_bars("failures", &rows, &kinds)
@@ -74,7 +84,11 @@ fn case_geometry(settings: &Value) -> BTreeMap<String, (f64, f64)> {
         forkbench_core::Pose2::new(g("x_m"), g("y_m"), g("heading_rad"))
     };
     let fork_m = settings["truck"]["fork_length_m"].as_f64().unwrap_or(0.0);
-    let cases = settings.get("cases").and_then(Value::as_array).cloned().unwrap_or_default();
+    let cases = settings
+        .get("cases")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
     cases
         .iter()
         .map(|c| {
@@ -90,6 +104,9 @@ fn case_geometry(settings: &Value) -> BTreeMap<String, (f64, f64)> {
         .collect()
 }
 
+/// (successes, trials) per (lateral offset cm, angle in 0.1°) cell.
+type Grid = BTreeMap<(i64, i64), (u64, u64)>;
+
 /// Success over lateral offset × pallet angle, per scenario (with at least 4 cases) and
 /// planner × tracker.
 pub fn heatmaps(manifest: &Manifest, records: &[TrialRecord]) -> String {
@@ -101,22 +118,25 @@ pub fn heatmaps(manifest: &Manifest, records: &[TrialRecord]) -> String {
             .is_some_and(|c| c.len() >= 4)
     }) {
         let geo = case_geometry(&sc.settings);
-        let mut cells: BTreeMap<(String, String), BTreeMap<(i64, i64), (u64, u64)>> =
-            BTreeMap::new();
+        let mut cells: BTreeMap<(String, String, bool), Grid> = BTreeMap::new();
         for r in records.iter().filter(|r| r.outcome.scenario == sc.name) {
             let Some(&(lat, ang)) = geo.get(&r.outcome.case) else {
                 continue;
             };
             let key = ((lat) as i64, (ang * 10.0) as i64);
             let c = cells
-                .entry((r.outcome.planner.clone(), r.outcome.tracker.clone()))
+                .entry((
+                    r.outcome.planner.clone(),
+                    r.outcome.tracker.clone(),
+                    r.replan.unwrap_or(false),
+                ))
                 .or_default()
                 .entry(key)
                 .or_default();
             c.0 += u64::from(r.outcome.success);
             c.1 += 1;
         }
-        for ((planner, tracker), grid) in &cells {
+        for ((planner, tracker, replan), grid) in &cells {
             let xs: Vec<i64> = grid
                 .keys()
                 .map(|k| k.0)
@@ -132,8 +152,13 @@ pub fn heatmaps(manifest: &Manifest, records: &[TrialRecord]) -> String {
             let xf: Vec<f64> = xs.iter().map(|x| *x as f64).collect();
             let yf: Vec<f64> = ys.iter().map(|y| *y as f64 / 10.0).collect();
             let cell = |i: usize, j: usize| grid.get(&(xs[i], ys[j])).copied();
-            let id = format!("heatmap-{}-{planner}-{tracker}", sc.name);
-            let title = format!("{}: {planner} / {tracker}", sc.name);
+            let mode = batch::mode_name(*replan);
+            let id = format!(
+                "heatmap-{}-{planner}-{tracker}-{}",
+                sc.name,
+                mode.replace(' ', "-")
+            );
+            let title = format!("{}: {planner} / {tracker} / {mode}", sc.name);
             h.push_str(&svg::heatmap(
                 &id,
                 &title,
@@ -161,7 +186,12 @@ pub fn error_distributions(manifest: &Manifest, records: &[TrialRecord]) -> Stri
     let mut lat: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut head: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     for r in records {
-        let key = format!("{} / {}", r.outcome.planner, r.outcome.tracker);
+        let key = format!(
+            "{} / {} / {}",
+            r.outcome.planner,
+            r.outcome.tracker,
+            batch::mode_name(r.replan.unwrap_or(false))
+        );
         if let Some(v) = r.outcome.lateral_error_m {
             lat.entry(key.clone()).or_default().push(v.abs() * 1e3);
         }
@@ -252,7 +282,7 @@ pub fn baseline_comparison(rows: &[RegressRow], alpha: f64, differences: &[Strin
         let _ = write!(
             h,
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{class}\">{}</td></tr>",
-            esc(&row_label(&r.scenario, &r.planner, &r.tracker)),
+            esc(&row_label(&r.scenario, &r.planner, &r.tracker, r.replan)),
             pct(r.baseline_rate),
             r.now_rate.map_or("missing".into(), |v| format!(
                 "{} (n={})",
@@ -337,7 +367,12 @@ pub fn sweep(points: &[(f64, Summary)]) -> String {
     for (v, s) in points {
         for r in &s.rows {
             series
-                .entry(row_label(&r.scenario, &r.planner, &r.tracker))
+                .entry(row_label(
+                    &r.scenario,
+                    &r.planner,
+                    &r.tracker,
+                    Some(r.replan),
+                ))
                 .or_default()
                 .push((
                     *v,

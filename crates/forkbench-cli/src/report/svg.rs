@@ -89,8 +89,9 @@ pub fn heatmap(
     (x_label, y_label): (&str, &str),
 ) -> String {
     let (cw, ch, left, top) = (56.0, 30.0, 70.0, 40.0);
+    // Wide enough for the title even with few columns.
     let (w, h) = (
-        left + cw * xs.len() as f64 + 20.0,
+        (left + cw * xs.len() as f64 + 20.0).max(left + 7.5 * title.chars().count() as f64),
         top + ch * ys.len() as f64 + 50.0,
     );
     let mut s = open(id, w, h);
@@ -202,6 +203,15 @@ fn axes(
     );
 }
 
+/// The fraction of `values` in each of `bins` equal bins over [0, x1].
+fn fractions(values: &[f64], x1: f64, bins: usize) -> Vec<f64> {
+    let mut c = vec![0.0; bins];
+    for x in values {
+        c[((x / x1 * bins as f64) as usize).min(bins - 1)] += 1.0 / values.len() as f64;
+    }
+    c
+}
+
 /// Histograms (step outlines, one colour per series) of values, with a tolerance line.
 pub fn histogram(
     id: &str,
@@ -217,16 +227,7 @@ pub fn histogram(
         .fold(tolerance * 1.2, f64::max)
         .max(1e-9);
     let bins = 30;
-    let counts: Vec<Vec<f64>> = series
-        .iter()
-        .map(|(_, v)| {
-            let mut c = vec![0.0; bins];
-            for x in v {
-                c[((x / x1 * bins as f64) as usize).min(bins - 1)] += 1.0 / v.len().max(1) as f64;
-            }
-            c
-        })
-        .collect();
+    let counts: Vec<Vec<f64>> = series.iter().map(|(_, v)| fractions(v, x1, bins)).collect();
     let y1 = counts
         .iter()
         .flatten()
@@ -285,13 +286,11 @@ pub fn histogram(
     s + "</svg>"
 }
 
+/// A point of a line chart: x, y and the error bar's low and high y.
+pub type Point = (f64, f64, f64, f64);
+
 /// Lines of (x, y, low, high) points with error bars; y in [0, 100] %.
-pub fn lines(
-    id: &str,
-    title: &str,
-    series: &[(String, Vec<(f64, f64, f64, f64)>)],
-    x_label: &str,
-) -> String {
+pub fn lines(id: &str, title: &str, series: &[(String, Vec<Point>)], x_label: &str) -> String {
     let (left, top, w, h) = (70.0, 30.0, 560.0, 260.0);
     let x1 = series
         .iter()

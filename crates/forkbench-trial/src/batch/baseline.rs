@@ -26,6 +26,10 @@ pub struct BaselineRow {
     /// Baselines made before trackers were pluggable have none: pure pursuit.
     #[serde(default = "super::summary::pure_pursuit")]
     pub tracker: String,
+    /// Replanning mode of the row; baselines made before modes were rows have none and
+    /// match the one result row of their scenario × planner × tracker.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replan: Option<bool>,
     pub trials: u64,
     pub successes: u64,
 }
@@ -41,6 +45,7 @@ impl Baseline {
                     scenario: r.scenario.clone(),
                     planner: r.planner.clone(),
                     tracker: r.tracker.clone(),
+                    replan: Some(r.replan),
                     trials: r.trials,
                     successes: r.successes,
                 })
@@ -97,8 +102,25 @@ impl Baseline {
 }
 
 impl BaselineRow {
-    fn key(&self) -> (&str, &str, &str) {
-        (&self.scenario, &self.planner, &self.tracker)
+    fn key(&self) -> (&str, &str, &str, Option<bool>) {
+        (&self.scenario, &self.planner, &self.tracker, self.replan)
+    }
+
+    /// The result row this baseline row compares with: same scenario × planner × tracker
+    /// and mode; without a mode, the only row of that triple (none when there are several).
+    fn find<'a>(&self, rows: &'a [super::SummaryRow]) -> Option<&'a super::SummaryRow> {
+        let mut same = rows.iter().filter(|r| {
+            (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str())
+                == (
+                    self.scenario.as_str(),
+                    self.planner.as_str(),
+                    self.tracker.as_str(),
+                )
+        });
+        match self.replan {
+            Some(m) => same.find(|r| r.replan == m),
+            None => same.next().filter(|_| same.next().is_none()),
+        }
     }
 }
 
@@ -108,6 +130,7 @@ pub struct RegressRow {
     pub scenario: String,
     pub planner: String,
     pub tracker: String,
+    pub replan: Option<bool>,
     pub baseline_rate: f64,
     pub now_rate: Option<f64>,
     pub now_trials: u64,
@@ -125,48 +148,47 @@ pub fn regress(
     floor: Option<f64>,
 ) -> (Vec<RegressRow>, bool) {
     let mut failed = false;
-    let rows =
-        base.rows
-            .iter()
-            .map(|b| {
-                let r = now.rows.iter().find(|r| {
-                    (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str()) == b.key()
-                });
-                let base_rate = b.successes as f64 / b.trials as f64;
-                let (now_rate, n, p, verdict) = match r {
-                    None => (None, 0, None, "missing"),
-                    Some(r) => {
-                        let p = drop_p_value(b.successes, b.trials, r.successes, r.trials);
-                        let v = if p < alpha {
-                            "drop"
-                        } else if floor.is_some_and(|f| r.success_rate < f) {
-                            "below_floor"
-                        } else {
-                            "ok"
-                        };
-                        (Some(r.success_rate), r.trials, Some(p), v)
-                    }
-                };
-                failed |= verdict != "ok";
-                RegressRow {
-                    scenario: b.scenario.clone(),
-                    planner: b.planner.clone(),
-                    tracker: b.tracker.clone(),
-                    baseline_rate: base_rate,
-                    now_rate,
-                    now_trials: n,
-                    p_value: p,
-                    verdict: verdict.to_owned(),
+    let rows = base
+        .rows
+        .iter()
+        .map(|b| {
+            let r = b.find(&now.rows);
+            let base_rate = b.successes as f64 / b.trials as f64;
+            let (now_rate, n, p, verdict) = match r {
+                None => (None, 0, None, "missing"),
+                Some(r) => {
+                    let p = drop_p_value(b.successes, b.trials, r.successes, r.trials);
+                    let v = if p < alpha {
+                        "drop"
+                    } else if floor.is_some_and(|f| r.success_rate < f) {
+                        "below_floor"
+                    } else {
+                        "ok"
+                    };
+                    (Some(r.success_rate), r.trials, Some(p), v)
                 }
-            })
-            .collect();
+            };
+            failed |= verdict != "ok";
+            RegressRow {
+                scenario: b.scenario.clone(),
+                planner: b.planner.clone(),
+                tracker: b.tracker.clone(),
+                replan: b.replan,
+                baseline_rate: base_rate,
+                now_rate,
+                now_trials: n,
+                p_value: p,
+                verdict: verdict.to_owned(),
+            }
+        })
+        .collect();
     (rows, failed)
 }
 
 /// The regression report as markdown.
 pub fn regress_markdown(rows: &[RegressRow], alpha: f64) -> String {
     let mut s = String::from(
-        "| scenario | planner | tracker | baseline | now | difference | p (one-sided drop) | verdict |\n|---|---|---|---|---|---|---|---|\n",
+        "| scenario | planner | tracker | mode | baseline | now | difference | p (one-sided drop) | verdict |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let now = r.now_rate.map_or("–".to_owned(), |v| {
@@ -177,10 +199,11 @@ pub fn regress_markdown(rows: &[RegressRow], alpha: f64) -> String {
         });
         let p = r.p_value.map_or("–".to_owned(), |p| format!("{p:.4}"));
         s.push_str(&format!(
-            "| {} | {} | {} | {:.1} % | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {:.1} % | {} | {} | {} | {} |\n",
             r.scenario,
             r.planner,
             r.tracker,
+            r.replan.map_or("any", super::summary::mode_name),
             100.0 * r.baseline_rate,
             now,
             diff,

@@ -84,9 +84,17 @@ pub fn junit_xml(suite: &str, cases: &[Case], provenance: Option<&Provenance>) -
     x
 }
 
-fn case_name(scenario: &str, planner: &str, tracker: &str) -> (String, String) {
+fn case_name(
+    scenario: &str,
+    planner: &str,
+    tracker: &str,
+    replan: Option<bool>,
+) -> (String, String) {
+    let mode = replan.map_or(String::new(), |m| {
+        format!(" / {}", super::summary::mode_name(m))
+    });
     (
-        format!("{scenario} / {planner} / {tracker}"),
+        format!("{scenario} / {planner} / {tracker}{mode}"),
         format!("forkbench.{scenario}"),
     )
 }
@@ -96,7 +104,7 @@ fn case_name(scenario: &str, planner: &str, tracker: &str) -> (String, String) {
 pub fn regress_cases(rows: &[RegressRow], alpha: f64, floor: Option<f64>) -> Vec<Case> {
     rows.iter()
         .map(|r| {
-            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker);
+            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker, r.replan);
             let now = r.now_rate.map_or("missing".to_owned(), |v| {
                 format!("{:.1} % (n={})", 100.0 * v, r.now_trials)
             });
@@ -131,7 +139,7 @@ pub fn batch_cases(summary: &Summary, floor: Option<f64>) -> Vec<Case> {
         .rows
         .iter()
         .map(|r| {
-            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker);
+            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker, Some(r.replan));
             let numbers = format!(
                 "success {:.1} % ({} of {}, 95 % CI {:.1}–{:.1} %)",
                 100.0 * r.success_rate,

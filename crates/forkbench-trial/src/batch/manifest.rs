@@ -25,6 +25,9 @@ pub struct Manifest {
     pub trackers: Vec<String>,
     pub pallet_noise_scale: Option<f64>,
     pub replan: Option<bool>,
+    /// Every trial run planning once and replanning.
+    #[serde(default)]
+    pub compare_replanning: bool,
     pub scenarios: Vec<ScenarioEntry>,
 }
 
@@ -72,6 +75,7 @@ impl Manifest {
             trackers: spec.trackers.clone(),
             pallet_noise_scale: spec.pallet_noise_scale,
             replan: spec.replan,
+            compare_replanning: spec.compare_replanning,
             scenarios,
         })
     }
@@ -132,7 +136,8 @@ impl Manifest {
 
     /// Trials this manifest's batch (this shard of it) runs.
     pub fn expected_trials(&self) -> u64 {
-        let components = (self.planners.len().max(1) * self.trackers.len().max(1)) as u64;
+        let modes = if self.compare_replanning { 2 } else { 1 };
+        let components = (self.planners.len().max(1) * self.trackers.len().max(1) * modes) as u64;
         let total: u64 = self
             .scenarios
             .iter()

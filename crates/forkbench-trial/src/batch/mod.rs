@@ -25,7 +25,7 @@ pub use manifest::{DirLock, Manifest};
 pub use provenance::{Provenance, rfc3339, scenario_differences};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_results, merge, read_records};
-pub use summary::{Summary, SummaryRow, summarize};
+pub use summary::{Summary, SummaryRow, mode_name, summarize};
 pub use sweep::{
     RecordChoice, RecordJob, SweepPoint, sweep_markdown, sweep_points, trials_to_record,
 };
@@ -55,6 +55,9 @@ pub struct BatchSpec {
     pub shard: (u64, u64),
     pub pallet_noise_scale: Option<f64>,
     pub replan: Option<bool>,
+    /// Run every trial both planning once (the papers' mode) and replanning on new
+    /// estimates, with the same seeds; `replan` is then ignored.
+    pub compare_replanning: bool,
     /// Discard the output directory's trials when they were run with other settings,
     /// instead of refusing to resume.
     pub force_new: bool,
@@ -110,8 +113,9 @@ impl TrialRecord {
     }
 }
 
-/// Identity of one trial in a batch: scenario, case, planner, tracker, trial index.
-pub type TrialKey = (String, String, String, String, u64);
+/// Identity of one trial in a batch: scenario, case, planner, tracker, replanning, trial
+/// index.
+pub type TrialKey = (String, String, String, String, bool, u64);
 
 impl TrialRecord {
     pub fn key(&self) -> TrialKey {
@@ -120,6 +124,7 @@ impl TrialRecord {
             self.outcome.case.clone(),
             self.outcome.planner.clone(),
             self.outcome.tracker.clone(),
+            self.replan.unwrap_or(false),
             self.trial,
         )
     }
@@ -156,6 +161,8 @@ pub struct Job {
     pub case: usize,
     pub planner: String,
     pub tracker: String,
+    /// Replanning forced on or off for this job (`None`: the scenario's setting).
+    pub replan: Option<bool>,
     pub trial: u64,
 }
 
@@ -171,22 +178,34 @@ impl BatchSpec {
                     .iter()
                     .flat_map(|p| trackers.iter().map(move |t| (p, t)))
                 {
-                    for t in 0..self.trials {
-                        if k % self.shard.1 == self.shard.0 {
-                            out.push(Job {
-                                scenario: si,
-                                case: ci,
-                                planner: p.clone(),
-                                tracker: tr.clone(),
-                                trial: t,
-                            });
+                    for replan in self.replan_modes() {
+                        for t in 0..self.trials {
+                            if k % self.shard.1 == self.shard.0 {
+                                out.push(Job {
+                                    scenario: si,
+                                    case: ci,
+                                    planner: p.clone(),
+                                    tracker: tr.clone(),
+                                    replan,
+                                    trial: t,
+                                });
+                            }
+                            k += 1;
                         }
-                        k += 1;
                     }
                 }
             }
         }
         out
+    }
+
+    /// The replanning modes every case runs with: both, or the batch's override (or none).
+    pub fn replan_modes(&self) -> Vec<Option<bool>> {
+        if self.compare_replanning {
+            vec![Some(false), Some(true)]
+        } else {
+            vec![self.replan]
+        }
     }
 
     /// The planner and tracker names a scenario runs with in this batch.
@@ -211,6 +230,7 @@ impl BatchSpec {
             s.cases[j.case].name.clone(),
             j.planner.clone(),
             j.tracker.clone(),
+            j.replan.unwrap_or(s.replan.enabled),
             j.trial,
         )
     }
@@ -226,14 +246,15 @@ impl BatchSpec {
             tracker: Some(j.tracker.clone()),
             no_noise: false,
             pallet_noise_scale: self.pallet_noise_scale,
-            replan: self.replan,
+            replan: j.replan,
         };
         let names = (j.planner.as_str(), j.tracker.as_str());
         let outcome = guarded(s, &case.name, names, seed, || run_trial(s, case, &opts));
         TrialRecord {
             trial: j.trial,
             pallet_noise_scale: self.pallet_noise_scale,
-            replan: self.replan,
+            // The mode the trial ran in, always written: rows are keyed by it.
+            replan: Some(j.replan.unwrap_or(s.replan.enabled)),
             outcome,
         }
     }

@@ -17,6 +17,9 @@ pub struct SummaryRow {
     /// Summaries written before trackers were pluggable have none: pure pursuit.
     #[serde(default = "pure_pursuit")]
     pub tracker: String,
+    /// Replanning on new pallet estimates (false: plan once, the papers' mode).
+    #[serde(default)]
+    pub replan: bool,
     pub trials: u64,
     pub successes: u64,
     pub success_rate: f64,
@@ -56,11 +59,16 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
         head: Vec<f64>,
         wall: Vec<f64>,
     }
-    let mut groups: BTreeMap<(String, String, String), Acc> = BTreeMap::new();
+    let mut groups: BTreeMap<(String, String, String, bool), Acc> = BTreeMap::new();
     for r in records {
         let o = &r.outcome;
         let a = groups
-            .entry((o.scenario.clone(), o.planner.clone(), o.tracker.clone()))
+            .entry((
+                o.scenario.clone(),
+                o.planner.clone(),
+                o.tracker.clone(),
+                r.replan.unwrap_or(false),
+            ))
             .or_default();
         a.n += 1;
         if o.success {
@@ -80,7 +88,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     let rows: Vec<SummaryRow> = groups
         .into_iter()
-        .map(|((scenario, planner, tracker), mut a)| {
+        .map(|((scenario, planner, tracker, replan), mut a)| {
             a.lat.sort_by(f64::total_cmp);
             a.head.sort_by(f64::total_cmp);
             a.wall.sort_by(f64::total_cmp);
@@ -89,6 +97,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 scenario,
                 planner,
                 tracker,
+                replan,
                 trials: a.n,
                 successes: a.k,
                 success_rate: a.k as f64 / a.n as f64,
@@ -115,7 +124,7 @@ impl Summary {
     /// The success table as markdown.
     pub fn markdown(&self) -> String {
         let mut s = String::from(
-            "| scenario | planner | tracker | trials | successes | success rate | 95 % CI (Wilson) | failures | lateral mean / p95 (mm) | heading mean / p95 (°) | trial CPU (s) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+            "| scenario | planner | tracker | mode | trials | successes | success rate | 95 % CI (Wilson) | failures | lateral mean / p95 (mm) | heading mean / p95 (°) | trial CPU (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         let mm = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.1}", v * 1e3));
         let deg = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.2}", v.to_degrees()));
@@ -130,10 +139,11 @@ impl Summary {
                     .join(", ")
             };
             s.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % | {} | {} / {} | {} / {} | {:.2} |\n",
+                "| {} | {} | {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % | {} | {} / {} | {} / {} | {:.2} |\n",
                 r.scenario,
                 r.planner,
                 r.tracker,
+                mode_name(r.replan),
                 r.trials,
                 r.successes,
                 100.0 * r.success_rate,
@@ -153,8 +163,31 @@ impl Summary {
             self.successes,
             100.0 * self.successes as f64 / self.trials.max(1) as f64
         ));
+        let modes: Vec<bool> = [false, true]
+            .into_iter()
+            .filter(|m| self.rows.iter().any(|r| r.replan == *m))
+            .collect();
+        if modes.len() > 1 {
+            for m in modes {
+                let (n, k) = self
+                    .rows
+                    .iter()
+                    .filter(|r| r.replan == m)
+                    .fold((0, 0), |(n, k), r| (n + r.trials, k + r.successes));
+                s.push_str(&format!(
+                    "{}: {k} of {n} ({:.1} %)\n",
+                    mode_name(m),
+                    100.0 * k as f64 / n.max(1) as f64
+                ));
+            }
+        }
         s
     }
+}
+
+/// How a row's trials handled new pallet estimates.
+pub fn mode_name(replan: bool) -> &'static str {
+    if replan { "replan" } else { "plan once" }
 }
 
 pub(super) fn pure_pursuit() -> String {
