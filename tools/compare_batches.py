@@ -10,7 +10,7 @@ def records(d):
         r = json.loads(line)
         r.pop("wall_time_ms", None)
         out.append(r)
-    return sorted(out, key=lambda r: (r["scenario"], r["case"], r["planner"], r.get("tracker", ""), r["trial"]))
+    return sorted(out, key=lambda r: (r["scenario"], r["case"], r["planner"], r.get("tracker", ""), bool(r.get("replan")), r["trial"]))
 
 
 def summary(d):

@@ -1,7 +1,7 @@
 //! `forkbench corridor` and `reproduce corridor`: minimum widths and G regions per turning mode.
 
 use std::fmt::Write as _;
-use std::path::Path as FsPath;
+use std::path::{Path as FsPath, PathBuf};
 
 use forkbench_corridor::{
     CorridorQuery, CorridorRun, GRegion, Junction, Mode, Vehicle, WidthRow as Row, analyse,
@@ -59,6 +59,65 @@ pub fn parse_sweep(text: &str) -> Result<Angles, String> {
         _ => Err(format!(
             "--sweep-angles {text:?}: expected A:B:STEP in degrees with STEP > 0 and B ≥ A"
         )),
+    }
+}
+
+/// `forkbench corridor`, as parsed.
+#[derive(Debug, clap::Args)]
+pub struct CorridorCli {
+    /// Vehicle LENGTHxWIDTH in metres (default: the paper's AMV 0.56x0.40).
+    #[arg(long, value_parser = parse_vehicle, conflicts_with = "truck")]
+    pub vehicle: Option<forkbench_corridor::Vehicle>,
+    /// The forklift body (--truck-spec or the A30 defaults), adds the `truck` mode.
+    #[arg(long)]
+    pub truck: bool,
+    /// Forklift spec TOML for --truck.
+    #[arg(long, requires = "truck")]
+    pub truck_spec: Option<PathBuf>,
+    /// Corridor width (m): also compute the G regions and compare with circle inflation.
+    #[arg(long, allow_negative_numbers = true)]
+    pub width: Option<f64>,
+    /// Junction: `l` (a bend of --angle) or `t` (from the stem of a T into its right
+    /// arm, 90°).
+    #[arg(long, value_parser = parse_junction, default_value = "l")]
+    pub junction: forkbench_corridor::Junction,
+    /// Bend angle (degrees).
+    #[arg(long, conflicts_with = "sweep_angles", allow_negative_numbers = true)]
+    pub angle: Option<f64>,
+    /// Bend angles A:B:STEP (degrees).
+    #[arg(long, value_parser = parse_sweep)]
+    pub sweep_angles: Option<Angles>,
+    /// Grid cell (m); default Wc/40 (1 cm for the AMV, 3 cm for the A30).
+    #[arg(long, allow_negative_numbers = true)]
+    pub resolution: Option<f64>,
+    /// W_min vs θ, or with --width and one angle the G regions (.svg or .png).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl CorridorCli {
+    /// The run these arguments ask for (the truck spec read, defaults filled in).
+    pub fn resolve(&self) -> anyhow::Result<Args<'_>> {
+        let v = if self.truck {
+            Vehicle::forklift(&crate::load_truck(self.truck_spec.as_ref())?)
+        } else {
+            self.vehicle.unwrap_or_else(amv)
+        };
+        let angles_deg = self
+            .sweep_angles
+            .clone()
+            .map_or_else(|| vec![self.angle.unwrap_or(90.0)], |a| a.0);
+        Ok(Args {
+            vehicle: v,
+            junction: self.junction,
+            width_m: self.width,
+            angles_deg,
+            cell_m: self.resolution.unwrap_or(v.width_m / 40.0),
+            plot: self.plot.as_deref(),
+            json: self.json,
+        })
     }
 }
 

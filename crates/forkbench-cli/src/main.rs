@@ -70,35 +70,7 @@ impl RecordFlags {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Plan one pick path from a start pose to a pallet pose.
-    Plan {
-        /// Planner kind (bspline, spiral, external, or one a library user registered).
-        planner: String,
-        /// Start pose of the fork root: x_m,y_m,heading_deg
-        #[arg(long, value_parser = parse_pose, allow_hyphen_values = true)]
-        start: Pose2,
-        /// Goal pose (pallet pocket centre): x_m,y_m,heading_deg
-        #[arg(long, value_parser = parse_pose, allow_hyphen_values = true)]
-        goal: Pose2,
-        /// Path curvature at the start in m⁻¹ (from the current steering angle; spiral only).
-        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-        start_curvature: f64,
-        /// Forklift spec overrides (TOML with fields of ForkliftSpec).
-        #[arg(long)]
-        truck: Option<PathBuf>,
-        /// Planner settings: a TOML file with the keys of a scenario's [planner] table
-        /// (without `kind`).
-        #[arg(long)]
-        config: Option<PathBuf>,
-        /// Spiral: search lengths outside the paper's window 1 + θ²/5 ≤ s_f ≤ 2 + θ²/5.
-        #[arg(long)]
-        no_length_window: bool,
-        /// Print one JSON object instead of text.
-        #[arg(long)]
-        json: bool,
-        /// Draw path, curvature and steering to FILE (.svg or .png).
-        #[arg(long)]
-        plot: Option<PathBuf>,
-    },
+    Plan(plan_cmd::PlanCli),
     /// Run one pick trial from a scenario file (exit status 3 when the pick fails).
     Trial {
         scenario: PathBuf,
@@ -171,38 +143,7 @@ enum Command {
         out: Option<PathBuf>,
     },
     /// Corridor bends: minimum width per turning mode and angle, and G regions at a width.
-    Corridor {
-        /// Vehicle LENGTHxWIDTH in metres (default: the paper's AMV 0.56x0.40).
-        #[arg(long, value_parser = corridor_cmd::parse_vehicle, conflicts_with = "truck")]
-        vehicle: Option<forkbench_corridor::Vehicle>,
-        /// The forklift body (--truck-spec or the A30 defaults), adds the `truck` mode.
-        #[arg(long)]
-        truck: bool,
-        /// Forklift spec TOML for --truck.
-        #[arg(long, requires = "truck")]
-        truck_spec: Option<PathBuf>,
-        /// Corridor width (m): also compute the G regions and compare with circle inflation.
-        #[arg(long, allow_negative_numbers = true)]
-        width: Option<f64>,
-        /// Junction: `l` (a bend of --angle) or `t` (from the stem of a T into its right
-        /// arm, 90°).
-        #[arg(long, value_parser = corridor_cmd::parse_junction, default_value = "l")]
-        junction: forkbench_corridor::Junction,
-        /// Bend angle (degrees).
-        #[arg(long, conflicts_with = "sweep_angles", allow_negative_numbers = true)]
-        angle: Option<f64>,
-        /// Bend angles A:B:STEP (degrees).
-        #[arg(long, value_parser = corridor_cmd::parse_sweep)]
-        sweep_angles: Option<corridor_cmd::Angles>,
-        /// Grid cell (m); default Wc/40 (1 cm for the AMV, 3 cm for the A30).
-        #[arg(long, allow_negative_numbers = true)]
-        resolution: Option<f64>,
-        /// W_min vs θ, or with --width and one angle the G regions (.svg or .png).
-        #[arg(long)]
-        plot: Option<PathBuf>,
-        #[arg(long)]
-        json: bool,
-    },
+    Corridor(corridor_cmd::CorridorCli),
     /// Reproduce a paper's table side by side with this project's results.
     Reproduce {
         what: ReproduceArg,
@@ -227,12 +168,12 @@ pub(crate) fn emit(text: &str) -> anyhow::Result<()> {
     }
 }
 
-fn parse_pose(text: &str) -> Result<Pose2, String> {
+pub(crate) fn parse_pose(text: &str) -> Result<Pose2, String> {
     Pose2::parse_ui(text).map_err(|e| e.to_string())
 }
 
 /// Reads a forklift spec override file, or the A30 defaults.
-fn load_truck(path: Option<&PathBuf>) -> anyhow::Result<ForkliftSpec> {
+pub(crate) fn load_truck(path: Option<&PathBuf>) -> anyhow::Result<ForkliftSpec> {
     let Some(path) = path else {
         return Ok(ForkliftSpec::default());
     };
@@ -301,42 +242,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             let ok = batch_cmd::replay(&file, line, scenario.as_deref(), &record.args())?;
             Ok(if ok { Done::Ok } else { Done::PickFailed })
         }
-        Command::Plan {
-            planner,
-            start,
-            goal,
-            start_curvature,
-            truck,
-            config,
-            no_length_window,
-            json,
-            plot,
-        } => {
-            let truck = load_truck(truck.as_ref())?;
-            let mut settings = match &config {
-                Some(p) => {
-                    let text = std::fs::read_to_string(p)
-                        .with_context(|| format!("reading {}", p.display()))?;
-                    toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?
-                }
-                None => forkbench_core::Settings::new(),
-            };
-            if no_length_window {
-                settings.insert("enforce_length_window".into(), false.into());
-            }
-            plan_cmd::run(plan_cmd::PlanArgs {
-                planner,
-                settings,
-                config_dir: config.as_deref().map(forkbench_plan::external::dir_of),
-                start,
-                goal,
-                start_curvature_per_m: start_curvature,
-                truck,
-                json,
-                plot,
-            })
-            .map(|()| Done::Ok)
-        }
+        Command::Plan(args) => plan_cmd::run(args.resolve()?).map(|()| Done::Ok),
         Command::Reproduce {
             what,
             table,
@@ -357,35 +263,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             }
         }
         .map(|()| Done::Ok),
-        Command::Corridor {
-            vehicle,
-            truck,
-            truck_spec,
-            width,
-            junction,
-            angle,
-            sweep_angles,
-            resolution,
-            plot,
-            json,
-        } => {
-            let v = if truck {
-                forkbench_corridor::Vehicle::forklift(&load_truck(truck_spec.as_ref())?)
-            } else {
-                vehicle.unwrap_or_else(corridor_cmd::amv)
-            };
-            let angles_deg = sweep_angles.map_or_else(|| vec![angle.unwrap_or(90.0)], |a| a.0);
-            corridor_cmd::run(&corridor_cmd::Args {
-                vehicle: v,
-                junction,
-                width_m: width,
-                angles_deg,
-                cell_m: resolution.unwrap_or(v.width_m / 40.0),
-                plot: plot.as_deref(),
-                json,
-            })
-            .map(|()| Done::Ok)
-        }
+        Command::Corridor(args) => corridor_cmd::run(&args.resolve()?).map(|()| Done::Ok),
     }
 }
 

@@ -4,6 +4,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
+use anyhow::Context as _;
+
 use forkbench_core::Settings;
 use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_plan::{PlanParams, PlanRequest};
@@ -11,6 +13,67 @@ use forkbench_trial::{ComponentSpec, Registry, Role};
 use serde_json::json;
 
 use crate::plot;
+
+/// `forkbench plan`, as parsed.
+#[derive(Debug, clap::Args)]
+pub struct PlanCli {
+    /// Planner kind (bspline, spiral, external, or one a library user registered).
+    pub planner: String,
+    /// Start pose of the fork root: x_m,y_m,heading_deg
+    #[arg(long, value_parser = crate::parse_pose, allow_hyphen_values = true)]
+    pub start: Pose2,
+    /// Goal pose (pallet pocket centre): x_m,y_m,heading_deg
+    #[arg(long, value_parser = crate::parse_pose, allow_hyphen_values = true)]
+    pub goal: Pose2,
+    /// Path curvature at the start in m⁻¹ (from the current steering angle; spiral only).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub start_curvature: f64,
+    /// Forklift spec overrides (TOML with fields of ForkliftSpec).
+    #[arg(long)]
+    pub truck: Option<PathBuf>,
+    /// Planner settings: a TOML file with the keys of a scenario's [planner] table
+    /// (without `kind`).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Spiral: search lengths outside the paper's window 1 + θ²/5 ≤ s_f ≤ 2 + θ²/5.
+    #[arg(long)]
+    pub no_length_window: bool,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Draw path, curvature and steering to FILE (.svg or .png).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+}
+
+impl PlanCli {
+    /// Reads the truck and settings files into the planning arguments.
+    pub fn resolve(self) -> anyhow::Result<PlanArgs> {
+        let truck = crate::load_truck(self.truck.as_ref())?;
+        let mut settings = match &self.config {
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .with_context(|| format!("reading {}", p.display()))?;
+                toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?
+            }
+            None => Settings::new(),
+        };
+        if self.no_length_window {
+            settings.insert("enforce_length_window".into(), false.into());
+        }
+        Ok(PlanArgs {
+            config_dir: self.config.as_deref().map(forkbench_plan::external::dir_of),
+            planner: self.planner,
+            settings,
+            start: self.start,
+            goal: self.goal,
+            start_curvature_per_m: self.start_curvature,
+            truck,
+            json: self.json,
+            plot: self.plot,
+        })
+    }
+}
 
 #[derive(Debug)]
 pub struct PlanArgs {
