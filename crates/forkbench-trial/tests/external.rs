@@ -75,27 +75,48 @@ fn each_misbehaviour_is_a_plan_failure_with_its_reason() {
         assert_eq!(out.failure, Some(Failure::PlanFailed), "{mode}: {out:?}");
         let detail = out.failure_detail.unwrap_or_default();
         assert!(detail.contains(reason), "{mode}: {detail}");
+        // In a batch too: the trial records the reason and the batch finishes.
+        let out_dir = dir.join(format!("batch-{mode}"));
+        let summary = run_batch(&spec(s, 2), &out_dir, 2, &|_| {}).expect("batch finishes");
+        assert_eq!(
+            summary.rows[0].failures.get("plan_failed"),
+            Some(&2),
+            "{mode}"
+        );
+        let recs = read_records(&out_dir.join("trials.jsonl")).expect("records");
+        assert!(
+            recs.iter().all(|r| r
+                .outcome
+                .failure_detail
+                .as_deref()
+                .is_some_and(|d| d.contains(reason))),
+            "{mode}: {recs:?}"
+        );
     }
 }
 
-#[test]
-fn a_crashed_planner_is_restarted_and_the_batch_goes_on() {
-    let dir = tmp("batch");
-    let spec = |s: Scenario| BatchSpec {
+/// A small batch of `s` with a perfect pallet estimate.
+fn spec(s: Scenario, trials: u64) -> BatchSpec {
+    BatchSpec {
         scenarios: vec![s],
         planners: vec![],
         trackers: vec![],
-        trials: 3,
+        trials,
         seed: 5,
         shard: (0, 1),
         pallet_noise_scale: Some(0.0),
         replan: None,
         compare_replanning: false,
         force_new: false,
-    };
+    }
+}
+
+#[test]
+fn a_crashed_planner_is_restarted_and_the_batch_goes_on() {
+    let dir = tmp("batch");
     // One worker: the first trial's process crashes, the next trials get a new one.
     let out = dir.join("once");
-    run_batch(&spec(scenario("crash_once", &dir)), &out, 1, &|_| {}).expect("finishes");
+    run_batch(&spec(scenario("crash_once", &dir), 3), &out, 1, &|_| {}).expect("finishes");
     let mut recs = read_records(&out.join("trials.jsonl")).expect("records");
     recs.sort_by_key(|r| r.trial);
     let failures: Vec<_> = recs.iter().map(|r| r.outcome.failure).collect();
@@ -108,7 +129,7 @@ fn a_crashed_planner_is_restarted_and_the_batch_goes_on() {
     );
     // Every trial of a planner that always hangs fails on its own; the batch finishes.
     let out = dir.join("hang");
-    let summary = run_batch(&spec(scenario("hang", &dir)), &out, 2, &|_| {}).expect("finishes");
+    let summary = run_batch(&spec(scenario("hang", &dir), 3), &out, 2, &|_| {}).expect("finishes");
     assert_eq!(summary.trials, 3);
     assert_eq!(summary.rows[0].failures.get("plan_failed"), Some(&3));
 }
