@@ -51,6 +51,8 @@ thread_local! {
 pub struct ExternalPlanner {
     cfg: ExternalConfig,
     dir: PathBuf,
+    /// What its plans and errors are reported under.
+    name: String,
 }
 
 impl ExternalPlanner {
@@ -69,7 +71,17 @@ impl ExternalPlanner {
                 format!("must lie in (0, {MAX_TIMEOUT_S}] s"),
             ));
         }
-        Ok(Self { cfg, dir })
+        Ok(Self {
+            cfg,
+            dir,
+            name: "external".into(),
+        })
+    }
+
+    /// The same planner reported under `name` (a scenario's `[planner] name`).
+    pub fn named(mut self, name: &str) -> Self {
+        self.name = name.to_owned();
+        self
     }
 
     fn timeout(&self) -> Duration {
@@ -118,7 +130,7 @@ impl ExternalPlanner {
 
 impl Planner for ExternalPlanner {
     fn name(&self) -> &str {
-        "external"
+        &self.name
     }
 
     fn plan(&mut self, req: &PlanRequest) -> Result<Plan, PlanError> {

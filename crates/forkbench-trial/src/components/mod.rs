@@ -14,10 +14,13 @@ use forkbench_track::{PurePursuit, RegulatedPurePursuit, Tracker};
 
 pub use spec::{ComponentSpec, Role};
 
-/// What a constructor knows besides the settings: where the defining file lives.
+/// What a constructor knows besides the settings: the component's name and where the
+/// defining file lives.
 #[derive(Debug, Clone, Default)]
 pub struct ComponentContext {
-    /// Directory of the scenario (or components) file that configured the component.
+    /// What results are reported under (the table's `name`, or its kind).
+    pub name: String,
+    /// Directory of the scenario file that configured the component.
     pub dir: PathBuf,
 }
 
@@ -61,7 +64,9 @@ impl Registry {
                 Ok(Box::new(SpiralPlanner::from_settings(s)?))
             })
             .with_planner("external", |s, cx| {
-                Ok(Box::new(ExternalPlanner::from_settings(s, cx.dir.clone())?))
+                Ok(Box::new(
+                    ExternalPlanner::from_settings(s, cx.dir.clone())?.named(&cx.name),
+                ))
             })
             .with_tracker("pure_pursuit", |s, _| {
                 Ok(Box::new(PurePursuit::from_settings(s)?))

@@ -102,6 +102,7 @@ impl ComponentSpec {
 
     pub fn context(&self) -> ComponentContext {
         ComponentContext {
+            name: self.name.clone(),
             dir: self.dir.clone(),
         }
     }
