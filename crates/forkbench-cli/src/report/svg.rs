@@ -203,6 +203,19 @@ fn axes(
     );
 }
 
+/// Entry `k` of a series legend right of a plot whose top right corner is `(x, top)`.
+fn legend_entry(s: &mut String, (x, top): (f64, f64), k: usize, colour: &str, label: &str) {
+    let y = top + 10.0 + 18.0 * k as f64;
+    let _ = write!(
+        s,
+        "<rect x=\"{}\" y=\"{y}\" width=\"12\" height=\"3\" fill=\"{colour}\"/><text x=\"{}\" y=\"{}\">{}</text>",
+        x + 12.0,
+        x + 28.0,
+        y + 4.0,
+        esc(label)
+    );
+}
+
 /// The fraction of `values` in each of `bins` equal bins over [0, x1].
 fn fractions(values: &[f64], x1: f64, bins: usize) -> Vec<f64> {
     let mut c = vec![0.0; bins];
@@ -265,15 +278,7 @@ pub fn histogram(
             left + w,
             top + h
         );
-        let _ = write!(
-            s,
-            "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"3\" fill=\"{colour}\"/><text x=\"{}\" y=\"{}\">{}</text>",
-            left + w + 12.0,
-            top + 10.0 + 18.0 * k as f64,
-            left + w + 28.0,
-            top + 14.0 + 18.0 * k as f64,
-            esc(&series[k].0)
-        );
+        legend_entry(&mut s, (left + w, top), k, colour, &series[k].0);
     }
     let xt = left + w * tolerance / x1;
     let _ = write!(
@@ -334,15 +339,7 @@ pub fn lines(id: &str, title: &str, series: &[(String, Vec<Point>)], x_label: &s
                 py(p.1)
             );
         }
-        let _ = write!(
-            s,
-            "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"3\" fill=\"{colour}\"/><text x=\"{}\" y=\"{}\">{}</text>",
-            left + w + 12.0,
-            top + 10.0 + 18.0 * k as f64,
-            left + w + 28.0,
-            top + 14.0 + 18.0 * k as f64,
-            esc(label)
-        );
+        legend_entry(&mut s, (left + w, top), k, colour, label);
     }
     s + "</svg>"
 }
