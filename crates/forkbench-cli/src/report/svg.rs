@@ -159,10 +159,11 @@ fn tick(v: f64) -> String {
     }
 }
 
-/// Axes with ticks for a `w` × `h` plot area at (`left`, `top`), x in [x0, x1], y in [y0, y1].
+/// Title, frame and axes with ticks for a `w` × `h` plot area at (`left`, `top`), x in [x0, x1], y in [y0, y1].
 #[allow(clippy::too_many_arguments)]
 fn axes(
     s: &mut String,
+    title: &str,
     (left, top, w, h): (f64, f64, f64, f64),
     (x0, x1): (f64, f64),
     (y0, y1): (f64, f64),
@@ -171,7 +172,8 @@ fn axes(
 ) {
     let _ = write!(
         s,
-        "<rect x=\"{left}\" y=\"{top}\" width=\"{w}\" height=\"{h}\" fill=\"none\" stroke=\"#444\"/>"
+        "<text x=\"{left}\" y=\"18\" font-weight=\"bold\">{}</text><rect x=\"{left}\" y=\"{top}\" width=\"{w}\" height=\"{h}\" fill=\"none\" stroke=\"#444\"/>",
+        esc(title)
     );
     for i in 0..=4 {
         let f = i as f64 / 4.0;
@@ -248,13 +250,9 @@ pub fn histogram(
         .fold(0.0, f64::max)
         .max(1e-9);
     let mut s = open(id, left + w + 240.0, top + h + 50.0);
-    let _ = write!(
-        s,
-        "<text x=\"{left}\" y=\"18\" font-weight=\"bold\">{}</text>",
-        esc(title)
-    );
     axes(
         &mut s,
+        title,
         (left, top, w, h),
         (0.0, x1),
         (0.0, y1),
@@ -303,13 +301,9 @@ pub fn lines(id: &str, title: &str, series: &[(String, Vec<Point>)], x_label: &s
         .fold(0.0, f64::max)
         .max(1e-9);
     let mut s = open(id, left + w + 320.0, top + h + 50.0);
-    let _ = write!(
-        s,
-        "<text x=\"{left}\" y=\"18\" font-weight=\"bold\">{}</text>",
-        esc(title)
-    );
     axes(
         &mut s,
+        title,
         (left, top, w, h),
         (0.0, x1),
         (0.0, 100.0),
