@@ -42,7 +42,7 @@ impl Trial<'_> {
         if !self.scn.validate_paths {
             return None;
         }
-        let (obstacles, labels) = self.scn.world.footprint_obstacles();
+        let (obstacles, labels) = &self.footprints;
         let body = truck_footprint(&self.scn.truck);
         obstacles
             .first_hit_along(&body, path, PATH_CHECK_STEP_M)

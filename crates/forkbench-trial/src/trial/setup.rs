@@ -39,6 +39,8 @@ pub struct Trial<'a> {
     /// Depth the forks are driven to past the face.
     pub(super) insertion_m: f64,
     pub(super) obstacles: Vec<forkbench_sim::Obstacle>,
+    /// Racks and walls for the swept-body check of every plan, built once per trial.
+    pub(super) footprints: (forkbench_geom::Obstacles, Vec<String>),
     /// Pallet pose before the truck moved: displacement is measured from it.
     pub(super) pallet0: Pose2,
     pub(super) collision: bool,
@@ -125,6 +127,7 @@ impl<'a> Trial<'a> {
             pallet_est: true_pallet,
             insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
             obstacles,
+            footprints: scn.world.footprint_obstacles(),
             pallet0,
             collision: false,
             timed_out: true,
