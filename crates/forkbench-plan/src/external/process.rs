@@ -23,6 +23,8 @@ pub struct Process {
     stdin: ChildStdin,
     lines: Receiver<std::io::Result<String>>,
     stderr: Arc<Mutex<Vec<u8>>>,
+    /// Disconnects when the stderr reader has seen end of file.
+    stderr_done: Receiver<()>,
 }
 
 impl Process {
@@ -45,11 +47,13 @@ impl Process {
             let _ = child.kill();
             return Err("the planner's pipes could not be opened".into());
         };
+        let (stderr, stderr_done) = spawn_stderr_tail(stderr);
         let mut p = Self {
             child,
             stdin,
             lines: spawn_line_reader(stdout),
-            stderr: spawn_stderr_tail(stderr),
+            stderr,
+            stderr_done,
         };
         p.handshake(timeout)?;
         Ok(p)
@@ -112,6 +116,9 @@ impl Process {
                 _ => break None,
             }
         };
+        // The stderr reader may still be draining the pipe: wait for its end of file (bounded,
+        // since a grandchild could hold the pipe open) so the message carries the whole tail.
+        let _ = self.stderr_done.recv_timeout(Duration::from_millis(500));
         let mut msg = what.to_owned();
         if let Some(s) = status {
             msg.push_str(&format!(" (it exited: {s})"));
@@ -161,10 +168,13 @@ fn spawn_line_reader(stdout: impl Read + Send + 'static) -> Receiver<std::io::Re
     rx
 }
 
-fn spawn_stderr_tail(stderr: impl Read + Send + 'static) -> Arc<Mutex<Vec<u8>>> {
+/// Keeps the last bytes of `stderr`; the receiver disconnects when the pipe reaches its end.
+fn spawn_stderr_tail(stderr: impl Read + Send + 'static) -> (Arc<Mutex<Vec<u8>>>, Receiver<()>) {
     let tail = Arc::new(Mutex::new(Vec::new()));
     let keep = Arc::clone(&tail);
+    let (done_tx, done_rx) = channel::<()>();
     std::thread::spawn(move || {
+        let _done = done_tx;
         let mut r = stderr;
         let mut buf = [0u8; 4096];
         while let Ok(n) = r.read(&mut buf) {
@@ -178,7 +188,7 @@ fn spawn_stderr_tail(stderr: impl Read + Send + 'static) -> Arc<Mutex<Vec<u8>>> 
             }
         }
     });
-    tail
+    (tail, done_rx)
 }
 
 /// At most 200 characters of a line, for messages.
