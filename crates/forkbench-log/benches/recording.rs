@@ -1,4 +1,4 @@
-//! Cost of recording one field-test trial to .rrd and .mcap against the plain trial (target < 2×).
+//! Cost of recording one field-test trial to .rrd and .mcap against the plain trial (target ≤ 3× with both).
 
 mod common;
 

@@ -2,7 +2,7 @@
 
 pub mod mcap_sink;
 pub mod rerun_sink;
-mod rrd_file;
+mod writer;
 
 use std::path::Path;
 
@@ -82,4 +82,22 @@ pub(crate) fn pallet_outlines(pallet: &PalletSpec, face: &Pose2) -> Vec<[[f64; 2
         .iter()
         .map(|c| rect_outline(c, pallet.depth_m, pallet.stringer_width_m()))
         .collect()
+}
+
+/// The trial's verdict in one line: success with the entry errors, or the failed
+/// criterion with its value and limit.
+pub(crate) fn verdict(o: &forkbench_trial::TrialOutcome) -> String {
+    match (o.success, o.failure) {
+        (true, _) => format!(
+            "SUCCESS: entry {:.3} m off the pocket centre line, {:.2}° off the pallet axis; forks {:.2} m deep",
+            o.lateral_error_m.unwrap_or(f64::NAN),
+            o.heading_error_rad.unwrap_or(f64::NAN).to_degrees(),
+            o.insertion_depth_m
+        ),
+        (false, Some(f)) => match o.failure_detail.as_deref() {
+            Some(d) => format!("FAILED: {}: {d}", f.name()),
+            None => format!("FAILED: {}", f.name()),
+        },
+        (false, None) => "FAILED".to_owned(),
+    }
 }

@@ -1,4 +1,4 @@
-//! Recordings are read back: MCAP with the mcap crate, .rrd with rerun's own decoder.
+//! Recordings are read back: MCAP with the mcap crate, rerun's messages with its public SDK (CI checks the .rrd files with `rerun rrd verify` and rerun's Python reader).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -43,6 +43,8 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
     let mut outcome_msg = None;
     let mut frames: BTreeMap<String, usize> = BTreeMap::new();
     let mut locked = BTreeSet::new();
+    let mut world_ids = BTreeSet::new();
+    let mut logs = Vec::new();
     for m in mcap::MessageStream::new(&bytes).expect("valid mcap") {
         let m = m.expect("message");
         assert!(
@@ -71,9 +73,29 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
                 ));
             }
         }
+        if m.channel.topic == "/world" {
+            for e in v["entities"].as_array().expect("entities") {
+                world_ids.insert(e["id"].as_str().expect("id").to_owned());
+            }
+        }
+        if m.channel.topic == "/log" {
+            logs.push(v["message"].as_str().expect("message").to_owned());
+        }
         if m.channel.topic == "/forkbench/outcome" {
             outcome_msg = Some(v);
         }
+    }
+    // The drive, the look-ahead point and the markers are drawn in the world.
+    for id in [
+        "trajectory/0",
+        "trajectory/1",
+        "lookahead",
+        "start",
+        "goal",
+        "pallet_initial",
+        "plan/0",
+    ] {
+        assert!(world_ids.contains(id), "no {id} in /world: {world_ids:?}");
     }
     for s in [
         "foxglove.SceneUpdate",
@@ -116,16 +138,68 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
         (out.sim_time_s * 1e9).round() as u64,
         "log time is simulation time"
     );
+    // The verdict in /log and in forkbench.Outcome, beside the judged outcome's fields.
+    let mut outcome_msg = outcome_msg.expect("outcome");
+    let verdict = outcome_msg["verdict"].as_str().expect("verdict").to_owned();
+    let word = if out.success { "SUCCESS" } else { "FAILED" };
+    assert!(verdict.starts_with(word), "{verdict}");
+    if let Some(d) = &out.failure_detail {
+        assert!(verdict.contains(d.as_str()), "{verdict}");
+    }
     assert_eq!(
-        outcome_msg.expect("outcome"),
-        serde_json::to_value(&out).expect("serialises")
+        logs.last(),
+        Some(&format!("outcome: {verdict}")),
+        "{logs:?}"
     );
+    outcome_msg
+        .as_object_mut()
+        .expect("object")
+        .remove("verdict");
+    assert_eq!(outcome_msg, serde_json::to_value(&out).expect("serialises"));
 
     let summary = mcap::Summary::read(&bytes)
         .expect("readable")
         .expect("indexed file has a summary");
     assert!(!summary.chunk_indexes.is_empty(), "chunked");
     assert_eq!(summary.metadata_indexes.len(), 1);
+}
+
+/// A replan deletes the superseded plan's entity before drawing the new one.
+#[test]
+fn mcap_deletes_a_superseded_plan() {
+    let scn = field_test();
+    let path = tmp("replan.mcap");
+    let mut rec = McapRecorder::create(&path, BTreeMap::new()).expect("opens");
+    let replan = TrialOptions {
+        replan: Some(true),
+        ..opts()
+    };
+    let out = run_trial_recorded(&scn, &scn.cases[0], &replan, &mut rec);
+    rec.finish().expect("finishes");
+    assert!(out.replans >= 1, "the field test replans: {out:?}");
+    let bytes = std::fs::read(&path).expect("written");
+    let (mut deleted, mut drawn) = (Vec::new(), Vec::new());
+    for m in mcap::MessageStream::new(&bytes).expect("valid mcap") {
+        let m = m.expect("message");
+        if m.channel.topic != "/world" {
+            continue;
+        }
+        let v: serde_json::Value = serde_json::from_slice(&m.data).expect("JSON");
+        for d in v["deletions"].as_array().expect("deletions") {
+            deleted.push(d["id"].as_str().expect("id").to_owned());
+        }
+        for e in v["entities"].as_array().expect("entities") {
+            let id = e["id"].as_str().expect("id");
+            if id.starts_with("plan/") {
+                drawn.push(id.to_owned());
+            }
+        }
+    }
+    let n = out.replans as usize;
+    let want_drawn: Vec<String> = (0..=n).map(|i| format!("plan/{i}")).collect();
+    let want_deleted: Vec<String> = (0..n).map(|i| format!("plan/{i}")).collect();
+    assert_eq!(drawn, want_drawn);
+    assert_eq!(deleted, want_deleted);
 }
 
 #[test]
@@ -174,13 +248,87 @@ fn a_crash_mid_trial_leaves_a_readable_mcap_up_to_the_last_chunk() {
     );
 }
 
-#[test]
-fn rrd_decodes_with_rerun_and_holds_the_entities() {
-    use rerun::external::re_log_encoding::DecoderApp;
-    use rerun::external::re_log_types::LogMsg;
+/// Chunks of a recording kept in memory, by entity path (rerun's public SDK).
+fn chunks_by_entity(msgs: Vec<rerun::log::LogMsg>) -> BTreeMap<String, Vec<rerun::log::Chunk>> {
+    let mut chunks: BTreeMap<String, Vec<rerun::log::Chunk>> = BTreeMap::new();
+    for msg in msgs {
+        if let rerun::log::LogMsg::ArrowMsg(store, m) = msg
+            && store.kind() == rerun::StoreKind::Recording
+        {
+            let chunk = rerun::log::Chunk::from_arrow_msg(&m).expect("a chunk");
+            chunks
+                .entry(chunk.entity_path().to_string())
+                .or_default()
+                .push(chunk);
+        }
+    }
+    chunks
+}
 
+/// Every string of `component` logged to `entity`.
+fn strings(
+    chunks: &BTreeMap<String, Vec<rerun::log::Chunk>>,
+    entity: &str,
+    component: rerun::ComponentIdentifier,
+) -> Vec<String> {
+    chunks
+        .get(entity)
+        .into_iter()
+        .flatten()
+        .flat_map(|c| {
+            c.iter_slices::<String>(component)
+                .flatten()
+                .map(|s| s.to_string())
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// Rows sent on `sim_time` per entity.
+fn temporal_rows(chunks: &BTreeMap<String, Vec<rerun::log::Chunk>>) -> BTreeMap<String, usize> {
+    chunks
+        .iter()
+        .map(|(e, cs)| {
+            (
+                e.clone(),
+                cs.iter()
+                    .filter(|c| !c.is_static())
+                    .map(|c| c.num_rows())
+                    .sum(),
+            )
+        })
+        .collect()
+}
+
+/// Runs the field test into a recorder kept in memory; returns its chunks, the blueprint's
+/// message count and the outcome.
+fn recorded_in_memory(
+    opts: &TrialOptions,
+    extra: &mut dyn Recorder,
+) -> (
+    BTreeMap<String, Vec<rerun::log::Chunk>>,
+    usize,
+    forkbench_trial::TrialOutcome,
+) {
     let scn = field_test();
-    let path = tmp("trial.rrd");
+    let (mut rec, storage) = RerunRecorder::in_memory().expect("opens");
+    let out = run_trial_recorded(
+        &scn,
+        &scn.cases[0],
+        opts,
+        &mut forkbench_trial::Tee(vec![&mut rec, extra]),
+    );
+    rec.finish().expect("closes");
+    let msgs = storage.take();
+    let blueprint = msgs
+        .iter()
+        .filter(|m| m.store_id().kind() == rerun::StoreKind::Blueprint)
+        .count();
+    (chunks_by_entity(msgs), blueprint, out)
+}
+
+#[test]
+fn rrd_holds_the_map_plots_verdict_and_the_trials_name() {
     /// Counts the NAV350 fixes the trial reports.
     struct Fixes(usize);
     impl Recorder for Fixes {
@@ -189,163 +337,133 @@ fn rrd_decodes_with_rerun_and_holds_the_entities() {
         }
     }
     let mut fixes = Fixes(0);
-    let out = {
-        let mut rec = RerunRecorder::new(&RerunTarget::File(path.clone())).expect("opens");
-        let out = run_trial_recorded(
-            &scn,
-            &scn.cases[0],
-            &opts(),
-            &mut forkbench_trial::Tee(vec![&mut rec, &mut fixes]),
-        );
-        rec.finish().expect("flushes");
-        out
-    };
-    let file = std::io::BufReader::new(std::fs::File::open(&path).expect("written"));
-    let (mut arrow, mut apps, mut kinds) = (0, BTreeSet::new(), BTreeSet::new());
-    let mut entities = BTreeSet::new();
-    let mut rows: BTreeMap<String, usize> = BTreeMap::new();
-    let mut chunks: BTreeMap<String, Vec<rerun::log::Chunk>> = BTreeMap::new();
-    for msg in DecoderApp::decode_lazy(file) {
-        match msg.expect("decodes") {
-            LogMsg::SetStoreInfo(info) => {
-                apps.insert(info.info.application_id().to_string());
-                kinds.insert(format!("{:?}", info.info.store_id.kind()));
-            }
-            LogMsg::ArrowMsg(_, m) => {
-                arrow += 1;
-                if let Ok(chunk) = rerun::log::Chunk::from_arrow_msg(&m) {
-                    entities.insert(chunk.entity_path().to_string());
-                    if !chunk.is_static() {
-                        *rows.entry(chunk.entity_path().to_string()).or_default() +=
-                            chunk.num_rows();
-                    }
-                    chunks
-                        .entry(chunk.entity_path().to_string())
-                        .or_default()
-                        .push(chunk);
-                }
-            }
-            LogMsg::BlueprintActivationCommand(_) => {}
-        }
-    }
-    assert!(apps.contains("forkbench"), "{apps:?}");
-    assert!(
-        kinds.iter().any(|k| k.contains("Blueprint")),
-        "a blueprint is stored: {kinds:?}"
-    );
-    assert!(arrow > 10, "{arrow} arrow messages");
+    let (chunks, blueprint, out) = recorded_in_memory(&opts(), &mut fixes);
+    assert!(blueprint > 10, "a blueprint is sent: {blueprint} messages");
     for e in [
-        "/world/pallet",
-        "/truck",
-        "/plan/path",
-        "/plan/path/control_polygon",
-        "/track/trajectory",
-        "/track/lookahead",
-        "/sensors/nav350_fix",
-        "/sensors/pallet_estimate",
-        "/plots/curvature",
+        "/map",
+        "/map/initial",
+        "/map/world/pallet",
+        "/map/truck",
+        "/map/plan/0",
+        "/map/track/trajectory",
+        "/map/track/now",
+        "/map/sensors/nav350_fix",
+        "/map/sensors/pallet_estimate",
+        "/plots/lateral_error",
+        "/plots/heading_error",
         "/plots/steering",
         "/plots/speed",
-        "/plots/lateral_error",
+        "/plots/curvature",
         "/plots/contact_force",
         "/events",
+        "/verdict",
     ] {
-        assert!(entities.contains(e), "missing {e}: {entities:?}");
+        assert!(chunks.contains_key(e), "missing {e}: {:?}", chunks.keys());
     }
-    // Every step's truck pose and plot values (sent as columns), plus the start pose.
-    let steps = (out.sim_time_s / scn.sim.dt_s).round() as usize;
-    assert_eq!(rows["/truck"], steps + 1, "{rows:?}");
-    for p in [
-        "/plots/steering",
-        "/plots/contact_force",
-        "/track/lookahead",
-    ] {
+    // Every step's truck pose, trajectory tail, look-ahead and drive plots (sent as
+    // columns), plus the start pose; the entry errors over the approach only.
+    let rows = temporal_rows(&chunks);
+    let steps = (out.sim_time_s / field_test().sim.dt_s).round() as usize;
+    assert_eq!(rows["/map/truck"], steps + 1, "{rows:?}");
+    for p in ["/plots/steering", "/plots/contact_force", "/map/track/now"] {
         assert_eq!(rows[p], steps, "{p}: {rows:?}");
     }
-    // Outlines and series names are sent once, as the first row of their entity's columns
-    // (null after it): a latest-at query at the end of the trial still finds them.
-    let end = rerun::external::re_chunk_store::LatestAtQuery::new(
-        "sim_time".into(),
-        rerun::external::re_log_types::TimeInt::new_temporal((out.sim_time_s * 1e9).round() as i64),
+    let approach = rows["/plots/lateral_error"];
+    assert!(
+        approach > 10 && approach < steps / 2,
+        "{approach} of {steps} steps"
     );
-    let strips = rerun::LineStrips2D::descriptor_strips().component;
-    let names = rerun::SeriesLines::descriptor_names().component;
-    for (entity, component) in [
-        ("/truck", strips),
-        ("/world/pallet", strips),
-        ("/sensors/pallet_estimate", strips),
-        ("/plots/curvature", names),
-        ("/plots/contact_force", names),
-    ] {
-        let found = chunks[entity]
-            .iter()
-            .filter_map(|c| c.latest_at(&end, component))
-            .count();
-        assert_eq!(found, 1, "{entity} {component} at the end of the trial");
-    }
     // One row (true and measured arrow) per NAV350 fix.
     assert!(fixes.0 > 10, "{} fixes", fixes.0);
-    assert_eq!(rows["/sensors/nav350_fix"], fixes.0, "{rows:?}");
+    assert_eq!(rows["/map/sensors/nav350_fix"], fixes.0, "{rows:?}");
+    // The recording is named after the trial, the verdict names the failed criterion or
+    // success, and the series have their names and fixed colours.
+    let name = strings(
+        &chunks,
+        "/__properties",
+        rerun::RecordingInfo::descriptor_name().component,
+    );
+    let want = format!(
+        "field-test / {} / {} / {} / seed {}",
+        out.case, out.planner, out.tracker, out.seed
+    );
+    assert!(name.contains(&want), "{name:?} lacks {want}");
+    let verdict = strings(
+        &chunks,
+        "/verdict",
+        rerun::TextDocument::descriptor_text().component,
+    );
+    let last = verdict.last().expect("a verdict");
+    match out.failure {
+        None => assert!(last.contains("SUCCESS"), "{last}"),
+        Some(f) => {
+            assert!(last.contains(&format!("FAILED: {}", f.name())), "{last}");
+            assert!(
+                last.contains(out.failure_detail.as_deref().unwrap_or("?")),
+                "{last}"
+            );
+        }
+    }
+    let names = strings(
+        &chunks,
+        "/plots/lateral_error",
+        rerun::SeriesLines::descriptor_names().component,
+    );
+    assert_eq!(names, ["fork root", "+ limit", "− limit"]);
+    let colors = rerun::SeriesLines::descriptor_colors().component;
+    for plot in ["/plots/lateral_error", "/plots/steering"] {
+        assert!(
+            chunks[plot]
+                .iter()
+                .any(|c| c.components().contains_component(colors)),
+            "{plot} colours"
+        );
+    }
 }
 
-/// The .rrd footer (written by forkbench's own sink, from rerun's pieces) is what rerun's
-/// reader expects: one manifest per store (recording and blueprint), and every chunk it
-/// lists decodes, at the byte span it gives, to the chunk of that id; together they list
-/// every chunk of the file. Two files from one process check the blueprint, encoded once,
-/// in a second file too.
+/// A replan fades the plan driven so far: its colour is logged again, at the replan.
 #[test]
-fn rrd_footer_lists_every_chunk_where_it_is() {
-    use rerun::external::re_log_encoding::{
-        DecoderApp, MessageHeader, RawRrdManifest, StreamHeader,
+fn rrd_fades_a_superseded_plan() {
+    let replan = TrialOptions {
+        replan: Some(true),
+        ..opts()
     };
-    use rerun::external::re_log_types::LogMsg;
+    let (chunks, _, out) = recorded_in_memory(&replan, &mut forkbench_trial::NoRecorder);
+    assert!(out.replans >= 1, "the field test replans: {out:?}");
+    let colors = rerun::LineStrips2D::descriptor_colors().component;
+    let logged = |e: &str| {
+        chunks[e]
+            .iter()
+            .filter(|c| c.components().contains_component(colors))
+            .map(|c| c.num_rows())
+            .sum::<usize>()
+    };
+    assert_eq!(logged("/map/plan/0"), 2, "drawn, then faded");
+    let last = format!("/map/plan/{}", out.replans);
+    assert_eq!(logged(&last), 1, "the plan being driven is drawn once");
+}
 
+/// The .rrd file is rerun's stream (FourCC, and CI's `rerun rrd verify` checks the rest),
+/// holds the blueprint and the trial, and two files from one process are complete.
+#[test]
+fn rrd_files_are_written_whole() {
     let scn = field_test();
-    for name in ["footer-a.rrd", "footer-b.rrd"] {
+    let mut sizes = Vec::new();
+    for name in ["a.rrd", "b.rrd"] {
         let path = tmp(name);
         let mut rec = RerunRecorder::new(&RerunTarget::File(path.clone())).expect("opens");
         run_trial_recorded(&scn, &scn.cases[0], &opts(), &mut rec);
         rec.finish().expect("flushes");
         let bytes = std::fs::read(&path).expect("written");
-        // The chunks the file holds, in order, by decoding it from the start.
-        let chunk_of = |msg: LogMsg| match msg {
-            LogMsg::ArrowMsg(store, m) => Some((
-                format!("{:?}", store.kind()),
-                rerun::log::Chunk::from_arrow_msg(&m).expect("chunk").id(),
-            )),
-            _ => None,
-        };
-        let in_file: BTreeSet<_> = DecoderApp::decode_lazy(bytes.as_slice())
-            .filter_map(|m| chunk_of(m.expect("decodes")))
-            .collect();
-        let manifests = RawRrdManifest::from_rrd_bytes(&bytes).expect("footer reads");
-        let kinds: BTreeSet<String> = manifests
-            .iter()
-            .map(|m| format!("{:?}", m.store_id.kind()))
-            .collect();
-        assert_eq!(kinds.len(), 2, "{name}: one manifest per store: {kinds:?}");
-        let header = &bytes[..StreamHeader::ENCODED_SIZE_BYTES];
-        let mut listed = BTreeSet::new();
-        for m in &manifests {
-            let kind = format!("{:?}", m.store_id.kind());
-            let ids: Vec<_> = m.col_chunk_id().expect("ids").collect();
-            let offsets: Vec<_> = m.col_chunk_byte_offset().expect("offsets").collect();
-            let sizes: Vec<_> = m.col_chunk_byte_size().expect("sizes").collect();
-            assert_eq!(ids.len(), offsets.len());
-            for ((id, offset), size) in ids.iter().zip(offsets).zip(sizes) {
-                // The span excludes the message header: decode header + span on its own.
-                let start = offset as usize - MessageHeader::ENCODED_SIZE_BYTES;
-                let one = [header, &bytes[start..offset as usize + size as usize]].concat();
-                let decoded: Vec<_> = DecoderApp::decode_lazy(one.as_slice())
-                    .filter_map(|m| chunk_of(m.expect("the span decodes")))
-                    .collect();
-                assert_eq!(decoded, [(kind.clone(), *id)], "{name}: chunk at {offset}");
-                listed.insert((kind.clone(), *id));
-            }
-        }
-        assert_eq!(listed, in_file, "{name}: the footer lists every chunk");
-        assert!(listed.len() > 20, "{name}: {} chunks", listed.len());
+        assert_eq!(&bytes[..4], b"RRF2", "{name}: rerun's stream header");
+        sizes.push(bytes.len());
     }
+    assert!(sizes.iter().all(|s| *s > 100_000), "{sizes:?}");
+    let ratio = sizes[0] as f64 / sizes[1] as f64;
+    assert!(
+        (0.9..1.1).contains(&ratio),
+        "same trial, same size: {sizes:?}"
+    );
 }
 
 /// A full disk reaches the caller as an error naming the file and the reason, for both

@@ -11,6 +11,7 @@ pub struct SceneInfo<'a> {
     pub scenario: &'a str,
     pub case: &'a str,
     pub planner: &'a str,
+    pub tracker: &'a str,
     pub seed: u64,
     pub truck: &'a ForkliftSpec,
     pub pallet: &'a PalletSpec,
@@ -19,6 +20,8 @@ pub struct SceneInfo<'a> {
     pub obstacles: &'a [Obstacle],
     /// Fork-root start pose.
     pub start: Pose2,
+    /// What the judge checks, for drawing the limits beside the errors.
+    pub tolerances: &'a crate::Tolerances,
 }
 
 /// One control step: truth, what the controller saw, what it commanded.

@@ -103,12 +103,14 @@ impl<'a> Trial<'a> {
             scenario: &scn.name,
             case: &case.name,
             planner: &run.planner.name,
+            tracker: &run.tracker.name,
             seed: run.seed,
             truck: &scn.truck,
             pallet: &scn.pallet,
             pallet_pose: true_pallet,
             obstacles: &obstacles,
             start: case.start,
+            tolerances: &scn.tolerances,
         });
         let pallet0 = sim.pallet_pose();
         let mut trial = Trial {

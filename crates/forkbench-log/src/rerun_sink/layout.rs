@@ -1,0 +1,132 @@
+//! The viewer layout (blueprint) and the fixed colours every recording uses.
+
+use rerun::blueprint::components::{PanelState, PlayState};
+use rerun::blueprint::{
+    Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial2DView, Tabs, TextDocumentView,
+    TextLogView, TimePanel, TimeSeriesView, Vertical,
+};
+
+/// Colours are fixed here, not assigned by the viewer, so every recording reads alike.
+pub(super) const TRUCK_RGB: [u8; 3] = [230, 190, 25];
+pub(super) const PALLET_RGB: [u8; 3] = [205, 140, 50];
+pub(super) const PALLET_INITIAL_RGBA: [u8; 4] = [205, 140, 50, 90];
+pub(super) const ESTIMATE_RGB: [u8; 3] = [220, 40, 40];
+pub(super) const RACK_RGB: [u8; 3] = [150, 150, 150];
+pub(super) const GRID_RGBA: [u8; 4] = [120, 120, 120, 70];
+pub(super) const PLAN_RGB: [u8; 3] = [40, 110, 240];
+pub(super) const SUPERSEDED_RGBA: [u8; 4] = [40, 110, 240, 60];
+pub(super) const CONTROL_RGB: [u8; 3] = [120, 150, 230];
+pub(super) const TRAJECTORY_RGB: [u8; 3] = [40, 200, 80];
+pub(super) const LOOKAHEAD_RGB: [u8; 3] = [235, 60, 220];
+pub(super) const START_RGB: [u8; 3] = [240, 240, 240];
+pub(super) const GOAL_RGB: [u8; 3] = [80, 170, 255];
+/// True (green) and measured (red) pose at a NAV350 fix.
+pub(super) const TRUE_RGB: [u8; 3] = [40, 200, 80];
+pub(super) const MEASURED_RGB: [u8; 3] = [240, 70, 70];
+/// Command and actual of a plotted quantity; limits.
+pub(super) const COMMAND_RGB: [u8; 3] = [255, 170, 40];
+pub(super) const ACTUAL_RGB: [u8; 3] = [70, 160, 255];
+pub(super) const LIMIT_RGB: [u8; 3] = [235, 60, 60];
+
+/// Draw order in the map (higher on top): the driven trajectory over the plans.
+pub(super) const ORDER_GRID: f32 = 0.0;
+pub(super) const ORDER_WORLD: f32 = 1.0;
+pub(super) const ORDER_PLAN: f32 = 2.0;
+pub(super) const ORDER_TRUCK: f32 = 3.0;
+pub(super) const ORDER_TRAJECTORY: f32 = 4.0;
+pub(super) const ORDER_MARKERS: f32 = 5.0;
+
+/// The entry-error plots cover the fork root's last this many metres before the pallet face.
+pub(super) const APPROACH_M: f64 = 1.5;
+
+/// A plot: its entity, title and series (name, colour); several series share one entity,
+/// so one chunk.
+pub(super) struct Plot {
+    pub entity: &'static str,
+    pub title: &'static str,
+    pub series: &'static [(&'static str, [u8; 3])],
+}
+
+/// Entry errors first: they decide the verdict, and the limits are drawn beside them. They
+/// are plotted over the approach only (see [`APPROACH_M`]), where the limits apply and the
+/// axis range shows centimetres.
+pub(super) const PLOTS: [Plot; 6] = [
+    Plot {
+        entity: "plots/lateral_error",
+        title: "entry: lateral offset to pallet axis (m)",
+        series: &[
+            ("fork root", ACTUAL_RGB),
+            ("+ limit", LIMIT_RGB),
+            ("− limit", LIMIT_RGB),
+        ],
+    },
+    Plot {
+        entity: "plots/heading_error",
+        title: "entry: heading to pallet axis (°)",
+        series: &[
+            ("truck", ACTUAL_RGB),
+            ("+ limit", LIMIT_RGB),
+            ("− limit", LIMIT_RGB),
+        ],
+    },
+    Plot {
+        entity: "plots/steering",
+        title: "steering (rad)",
+        series: &[("command", COMMAND_RGB), ("actual", ACTUAL_RGB)],
+    },
+    Plot {
+        entity: "plots/speed",
+        title: "speed (m/s)",
+        series: &[("command", COMMAND_RGB), ("actual", ACTUAL_RGB)],
+    },
+    Plot {
+        entity: "plots/curvature",
+        title: "curvature (1/m)",
+        series: &[("planned", COMMAND_RGB), ("driven", ACTUAL_RGB)],
+    },
+    Plot {
+        entity: "plots/contact_force",
+        title: "fork contact force (N)",
+        series: &[("contact", ACTUAL_RGB)],
+    },
+];
+
+fn plot_view(p: &Plot) -> TimeSeriesView {
+    TimeSeriesView::new(p.title).with_origin(p.entity)
+}
+
+/// Map on the left; on the right the verdict, two tab groups of tall plots (entry errors,
+/// then the drive) and the event log.
+pub(super) fn blueprint() -> Blueprint {
+    let errors = Tabs::new(PLOTS[..2].iter().map(|p| plot_view(p).into()));
+    let drive = Tabs::new(PLOTS[2..].iter().map(|p| plot_view(p).into()));
+    let right = Vertical::new([
+        TextDocumentView::new("verdict")
+            .with_origin("verdict")
+            .into(),
+        errors.into(),
+        drive.into(),
+        TextLogView::new("events").with_origin("events").into(),
+    ])
+    .with_row_shares([1.7, 1.4, 1.4, 0.9]);
+    Blueprint::new(
+        Horizontal::new([
+            Spatial2DView::new("map (y up, 1 m grid)")
+                .with_origin("/")
+                .with_contents(["map/**"])
+                .into(),
+            right.into(),
+        ])
+        .with_column_shares([0.55, 0.45]),
+    )
+    .with_auto_views(false)
+    // The views get the whole window; the panels open with a click.
+    .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+    .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+    // A finished recording opens at its end, where the verdict was made.
+    .with_time_panel(
+        TimePanel::new()
+            .with_timeline("sim_time")
+            .with_play_state(PlayState::Following),
+    )
+}

@@ -1,0 +1,248 @@
+//! What the trial reports, turned into rerun entities: scene, plans, steps, events and the verdict.
+
+use forkbench_core::Pose2;
+use forkbench_core::units::wrap_angle;
+use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
+
+use super::RerunRecorder;
+use super::columns::{color, rgba, strip};
+use super::layout::*;
+use super::scene::pose_arrow;
+use crate::{pallet_outlines, truck_outlines};
+
+/// A path's samples as a strip.
+fn strip_of(path: &forkbench_core::Path) -> Vec<[f32; 2]> {
+    path.samples
+        .iter()
+        .map(|p| [p.x_m as f32, p.y_m as f32])
+        .collect()
+}
+
+impl RerunRecorder {
+    /// Fixed styles and series names, sent with each entity's first columns.
+    fn styles(&mut self) {
+        for plot in &PLOTS {
+            let lines = rerun::SeriesLines::new()
+                .with_names(plot.series.iter().map(|(n, _)| *n))
+                .with_colors(plot.series.iter().map(|(_, c)| color(*c)))
+                .with_widths(
+                    plot.series
+                        .iter()
+                        .map(|(n, _)| if n.contains("limit") { 1.0 } else { 2.0 }),
+                );
+            self.set_once(plot.entity, &lines);
+        }
+        let trajectory = rerun::LineStrips2D::update_fields()
+            .with_colors([color(TRAJECTORY_RGB)])
+            .with_radii([0.02])
+            .with_draw_order(ORDER_TRAJECTORY);
+        self.set_once("map/track/trajectory", &trajectory);
+        // The trajectory's tail and the look-ahead point share the entity of "now".
+        let lookahead = rerun::Points2D::update_fields()
+            .with_colors([color(LOOKAHEAD_RGB)])
+            .with_radii([0.07])
+            .with_draw_order(ORDER_MARKERS);
+        self.set_once("map/track/now", &trajectory);
+        self.set_once("map/track/now", &lookahead);
+        let fixes = rerun::Arrows2D::update_fields()
+            .with_radii([0.02])
+            .with_draw_order(ORDER_MARKERS);
+        self.set_once("map/sensors/nav350_fix", &fixes);
+    }
+
+    /// The verdict view's text: the outcome first, then what the map's colours mean.
+    fn verdict_text(&self, o: &TrialOutcome) -> String {
+        let head = if o.success {
+            "#### ✅ SUCCESS".to_owned()
+        } else {
+            format!(
+                "#### ❌ FAILED: {}",
+                o.failure.map_or("unknown", |f| f.name())
+            )
+        };
+        let detail = o.failure_detail.as_deref().unwrap_or("");
+        let [lat_limit, head_limit] = self.limits;
+        let num = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map_or("—".to_owned(), f);
+        format!(
+            "{head}\n\n{detail}\n\n\
+             | at entry | value | limit |\n|---|---|---|\n\
+             | lateral offset | {} | {lat_limit} m |\n\
+             | heading | {} | {head_limit}° |\n\
+             | fork depth | {:.3} m | |\n\
+             | max contact force | {:.0} N | |\n\n\
+             **{}** · case `{}` · planner `{}` · tracker `{}` · seed {} · {:.2} s simulated, {} replans\n\n\
+             Map (y up, 1 m grid): white arrow start · light-blue arrow goal (pre-entry) · \
+             blue plan being driven (thin: its control polygon), faded plans superseded · \
+             green driven trajectory · \
+             magenta look-ahead · yellow truck · orange pallet, faint where it stood · \
+             red pallet estimate · green/red arrows true/measured NAV350 fix\n\n\
+             ```json\n{}\n```\n",
+            num(o.lateral_error_m, &|v| format!("{v:.3} m")),
+            num(o.heading_error_rad, &|v| format!("{:.2}°", v.to_degrees())),
+            o.insertion_depth_m,
+            o.max_contact_force_n,
+            o.scenario,
+            o.case,
+            o.planner,
+            o.tracker,
+            o.seed,
+            o.sim_time_s,
+            o.replans,
+            serde_json::to_string_pretty(o).unwrap_or_default(),
+        )
+    }
+
+    fn log_verdict(&mut self, markdown: String) {
+        let doc = rerun::TextDocument::new(markdown).with_media_type(rerun::MediaType::markdown());
+        let r = self.rec.log_static("verdict", &doc);
+        self.note(r);
+    }
+}
+
+impl Recorder for RerunRecorder {
+    fn scene(&mut self, s: &SceneInfo<'_>) {
+        self.truck = Some(s.truck.clone());
+        self.pallet0 = s.pallet_pose;
+        self.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg];
+        let name = format!(
+            "{} / {} / {} / {} / seed {}",
+            s.scenario, s.case, s.planner, s.tracker, s.seed
+        );
+        let r = self.rec.send_recording_name(name.clone());
+        self.note(r);
+        self.at(0.0);
+        let r = self.rec.log(
+            "events",
+            &rerun::TextLog::new(format!("trial {name}")).with_level(rerun::TextLogLevel::INFO),
+        );
+        self.note(r);
+        self.draw_scene(s);
+        self.styles();
+        let origin = Pose2::new(0.0, 0.0, 0.0);
+        self.local_outlines(
+            "map/world/pallet",
+            &pallet_outlines(s.pallet, &origin),
+            PALLET_RGB,
+        );
+        self.local_outlines(
+            "map/sensors/pallet_estimate",
+            &pallet_outlines(s.pallet, &origin),
+            ESTIMATE_RGB,
+        );
+        self.local_outlines("map/truck", &truck_outlines(s.truck, &origin), TRUCK_RGB);
+        // The start pose and the pallet's first pose go out with the first columns.
+        self.cols.truck_start = Some(s.start);
+        self.cols.pallet_pose.0.push(0.0);
+        self.cols.pallet_pose.1.push(s.pallet_pose);
+        self.cols.last_pallet = Some(s.pallet_pose);
+    }
+
+    fn plan(
+        &mut self,
+        t_s: f64,
+        index: u32,
+        path: &forkbench_core::Path,
+        control_polygon: Option<&[[f64; 2]]>,
+    ) {
+        self.at(t_s);
+        // The plan driven so far fades: only the new one is drawn bright.
+        if self.plans > 0 {
+            let faded = [rgba(SUPERSEDED_RGBA)];
+            let lines = rerun::LineStrips2D::update_fields().with_colors(faded);
+            let points = rerun::Points2D::update_fields().with_colors(faded);
+            let goal = rerun::Arrows2D::update_fields().with_colors(faded);
+            let r = self.rec.log(
+                format!("map/plan/{}", self.plans - 1),
+                &[&lines as &dyn rerun::AsComponents, &points, &goal],
+            );
+            self.note(r);
+        }
+        self.plans = index + 1;
+        // Path, control polygon and points, and the goal arrow in one row of one entity:
+        // one chunk per plan.
+        let mut strips = vec![strip_of(path)];
+        let (mut colors, mut radii) = (vec![color(PLAN_RGB)], vec![0.03]);
+        if let Some(c) = control_polygon {
+            strips.push(strip(c));
+            colors.push(color(CONTROL_RGB));
+            radii.push(0.008);
+        }
+        let lines = rerun::LineStrips2D::new(strips)
+            .with_colors(colors)
+            .with_radii(radii)
+            .with_draw_order(ORDER_PLAN);
+        let points = rerun::Points2D::new(control_polygon.map(strip).unwrap_or_default())
+            .with_radii([0.05])
+            .with_colors([color(CONTROL_RGB)])
+            .with_draw_order(ORDER_PLAN);
+        let end = path.samples.last().map_or(Pose2::new(0.0, 0.0, 0.0), |e| {
+            Pose2::new(e.x_m, e.y_m, e.heading_rad)
+        });
+        let goal = pose_arrow(&end, GOAL_RGB);
+        let r = self.rec.log(
+            format!("map/plan/{index}"),
+            &[&lines as &dyn rerun::AsComponents, &points, &goal],
+        );
+        self.note(r);
+    }
+
+    fn step(&mut self, s: &StepRecord) {
+        let local = self.pallet0.to_local(&s.truth);
+        let heading_deg = wrap_angle(local.heading_rad).to_degrees();
+        let actual_curvature =
+            s.steer_rad.tan() / self.truck.as_ref().map_or(1.0, |t| t.wheelbase_m);
+        let [lat, head] = self.limits;
+        let approach = local.x_m >= -APPROACH_M;
+        let (lateral, heading): (&[f64], &[f64]) = if approach {
+            (&[local.y_m, lat, -lat], &[heading_deg, head, -head])
+        } else {
+            (&[], &[])
+        };
+        self.cols.push(
+            s,
+            [
+                lateral,
+                heading,
+                &[s.steer_cmd_rad, s.steer_rad],
+                &[s.speed_cmd_mps, s.speed_mps],
+                &[s.path_curvature_per_m, actual_curvature],
+                &[s.contact_force_n],
+            ],
+        );
+        if self.cols.times.len() >= self.send_every {
+            self.send_buffered();
+        }
+    }
+
+    fn event(&mut self, t_s: f64, level: Level, text: &str) {
+        self.at(t_s);
+        let level = match level {
+            Level::Info => rerun::TextLogLevel::INFO,
+            Level::Warn => rerun::TextLogLevel::WARN,
+            Level::Error => rerun::TextLogLevel::ERROR,
+        };
+        let r = self
+            .rec
+            .log("events", &rerun::TextLog::new(text).with_level(level));
+        self.note(r);
+    }
+
+    fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
+        self.at(t_s);
+        self.cols.whole_strip(t_s);
+        let level = if outcome.success {
+            rerun::TextLogLevel::INFO
+        } else {
+            rerun::TextLogLevel::ERROR
+        };
+        let line = format!("outcome: {}", crate::verdict(outcome));
+        let r = self
+            .rec
+            .log("events", &rerun::TextLog::new(line).with_level(level));
+        self.note(r);
+        let text = self.verdict_text(outcome);
+        self.log_verdict(text);
+        // The outcome is the trial's last call: close now, in parallel with other sinks.
+        self.close_async();
+    }
+}
