@@ -122,8 +122,17 @@ pub fn metadata(
     ])
 }
 
-/// Re-runs one trial of a scenario into
-/// `<dir>/<scenario>-<case>-<planner>-<tracker>-seed<seed>.{rrd,mcap}`.
+/// The file stem of a trial's recordings: `<scenario>-<case>-<planner>-<tracker>-seed<seed>`,
+/// with `-replan` for a trial that replans (both modes of a batch run the same seeds).
+pub fn recording_stem(o: &forkbench_trial::TrialOutcome, replan: bool) -> String {
+    let mode = if replan { "-replan" } else { "" };
+    safe_file_stem(&format!(
+        "{}-{}-{}-{}-seed{}{mode}",
+        o.scenario, o.case, o.planner, o.tracker, o.seed
+    ))
+}
+
+/// Re-runs one trial of a scenario into `<dir>/<stem>.{rrd,mcap}` ([`recording_stem`]).
 pub fn record_trial(
     scn: &forkbench_trial::Scenario,
     case: &forkbench_trial::Case,
@@ -133,10 +142,10 @@ pub fn record_trial(
     let run = scn.resolve(opts)?;
     // Names are free text: only letters, digits, '-' and '_' reach the file name, so a
     // name can neither leave `dir` nor fail the write (the real names are in the files).
-    let stem = safe_file_stem(&format!(
-        "{}-{}-{}-{}-seed{}",
-        scn.name, case.name, run.planner.name, run.tracker.name, run.seed
-    ));
+    let names = (run.planner.name.as_str(), run.tracker.name.as_str());
+    let id =
+        forkbench_trial::TrialOutcome::blank(&scn.name, &case.name, names, run.seed, run.noise);
+    let stem = recording_stem(&id, run.replan);
     let rrd = dir.join(format!("{stem}.rrd"));
     let args = RecordArgs {
         rrd: Some(rrd.clone()),

@@ -4,7 +4,7 @@ mod common;
 
 use std::collections::BTreeMap;
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use forkbench_log::{McapRecorder, RerunRecorder, RerunTarget};
 use forkbench_trial::{Tee, run_trial, run_trial_recorded};
 
@@ -14,21 +14,41 @@ fn bench(c: &mut Criterion) {
     let dir = common::scratch_dir("bench");
     let mut g = c.benchmark_group("recording");
     g.bench_function("off", |b| b.iter(|| run_trial(&scn, case, &opts)));
+    // Each iteration writes fresh files, as a batch does (truncating last iteration's
+    // files would add the file system's cost of freeing them to the timing).
+    let fresh = |names: &'static [&'static str]| {
+        let dir = dir.clone();
+        move || {
+            for n in names {
+                let _ = std::fs::remove_file(dir.join(n));
+            }
+        }
+    };
     g.bench_function("mcap", |b| {
-        b.iter(|| {
-            let mut m = McapRecorder::create(&dir.join("b.mcap"), BTreeMap::new()).expect("opens");
-            let out = run_trial_recorded(&scn, case, &opts, &mut m);
-            m.finish().expect("finishes");
-            out
-        })
+        b.iter_batched(
+            fresh(&["b.mcap"]),
+            |()| {
+                let mut m =
+                    McapRecorder::create(&dir.join("b.mcap"), BTreeMap::new()).expect("opens");
+                let out = run_trial_recorded(&scn, case, &opts, &mut m);
+                m.finish().expect("finishes");
+                out
+            },
+            BatchSize::PerIteration,
+        )
     });
     g.bench_function("rrd", |b| {
-        b.iter(|| {
-            let mut r = RerunRecorder::new(&RerunTarget::File(dir.join("b.rrd"))).expect("opens");
-            let out = run_trial_recorded(&scn, case, &opts, &mut r);
-            r.finish().expect("flushes");
-            out
-        })
+        b.iter_batched(
+            fresh(&["b.rrd"]),
+            |()| {
+                let mut r =
+                    RerunRecorder::new(&RerunTarget::File(dir.join("b.rrd"))).expect("opens");
+                let out = run_trial_recorded(&scn, case, &opts, &mut r);
+                r.finish().expect("flushes");
+                out
+            },
+            BatchSize::PerIteration,
+        )
     });
     g.bench_function("rrd-setup", |b| {
         b.iter(|| {
@@ -37,14 +57,20 @@ fn bench(c: &mut Criterion) {
         })
     });
     g.bench_function("rrd+mcap", |b| {
-        b.iter(|| {
-            let mut m = McapRecorder::create(&dir.join("c.mcap"), BTreeMap::new()).expect("opens");
-            let mut r = RerunRecorder::new(&RerunTarget::File(dir.join("c.rrd"))).expect("opens");
-            let out = run_trial_recorded(&scn, case, &opts, &mut Tee(vec![&mut m, &mut r]));
-            m.finish().expect("finishes");
-            r.finish().expect("flushes");
-            out
-        })
+        b.iter_batched(
+            fresh(&["c.mcap", "c.rrd"]),
+            |()| {
+                let mut m =
+                    McapRecorder::create(&dir.join("c.mcap"), BTreeMap::new()).expect("opens");
+                let mut r =
+                    RerunRecorder::new(&RerunTarget::File(dir.join("c.rrd"))).expect("opens");
+                let out = run_trial_recorded(&scn, case, &opts, &mut Tee(vec![&mut m, &mut r]));
+                m.finish().expect("finishes");
+                r.finish().expect("flushes");
+                out
+            },
+            BatchSize::PerIteration,
+        )
     });
     g.finish();
 }

@@ -353,7 +353,6 @@ fn rrd_holds_the_map_plots_verdict_and_the_trials_name() {
         "/plots/heading_error",
         "/plots/steering",
         "/plots/speed",
-        "/plots/curvature",
         "/plots/contact_force",
         "/events",
         "/verdict",

@@ -227,10 +227,7 @@ pub fn failed_trials(dir: &Path, records: &[TrialRecord]) -> String {
     let shown = failed.len().min(200);
     for r in &failed[..shown] {
         let o = &r.outcome;
-        let stem = crate::record::safe_file_stem(&format!(
-            "{}-{}-{}-{}-seed{}",
-            o.scenario, o.case, o.planner, o.tracker, o.seed
-        ));
+        let stem = crate::record::recording_stem(o, r.replan == Some(true));
         let links: Vec<String> = ["rrd", "mcap"]
             .iter()
             .filter(|ext| rec_dir.join(format!("{stem}.{ext}")).is_file())

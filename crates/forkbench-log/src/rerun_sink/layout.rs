@@ -3,7 +3,7 @@
 use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::blueprint::{
     Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial2DView, Tabs, TextDocumentView,
-    TextLogView, TimePanel, TimeSeriesView, Vertical,
+    TimePanel, TimeSeriesView, Vertical,
 };
 
 /// Colours are fixed here, not assigned by the viewer, so every recording reads alike.
@@ -23,7 +23,7 @@ pub(super) const GOAL_RGB: [u8; 3] = [80, 170, 255];
 /// True (green) and measured (red) pose at a NAV350 fix.
 pub(super) const TRUE_RGB: [u8; 3] = [40, 200, 80];
 pub(super) const MEASURED_RGB: [u8; 3] = [240, 70, 70];
-/// Command and actual of a plotted quantity; limits.
+/// Actual (drawn first, wide) and command (on top, narrow) of a plotted quantity; limits.
 pub(super) const COMMAND_RGB: [u8; 3] = [255, 170, 40];
 pub(super) const ACTUAL_RGB: [u8; 3] = [70, 160, 255];
 pub(super) const LIMIT_RGB: [u8; 3] = [235, 60, 60];
@@ -50,7 +50,7 @@ pub(super) struct Plot {
 /// Entry errors first: they decide the verdict, and the limits are drawn beside them. They
 /// are plotted over the approach only (see [`APPROACH_M`]), where the limits apply and the
 /// axis range shows centimetres.
-pub(super) const PLOTS: [Plot; 6] = [
+pub(super) const PLOTS: [Plot; 5] = [
     Plot {
         entity: "plots/lateral_error",
         title: "entry: lateral offset to pallet axis (m)",
@@ -72,17 +72,12 @@ pub(super) const PLOTS: [Plot; 6] = [
     Plot {
         entity: "plots/steering",
         title: "steering (rad)",
-        series: &[("command", COMMAND_RGB), ("actual", ACTUAL_RGB)],
+        series: &[("actual", ACTUAL_RGB), ("command", COMMAND_RGB)],
     },
     Plot {
         entity: "plots/speed",
         title: "speed (m/s)",
-        series: &[("command", COMMAND_RGB), ("actual", ACTUAL_RGB)],
-    },
-    Plot {
-        entity: "plots/curvature",
-        title: "curvature (1/m)",
-        series: &[("planned", COMMAND_RGB), ("driven", ACTUAL_RGB)],
+        series: &[("actual", ACTUAL_RGB), ("command", COMMAND_RGB)],
     },
     Plot {
         entity: "plots/contact_force",
@@ -95,8 +90,9 @@ fn plot_view(p: &Plot) -> TimeSeriesView {
     TimeSeriesView::new(p.title).with_origin(p.entity)
 }
 
-/// Map on the left; on the right the verdict, two tab groups of tall plots (entry errors,
-/// then the drive) and the event log.
+/// Map on the left; on the right the verdict (with the event log) and two tab groups of
+/// tall plots: entry errors, then the drive. Every view costs the file two chunks, so the
+/// event log is part of the verdict document rather than a view of its own.
 pub(super) fn blueprint() -> Blueprint {
     let errors = Tabs::new(PLOTS[..2].iter().map(|p| plot_view(p).into()));
     let drive = Tabs::new(PLOTS[2..].iter().map(|p| plot_view(p).into()));
@@ -106,9 +102,8 @@ pub(super) fn blueprint() -> Blueprint {
             .into(),
         errors.into(),
         drive.into(),
-        TextLogView::new("events").with_origin("events").into(),
     ])
-    .with_row_shares([1.7, 1.4, 1.4, 0.9]);
+    .with_row_shares([1.6, 1.2, 1.2]);
     Blueprint::new(
         Horizontal::new([
             Spatial2DView::new("map (y up, 1 m grid)")

@@ -14,7 +14,7 @@ use std::io::{BufWriter, Write as _};
 use std::path::PathBuf;
 use std::sync::mpsc::Receiver;
 
-use forkbench_core::{ForkliftSpec, Pose2};
+use forkbench_core::Pose2;
 
 use crate::LogError;
 use crate::writer::{WriterThread, with_causes};
@@ -67,13 +67,14 @@ pub struct RerunRecorder {
     rec: rerun::RecordingStream,
     sink: Sink,
     send_every: usize,
-    truck: Option<ForkliftSpec>,
     /// The true pallet pose at the start: the frame of the entry-error plots.
     pallet0: Pose2,
     /// Entry limits drawn on the error plots: lateral (m) and heading (°).
     limits: [f64; 2],
     /// Plans on screen, the last one the one being driven.
     plans: u32,
+    /// The event log so far, for the verdict document.
+    events: Vec<String>,
     cols: Columns,
     error: Option<String>,
     close: Close,
@@ -184,10 +185,10 @@ impl RerunRecorder {
                 RerunTarget::File(_) => SEND_EVERY_FILE,
                 RerunTarget::Spawn | RerunTarget::Connect(_) => SEND_EVERY_LIVE,
             },
-            truck: None,
             pallet0: Pose2::new(0.0, 0.0, 0.0),
             limits: [f64::NAN; 2],
             plans: 0,
+            events: Vec::new(),
             cols: Columns::default(),
             error: None,
             close: Close::Open,

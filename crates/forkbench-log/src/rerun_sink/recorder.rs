@@ -10,6 +10,15 @@ use super::layout::*;
 use super::scene::pose_arrow;
 use crate::{pallet_outlines, truck_outlines};
 
+/// Limits thin, commands narrower than the actual values they are drawn over.
+fn series_width(name: &str) -> f32 {
+    match name {
+        n if n.contains("limit") => 1.0,
+        "command" | "planned" => 1.5,
+        _ => 2.5,
+    }
+}
+
 /// A path's samples as a strip.
 fn strip_of(path: &forkbench_core::Path) -> Vec<[f32; 2]> {
     path.samples
@@ -25,11 +34,7 @@ impl RerunRecorder {
             let lines = rerun::SeriesLines::new()
                 .with_names(plot.series.iter().map(|(n, _)| *n))
                 .with_colors(plot.series.iter().map(|(_, c)| color(*c)))
-                .with_widths(
-                    plot.series
-                        .iter()
-                        .map(|(n, _)| if n.contains("limit") { 1.0 } else { 2.0 }),
-                );
+                .with_widths(plot.series.iter().map(|(n, _)| series_width(n)));
             self.set_once(plot.entity, &lines);
         }
         let trajectory = rerun::LineStrips2D::update_fields()
@@ -76,7 +81,8 @@ impl RerunRecorder {
              green driven trajectory · \
              magenta look-ahead · yellow truck · orange pallet, faint where it stood · \
              red pallet estimate · green/red arrows true/measured NAV350 fix\n\n\
-             ```json\n{}\n```\n",
+             **Events**\n\n```text\n{}\n```\n\n\
+             **Outcome**\n\n```json\n{}\n```\n",
             num(o.lateral_error_m, &|v| format!("{v:.3} m")),
             num(o.heading_error_rad, &|v| format!("{:.2}°", v.to_degrees())),
             o.insertion_depth_m,
@@ -88,6 +94,7 @@ impl RerunRecorder {
             o.seed,
             o.sim_time_s,
             o.replans,
+            self.events.join("\n"),
             serde_json::to_string_pretty(o).unwrap_or_default(),
         )
     }
@@ -101,7 +108,6 @@ impl RerunRecorder {
 
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
-        self.truck = Some(s.truck.clone());
         self.pallet0 = s.pallet_pose;
         self.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg];
         let name = format!(
@@ -189,8 +195,6 @@ impl Recorder for RerunRecorder {
     fn step(&mut self, s: &StepRecord) {
         let local = self.pallet0.to_local(&s.truth);
         let heading_deg = wrap_angle(local.heading_rad).to_degrees();
-        let actual_curvature =
-            s.steer_rad.tan() / self.truck.as_ref().map_or(1.0, |t| t.wheelbase_m);
         let [lat, head] = self.limits;
         let approach = local.x_m >= -APPROACH_M;
         let (lateral, heading): (&[f64], &[f64]) = if approach {
@@ -203,9 +207,8 @@ impl Recorder for RerunRecorder {
             [
                 lateral,
                 heading,
-                &[s.steer_cmd_rad, s.steer_rad],
-                &[s.speed_cmd_mps, s.speed_mps],
-                &[s.path_curvature_per_m, actual_curvature],
+                &[s.steer_rad, s.steer_cmd_rad],
+                &[s.speed_mps, s.speed_cmd_mps],
                 &[s.contact_force_n],
             ],
         );
@@ -216,6 +219,7 @@ impl Recorder for RerunRecorder {
 
     fn event(&mut self, t_s: f64, level: Level, text: &str) {
         self.at(t_s);
+        self.events.push(format!("{t_s:7.2} s  {level:?}  {text}"));
         let level = match level {
             Level::Info => rerun::TextLogLevel::INFO,
             Level::Warn => rerun::TextLogLevel::WARN,
