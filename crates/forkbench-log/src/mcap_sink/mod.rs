@@ -179,6 +179,24 @@ impl McapRecorder {
     }
 }
 
+impl McapRecorder {
+    /// The start pose and the pallet where it stood, kept while the truck moves.
+    fn send_markers(&mut self, s: &SceneInfo<'_>) {
+        let mut start = entity(0.0, "start", Vec::new());
+        start.arrows.push(pose_arrow(&s.start, START_RGBA));
+        let pallet0 = pallet_outlines(s.pallet, &s.pallet_pose)
+            .iter()
+            .map(|c| line(c, [0.8, 0.55, 0.2, 0.3], 0.01))
+            .collect();
+        let pallet0 = entity(0.0, "pallet_initial", pallet0);
+        let update = SceneUpdate {
+            deletions: Vec::new(),
+            entities: vec![start, pallet0],
+        };
+        self.send("/world", 0.0, update);
+    }
+}
+
 impl Drop for McapRecorder {
     fn drop(&mut self) {
         let _ = self.finish();
@@ -244,26 +262,7 @@ impl Recorder for McapRecorder {
                 entities,
             },
         );
-        // Start pose and the pallet where it stood, kept while the truck moves.
-        let mut start = entity(0.0, "start", Vec::new());
-        start.arrows.push(pose_arrow(&s.start, START_RGBA));
-        let mut pallet0 = entity(
-            0.0,
-            "pallet_initial",
-            outlines(
-                pallet_outlines(s.pallet, &s.pallet_pose),
-                [0.8, 0.55, 0.2, 0.3],
-            ),
-        );
-        pallet0.lines.iter_mut().for_each(|l| l.thickness = 0.01);
-        self.send(
-            "/world",
-            0.0,
-            SceneUpdate {
-                deletions: Vec::new(),
-                entities: vec![start, pallet0],
-            },
-        );
+        self.send_markers(s);
         for (child, pose) in [("fork_root", &s.start), ("pallet", &s.pallet_pose)] {
             self.send("/tf", 0.0, FrameTransform::world(0.0, child, pose));
         }
