@@ -2,11 +2,13 @@
 
 mod batch_cmd;
 mod corridor_cmd;
+mod map_cmd;
 mod plan_cmd;
 mod plot;
 mod record;
 mod report;
 mod reproduce_cmd;
+mod route_cmd;
 mod trial_cmd;
 
 use std::path::PathBuf;
@@ -33,6 +35,7 @@ enum ReproduceArg {
     Bspline,
     Spiral,
     Corridor,
+    Prm,
 }
 
 /// Recording targets of one trial.
@@ -144,6 +147,8 @@ enum Command {
     },
     /// Corridor bends: minimum width per turning mode and angle, and G regions at a width.
     Corridor(corridor_cmd::CorridorCli),
+    /// A world rasterised to an occupancy grid, written as a ROS map_server map (YAML + PGM).
+    Map(map_cmd::MapArgs),
     /// Reproduce a paper's table side by side with this project's results.
     Reproduce {
         what: ReproduceArg,
@@ -242,7 +247,10 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             let ok = batch_cmd::replay(&file, line, scenario.as_deref(), &record.args())?;
             Ok(if ok { Done::Ok } else { Done::PickFailed })
         }
-        Command::Plan(args) => plan_cmd::run(args.resolve()?).map(|()| Done::Ok),
+        Command::Plan(args) => match args.route()? {
+            Some(route) => route_cmd::run(&route).map(|()| Done::Ok),
+            None => plan_cmd::run(args.resolve()?).map(|()| Done::Ok),
+        },
         Command::Reproduce {
             what,
             table,
@@ -261,9 +269,16 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
                 }
                 corridor_cmd::reproduce(json, plot.as_deref())
             }
+            ReproduceArg::Prm => {
+                if table.is_some() || plot.is_some() {
+                    anyhow::bail!("reproduce prm: --table and --plot are not supported yet");
+                }
+                route_cmd::reproduce(100, json)
+            }
         }
         .map(|()| Done::Ok),
         Command::Corridor(args) => corridor_cmd::run(&args.resolve()?).map(|()| Done::Ok),
+        Command::Map(args) => map_cmd::run(&args).map(|()| Done::Ok),
     }
 }
 

@@ -44,9 +44,54 @@ pub struct PlanCli {
     /// Draw path, curvature and steering to FILE (.svg or .png).
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Global planners (prm, rrt, rrt-connect): the map, a world TOML or a ROS map_server
+    /// YAML.
+    #[arg(long)]
+    pub map: Option<PathBuf>,
+    /// PRM: samples drawn over the map.
+    #[arg(long, default_value_t = 500)]
+    pub nodes: usize,
+    /// PRM: connection distance in metres, or `inf`.
+    #[arg(long, default_value = "10", value_parser = crate::route_cmd::parse_connect)]
+    pub connect_m: f64,
+    /// Global planners: seed of the samples.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Global planners: cell size when the map is a world file.
+    #[arg(long, default_value_t = 0.05)]
+    pub resolution_m: f64,
+    /// Global planners: obstacle inflation (default 0.5 × wheelbase, as the paper).
+    #[arg(long)]
+    pub inflate_m: Option<f64>,
 }
 
 impl PlanCli {
+    /// A global planner's arguments, when `planner` is one.
+    pub fn route(&self) -> anyhow::Result<Option<crate::route_cmd::RouteArgs>> {
+        if !crate::route_cmd::GLOBAL_PLANNERS.contains(&self.planner.as_str()) {
+            return Ok(None);
+        }
+        let map = self.map.clone().ok_or_else(|| {
+            anyhow::anyhow!(
+                "plan {}: --map WORLD.toml|MAP.yaml is required",
+                self.planner
+            )
+        })?;
+        Ok(Some(crate::route_cmd::RouteArgs {
+            planner: self.planner.clone(),
+            map,
+            start: [self.start.x_m, self.start.y_m],
+            goal: [self.goal.x_m, self.goal.y_m],
+            nodes: self.nodes,
+            connect_m: self.connect_m.is_finite().then_some(self.connect_m),
+            seed: self.seed,
+            resolution_m: self.resolution_m,
+            inflate_m: self.inflate_m,
+            truck: crate::load_truck(self.truck.as_ref())?,
+            json: self.json,
+        }))
+    }
+
     /// Reads the truck and settings files into the planning arguments.
     pub fn resolve(self) -> anyhow::Result<PlanArgs> {
         let truck = crate::load_truck(self.truck.as_ref())?;

@@ -24,7 +24,7 @@ const SCENARIOS: [(&str, &str); 4] = [
     ),
 ];
 
-const WORLDS: [(&str, &str); 2] = [
+const WORLDS: [(&str, &str); 4] = [
     (
         "open-floor.toml",
         include_str!("../data/worlds/open-floor.toml"),
@@ -33,7 +33,29 @@ const WORLDS: [(&str, &str); 2] = [
         "rack-bay.toml",
         include_str!("../data/worlds/rack-bay.toml"),
     ),
+    (
+        "warehouse.toml",
+        include_str!("../data/worlds/warehouse.toml"),
+    ),
+    (
+        "warehouse-narrow.toml",
+        include_str!("../data/worlds/warehouse-narrow.toml"),
+    ),
 ];
+
+/// An embedded world by file name (`warehouse.toml`), as `worlds/` holds it.
+pub fn embedded_world(name: &str) -> Result<World, TrialError> {
+    let (file, text) =
+        WORLDS
+            .iter()
+            .find(|(f, _)| *f == name)
+            .ok_or_else(|| TrialError::Invalid {
+                file: name.to_owned(),
+                field: "world".into(),
+                reason: format!("no embedded world {name:?}"),
+            })?;
+    World::parse(text, &format!("worlds/{file}"))
+}
 
 /// Loads the embedded default scenarios (worlds resolved among the embedded worlds).
 pub fn default_scenarios() -> Result<Vec<Scenario>, TrialError> {
@@ -45,16 +67,14 @@ pub fn default_scenarios() -> Result<Vec<Scenario>, TrialError> {
                     .file_name()
                     .and_then(|n| n.to_str())
                     .unwrap_or_default();
-                let (wfile, wtext) =
-                    WORLDS
-                        .iter()
-                        .find(|(f, _)| *f == name)
-                        .ok_or_else(|| TrialError::Invalid {
-                            file: (*file).to_owned(),
-                            field: "world".into(),
-                            reason: format!("no embedded world {name:?}"),
-                        })?;
-                World::parse(wtext, &format!("worlds/{wfile}"))
+                embedded_world(name).map_err(|e| match e {
+                    TrialError::Invalid { reason, .. } => TrialError::Invalid {
+                        file: (*file).to_owned(),
+                        field: "world".into(),
+                        reason,
+                    },
+                    e => e,
+                })
             })
         })
         .collect()

@@ -98,6 +98,10 @@ pub struct World {
     pub wall: Vec<RectFile>,
     #[serde(default)]
     pub pallet_slot: Vec<PalletSlot>,
+    /// Named places a truck drives to (charging station, sorting station): the pose the
+    /// fork root should reach.
+    #[serde(default)]
+    pub station: Vec<PalletSlot>,
 }
 
 impl World {
@@ -128,13 +132,15 @@ impl World {
                 }
             }
         }
-        for (i, s) in w.pallet_slot.iter().enumerate() {
-            PoseDeg {
-                x_m: s.x_m,
-                y_m: s.y_m,
-                heading_deg: s.heading_deg,
+        for (kind, list) in [("pallet_slot", &w.pallet_slot), ("station", &w.station)] {
+            for (i, s) in list.iter().enumerate() {
+                PoseDeg {
+                    x_m: s.x_m,
+                    y_m: s.y_m,
+                    heading_deg: s.heading_deg,
+                }
+                .check(file, &format!("{kind}[{i}]"))?;
             }
-            .check(file, &format!("pallet_slot[{i}]"))?;
         }
         Ok(w)
     }

@@ -1,0 +1,43 @@
+//! `forkbench map`: a world file rasterised to an occupancy grid, written as a ROS map_server map.
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+use forkbench_nav::{OccupancyGrid, write_map};
+
+/// Arguments of `forkbench map`.
+#[derive(Debug, clap::Args)]
+pub struct MapArgs {
+    /// World file (TOML) to rasterise.
+    world: PathBuf,
+    /// Directory for NAME.yaml and NAME.pgm (NAME: the world's name).
+    #[arg(long)]
+    out: PathBuf,
+    /// Cell size.
+    #[arg(long, default_value_t = 0.05)]
+    resolution_m: f64,
+    /// Free floor around the world's racks and walls.
+    #[arg(long, default_value_t = 1.0)]
+    margin_m: f64,
+}
+
+pub fn run(a: &MapArgs) -> anyhow::Result<()> {
+    let world = forkbench_trial::World::load(&a.world)?;
+    let slots: Vec<[f64; 2]> = world.pallet_slot.iter().map(|s| [s.x_m, s.y_m]).collect();
+    let grid =
+        OccupancyGrid::from_obstacles(&world.obstacles(), &slots, a.resolution_m, a.margin_m)
+            .with_context(|| format!("{}: rasterising", a.world.display()))?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let name = crate::record::safe_file_stem(&world.name);
+    let yaml = write_map(&grid, &a.out, &name)?;
+    let (free, occupied, unknown) = grid.counts();
+    crate::emit(&format!(
+        "{}: {} × {} cells at {} m, origin ({:.2}, {:.2}) m; {free} free, {occupied} occupied, {unknown} unknown\n",
+        yaml.display(),
+        grid.width,
+        grid.height,
+        grid.resolution_m,
+        grid.origin_m[0],
+        grid.origin_m[1],
+    ))
+}

@@ -1,0 +1,242 @@
+//! ROS map_server maps: a YAML file (resolution, origin, thresholds) beside a PGM image, read and written.
+//!
+//! The PGM is read here rather than through the `image` crate: rerun builds `image` with
+//! other features, and asking for PNM would rebuild rerun (about 10 minutes) for a format
+//! that is a short header and raw bytes.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::grid::{Cell, GridError, OccupancyGrid};
+
+/// A map that could not be read or written; every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum MapError {
+    #[error("{path}: {message}")]
+    Io { path: String, message: String },
+    #[error("{path}: {message}")]
+    Yaml { path: String, message: String },
+    #[error("{path}: field `{field}`: {reason}")]
+    Field {
+        path: String,
+        field: &'static str,
+        reason: String,
+    },
+    #[error("{path}: not a PGM image this reader knows: {reason}")]
+    Image { path: String, reason: String },
+    #[error("{path}: {source}")]
+    Grid { path: String, source: GridError },
+}
+
+/// The map's YAML, as map_server reads it (unknown fields are allowed: Nav2 adds some).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapYaml {
+    pub image: String,
+    pub resolution: f64,
+    /// Lower-left corner of the image's bottom-left pixel: x, y, yaw (ignored, as ROS does).
+    pub origin: [f64; 3],
+    #[serde(default)]
+    pub negate: u8,
+    pub occupied_thresh: f64,
+    pub free_thresh: f64,
+    #[serde(default = "trinary")]
+    pub mode: String,
+}
+
+fn trinary() -> String {
+    "trinary".to_owned()
+}
+
+/// Grey levels map_server's saver writes for each state.
+const FREE_GREY: u8 = 254;
+const OCCUPIED_GREY: u8 = 0;
+const UNKNOWN_GREY: u8 = 205;
+
+/// Writes `grid` as `dir/name.yaml` and `dir/name.pgm`; returns the YAML's path.
+pub fn write_map(grid: &OccupancyGrid, dir: &Path, name: &str) -> Result<PathBuf, MapError> {
+    let yaml_path = dir.join(format!("{name}.yaml"));
+    let pgm_path = dir.join(format!("{name}.pgm"));
+    let meta = MapYaml {
+        image: format!("{name}.pgm"),
+        resolution: grid.resolution_m,
+        origin: [grid.origin_m[0], grid.origin_m[1], 0.0],
+        negate: 0,
+        // ROS map_saver's thresholds: with 0.196 its unknown grey (205) reads back unknown.
+        occupied_thresh: 0.65,
+        free_thresh: 0.196,
+        mode: trinary(),
+    };
+    let mut pgm = format!(
+        "P5\n# forkbench occupancy grid, {} m per cell\n{} {}\n255\n",
+        grid.resolution_m, grid.width, grid.height
+    )
+    .into_bytes();
+    // PGM rows go from the top of the image: the highest y first.
+    for iy in (0..grid.height).rev() {
+        pgm.extend((0..grid.width).map(|ix| match grid.get(ix, iy) {
+            Cell::Free => FREE_GREY,
+            Cell::Occupied => OCCUPIED_GREY,
+            Cell::Unknown => UNKNOWN_GREY,
+        }));
+    }
+    let io = |p: &Path, e: std::io::Error| MapError::Io {
+        path: p.display().to_string(),
+        message: e.to_string(),
+    };
+    std::fs::write(&pgm_path, pgm).map_err(|e| io(&pgm_path, e))?;
+    let yaml = serde_norway::to_string(&meta).map_err(|e| MapError::Yaml {
+        path: yaml_path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    std::fs::write(&yaml_path, yaml).map_err(|e| io(&yaml_path, e))?;
+    Ok(yaml_path)
+}
+
+/// Reads a map_server map: the YAML at `path` and the PGM it names (relative to the YAML).
+pub fn read_map(path: &Path) -> Result<OccupancyGrid, MapError> {
+    let p = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| MapError::Io {
+        path: p.clone(),
+        message: e.to_string(),
+    })?;
+    let meta: MapYaml = serde_norway::from_str(&text).map_err(|e| MapError::Yaml {
+        path: p.clone(),
+        message: e.to_string(),
+    })?;
+    check(&meta, &p)?;
+    let image = path.parent().unwrap_or(Path::new(".")).join(&meta.image);
+    let bytes = std::fs::read(&image).map_err(|e| MapError::Io {
+        path: image.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let pgm = parse_pgm(&bytes).map_err(|reason| MapError::Image {
+        path: image.display().to_string(),
+        reason,
+    })?;
+    let origin = [meta.origin[0], meta.origin[1]];
+    let mut grid = OccupancyGrid::new(
+        meta.resolution,
+        origin,
+        (pgm.width, pgm.height),
+        Cell::Unknown,
+    )
+    .map_err(|source| MapError::Grid { path: p, source })?;
+    for row in 0..pgm.height {
+        for ix in 0..pgm.width {
+            let v = f64::from(pgm.pixels[row * pgm.width + ix]) / f64::from(pgm.max);
+            // map_server: occupancy probability from the grey level, then the thresholds.
+            let occ = if meta.negate == 0 { 1.0 - v } else { v };
+            let cell = if occ > meta.occupied_thresh {
+                Cell::Occupied
+            } else if occ < meta.free_thresh {
+                Cell::Free
+            } else {
+                Cell::Unknown
+            };
+            grid.set(ix, pgm.height - 1 - row, cell);
+        }
+    }
+    Ok(grid)
+}
+
+/// The YAML's numbers, checked before the image is read.
+fn check(m: &MapYaml, path: &str) -> Result<(), MapError> {
+    let field = |field, reason: &str| MapError::Field {
+        path: path.to_owned(),
+        field,
+        reason: reason.to_owned(),
+    };
+    if !(m.resolution.is_finite() && m.resolution > 0.0) {
+        return Err(field(
+            "resolution",
+            "must be a positive number of metres per cell",
+        ));
+    }
+    if !m.origin.iter().all(|v| v.is_finite()) {
+        return Err(field("origin", "must be three finite numbers [x, y, yaw]"));
+    }
+    if !(0.0..=1.0).contains(&m.free_thresh)
+        || !(0.0..=1.0).contains(&m.occupied_thresh)
+        || m.free_thresh > m.occupied_thresh
+    {
+        return Err(field(
+            "free_thresh",
+            "thresholds must satisfy 0 ≤ free_thresh ≤ occupied_thresh ≤ 1",
+        ));
+    }
+    if m.negate > 1 {
+        return Err(field("negate", "must be 0 or 1"));
+    }
+    if m.mode != "trinary" && m.mode != "scale" {
+        return Err(field(
+            "mode",
+            "must be trinary or scale (raw maps are not read)",
+        ));
+    }
+    Ok(())
+}
+
+/// A greyscale image.
+struct Pgm {
+    width: usize,
+    height: usize,
+    max: u16,
+    pixels: Vec<u8>,
+}
+
+/// Parses a binary (P5) 8-bit PGM, comments allowed in the header.
+fn parse_pgm(bytes: &[u8]) -> Result<Pgm, String> {
+    let mut pos = 0;
+    let mut token = || -> Result<String, String> {
+        loop {
+            while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+                pos += 1;
+            }
+            if pos < bytes.len() && bytes[pos] == b'#' {
+                while pos < bytes.len() && bytes[pos] != b'\n' {
+                    pos += 1;
+                }
+                continue;
+            }
+            let start = pos;
+            while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+                pos += 1;
+            }
+            if start == pos {
+                return Err("the header ends early".into());
+            }
+            return Ok(String::from_utf8_lossy(&bytes[start..pos]).into_owned());
+        }
+    };
+    let magic = token()?;
+    if magic != "P5" {
+        return Err(format!("magic {magic:?}, expected P5 (binary greyscale)"));
+    }
+    let mut number = |what: &str| -> Result<usize, String> {
+        let t = token()?;
+        t.parse::<usize>()
+            .map_err(|_| format!("{what} {t:?} is not a number"))
+    };
+    let (width, height, max) = (number("width")?, number("height")?, number("maxval")?);
+    if width == 0 || height == 0 || !(1..=255).contains(&max) {
+        return Err(format!(
+            "{width} × {height} pixels, maxval {max}: expected a non-empty 8-bit image"
+        ));
+    }
+    // One whitespace byte separates the header from the pixels.
+    let start = pos + 1;
+    let need = width.checked_mul(height).ok_or("the image is too large")?;
+    let pixels = bytes.get(start..start + need).ok_or_else(|| {
+        format!(
+            "{} pixel bytes, expected {need}",
+            bytes.len().saturating_sub(start)
+        )
+    })?;
+    Ok(Pgm {
+        width,
+        height,
+        max: max as u16,
+        pixels: pixels.to_vec(),
+    })
+}
