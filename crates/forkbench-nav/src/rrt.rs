@@ -96,13 +96,19 @@ fn sample(rng: &mut ChaCha8Rng, grid: &OccupancyGrid) -> [f64; 2] {
     ]
 }
 
-fn check(p: &RrtParams) -> Result<(), NavError> {
+/// Checks the query and settings; the clock and the seeded stream of a plan.
+fn begin(
+    grid: &OccupancyGrid,
+    (start, goal): ([f64; 2], [f64; 2]),
+    p: &RrtParams,
+) -> Result<(Instant, ChaCha8Rng), NavError> {
+    crate::check_endpoints(grid, start, goal)?;
     if !(p.step_m.is_finite() && p.step_m > 0.0 && (0.0..=1.0).contains(&p.goal_bias)) {
         return Err(NavError::Params(
             "step_m must be positive and goal_bias within 0..1".into(),
         ));
     }
-    Ok(())
+    Ok((Instant::now(), ChaCha8Rng::seed_from_u64(p.seed)))
 }
 
 /// RRT from `start`, biased toward `goal`; done when a node reaches the goal by a free
@@ -113,10 +119,7 @@ pub fn plan_rrt(
     goal: [f64; 2],
     p: &RrtParams,
 ) -> Result<Route, NavError> {
-    crate::check_endpoints(grid, start, goal)?;
-    check(p)?;
-    let t0 = Instant::now();
-    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+    let (t0, mut rng) = begin(grid, (start, goal), p)?;
     let mut tree = Tree::new(start);
     let mut found = None;
     for _ in 0..p.max_iterations {
@@ -153,10 +156,7 @@ pub fn plan_rrt_connect(
     goal: [f64; 2],
     p: &RrtParams,
 ) -> Result<Route, NavError> {
-    crate::check_endpoints(grid, start, goal)?;
-    check(p)?;
-    let t0 = Instant::now();
-    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+    let (t0, mut rng) = begin(grid, (start, goal), p)?;
     let (mut a, mut b) = (Tree::new(start), Tree::new(goal));
     let mut a_is_start = true;
     let mut found = None;
