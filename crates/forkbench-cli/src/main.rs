@@ -256,29 +256,35 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             table,
             json,
             plot,
-        } => match what {
-            ReproduceArg::Bspline | ReproduceArg::Spiral => reproduce_cmd::run(
-                matches!(what, ReproduceArg::Bspline),
-                table.as_deref(),
-                json,
-                plot.as_deref(),
-            ),
-            ReproduceArg::Corridor => {
-                if table.is_some() {
-                    anyhow::bail!("--table: reproduce corridor has no reference table file");
-                }
-                corridor_cmd::reproduce(json, plot.as_deref())
-            }
-            ReproduceArg::Prm => {
-                if table.is_some() || plot.is_some() {
-                    anyhow::bail!("reproduce prm: --table and --plot are not supported yet");
-                }
-                route_cmd::reproduce(100, json)
-            }
-        }
-        .map(|()| Done::Ok),
+        } => reproduce(&what, table.as_deref(), json, plot.as_deref()).map(|()| Done::Ok),
         Command::Corridor(args) => corridor_cmd::run(&args.resolve()?).map(|()| Done::Ok),
         Command::Map(args) => map_cmd::run(&args).map(|()| Done::Ok),
+    }
+}
+
+/// `reproduce WHAT`: the table of one paper, each from its own module.
+fn reproduce(
+    what: &ReproduceArg,
+    table: Option<&std::path::Path>,
+    json: bool,
+    plot: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    match what {
+        ReproduceArg::Bspline | ReproduceArg::Spiral => {
+            reproduce_cmd::run(matches!(what, ReproduceArg::Bspline), table, json, plot)
+        }
+        ReproduceArg::Corridor => {
+            if table.is_some() {
+                anyhow::bail!("--table: reproduce corridor has no reference table file");
+            }
+            corridor_cmd::reproduce(json, plot)
+        }
+        ReproduceArg::Prm => {
+            if table.is_some() || plot.is_some() {
+                anyhow::bail!("reproduce prm: --table and --plot are not supported yet");
+            }
+            route_cmd::reproduce(100, json)
+        }
     }
 }
 

@@ -164,26 +164,48 @@ pub fn run(a: PlanArgs) -> anyhow::Result<()> {
             &a.truck,
         )?;
     }
-    if a.json {
-        let pose = |p: &Pose2| json!({"x_m": p.x_m, "y_m": p.y_m, "heading_rad": p.heading_rad});
-        let out = json!({
-            "planner": a.planner,
-            "start": pose(&a.start),
-            "goal": pose(&a.goal),
-            "start_curvature_per_m": a.start_curvature_per_m,
-            "params": plan.params,
-            "cost": plan.cost,
-            "max_curvature_per_m": m.max_abs_curvature_per_m,
-            "max_steer_rad": m.max_steer_rad,
-            "length_m": m.length_m,
-            "endpoint_error_m": m.endpoint_position_error_m,
-            "endpoint_heading_error_rad": m.endpoint_heading_error_rad,
-            "max_curvature_jump_per_m": m.max_curvature_jump_per_m,
-            "solve_time_us": solve_time_us,
-            "samples": plan.path.samples,
-        });
-        return crate::emit(&format!("{out}\n"));
-    }
+    let text = if a.json {
+        json_report(&a, &plan, &m, solve_time_us)
+    } else {
+        text_report(&a, &plan, &m, solve_time_us)
+    };
+    crate::emit(&text)
+}
+
+/// `--json`: the plan, its metrics and the samples as one object.
+fn json_report(
+    a: &PlanArgs,
+    plan: &forkbench_plan::Plan,
+    m: &forkbench_core::PathMetrics,
+    solve_time_us: f64,
+) -> String {
+    let pose = |p: &Pose2| json!({"x_m": p.x_m, "y_m": p.y_m, "heading_rad": p.heading_rad});
+    let out = json!({
+        "planner": a.planner,
+        "start": pose(&a.start),
+        "goal": pose(&a.goal),
+        "start_curvature_per_m": a.start_curvature_per_m,
+        "params": plan.params,
+        "cost": plan.cost,
+        "max_curvature_per_m": m.max_abs_curvature_per_m,
+        "max_steer_rad": m.max_steer_rad,
+        "length_m": m.length_m,
+        "endpoint_error_m": m.endpoint_position_error_m,
+        "endpoint_heading_error_rad": m.endpoint_heading_error_rad,
+        "max_curvature_jump_per_m": m.max_curvature_jump_per_m,
+        "solve_time_us": solve_time_us,
+        "samples": plan.path.samples,
+    });
+    format!("{out}\n")
+}
+
+/// The plan and its metrics as aligned text lines.
+fn text_report(
+    a: &PlanArgs,
+    plan: &forkbench_plan::Plan,
+    m: &forkbench_core::PathMetrics,
+    solve_time_us: f64,
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "planner              {}", a.planner);
     match &plan.params {
@@ -233,5 +255,5 @@ pub fn run(a: PlanArgs) -> anyhow::Result<()> {
     if let Some(file) = &a.plot {
         let _ = writeln!(s, "plot                 {}", file.display());
     }
-    crate::emit(&s)
+    s
 }
