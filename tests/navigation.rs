@@ -106,6 +106,30 @@ fn every_global_planner_finds_the_shelf_and_a_blocked_goal_is_refused() {
             "{planner}"
         );
     }
+    // The map, roadmap and path drawn, in both formats.
+    let dir = tmp("plots");
+    for ext in ["png", "svg"] {
+        let file = dir.join(format!("prm.{ext}"));
+        let out = forkbench(&[
+            "plan",
+            "prm",
+            "--map",
+            &world("warehouse.toml"),
+            "--start",
+            START,
+            "--goal",
+            GOAL,
+            "--plot",
+            file.to_str().expect("utf-8"),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let size = std::fs::metadata(&file).expect("drawn").len();
+        assert!(size > 20_000, "{ext}: {size} bytes");
+    }
     // Inside the row-2 flue wall: refused with the reason, exit 1, no panic.
     let out = forkbench(&[
         "plan",

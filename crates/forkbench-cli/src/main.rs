@@ -3,6 +3,7 @@
 mod batch_cmd;
 mod corridor_cmd;
 mod map_cmd;
+mod map_plot;
 mod plan_cmd;
 mod plot;
 mod record;

@@ -89,6 +89,7 @@ impl PlanCli {
             inflate_m: self.inflate_m,
             truck: crate::load_truck(self.truck.as_ref())?,
             json: self.json,
+            plot: self.plot.clone(),
         }))
     }
 

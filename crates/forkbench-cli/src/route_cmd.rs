@@ -28,6 +28,8 @@ pub struct RouteArgs {
     pub inflate_m: Option<f64>,
     pub truck: ForkliftSpec,
     pub json: bool,
+    /// Draw the map, roadmap and path to FILE (.svg or .png).
+    pub plot: Option<PathBuf>,
 }
 
 /// `--connect-m`: metres, or `inf` (infinity) for unlimited.
@@ -55,7 +57,9 @@ pub fn load_grid(map: &Path, resolution_m: f64) -> anyhow::Result<OccupancyGrid>
 
 pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
     let inflate_m = a.inflate_m.unwrap_or(0.5 * a.truck.wheelbase_m);
-    let grid = load_grid(&a.map, a.resolution_m)?.inflated(inflate_m);
+    let map = load_grid(&a.map, a.resolution_m)?;
+    let grid = map.inflated(inflate_m);
+    let mut roadmap = None;
     let route = match a.planner.as_str() {
         "prm" => {
             let p = PrmParams {
@@ -63,7 +67,9 @@ pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
                 connect_m: a.connect_m,
                 seed: a.seed,
             };
-            plan_prm(&grid, a.start, a.goal, &p)?.0
+            let (route, built) = plan_prm(&grid, a.start, a.goal, &p)?;
+            roadmap = Some(built);
+            route
         }
         kind => {
             let p = RrtParams {
@@ -77,6 +83,27 @@ pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
             }
         }
     };
+    if let Some(file) = &a.plot {
+        let title = match &route.points {
+            Some(_) => format!(
+                "{} on {}: {:.1} m",
+                a.planner,
+                a.map.display(),
+                route.length_m
+            ),
+            None => format!("{} on {}: no path", a.planner, a.map.display()),
+        };
+        let fig = crate::map_plot::MapFigure {
+            title,
+            grid: &map,
+            inflated: &grid,
+            roadmap: roadmap.as_ref(),
+            path: route.points.as_deref(),
+            start: a.start,
+            goal: a.goal,
+        };
+        crate::map_plot::draw_map(file, &fig)?;
+    }
     crate::emit(&report(a, &grid, inflate_m, &route))
 }
 

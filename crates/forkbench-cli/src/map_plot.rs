@@ -1,0 +1,149 @@
+//! A global plan drawn on its map: obstacles, the inflated band around them, the roadmap, the path, start and goal.
+
+use std::path::Path;
+
+use forkbench_nav::{Cell, OccupancyGrid, Roadmap};
+use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+
+use crate::plot::{err, to_file};
+
+/// What one figure shows.
+pub struct MapFigure<'a> {
+    pub title: String,
+    /// The map as loaded, and the one the planner searched (obstacles inflated).
+    pub grid: &'a OccupancyGrid,
+    pub inflated: &'a OccupancyGrid,
+    pub roadmap: Option<&'a Roadmap>,
+    pub path: Option<&'a [[f64; 2]]>,
+    pub start: [f64; 2],
+    pub goal: [f64; 2],
+}
+
+/// Draws `fig` to FILE (.svg or .png), 1 m on the map the same on both axes.
+pub fn draw_map(file: &Path, fig: &MapFigure) -> anyhow::Result<()> {
+    let (lo, hi) = fig.grid.extent();
+    let (w_m, h_m) = (hi[0] - lo[0], hi[1] - lo[1]);
+    let width = 1400u32;
+    let height = ((f64::from(width - 80) * h_m / w_m) as u32 + 90).clamp(300, 2000);
+    to_file(file, (width, height), |a| draw(a, fig), |a| draw(a, fig))
+}
+
+/// Each row's runs of non-free cells as rectangles (few, however fine the grid).
+fn runs(g: &OccupancyGrid) -> Vec<[[f64; 2]; 2]> {
+    let r = g.resolution_m;
+    let mut out = Vec::new();
+    for iy in 0..g.height {
+        let mut ix = 0;
+        while ix < g.width {
+            if g.get(ix, iy) == Cell::Free {
+                ix += 1;
+                continue;
+            }
+            let start = ix;
+            while ix < g.width && g.get(ix, iy) != Cell::Free {
+                ix += 1;
+            }
+            let x0 = g.origin_m[0] + start as f64 * r;
+            let y0 = g.origin_m[1] + iy as f64 * r;
+            out.push([[x0, y0], [g.origin_m[0] + ix as f64 * r, y0 + r]]);
+        }
+    }
+    out
+}
+
+fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> anyhow::Result<()> {
+    area.fill(&WHITE).map_err(err)?;
+    let (lo, hi) = fig.grid.extent();
+    let mut chart = ChartBuilder::on(&area)
+        .caption(&fig.title, ("sans-serif", 22))
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(40)
+        .build_cartesian_2d(lo[0]..hi[0], lo[1]..hi[1])
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .draw()
+        .map_err(err)?;
+    let band = RGBColor(225, 225, 225).filled();
+    let solid = RGBColor(90, 90, 90).filled();
+    chart
+        .draw_series(
+            runs(fig.inflated)
+                .into_iter()
+                .map(|[a, b]| Rectangle::new([(a[0], a[1]), (b[0], b[1])], band)),
+        )
+        .map_err(err)?;
+    chart
+        .draw_series(
+            runs(fig.grid)
+                .into_iter()
+                .map(|[a, b]| Rectangle::new([(a[0], a[1]), (b[0], b[1])], solid)),
+        )
+        .map_err(err)?;
+    if let Some(map) = fig.roadmap {
+        draw_roadmap(&mut chart, map)?;
+    }
+    if let Some(p) = fig.path {
+        let line = RGBColor(220, 40, 40).stroke_width(3);
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>(),
+                line,
+            )))
+            .map_err(err)?
+            .label("path")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+    }
+    for (at, name, colour) in [
+        (fig.start, "start", RGBColor(30, 150, 60)),
+        (fig.goal, "goal", RGBColor(230, 130, 20)),
+    ] {
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (at[0], at[1]),
+                7,
+                colour.filled(),
+            )))
+            .map_err(err)?
+            .label(name)
+            .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    area.present().map_err(err)?;
+    Ok(())
+}
+
+/// The roadmap's edges (thin) and nodes.
+fn draw_roadmap<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    map: &Roadmap,
+) -> anyhow::Result<()> {
+    let edge = RGBColor(150, 185, 235).stroke_width(1);
+    let edges = map.edges.iter().enumerate().flat_map(|(i, e)| {
+        e.iter()
+            .filter(move |(j, _)| *j > i)
+            .map(move |&(j, _)| (i, j))
+    });
+    chart
+        .draw_series(edges.map(|(i, j)| {
+            let (a, b) = (map.nodes[i], map.nodes[j]);
+            PathElement::new(vec![(a[0], a[1]), (b[0], b[1])], edge)
+        }))
+        .map_err(err)?;
+    let node = RGBColor(60, 110, 200).filled();
+    chart
+        .draw_series(map.nodes.iter().map(|n| Circle::new((n[0], n[1]), 2, node)))
+        .map_err(err)?;
+    Ok(())
+}
