@@ -158,7 +158,7 @@ impl RerunRecorder {
             RerunTarget::Spawn => (builder.spawn().map_err(rerun_err)?, Sink::Live),
             RerunTarget::Connect(addr) => (connect(builder, addr)?, Sink::Live),
         };
-        Self::on(rec, sink, target)
+        Self::on(rec, sink)
     }
 
     /// A recorder whose messages stay in memory, for reading back (tests, tools).
@@ -167,24 +167,25 @@ impl RerunRecorder {
             .send_properties(false)
             .memory()
             .map_err(|e| LogError::Rerun(e.to_string()))?;
-        let me = Self::on(rec, Sink::Memory, &RerunTarget::File(PathBuf::new()))?;
+        let me = Self::on(rec, Sink::Memory)?;
         Ok((me, storage))
     }
 
-    fn on(rec: rerun::RecordingStream, sink: Sink, target: &RerunTarget) -> Result<Self, LogError> {
+    fn on(rec: rerun::RecordingStream, sink: Sink) -> Result<Self, LogError> {
         // `sim_time` is the recording's only timeline: a wall-clock `log_time` on some
         // entities would only confuse.
         rec.set_log_time_enabled(false);
         for msg in blueprint_msgs()? {
             rec.record_msg(msg.clone());
         }
+        let send_every = match sink {
+            Sink::File { .. } | Sink::Memory => SEND_EVERY_FILE,
+            Sink::Live => SEND_EVERY_LIVE,
+        };
         Ok(Self {
             rec,
             sink,
-            send_every: match target {
-                RerunTarget::File(_) => SEND_EVERY_FILE,
-                RerunTarget::Spawn | RerunTarget::Connect(_) => SEND_EVERY_LIVE,
-            },
+            send_every,
             pallet0: Pose2::new(0.0, 0.0, 0.0),
             limits: [f64::NAN; 2],
             plans: 0,
