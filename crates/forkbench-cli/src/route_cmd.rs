@@ -51,12 +51,21 @@ pub fn load_grid(map: &Path, resolution_m: f64) -> anyhow::Result<OccupancyGrid>
         return Ok(read_map(map)?);
     }
     let world = forkbench_trial::World::load(map)?;
+    world_grid(&world, resolution_m).with_context(|| format!("{}: rasterising", map.display()))
+}
+
+/// A world's racks and walls rasterised, the grid ending at their outer edges.
+fn world_grid(
+    world: &forkbench_trial::World,
+    resolution_m: f64,
+) -> Result<OccupancyGrid, forkbench_nav::GridError> {
     OccupancyGrid::from_obstacles(&world.obstacles(), &[], resolution_m, 0.0)
-        .with_context(|| format!("{}: rasterising", map.display()))
 }
 
 pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
-    let inflate_m = a.inflate_m.unwrap_or(0.5 * a.truck.wheelbase_m);
+    let inflate_m = a
+        .inflate_m
+        .unwrap_or(forkbench_nav::luo_inflation_m(&a.truck));
     let map = load_grid(&a.map, a.resolution_m)?;
     let grid = map.inflated(inflate_m);
     let mut roadmap = None;
@@ -169,9 +178,8 @@ fn study_leg(world: &forkbench_trial::World) -> anyhow::Result<([f64; 2], [f64; 
 pub fn reproduce(runs: u64, json: bool) -> anyhow::Result<()> {
     let world = forkbench_trial::defaults::embedded_world("warehouse.toml")?;
     let truck = ForkliftSpec::default();
-    let inflate_m = 0.5 * truck.wheelbase_m;
-    let grid =
-        OccupancyGrid::from_obstacles(&world.obstacles(), &[], 0.05, 0.0)?.inflated(inflate_m);
+    let inflate_m = forkbench_nav::luo_inflation_m(&truck);
+    let grid = world_grid(&world, 0.05)?.inflated(inflate_m);
     let ends = study_leg(&world)?;
     let rows = forkbench_nav::reproduce::studies(&grid, ends, runs)?;
     if json {

@@ -11,7 +11,7 @@ fn warehouse() -> OccupancyGrid {
     let truck = forkbench_core::ForkliftSpec::default();
     OccupancyGrid::from_obstacles(&world.obstacles(), &[], 0.05, 0.0)
         .expect("grid")
-        .inflated(0.5 * truck.wheelbase_m)
+        .inflated(forkbench_nav::luo_inflation_m(&truck))
 }
 
 fn bench(c: &mut Criterion) {

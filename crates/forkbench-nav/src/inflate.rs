@@ -1,6 +1,13 @@
 //! Obstacle inflation: every cell within a radius of an occupied (or unknown) cell becomes occupied (Luo: 0.5 × wheelbase).
 
+use forkbench_core::ForkliftSpec;
+
 use crate::grid::{Cell, OccupancyGrid};
+
+/// Luo's robot-size model: obstacles inflated by half the wheelbase.
+pub fn luo_inflation_m(truck: &ForkliftSpec) -> f64 {
+    0.5 * truck.wheelbase_m
+}
 
 impl OccupancyGrid {
     /// A copy in which every cell whose centre lies within `radius_m` of a non-free cell's

@@ -8,6 +8,7 @@ pub mod roadmap;
 pub mod rrt;
 
 pub use grid::{Cell, GridError, OccupancyGrid};
+pub use inflate::luo_inflation_m;
 pub use map_server::{MapError, read_map, write_map};
 pub use roadmap::{PrmParams, Roadmap, astar, plan_prm};
 pub use rrt::{RrtParams, plan_rrt, plan_rrt_connect};
