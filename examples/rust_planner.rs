@@ -127,7 +127,7 @@ fn sample(p: &[[f64; 2]; 4], spacing_m: f64) -> PlanPath {
             forkbench_core::units::wrap_angle(samples[i].heading_rad - samples[i - 1].heading_rad);
         samples[i].heading_rad = samples[i - 1].heading_rad + d;
     }
-    PlanPath { samples }
+    PlanPath::new(samples)
 }
 
 /// The built-in components plus this planner: the one line that adds it.

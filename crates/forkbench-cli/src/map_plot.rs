@@ -17,6 +17,9 @@ pub struct MapFigure<'a> {
     pub inflated: &'a OccupancyGrid,
     pub roadmap: Option<&'a Roadmap>,
     pub path: Option<&'a [[f64; 2]]>,
+    /// The smoothed path, and where its swept footprint strikes an obstacle.
+    pub smoothed: Option<&'a [[f64; 2]]>,
+    pub strike: Option<[f64; 2]>,
     pub start: [f64; 2],
     pub goal: [f64; 2],
 }
@@ -98,6 +101,28 @@ fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> an
             .map_err(err)?
             .label("path")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+    }
+    if let Some(p) = fig.smoothed {
+        let line = RGBColor(30, 90, 220).stroke_width(2);
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>(),
+                line,
+            )))
+            .map_err(err)?
+            .label("smoothed")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+    }
+    if let Some(at) = fig.strike {
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (at[0], at[1]),
+                9,
+                BLACK.stroke_width(3),
+            )))
+            .map_err(err)?
+            .label("footprint strikes")
+            .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
     }
     for (at, name, colour) in [
         (fig.start, "start", RGBColor(30, 150, 60)),

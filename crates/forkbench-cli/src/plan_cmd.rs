@@ -63,6 +63,25 @@ pub struct PlanCli {
     /// Global planners: obstacle inflation (default 0.5 × wheelbase, as the paper).
     #[arg(long)]
     pub inflate_m: Option<f64>,
+    /// Global planners: `inflate` (the paper: obstacles grown by 0.5 × wheelbase) or
+    /// `footprint` (the chassis and forks swept along each edge).
+    #[arg(long, default_value = "inflate")]
+    pub collision: forkbench_nav::CollisionModel,
+    /// Global planners: smooth the route into a drivable path (κ ≤ κ_max, clothoid
+    /// corners) from the start heading to the goal heading, its swept footprint checked.
+    #[arg(long)]
+    pub smooth: bool,
+    /// With --smooth: the straight lead-in after the start and lead-out before the goal
+    /// that fix the headings.
+    #[arg(long, default_value_t = 2.5)]
+    pub lead_m: f64,
+    /// With --smooth: the straight lead-out before the goal (default: --lead-m).
+    #[arg(long)]
+    pub approach_m: Option<f64>,
+    /// Clearance kept around the footprint (default 0.15 m with `footprint`, 0 with
+    /// `inflate`, as the paper).
+    #[arg(long)]
+    pub margin_m: Option<f64>,
 }
 
 impl PlanCli {
@@ -80,13 +99,21 @@ impl PlanCli {
         Ok(Some(crate::route_cmd::RouteArgs {
             planner: self.planner.clone(),
             map,
-            start: [self.start.x_m, self.start.y_m],
-            goal: [self.goal.x_m, self.goal.y_m],
+            start: self.start,
+            goal: self.goal,
             nodes: self.nodes,
             connect_m: self.connect_m.is_finite().then_some(self.connect_m),
             seed: self.seed,
             resolution_m: self.resolution_m,
             inflate_m: self.inflate_m,
+            collision: self.collision,
+            smooth: self.smooth,
+            lead_m: self.lead_m,
+            approach_m: self.approach_m,
+            margin_m: self.margin_m.unwrap_or(match self.collision {
+                forkbench_nav::CollisionModel::Inflate => 0.0,
+                forkbench_nav::CollisionModel::Footprint => 0.15,
+            }),
             truck: crate::load_truck(self.truck.as_ref())?,
             json: self.json,
             plot: self.plot.clone(),

@@ -4,8 +4,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use forkbench_core::ForkliftSpec;
+use forkbench_core::Pose2;
 use forkbench_nav::{
-    OccupancyGrid, PrmParams, Route, RrtParams, plan_prm, plan_rrt, plan_rrt_connect, read_map,
+    Algorithm, CollisionModel, GlobalPlan, GlobalQuery, NavMap, OccupancyGrid, PrmParams,
+    RrtParams, plan_global, read_map,
 };
 use serde_json::json;
 
@@ -17,8 +19,8 @@ pub const GLOBAL_PLANNERS: [&str; 3] = ["prm", "rrt", "rrt-connect"];
 pub struct RouteArgs {
     pub planner: String,
     pub map: PathBuf,
-    pub start: [f64; 2],
-    pub goal: [f64; 2],
+    pub start: Pose2,
+    pub goal: Pose2,
     pub nodes: usize,
     /// `None`: unlimited.
     pub connect_m: Option<f64>,
@@ -26,6 +28,11 @@ pub struct RouteArgs {
     pub resolution_m: f64,
     /// Obstacle inflation; the paper's 0.5 × wheelbase by default.
     pub inflate_m: Option<f64>,
+    pub collision: CollisionModel,
+    pub smooth: bool,
+    pub lead_m: f64,
+    pub approach_m: Option<f64>,
+    pub margin_m: f64,
     pub truck: ForkliftSpec,
     pub json: bool,
     /// Draw the map, roadmap and path to FILE (.svg or .png).
@@ -46,96 +53,171 @@ pub fn parse_connect(text: &str) -> Result<f64, String> {
 }
 
 /// The map: a ROS map_server YAML, or a world TOML rasterised at `resolution_m`.
-pub fn load_grid(map: &Path, resolution_m: f64) -> anyhow::Result<OccupancyGrid> {
+pub fn load_map(map: &Path, resolution_m: f64) -> anyhow::Result<NavMap> {
     if map.extension().is_some_and(|e| e == "yaml" || e == "yml") {
-        return Ok(read_map(map)?);
+        return Ok(NavMap::from_grid(read_map(map)?));
     }
     let world = forkbench_trial::World::load(map)?;
-    world_grid(&world, resolution_m).with_context(|| format!("{}: rasterising", map.display()))
+    NavMap::from_world(&world.obstacles(), resolution_m)
+        .with_context(|| format!("{}: rasterising", map.display()))
 }
 
-/// A world's racks and walls rasterised, the grid ending at their outer edges.
-fn world_grid(
-    world: &forkbench_trial::World,
-    resolution_m: f64,
-) -> Result<OccupancyGrid, forkbench_nav::GridError> {
-    OccupancyGrid::from_obstacles(&world.obstacles(), &[], resolution_m, 0.0)
+impl RouteArgs {
+    fn query(&self) -> GlobalQuery {
+        let rrt = RrtParams {
+            seed: self.seed,
+            ..RrtParams::default()
+        };
+        let algorithm = match self.planner.as_str() {
+            "prm" => Algorithm::Prm(PrmParams {
+                nodes: self.nodes,
+                connect_m: self.connect_m,
+                seed: self.seed,
+            }),
+            "rrt" => Algorithm::Rrt(rrt),
+            _ => Algorithm::RrtConnect(rrt),
+        };
+        GlobalQuery {
+            start: self.start,
+            goal: self.goal,
+            algorithm,
+            collision: self.collision,
+            inflate_m: self
+                .inflate_m
+                .unwrap_or(forkbench_nav::luo_inflation_m(&self.truck)),
+            smooth: self.smooth,
+            lead_m: [self.lead_m, self.approach_m.unwrap_or(self.lead_m)],
+            approach: Vec::new(),
+            margin_m: self.margin_m,
+            truck: self.truck.clone(),
+        }
+    }
 }
 
 pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
-    let inflate_m = a
-        .inflate_m
-        .unwrap_or(forkbench_nav::luo_inflation_m(&a.truck));
-    let map = load_grid(&a.map, a.resolution_m)?;
-    let grid = map.inflated(inflate_m);
-    let mut roadmap = None;
-    let route = match a.planner.as_str() {
-        "prm" => {
-            let p = PrmParams {
-                nodes: a.nodes,
-                connect_m: a.connect_m,
-                seed: a.seed,
-            };
-            let (route, built) = plan_prm(&grid, a.start, a.goal, &p)?;
-            roadmap = Some(built);
-            route
-        }
-        kind => {
-            let p = RrtParams {
-                seed: a.seed,
-                ..RrtParams::default()
-            };
-            if kind == "rrt" {
-                plan_rrt(&grid, a.start, a.goal, &p)?
-            } else {
-                plan_rrt_connect(&grid, a.start, a.goal, &p)?
-            }
-        }
-    };
+    let map = load_map(&a.map, a.resolution_m)?;
+    let q = a.query();
+    let plan = plan_global(&map, &q)
+        .with_context(|| format!("plan {} on {}", a.planner, a.map.display()))?;
     if let Some(file) = &a.plot {
-        let title = match &route.points {
-            Some(_) => format!(
-                "{} on {}: {:.1} m",
-                a.planner,
-                a.map.display(),
-                route.length_m
-            ),
-            None => format!("{} on {}: no path", a.planner, a.map.display()),
-        };
-        let fig = crate::map_plot::MapFigure {
-            title,
-            grid: &map,
-            inflated: &grid,
-            roadmap: roadmap.as_ref(),
-            path: route.points.as_deref(),
-            start: a.start,
-            goal: a.goal,
-        };
-        crate::map_plot::draw_map(file, &fig)?;
+        plot(a, &map, &q, &plan, file)?;
     }
-    crate::emit(&report(a, &grid, inflate_m, &route))
+    crate::emit(&report(a, &map.grid, &q, &plan))
 }
 
-fn report(a: &RouteArgs, grid: &OccupancyGrid, inflate_m: f64, r: &Route) -> String {
+fn plot(
+    a: &RouteArgs,
+    map: &NavMap,
+    q: &GlobalQuery,
+    plan: &GlobalPlan,
+    file: &Path,
+) -> anyhow::Result<()> {
+    let route = &plan.route;
+    let title = match &route.points {
+        Some(_) => format!(
+            "{} on {}: {:.1} m",
+            a.planner,
+            a.map.display(),
+            route.length_m
+        ),
+        None => format!("{} on {}: no path", a.planner, a.map.display()),
+    };
+    let band = match q.collision {
+        CollisionModel::Inflate => q.inflate_m,
+        CollisionModel::Footprint => q.truck.body_width_m / 2.0 + q.margin_m,
+    };
+    let inflated = map.grid.inflated(band);
+    let smoothed = match &plan.smoothed {
+        Some(Ok(s)) => Some(s),
+        _ => None,
+    };
+    let line: Option<Vec<[f64; 2]>> =
+        smoothed.map(|s| s.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect());
+    let fig = crate::map_plot::MapFigure {
+        title,
+        grid: &map.grid,
+        inflated: &inflated,
+        roadmap: plan.roadmap.as_ref(),
+        path: route.points.as_deref(),
+        smoothed: line.as_deref(),
+        strike: smoothed.and_then(|s| s.hit).map(|h| [h.x_m, h.y_m]),
+        start: [a.start.x_m, a.start.y_m],
+        goal: [a.goal.x_m, a.goal.y_m],
+    };
+    crate::map_plot::draw_map(file, &fig)
+}
+
+/// The smoothing result as JSON: the samples, or why there are none.
+fn smoothing_json(plan: &GlobalPlan) -> serde_json::Value {
+    match &plan.smoothed {
+        None => serde_json::Value::Null,
+        Some(Err(e)) => json!({"ok": false, "error": e.to_string()}),
+        Some(Ok(s)) => json!({
+            "ok": s.clear(),
+            "polyline_m": s.polyline,
+            "length_m": s.path.length_m(),
+            "max_curvature_per_m": s.max_curvature_per_m,
+            "min_clearance_m": s.min_clearance_m,
+            "strike": s.hit,
+            "samples": s.path.samples.iter().map(|p| [p.s_m, p.x_m, p.y_m, p.heading_rad, p.curvature_per_m]).collect::<Vec<_>>(),
+        }),
+    }
+}
+
+/// The smoothing result in one line of text.
+fn smoothing_text(plan: &GlobalPlan) -> String {
+    match &plan.smoothed {
+        None => String::new(),
+        Some(Err(e)) => format!("smoothing failed: {e}\n"),
+        Some(Ok(s)) => match s.hit {
+            Some(h) => format!(
+                "smoothing failed: the swept footprint strikes obstacle {} at s = {:.2} m ({:.2}, {:.2})\n",
+                h.obstacle, h.s_m, h.x_m, h.y_m
+            ),
+            None => format!(
+                "smoothed: {:.2} m, |κ| ≤ {:.3} 1/m, footprint clearance ≥ {:.3} m\n",
+                s.path.length_m(),
+                s.max_curvature_per_m,
+                s.min_clearance_m
+            ),
+        },
+    }
+}
+
+fn report(a: &RouteArgs, grid: &OccupancyGrid, q: &GlobalQuery, plan: &GlobalPlan) -> String {
+    let r = &plan.route;
+    let t = &r.timing;
+    let total = t.total_s() + plan.smoothing_s;
     if a.json {
         let out = json!({
             "planner": a.planner,
             "map": a.map.display().to_string(),
             "grid": {"width": grid.width, "height": grid.height, "resolution_m": grid.resolution_m, "origin_m": grid.origin_m},
-            "inflate_m": inflate_m,
+            "collision": q.collision,
+            "inflate_m": (q.collision == CollisionModel::Inflate).then_some(q.inflate_m),
             "nodes_requested": a.nodes,
             "connect_m": a.connect_m,
             "seed": a.seed,
-            "success": r.found(),
+            "success": r.found() && (!a.smooth || plan.drivable().is_some()),
             "polyline_m": r.points,
             "length_m": r.found().then_some(r.length_m),
             "roadmap_nodes": r.nodes,
-            "timing_s": {"sampling": r.timing.sampling_s, "connection": r.timing.connection_s, "search": r.timing.search_s, "total": r.timing.total_s()},
+            "roadmap_edges": plan.roadmap.as_ref().map(forkbench_nav::Roadmap::edge_count),
+            "smoothing": smoothing_json(plan),
+            "min_clearance_m": plan.drivable().map(|s| s.min_clearance_m),
+            "timing_s": {"sampling": t.sampling_s, "connection": t.connection_s, "search": t.search_s, "smoothing": plan.smoothing_s, "total": total},
         });
         return format!("{out}\n");
     }
+    let model = match q.collision {
+        CollisionModel::Inflate => format!("obstacles inflated by {:.3} m", q.inflate_m),
+        CollisionModel::Footprint => format!(
+            "the truck's footprint swept along each edge, {:.2} m margin",
+            q.margin_m
+        ),
+    };
     let head = format!(
-        "{} on {} ({} × {} cells at {} m, obstacles inflated by {inflate_m:.3} m), seed {}\n",
+        "{} on {} ({} × {} cells at {} m, {model}), seed {}\n",
         a.planner,
         a.map.display(),
         grid.width,
@@ -143,20 +225,20 @@ fn report(a: &RouteArgs, grid: &OccupancyGrid, inflate_m: f64, r: &Route) -> Str
         grid.resolution_m,
         a.seed
     );
-    let t = &r.timing;
     let timing = format!(
-        "time {:.2} ms (sampling {:.2}, connection {:.2}, search {:.2}); {} nodes\n",
-        1e3 * t.total_s(),
+        "time {:.2} ms (sampling {:.2}, connection {:.2}, search {:.2}, smoothing {:.2}); {} nodes\n",
+        1e3 * total,
         1e3 * t.sampling_s,
         1e3 * t.connection_s,
         1e3 * t.search_s,
+        1e3 * plan.smoothing_s,
         r.nodes
     );
     let body = match &r.points {
         Some(p) => format!("path found: {} waypoints, {:.2} m\n", p.len(), r.length_m),
         None => "no path found\n".to_owned(),
     };
-    head + &body + &timing
+    head + &body + &smoothing_text(plan) + &timing
 }
 
 /// The warehouse leg the reproduction plans: charging station to the aisle in front of a
@@ -179,7 +261,9 @@ pub fn reproduce(runs: u64, json: bool) -> anyhow::Result<()> {
     let world = forkbench_trial::defaults::embedded_world("warehouse.toml")?;
     let truck = ForkliftSpec::default();
     let inflate_m = forkbench_nav::luo_inflation_m(&truck);
-    let grid = world_grid(&world, 0.05)?.inflated(inflate_m);
+    let grid = NavMap::from_world(&world.obstacles(), 0.05)?
+        .grid
+        .inflated(inflate_m);
     let ends = study_leg(&world)?;
     let rows = forkbench_nav::reproduce::studies(&grid, ends, runs)?;
     if json {

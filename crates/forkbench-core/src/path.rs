@@ -22,10 +22,17 @@ impl PathSample {
     }
 }
 
-/// A forward path as dense samples ordered by arc length.
+/// A path as dense samples ordered by arc length travelled. Headings are the truck's (the
+/// forks' direction) and positions the fork root's.
+///
+/// A `reverse` path is driven backwards: the truck travels against its heading. Its
+/// curvature is the steering curvature (heading change per metre of signed displacement),
+/// so the same κ gives the same steering angle in either direction.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Path {
     pub samples: Vec<PathSample>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub reverse: bool,
 }
 
 /// Summary figures of a path against the pose it was meant to reach.
@@ -46,6 +53,33 @@ pub struct PathMetrics {
 }
 
 impl Path {
+    /// A forward path.
+    pub fn new(samples: Vec<PathSample>) -> Self {
+        Self {
+            samples,
+            reverse: false,
+        }
+    }
+
+    /// The same track driven the other way: a forward path from B to A becomes the
+    /// reverse path from A to B (same poses, order and arc length reversed).
+    pub fn driven_backwards(&self) -> Path {
+        let len = self.length_m();
+        let samples = self
+            .samples
+            .iter()
+            .rev()
+            .map(|p| PathSample {
+                s_m: len - p.s_m,
+                ..*p
+            })
+            .collect();
+        Path {
+            samples,
+            reverse: !self.reverse,
+        }
+    }
+
     pub fn length_m(&self) -> f64 {
         self.samples.last().map_or(0.0, |p| p.s_m)
     }
@@ -63,15 +97,13 @@ impl Path {
     /// A straight path of `length_m` from `start` along its heading, samples at most
     /// `spacing_m` apart.
     pub fn straight(start: &Pose2, length_m: f64, spacing_m: f64) -> Path {
-        let mut p = Path {
-            samples: vec![PathSample {
-                s_m: 0.0,
-                x_m: start.x_m,
-                y_m: start.y_m,
-                heading_rad: start.heading_rad,
-                curvature_per_m: 0.0,
-            }],
-        };
+        let mut p = Path::new(vec![PathSample {
+            s_m: 0.0,
+            x_m: start.x_m,
+            y_m: start.y_m,
+            heading_rad: start.heading_rad,
+            curvature_per_m: 0.0,
+        }]);
         p.extend_straight(length_m, spacing_m);
         p
     }
@@ -133,15 +165,13 @@ mod tests {
 
     #[test]
     fn extend_straight_appends_along_the_heading() {
-        let mut p = Path {
-            samples: vec![PathSample {
-                s_m: 0.0,
-                x_m: 1.0,
-                y_m: 1.0,
-                heading_rad: std::f64::consts::FRAC_PI_2,
-                curvature_per_m: 0.3,
-            }],
-        };
+        let mut p = Path::new(vec![PathSample {
+            s_m: 0.0,
+            x_m: 1.0,
+            y_m: 1.0,
+            heading_rad: std::f64::consts::FRAC_PI_2,
+            curvature_per_m: 0.3,
+        }]);
         p.extend_straight(0.5, 0.01);
         let last = p.samples.last().expect("samples");
         assert_eq!(p.samples.len(), 51);
@@ -163,7 +193,7 @@ mod tests {
                 }
             })
             .collect();
-        let path = Path { samples };
+        let path = Path::new(samples);
         let m = path.metrics(
             &Pose2::new(0.0, 0.0, 0.0),
             &Pose2::new(1.0, 0.1, 0.0),

@@ -2,7 +2,7 @@
 
 use forkbench_core::{Path, Pose2};
 use parry2d::math::{Pose, Vector};
-use parry2d::query::intersection_test;
+use parry2d::query::{distance, intersection_test};
 use parry2d::shape::{ConvexPolygon, Cuboid, Shape};
 
 /// A rectangular vehicle body, placed relative to the vehicle's reference point (the
@@ -30,16 +30,54 @@ impl Footprint {
         reference.to_world(&Pose2::new(self.centre_ahead_m, 0.0, 0.0))
     }
 
+    fn cuboid(&self) -> Cuboid {
+        Cuboid::new(Vector::new(
+            (self.length_m / 2.0) as f32,
+            (self.width_m / 2.0) as f32,
+        ))
+    }
+
     /// The four corners (world frame) for a reference pose, counter-clockwise from front left.
     pub fn corners(&self, reference: &Pose2) -> [[f64; 2]; 4] {
         forkbench_core::geometry::rect_corners(&self.centre(reference), self.length_m, self.width_m)
     }
 }
 
-/// Fixed rectangular obstacles (racks, walls).
+/// Fixed rectangular obstacles (racks, walls). Each keeps its axis-aligned bounds, so a
+/// query tests only the shapes near it (a map's cell runs give thousands of shapes).
 #[derive(Default)]
 pub struct Obstacles {
     shapes: Vec<(Pose, Box<dyn Shape>)>,
+    bounds: Vec<Bounds>,
+}
+
+/// Axis-aligned bounds: min x, min y, max x, max y.
+type Bounds = [f64; 4];
+
+fn bounds_of(points: &[[f64; 2]]) -> Bounds {
+    points.iter().fold(
+        [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ],
+        |b, p| {
+            [
+                b[0].min(p[0]),
+                b[1].min(p[1]),
+                b[2].max(p[0]),
+                b[3].max(p[1]),
+            ]
+        },
+    )
+}
+
+/// Distance between two bounds (0 when they overlap): a lower bound of the shapes'.
+fn bounds_gap(a: &Bounds, b: &Bounds) -> f64 {
+    let dx = (a[0] - b[2]).max(b[0] - a[2]).max(0.0);
+    let dy = (a[1] - b[3]).max(b[1] - a[3]).max(0.0);
+    dx.hypot(dy)
 }
 
 impl std::fmt::Debug for Obstacles {
@@ -71,6 +109,8 @@ impl Obstacles {
 
     /// Adds a rectangle given by its centre pose and full side lengths.
     pub fn add_rect(&mut self, centre: &Pose2, length_m: f64, width_m: f64) {
+        let corners = forkbench_core::geometry::rect_corners(centre, length_m, width_m);
+        self.bounds.push(bounds_of(&corners));
         self.shapes.push((
             pose(centre),
             Box::new(Cuboid::new(Vector::new(
@@ -88,6 +128,7 @@ impl Obstacles {
             .collect();
         match ConvexPolygon::from_convex_hull(&pts) {
             Some(poly) => {
+                self.bounds.push(bounds_of(points));
                 self.shapes
                     .push((Pose::translation(0.0, 0.0), Box::new(poly)));
                 true
@@ -106,15 +147,33 @@ impl Obstacles {
 
     /// The first obstacle the footprint at `reference` overlaps (touching counts), if any.
     pub fn hit(&self, fp: &Footprint, reference: &Pose2) -> Option<usize> {
-        let body = Cuboid::new(Vector::new(
-            (fp.length_m / 2.0) as f32,
-            (fp.width_m / 2.0) as f32,
-        ));
+        let body = fp.cuboid();
         let at = pose(&fp.centre(reference));
-        self.shapes.iter().position(|(p, s)| {
-            // Cuboid–cuboid is always supported; an unsupported pair would be a bug here.
-            intersection_test(&at, &body, p, s.as_ref()).is_ok_and(|r| r.intersecting)
+        let near = bounds_of(&fp.corners(reference));
+        (0..self.shapes.len()).find(|&i| {
+            let (p, s) = &self.shapes[i];
+            // Convex–cuboid pairs are always supported; an unsupported pair would be a bug here.
+            bounds_gap(&near, &self.bounds[i]) <= 0.0
+                && intersection_test(&at, &body, p, s.as_ref()).is_ok_and(|r| r.intersecting)
         })
+    }
+
+    /// Distance from the footprint at `reference` to the nearest obstacle (0 when they
+    /// touch), looking no further than `cap_m`: `cap_m` when nothing is that close.
+    pub fn clearance(&self, fp: &Footprint, reference: &Pose2, cap_m: f64) -> f64 {
+        let body = fp.cuboid();
+        let at = pose(&fp.centre(reference));
+        let near = bounds_of(&fp.corners(reference));
+        let mut best = cap_m;
+        for ((p, s), b) in self.shapes.iter().zip(&self.bounds) {
+            if bounds_gap(&near, b) >= best {
+                continue;
+            }
+            if let Ok(d) = distance(&at, &body, p, s.as_ref()) {
+                best = best.min(f64::from(d.distance));
+            }
+        }
+        best
     }
 
     pub fn collides(&self, fp: &Footprint, reference: &Pose2) -> bool {
@@ -162,5 +221,18 @@ mod tests {
         };
         assert!(obs.collides(&ahead, &Pose2::new(-2.0, 0.0, 0.0)));
         assert!(!obs.collides(&ahead, &Pose2::new(-2.0, 0.0, std::f64::consts::PI)));
+    }
+
+    #[test]
+    fn clearance_is_the_gap_and_capped() {
+        let mut obs = Obstacles::new();
+        obs.add_rect(&Pose2::new(0.0, 0.0, 0.0), 2.0, 1.0);
+        obs.add_convex(&[[10.0, 0.0], [11.0, 0.0], [11.0, 1.0]]);
+        let fp = Footprint::centred(1.0, 1.0);
+        let d = obs.clearance(&fp, &Pose2::new(2.0, 0.0, 0.0), 5.0);
+        assert!((d - 0.5).abs() < 1e-5, "{d}");
+        assert_eq!(obs.clearance(&fp, &Pose2::new(5.0, 20.0, 0.0), 3.0), 3.0);
+        assert_eq!(obs.clearance(&fp, &Pose2::new(1.0, 0.0, 0.0), 3.0), 0.0);
+        assert_eq!(obs.hit(&fp, &Pose2::new(10.6, 0.4, 0.0)), Some(1));
     }
 }

@@ -1,24 +1,32 @@
 //! Warehouse navigation for forkbench (Luo's PRM + A* paper): occupancy grids, ROS map_server maps, PRM, RRT and RRT-Connect.
 
+pub mod global;
 pub mod grid;
 mod inflate;
 pub mod map_server;
 pub mod reproduce;
 pub mod roadmap;
 pub mod rrt;
+pub mod smooth;
+pub mod space;
 
+pub use global::{Algorithm, GlobalPlan, GlobalQuery, NavMap, plan_global};
 pub use grid::{Cell, GridError, OccupancyGrid};
 pub use inflate::luo_inflation_m;
 pub use map_server::{MapError, read_map, write_map};
 pub use roadmap::{PrmParams, Roadmap, astar, plan_prm};
 pub use rrt::{RrtParams, plan_rrt, plan_rrt_connect};
+pub use smooth::{SmoothError, SmoothParams, Smoothed, SweptHit};
+pub use space::{CollisionModel, FootprintSpace, FreeSpace, grid_obstacles, truck_parts};
 
 /// A query the planners refuse.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NavError {
     #[error("the {which} ({x:.2}, {y:.2}) m is off the map")]
     OffMap { which: &'static str, x: f64, y: f64 },
-    #[error("the {which} ({x:.2}, {y:.2}) m is inside an obstacle (after inflation)")]
+    #[error(
+        "the {which} ({x:.2}, {y:.2}) m is inside an obstacle (after inflation, or too close for the truck)"
+    )]
     Blocked { which: &'static str, x: f64, y: f64 },
     #[error("{0}")]
     Params(String),
@@ -69,16 +77,16 @@ impl Route {
 }
 
 /// Start and goal must lie on the map in free cells.
-pub(crate) fn check_endpoints(
-    grid: &OccupancyGrid,
+pub(crate) fn check_endpoints<S: space::FreeSpace + ?Sized>(
+    grid: &S,
     start: [f64; 2],
     goal: [f64; 2],
 ) -> Result<(), NavError> {
     for (which, [x, y]) in [("start", start), ("goal", goal)] {
-        if grid.cell_of([x, y]).is_none() {
+        if !grid.on_map([x, y]) {
             return Err(NavError::OffMap { which, x, y });
         }
-        if !grid.is_free([x, y]) {
+        if !grid.point_free([x, y]) {
             return Err(NavError::Blocked { which, x, y });
         }
     }

@@ -8,7 +8,7 @@ use kiddo::{KdTree, SquaredEuclidean};
 use rand::{RngExt as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 
-use crate::grid::OccupancyGrid;
+use crate::space::FreeSpace;
 use crate::{NavError, Route, Timing};
 
 /// PRM settings: sample count, connection distance (`None`: unlimited) and seed.
@@ -34,8 +34,8 @@ impl Roadmap {
 }
 
 /// Plans from `start` to `goal` on `grid` (already inflated): a route, or why none.
-pub fn plan_prm(
-    grid: &OccupancyGrid,
+pub fn plan_prm<S: FreeSpace + ?Sized>(
+    grid: &S,
     start: [f64; 2],
     goal: [f64; 2],
     p: &PrmParams,
@@ -51,7 +51,7 @@ pub fn plan_prm(
             rng.random_range(lo[0]..hi[0]),
             rng.random_range(lo[1]..hi[1]),
         ];
-        if grid.is_free(q) {
+        if grid.point_free(q) {
             nodes.push(q);
         }
     }

@@ -6,7 +6,7 @@ use kiddo::{KdTree, SquaredEuclidean};
 use rand::{RngExt as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 
-use crate::grid::OccupancyGrid;
+use crate::space::FreeSpace;
 use crate::{NavError, Route, Timing};
 
 /// RRT settings: step length, iteration limit, goal bias (RRT only) and seed.
@@ -72,7 +72,7 @@ impl Tree {
 
     /// Grows one step from the node nearest `q` toward it; the new node, if its segment
     /// is free.
-    fn extend(&mut self, grid: &OccupancyGrid, q: [f64; 2], step: f64) -> Option<usize> {
+    fn extend<S: FreeSpace + ?Sized>(&mut self, grid: &S, q: [f64; 2], step: f64) -> Option<usize> {
         let near = self.nearest(q);
         let p = self.points[near];
         let d = (q[0] - p[0]).hypot(q[1] - p[1]);
@@ -88,7 +88,7 @@ impl Tree {
     }
 }
 
-fn sample(rng: &mut ChaCha8Rng, grid: &OccupancyGrid) -> [f64; 2] {
+fn sample<S: FreeSpace + ?Sized>(rng: &mut ChaCha8Rng, grid: &S) -> [f64; 2] {
     let (lo, hi) = grid.extent();
     [
         rng.random_range(lo[0]..hi[0]),
@@ -97,8 +97,8 @@ fn sample(rng: &mut ChaCha8Rng, grid: &OccupancyGrid) -> [f64; 2] {
 }
 
 /// Checks the query and settings; the clock and the seeded stream of a plan.
-fn begin(
-    grid: &OccupancyGrid,
+fn begin<S: FreeSpace + ?Sized>(
+    grid: &S,
     (start, goal): ([f64; 2], [f64; 2]),
     p: &RrtParams,
 ) -> Result<(Instant, ChaCha8Rng), NavError> {
@@ -113,8 +113,8 @@ fn begin(
 
 /// RRT from `start`, biased toward `goal`; done when a node reaches the goal by a free
 /// segment.
-pub fn plan_rrt(
-    grid: &OccupancyGrid,
+pub fn plan_rrt<S: FreeSpace + ?Sized>(
+    grid: &S,
     start: [f64; 2],
     goal: [f64; 2],
     p: &RrtParams,
@@ -150,8 +150,8 @@ pub fn plan_rrt(
 
 /// RRT-Connect (Kuffner & LaValle): a tree from each end; one extends toward a sample,
 /// the other greedily connects to the new node; the roles swap every iteration.
-pub fn plan_rrt_connect(
-    grid: &OccupancyGrid,
+pub fn plan_rrt_connect<S: FreeSpace + ?Sized>(
+    grid: &S,
     start: [f64; 2],
     goal: [f64; 2],
     p: &RrtParams,

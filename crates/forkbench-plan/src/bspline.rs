@@ -214,7 +214,7 @@ impl BsplineCurve {
             last.heading_rad = last.heading_rad
                 + forkbench_core::units::wrap_angle(goal.heading_rad - last.heading_rad);
         }
-        Path { samples }
+        Path::new(samples)
     }
 }
 

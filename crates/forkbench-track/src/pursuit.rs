@@ -104,6 +104,10 @@ impl PurePursuit {
         for p in &mut path.samples {
             p.x_m -= root_ahead_m * p.heading_rad.cos();
             p.y_m -= root_ahead_m * p.heading_rad.sin();
+            // Backwards, the truck is pursued as if it faced its direction of travel.
+            if path.reverse {
+                p.heading_rad = wrap_angle(p.heading_rad + std::f64::consts::PI);
+            }
         }
         Self {
             path,
@@ -153,7 +157,11 @@ impl PurePursuit {
         ld: f64,
         truck: &ForkliftSpec,
     ) -> Option<Geometry> {
-        let pose = &root.to_world(&Pose2::new(-self.root_ahead_m, 0.0, 0.0));
+        let mut axle = root.to_world(&Pose2::new(-self.root_ahead_m, 0.0, 0.0));
+        if self.path.reverse {
+            axle.heading_rad = wrap_angle(axle.heading_rad + std::f64::consts::PI);
+        }
+        let pose = &axle;
         let n = self.path.samples.len();
         let last = self.path.samples.last().copied()?;
         // Closest sample, searched forward from the last progress over a bounded window.
@@ -207,7 +215,12 @@ impl PurePursuit {
         let vy = target[1] - pose.y_m;
         let dist = vx.hypot(vy).max(1e-6);
         let eta = wrap_angle(vy.atan2(vx) - pose.heading_rad);
-        let arc_curvature_per_m = 2.0 * eta.sin() / dist;
+        let mut arc_curvature_per_m = 2.0 * eta.sin() / dist;
+        // Facing backwards, a left turn of the travel direction is a right turn of the
+        // truck's heading per metre of (negative) displacement.
+        if self.path.reverse {
+            arc_curvature_per_m = -arc_curvature_per_m;
+        }
         let steer_rad = truck
             .steer_for_curvature(arc_curvature_per_m)
             .clamp(-truck.max_steer_rad, truck.max_steer_rad);
@@ -218,6 +231,7 @@ impl PurePursuit {
             path_curvature_per_m: near.curvature_per_m,
             arc_curvature_per_m,
             steer_rad,
+            reverse: self.path.reverse,
         })
     }
 }
@@ -232,14 +246,17 @@ pub(crate) struct Geometry {
     /// Curvature of the arc through the look-ahead point.
     pub arc_curvature_per_m: f64,
     pub steer_rad: f64,
+    /// The path is driven backwards: commands carry negative speeds.
+    pub reverse: bool,
 }
 
 impl Geometry {
     /// The command at `speed_mps` (zero once the goal is reached).
     pub fn command(&self, speed_mps: f64) -> Command {
         let done = self.remaining_m <= 0.002;
+        let sign = if self.reverse { -1.0 } else { 1.0 };
         Command {
-            speed_mps: if done { 0.0 } else { speed_mps },
+            speed_mps: if done { 0.0 } else { sign * speed_mps },
             steer_rad: self.steer_rad,
             lookahead_point: self.target,
             cross_track_m: self.cross_track_m,

@@ -6,6 +6,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Failure {
+    /// A mission leg before the pick failed (no drivable path, a collision, or the truck
+    /// did not arrive).
+    LegFailed,
     /// The planner refused the (estimated) goal.
     PlanFailed,
     /// The truck touched a rack or wall.
@@ -31,6 +34,7 @@ pub enum Failure {
 impl Failure {
     pub fn name(self) -> &'static str {
         match self {
+            Failure::LegFailed => "leg_failed",
             Failure::PlanFailed => "plan_failed",
             Failure::Collision => "collision",
             Failure::ContactForce => "contact_force",
@@ -81,6 +85,47 @@ pub struct TrialOutcome {
     pub path_length_m: f64,
     pub sim_time_s: f64,
     pub wall_time_ms: f64,
+    /// A mission's legs before the pick, in order (empty for a pick trial).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub legs: Vec<LegOutcome>,
+}
+
+/// One mission leg: backing out of the station it starts at (if any), then the global
+/// path to the next place.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LegOutcome {
+    /// "from → to".
+    pub name: String,
+    pub success: bool,
+    pub failure_detail: Option<String>,
+    /// Length of the reverse segment out of the station (0: none).
+    pub reverse_length_m: f64,
+    /// The A* polyline's length and the smoothed path's.
+    #[serde(with = "nan_as_null")]
+    pub route_length_m: f64,
+    #[serde(with = "nan_as_null")]
+    pub planned_length_m: f64,
+    /// Planning wall time, all attempts (sampling, connection, search, smoothing).
+    pub planning_time_s: f64,
+    /// Seeds tried before a drivable path was found.
+    pub planning_attempts: u32,
+    /// "ok", or why smoothing found no drivable path.
+    pub smoothing: String,
+    /// Smallest planned clearance of the swept footprint (forward and reverse).
+    #[serde(with = "nan_as_null")]
+    pub min_clearance_m: f64,
+    /// Steps on which the truck touched a rack or wall.
+    pub collisions: u32,
+    #[serde(with = "nan_as_null")]
+    pub cross_track_mean_m: f64,
+    #[serde(with = "nan_as_null")]
+    pub cross_track_max_m: f64,
+    pub time_s: f64,
+    /// Where the truck stopped against the leg's goal.
+    #[serde(with = "nan_as_null")]
+    pub final_position_error_m: f64,
+    #[serde(with = "nan_as_null")]
+    pub final_heading_error_rad: f64,
 }
 
 impl TrialOutcome {
@@ -116,6 +161,7 @@ impl TrialOutcome {
             path_length_m: 0.0,
             sim_time_s: 0.0,
             wall_time_ms: 0.0,
+            legs: Vec::new(),
         }
     }
 }

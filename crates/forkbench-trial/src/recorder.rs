@@ -47,6 +47,20 @@ pub struct StepRecord {
     pub contact_force_n: f64,
 }
 
+/// A mission leg's global plan.
+#[derive(Debug, Clone, Copy)]
+pub struct RouteRecord<'a> {
+    /// Leg index from 0.
+    pub leg: usize,
+    pub name: &'a str,
+    /// PRM's roadmap: nodes, and per node its neighbours with the edge length.
+    pub roadmap: Option<(&'a [[f64; 2]], &'a [Vec<(usize, f64)>])>,
+    /// The A* polyline after shortcuts, with the lead-in and lead-out.
+    pub polyline: &'a [[f64; 2]],
+    /// The smoothed path driven.
+    pub path: &'a Path,
+}
+
 /// Severity of a trial event.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Level {
@@ -67,6 +81,10 @@ pub trait Recorder {
         _control_polygon: Option<&[[f64; 2]]>,
     ) {
     }
+    /// A mission's occupancy grid, once before its first leg.
+    fn nav_map(&mut self, _grid: &forkbench_nav::OccupancyGrid) {}
+    /// A mission leg's global plan, when the leg starts driving it.
+    fn route(&mut self, _t_s: f64, _route: &RouteRecord<'_>) {}
     fn step(&mut self, _step: &StepRecord) {}
     fn event(&mut self, _t_s: f64, _level: Level, _text: &str) {}
     fn outcome(&mut self, _t_s: f64, _outcome: &TrialOutcome) {}
@@ -93,6 +111,12 @@ impl Recorder for Tee<'_> {
     }
     fn plan(&mut self, t: f64, i: u32, p: &Path, c: Option<&[[f64; 2]]>) {
         self.0.iter_mut().for_each(|r| r.plan(t, i, p, c));
+    }
+    fn nav_map(&mut self, g: &forkbench_nav::OccupancyGrid) {
+        self.0.iter_mut().for_each(|r| r.nav_map(g));
+    }
+    fn route(&mut self, t: f64, route: &RouteRecord<'_>) {
+        self.0.iter_mut().for_each(|r| r.route(t, route));
     }
     fn step(&mut self, s: &StepRecord) {
         self.0.iter_mut().for_each(|r| r.step(s));

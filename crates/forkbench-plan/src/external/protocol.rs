@@ -115,8 +115,8 @@ pub enum ResponseMsg {
 
 /// Samples as a path.
 pub fn to_path(samples: &[[f64; 5]]) -> Path {
-    Path {
-        samples: samples
+    Path::new(
+        samples
             .iter()
             .map(
                 |&[s_m, x_m, y_m, heading_rad, curvature_per_m]| PathSample {
@@ -128,5 +128,5 @@ pub fn to_path(samples: &[[f64; 5]]) -> Path {
                 },
             )
             .collect(),
-    }
+    )
 }

@@ -199,5 +199,5 @@ pub fn sample(p: &SpiralParams, start: &Pose2, goal: &Pose2, spacing_m: f64) -> 
     if let Some(last) = samples.last_mut() {
         last.heading_rad += wrap_angle(goal.heading_rad - last.heading_rad);
     }
-    Path { samples }
+    Path::new(samples)
 }

@@ -147,6 +147,8 @@ pub(super) struct ScenarioFile {
     pub(super) pallet: Option<PalletPlacement>,
     #[serde(default)]
     pub(super) case: Vec<CaseFile>,
+    /// A warehouse mission that ends where the pick starts.
+    pub(super) mission: Option<super::mission::MissionFile>,
 }
 
 fn default_true() -> bool {

@@ -2,6 +2,7 @@
 
 mod checks;
 mod file;
+pub mod mission;
 mod world;
 
 use std::path::{Path as FsPath, PathBuf};
@@ -106,6 +107,9 @@ pub struct Scenario {
     pub pallet_jitter: Pose2,
     pub world: World,
     pub cases: Vec<Case>,
+    /// Legs driven before the pick: the truck starts at the mission's start and each
+    /// case's start is the staging pose the last leg ends at.
+    pub mission: Option<mission::MissionSpec>,
 }
 
 /// One start/pallet geometry of a scenario.
@@ -203,6 +207,10 @@ impl Scenario {
             ));
         }
         let cases = resolve_cases(&f, &world, &pallet, file)?;
+        let mission = match &f.mission {
+            Some(m) => Some(m.resolve(&world, file)?),
+            None => None,
+        };
         let zero = Pose2::new(0.0, 0.0, 0.0);
         Ok(Scenario {
             file: file.to_owned(),
@@ -224,6 +232,7 @@ impl Scenario {
             pallet_jitter: f.pallet_jitter.map_or(zero, PoseDeg::to_pose),
             world,
             cases,
+            mission,
         })
     }
 

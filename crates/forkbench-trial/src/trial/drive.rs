@@ -21,21 +21,9 @@ impl Trial<'_> {
             .filter(|r| *r < start_range)
             .collect();
         reestimates.sort_by(|a, b| b.total_cmp(a));
-        while self.sim.time_s() < self.scn.timeout_s {
-            let truth = self.sim.fork_root_pose();
-            let fix = self
-                .localizer
-                .update(self.sim.time_s(), &truth, &mut self.nav_rng);
-            if let Some(fix) = fix {
-                self.predictor.fix(fix);
-            }
-            let pose = self.predictor.pose().unwrap_or(self.first_fix);
-            if !(pose.is_finite() && truth.is_finite()) {
-                return Err(format!(
-                    "non-finite state at t = {:.3} s",
-                    self.sim.time_s()
-                ));
-            }
+        let deadline_s = self.sim.time_s() + self.scn.timeout_s;
+        while self.sim.time_s() < deadline_s {
+            let (fix, pose) = self.sense()?;
             if self.run.replan
                 && reestimates
                     .first()
@@ -62,6 +50,38 @@ impl Trial<'_> {
 
     /// One physics step under `cmd`, its record, and the entry check.
     fn step<R: Recorder + ?Sized>(
+        &mut self,
+        cmd: &Command,
+        fix: Option<Pose2>,
+        pose: Pose2,
+        rec: &mut R,
+    ) {
+        self.physics_step(cmd, fix, pose, rec);
+        self.check_entry(rec);
+    }
+
+    /// The NAV350 fix at this instant (if one is due) and the predicted pose; Err when the
+    /// state went non-finite.
+    pub(super) fn sense(&mut self) -> Result<(Option<Pose2>, Pose2), String> {
+        let truth = self.sim.fork_root_pose();
+        let fix = self
+            .localizer
+            .update(self.sim.time_s(), &truth, &mut self.nav_rng);
+        if let Some(fix) = fix {
+            self.predictor.fix(fix);
+        }
+        let pose = self.predictor.pose().unwrap_or(self.first_fix);
+        if !(pose.is_finite() && truth.is_finite()) {
+            return Err(format!(
+                "non-finite state at t = {:.3} s",
+                self.sim.time_s()
+            ));
+        }
+        Ok((fix, pose))
+    }
+
+    /// One physics step under `cmd`, the odometry update, collisions and the record.
+    pub(super) fn physics_step<R: Recorder + ?Sized>(
         &mut self,
         cmd: &Command,
         fix: Option<Pose2>,
@@ -102,7 +122,6 @@ impl Trial<'_> {
             path_curvature_per_m: cmd.path_curvature_per_m,
             contact_force_n: self.sim.fork_contact_force_n(),
         });
-        self.check_entry(rec);
     }
 
     /// Contact force before full depth, and the entry errors once the tips cross the face

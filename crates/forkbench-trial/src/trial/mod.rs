@@ -2,6 +2,7 @@
 
 mod drive;
 mod judge;
+mod mission;
 mod plan;
 mod setup;
 
@@ -142,6 +143,19 @@ fn run_stages<R: Recorder + ?Sized>(
         Ok(t) => t,
         Err(out) => return *out,
     };
+    if let Some(m) = &scn.mission {
+        let staging = crate::scenario::mission::Waypoint {
+            name: format!("staging ({})", case.name),
+            pose: case.start,
+        };
+        if let Err(why) = trial.run_legs(m, &staging, rec) {
+            trial.out.sim_time_s = trial.sim.time_s();
+            trial.out.fail(Failure::LegFailed, why);
+            return trial.out;
+        }
+        let pallet = trial.sim.pallet_pose();
+        trial.first_fix_and_estimate(&pallet);
+    }
     let path = match trial.first_plan(rec) {
         Ok(p) => p,
         Err((failure, why)) => {

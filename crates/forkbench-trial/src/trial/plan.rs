@@ -60,18 +60,19 @@ impl Trial<'_> {
         rec: &mut R,
     ) -> Result<Path, (Failure, String)> {
         let est = self.pallet_est;
+        let t = self.sim.time_s();
         let plan = self.plan_from(self.first_fix, 0.0, &est).map_err(|e| {
-            rec.event(0.0, Level::Error, &format!("planning failed: {e}"));
+            rec.event(t, Level::Error, &format!("planning failed: {e}"));
             (Failure::PlanFailed, e)
         })?;
-        rec.plan(0.0, 0, &plan.path, plan.control_polygon_m.as_deref());
+        rec.plan(t, 0, &plan.path, plan.control_polygon_m.as_deref());
         self.out.path_length_m = plan.path.length_m();
         if let Some(why) = self.clash(&plan.path) {
-            rec.event(0.0, Level::Error, &why);
+            rec.event(t, Level::Error, &why);
             return Err((Failure::PlanFailed, why));
         }
         rec.event(
-            0.0,
+            t,
             Level::Info,
             &format!(
                 "{} plan: {:.3} m to the pre-entry pose",

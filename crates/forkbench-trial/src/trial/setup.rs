@@ -84,9 +84,11 @@ impl<'a> Trial<'a> {
         // Per-trial jitter of where the pallet really stands (its own random stream).
         let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(run.seed, 3));
         let obstacles = scn.world.obstacles();
+        // A mission starts at its first place; the case's start is where its legs end.
+        let start = scn.mission.as_ref().map_or(case.start, |m| m.start.pose);
         let sim = Sim::new(
             &scn.truck,
-            &case.start,
+            &start,
             &scn.pallet,
             &true_pallet,
             &obstacles,
@@ -109,7 +111,7 @@ impl<'a> Trial<'a> {
             pallet: &scn.pallet,
             pallet_pose: true_pallet,
             obstacles: &obstacles,
-            start: case.start,
+            start,
             tolerances: &scn.tolerances,
         });
         let pallet0 = sim.pallet_pose();
@@ -125,7 +127,7 @@ impl<'a> Trial<'a> {
             nav_rng: stream(run.seed, 1),
             est_rng: stream(run.seed, 2),
             predictor: PosePredictor::new(),
-            first_fix: case.start,
+            first_fix: start,
             pallet_est: true_pallet,
             insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
             obstacles,
@@ -134,14 +136,20 @@ impl<'a> Trial<'a> {
             collision: false,
             timed_out: true,
         };
-        trial.first_fix_and_estimate(case, &true_pallet);
+        if scn.mission.is_none() {
+            trial.first_fix_and_estimate(&true_pallet);
+        }
         Ok(trial)
     }
 
-    fn first_fix_and_estimate(&mut self, case: &Case, true_pallet: &Pose2) {
+    /// The fix the pick plans from (the odometry-predicted pose when no fix is due) and
+    /// the first pallet estimate.
+    pub(super) fn first_fix_and_estimate(&mut self, true_pallet: &Pose2) {
         let truth = self.sim.fork_root_pose();
-        let fix = self.localizer.update(0.0, &truth, &mut self.nav_rng);
-        self.first_fix = fix.unwrap_or(case.start);
+        let fix = self
+            .localizer
+            .update(self.sim.time_s(), &truth, &mut self.nav_rng);
+        self.first_fix = fix.or(self.predictor.pose()).unwrap_or(self.first_fix);
         self.predictor.fix(self.first_fix);
         let range = self.first_fix.distance_to(true_pallet);
         self.pallet_est = self.estimate(true_pallet, range);

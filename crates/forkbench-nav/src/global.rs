@@ -1,0 +1,191 @@
+//! One global plan end to end: the map's two views (grid and shapes), the chosen planner and collision model, shortcuts and smoothing, each stage timed.
+
+use std::time::Instant;
+
+use forkbench_core::geometry::Obstacle;
+use forkbench_core::{ForkliftSpec, Pose2};
+use forkbench_geom::Obstacles;
+
+use crate::smooth::{SmoothError, SmoothParams, Smoothed, lead_points, shortcut, smooth};
+use crate::space::{CollisionModel, FootprintSpace, FreeSpace, grid_obstacles, truck_parts};
+use crate::{
+    GridError, NavError, OccupancyGrid, PrmParams, Roadmap, Route, RrtParams, plan_prm, plan_rrt,
+    plan_rrt_connect,
+};
+
+/// A map in both forms: the occupancy grid the planners sample, and shapes for the
+/// footprint checker (a world's racks and walls, or a map file's cell runs).
+#[derive(Debug)]
+pub struct NavMap {
+    pub grid: OccupancyGrid,
+    pub obstacles: Obstacles,
+}
+
+impl NavMap {
+    /// A world's rectangles, rasterised at `resolution_m`; the grid ends at their edges.
+    pub fn from_world(obstacles: &[Obstacle], resolution_m: f64) -> Result<Self, GridError> {
+        let grid = OccupancyGrid::from_obstacles(obstacles, &[], resolution_m, 0.0)?;
+        let mut shapes = Obstacles::new();
+        for o in obstacles {
+            shapes.add_rect(&o.centre, o.length_m, o.width_m);
+        }
+        Ok(Self {
+            grid,
+            obstacles: shapes,
+        })
+    }
+
+    /// A map read from a file: shapes from its occupied and unknown cells.
+    pub fn from_grid(grid: OccupancyGrid) -> Self {
+        let obstacles = grid_obstacles(&grid);
+        Self { grid, obstacles }
+    }
+}
+
+/// Which sampling planner.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Algorithm {
+    Prm(PrmParams),
+    Rrt(RrtParams),
+    RrtConnect(RrtParams),
+}
+
+/// A global planning query.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlobalQuery {
+    pub start: Pose2,
+    pub goal: Pose2,
+    pub algorithm: Algorithm,
+    pub collision: CollisionModel,
+    /// Inflation radius of the `Inflate` model (Luo: half the wheelbase).
+    pub inflate_m: f64,
+    /// Smooth into a drivable path. The start and goal headings then count: the route
+    /// runs through lead points `lead_m[0]` ahead of the start and `lead_m[1]` behind
+    /// the goal.
+    pub smooth: bool,
+    pub lead_m: [f64; 2],
+    /// With `smooth`: points the path passes through, in order, between the route and the
+    /// lead-out (e.g. a square turn onto a rack face). The sampler plans to the first.
+    pub approach: Vec<[f64; 2]>,
+    /// Footprint model: the clearance edges and the smoothed path keep (the smoothed
+    /// path is checked with the footprint grown by it in both models).
+    pub margin_m: f64,
+    pub truck: ForkliftSpec,
+}
+
+/// A global plan: the planner's route (with the lead points when smoothing), its roadmap
+/// (PRM), the smoothing result, and the smoothing time beside the route's stages.
+#[derive(Debug, Clone)]
+pub struct GlobalPlan {
+    pub route: Route,
+    pub roadmap: Option<Roadmap>,
+    /// `None` without `smooth` or without a route.
+    pub smoothed: Option<Result<Smoothed, SmoothError>>,
+    pub smoothing_s: f64,
+}
+
+impl GlobalPlan {
+    /// A drivable path whose swept footprint clears every obstacle.
+    pub fn drivable(&self) -> Option<&Smoothed> {
+        match &self.smoothed {
+            Some(Ok(s)) if s.clear() => Some(s),
+            _ => None,
+        }
+    }
+}
+
+/// Plans `q` on `map`.
+pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError> {
+    let inflated;
+    let footprint;
+    let space: &dyn FreeSpace = match q.collision {
+        CollisionModel::Inflate => {
+            inflated = map.grid.inflated(q.inflate_m);
+            &inflated
+        }
+        CollisionModel::Footprint => {
+            footprint = FootprintSpace::new(&map.grid, &map.obstacles, &q.truck, q.margin_m);
+            &footprint
+        }
+    };
+    let (from, to) = if q.smooth {
+        let (from, lead_out) = lead_points(&q.start, &q.goal, q.lead_m);
+        let tail: Vec<[f64; 2]> = q.approach.iter().copied().chain([lead_out]).collect();
+        if tail.windows(2).any(|w| !space.segment_free(w[0], w[1])) {
+            return Err(NavError::Params(
+                "the approach to the goal is blocked".into(),
+            ));
+        }
+        (from, tail[0])
+    } else {
+        ([q.start.x_m, q.start.y_m], [q.goal.x_m, q.goal.y_m])
+    };
+    crate::check_endpoints(space, from, to)?;
+    let (mut route, roadmap) = run_algorithm(space, from, to, &q.algorithm)?;
+    let mut plan = GlobalPlan {
+        route: route.clone(),
+        roadmap,
+        smoothed: None,
+        smoothing_s: 0.0,
+    };
+    let Some(points) = route.points.take() else {
+        return Ok(plan);
+    };
+    if q.smooth {
+        let t0 = Instant::now();
+        plan.smoothed = Some(smooth_route(map, space, q, &points));
+        plan.smoothing_s = t0.elapsed().as_secs_f64();
+    }
+    Ok(plan)
+}
+
+fn run_algorithm(
+    space: &dyn FreeSpace,
+    from: [f64; 2],
+    to: [f64; 2],
+    a: &Algorithm,
+) -> Result<(Route, Option<Roadmap>), NavError> {
+    Ok(match a {
+        Algorithm::Prm(p) => {
+            let (route, map) = plan_prm(space, from, to, p)?;
+            (route, Some(map))
+        }
+        Algorithm::Rrt(p) => (plan_rrt(space, from, to, p)?, None),
+        Algorithm::RrtConnect(p) => (plan_rrt_connect(space, from, to, p)?, None),
+    })
+}
+
+/// Start → lead-in → route → approach → lead-out → goal, shortcut (the lead legs and
+/// approach kept), smoothed.
+fn smooth_route(
+    map: &NavMap,
+    space: &dyn FreeSpace,
+    q: &GlobalQuery,
+    route: &[[f64; 2]],
+) -> Result<Smoothed, SmoothError> {
+    let mut pts = vec![[q.start.x_m, q.start.y_m]];
+    pts.extend_from_slice(route);
+    let (_, lead_out) = lead_points(&q.start, &q.goal, q.lead_m);
+    pts.extend(q.approach.iter().skip(1).copied().chain([lead_out]));
+    pts.push([q.goal.x_m, q.goal.y_m]);
+    let n = pts.len();
+    // The route ends at the first approach point (or the lead-out); what follows is fixed.
+    let fixed_from = n - 2 - q.approach.len();
+    let anchors: Vec<usize> = std::iter::once(1).chain(fixed_from..n - 1).collect();
+    let short = shortcut(space, &pts, &anchors);
+    let params = SmoothParams::for_curvature(q.truck.max_curvature_per_m());
+    smooth(
+        &short,
+        &map.obstacles,
+        &truck_parts(&q.truck, q.margin_m),
+        &params,
+    )
+    .map(|mut s| {
+        // Clearance of the true footprint: the grown one's plus the margin (a lower bound
+        // near the grown rectangle's square corners).
+        if s.clear() {
+            s.min_clearance_m += q.margin_m;
+        }
+        s
+    })
+}

@@ -1,0 +1,368 @@
+//! Mission stage: before the pick, the truck drives the mission's legs (back out of a station, then a smoothed global path) in the same physics world.
+
+use std::time::Instant;
+
+use forkbench_core::units::wrap_angle;
+use forkbench_core::{Path, Pose2};
+use forkbench_nav::smooth::{SmoothParams, smooth};
+use forkbench_nav::{
+    Algorithm, GlobalPlan, GlobalQuery, NavMap, PrmParams, RrtParams, plan_global, truck_parts,
+};
+use forkbench_track::{PurePursuit, Tracker, TrackerInput};
+
+use super::setup::Trial;
+use crate::outcome::LegOutcome;
+use crate::recorder::{Level, Recorder, RouteRecord};
+use crate::scenario::mission::{GlobalPlannerKind, MissionSpec, Waypoint};
+
+/// Running totals of one leg's drive.
+#[derive(Debug, Default)]
+struct DriveStats {
+    cross_track_sum_m: f64,
+    cross_track_max_m: f64,
+    steps: u64,
+    collisions: u32,
+}
+
+impl Trial<'_> {
+    /// Drives every leg to the staging pose; Err names the leg that failed and why.
+    pub(super) fn run_legs<R: Recorder + ?Sized>(
+        &mut self,
+        m: &MissionSpec,
+        staging: &Waypoint,
+        rec: &mut R,
+    ) -> Result<(), String> {
+        let map = NavMap::from_world(&self.obstacles, m.global.resolution_m)
+            .map_err(|e| format!("rasterising the world: {e}"))?;
+        rec.nav_map(&map.grid);
+        let mut from = m.start.clone();
+        let targets: Vec<&Waypoint> = m.via.iter().chain(std::iter::once(staging)).collect();
+        for (i, to) in targets.into_iter().enumerate() {
+            let leg = self.leg(&map, m, (i, &from, to), rec);
+            let ok = leg.success;
+            let why = leg.failure_detail.clone();
+            rec.event(
+                self.sim.time_s(),
+                if ok { Level::Info } else { Level::Error },
+                &format!("leg {}: {}", leg.name, why.as_deref().unwrap_or("arrived")),
+            );
+            self.out.legs.push(leg);
+            if !ok {
+                return Err(format!(
+                    "leg {} {}: {}",
+                    i + 1,
+                    self.out.legs[i].name,
+                    why.unwrap_or_default()
+                ));
+            }
+            from = to.clone();
+        }
+        Ok(())
+    }
+
+    /// One leg: back out of the place it starts at (all but the first), plan from where
+    /// the truck stands, drive, and measure the arrival.
+    fn leg<R: Recorder + ?Sized>(
+        &mut self,
+        map: &NavMap,
+        m: &MissionSpec,
+        (i, from, to): (usize, &Waypoint, &Waypoint),
+        rec: &mut R,
+    ) -> LegOutcome {
+        let t0 = self.sim.time_s();
+        let mut leg = blank_leg(format!("{} → {}", from.name, to.name));
+        let mut stats = DriveStats::default();
+        let mut run = || -> Result<(), String> {
+            if i > 0 {
+                let here = self.sense()?.1;
+                let back =
+                    plan_backout(map, m, &here, &to.pose, &self.scn.truck).ok_or_else(|| {
+                        format!(
+                            "no clear way to back {:.1} m out of {}",
+                            m.backout_m, from.name
+                        )
+                    })?;
+                leg.reverse_length_m = back.length_m();
+                leg.min_clearance_m = back_clearance(map, &back, &self.scn.truck);
+                self.drive_path(&back, m, &mut stats, rec)?;
+            }
+            let here = self.sense()?.1;
+            let (plan, attempts, secs) = plan_leg(
+                map,
+                m,
+                (&here, &to.pose),
+                &self.scn.truck,
+                self.run.seed ^ ((i as u64 + 1) << 32),
+            );
+            leg.planning_time_s = secs;
+            leg.planning_attempts = attempts;
+            leg.route_length_m = plan.as_ref().map_or(f64::NAN, |p| p.route.length_m);
+            let p = plan?;
+            let s = p.drivable().ok_or_else(|| leg_plan_failure(&p))?;
+            leg.smoothing = "ok".into();
+            leg.planned_length_m = s.path.length_m();
+            leg.min_clearance_m = leg.min_clearance_m.min(s.min_clearance_m);
+            rec.route(
+                self.sim.time_s(),
+                &RouteRecord {
+                    leg: i,
+                    name: &leg.name,
+                    roadmap: p.roadmap.as_ref().map(|r| (&r.nodes[..], &r.edges[..])),
+                    polyline: &s.polyline,
+                    path: &s.path,
+                },
+            );
+            self.drive_path(&s.path, m, &mut stats, rec)?;
+            Ok(())
+        };
+        let result = run();
+        finish_leg(&mut leg, result, &stats, self.sim.time_s() - t0);
+        if leg.success {
+            let truth = self.sim.fork_root_pose();
+            leg.final_position_error_m = truth.distance_to(&to.pose);
+            leg.final_heading_error_rad = wrap_angle(truth.heading_rad - to.pose.heading_rad);
+            if leg.final_position_error_m > m.arrive_tolerance_m
+                || leg.final_heading_error_rad.abs() > m.arrive_tolerance_rad
+            {
+                leg.success = false;
+                leg.failure_detail = Some(format!(
+                    "stopped {:.3} m and {:.1}° from {} (limits {} m, {:.1}°)",
+                    leg.final_position_error_m,
+                    leg.final_heading_error_rad.to_degrees(),
+                    to.name,
+                    m.arrive_tolerance_m,
+                    m.arrive_tolerance_rad.to_degrees()
+                ));
+            }
+        }
+        leg
+    }
+
+    /// Follows `path` (forward or reverse) with the mission's pure pursuit until it stops at
+    /// the end; a touch of a rack or wall ends the leg.
+    fn drive_path<R: Recorder + ?Sized>(
+        &mut self,
+        path: &Path,
+        m: &MissionSpec,
+        stats: &mut DriveStats,
+        rec: &mut R,
+    ) -> Result<(), String> {
+        let truck = &self.scn.truck;
+        let mut tracker = PurePursuit::with_config(m.tracker.clone());
+        tracker.reset(path, truck);
+        let deadline_s = self.sim.time_s() + m.leg_timeout_s;
+        while self.sim.time_s() < deadline_s {
+            let (fix, pose) = self.sense()?;
+            let cmd = Tracker::command(
+                &mut tracker,
+                &TrackerInput {
+                    t_s: self.sim.time_s(),
+                    pose,
+                    speed_mps: self.sim.speed_mps(),
+                    steer_rad: self.sim.steer_rad(),
+                    truck: &self.scn.truck,
+                },
+            );
+            if cmd.done && self.sim.speed_mps().abs() < 0.01 {
+                return Ok(());
+            }
+            self.physics_step(&cmd, fix, pose, rec);
+            stats.steps += 1;
+            stats.cross_track_sum_m += cmd.cross_track_m.abs();
+            stats.cross_track_max_m = stats.cross_track_max_m.max(cmd.cross_track_m.abs());
+            if self.sim.obstacle_contact() {
+                stats.collisions += 1;
+                let p = self.sim.fork_root_pose();
+                return Err(format!(
+                    "the truck struck a rack or wall at ({:.2}, {:.2}) m",
+                    p.x_m, p.y_m
+                ));
+            }
+        }
+        Err(format!(
+            "not stopped at the end of the path within {} s",
+            m.leg_timeout_s
+        ))
+    }
+}
+
+fn blank_leg(name: String) -> LegOutcome {
+    LegOutcome {
+        name,
+        success: false,
+        failure_detail: None,
+        reverse_length_m: 0.0,
+        route_length_m: f64::NAN,
+        planned_length_m: f64::NAN,
+        planning_time_s: 0.0,
+        planning_attempts: 0,
+        smoothing: String::new(),
+        min_clearance_m: f64::INFINITY,
+        collisions: 0,
+        cross_track_mean_m: f64::NAN,
+        cross_track_max_m: f64::NAN,
+        time_s: 0.0,
+        final_position_error_m: f64::NAN,
+        final_heading_error_rad: f64::NAN,
+    }
+}
+
+fn finish_leg(leg: &mut LegOutcome, result: Result<(), String>, s: &DriveStats, time_s: f64) {
+    leg.collisions = s.collisions;
+    if s.steps > 0 {
+        leg.cross_track_mean_m = s.cross_track_sum_m / s.steps as f64;
+        leg.cross_track_max_m = s.cross_track_max_m;
+    }
+    if !leg.min_clearance_m.is_finite() {
+        leg.min_clearance_m = f64::NAN;
+    }
+    leg.time_s = time_s;
+    match result {
+        Ok(()) => leg.success = true,
+        Err(why) => {
+            if leg.smoothing.is_empty() {
+                leg.smoothing = why.clone();
+            }
+            leg.failure_detail = Some(why);
+        }
+    }
+}
+
+/// Why a found route is not drivable.
+fn leg_plan_failure(p: &GlobalPlan) -> String {
+    match &p.smoothed {
+        Some(Err(e)) => format!("smoothing failed: {e}"),
+        Some(Ok(s)) => match s.hit {
+            Some(h) => format!(
+                "smoothing failed: the swept footprint strikes an obstacle at ({:.2}, {:.2}) m",
+                h.x_m, h.y_m
+            ),
+            None => "smoothing failed".into(),
+        },
+        None => "no path found".into(),
+    }
+}
+
+/// Ways into a leg's goal: straight through the lead-out, or a square turn onto the
+/// goal heading from either side (from the start's side first), the turn's first point
+/// `SQUARE_TURN_M` to the side of the lead-out.
+fn approaches(m: &MissionSpec, from: &Pose2, to: &Pose2) -> Vec<Vec<[f64; 2]>> {
+    const SQUARE_TURN_M: f64 = 3.0;
+    let (s, c) = to.heading_rad.sin_cos();
+    let a = m.global.approach_m;
+    let lead_out = [to.x_m - a * c, to.y_m - a * s];
+    let perp = [-s, c];
+    let start_side = (from.x_m - lead_out[0]) * perp[0] + (from.y_m - lead_out[1]) * perp[1];
+    let first = if start_side >= 0.0 { 1.0 } else { -1.0 };
+    let mut out = vec![Vec::new()];
+    for side in [first, -first] {
+        let d = side * SQUARE_TURN_M;
+        out.push(vec![[lead_out[0] + d * perp[0], lead_out[1] + d * perp[1]]]);
+    }
+    out
+}
+
+/// Plans a leg, trying each approach and then further seeds while no drivable path
+/// comes out.
+fn plan_leg(
+    map: &NavMap,
+    m: &MissionSpec,
+    (from, to): (&Pose2, &Pose2),
+    truck: &forkbench_core::ForkliftSpec,
+    seed: u64,
+) -> (Result<GlobalPlan, String>, u32, f64) {
+    let t0 = Instant::now();
+    let g = &m.global;
+    let mut last = Err("no attempt".to_owned());
+    for a in 0..g.attempts {
+        let seed = seed.wrapping_add(u64::from(a));
+        let rrt = RrtParams {
+            seed,
+            ..RrtParams::default()
+        };
+        let algorithm = match g.planner {
+            GlobalPlannerKind::Prm => Algorithm::Prm(PrmParams {
+                nodes: g.nodes,
+                connect_m: g.connect_m,
+                seed,
+            }),
+            GlobalPlannerKind::Rrt => Algorithm::Rrt(rrt),
+            GlobalPlannerKind::RrtConnect => Algorithm::RrtConnect(rrt),
+        };
+        for approach in approaches(m, from, to) {
+            let q = GlobalQuery {
+                start: *from,
+                goal: *to,
+                algorithm,
+                collision: g.collision,
+                inflate_m: g.inflate_m.unwrap_or(forkbench_nav::luo_inflation_m(truck)),
+                smooth: true,
+                lead_m: [g.lead_m, g.approach_m],
+                approach,
+                margin_m: g.margin_m,
+                truck: truck.clone(),
+            };
+            last = plan_global(map, &q).map_err(|e| e.to_string());
+            if last.as_ref().is_ok_and(|p| p.drivable().is_some()) {
+                return (last, a + 1, t0.elapsed().as_secs_f64());
+            }
+        }
+    }
+    (last, g.attempts, t0.elapsed().as_secs_f64())
+}
+
+/// A reverse path out of a station: back and turn a quarter either way, backing up to
+/// `backout_m`; of the tracks whose swept footprint clears every obstacle, the one with
+/// the most clearance, half a metre of it traded for the forks facing the next goal.
+/// Straight back when no turn is clear.
+fn plan_backout(
+    map: &NavMap,
+    m: &MissionSpec,
+    at: &Pose2,
+    next: &Pose2,
+    truck: &forkbench_core::ForkliftSpec,
+) -> Option<Path> {
+    let (s, c) = at.heading_rad.sin_cos();
+    let toward = (next.y_m - at.y_m).atan2(next.x_m - at.x_m);
+    let params = SmoothParams::for_curvature(truck.max_curvature_per_m());
+    let parts = truck_parts(truck, m.global.margin_m);
+    let true_parts = truck_parts(truck, 0.0);
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let mut best: Option<(f64, Path)> = None;
+    for turn in [quarter, -quarter] {
+        for k in 1..=4 {
+            let d = m.backout_m * f64::from(k) / 4.0;
+            let corner = [at.x_m - d * c, at.y_m - d * s];
+            let h = at.heading_rad + turn;
+            // Driven forward, the track runs from the backed-out pose to the station.
+            let out = [corner[0] - d * h.cos(), corner[1] - d * h.sin()];
+            let poly = [out, corner, [at.x_m, at.y_m]];
+            let Ok(sm) = smooth(&poly, &map.obstacles, &parts, &params) else {
+                continue;
+            };
+            if !sm.clear() {
+                continue;
+            }
+            let clearance = forkbench_nav::smooth::min_clearance(&map.obstacles, &true_parts, &sm.path, 0.1, 2.0);
+            let score = clearance + 0.5 * (h - toward).cos();
+            if best.as_ref().is_none_or(|(b, _)| score > *b) {
+                best = Some((score, sm.path.driven_backwards()));
+            }
+        }
+    }
+    if let Some((_, path)) = best {
+        return Some(path);
+    }
+    let d = m.backout_m;
+    let back = Pose2::new(at.x_m - d * c, at.y_m - d * s, at.heading_rad);
+    let straight = Path::straight(&back, d, 0.02);
+    forkbench_nav::smooth::first_strike(&map.obstacles, &parts, &straight, 0.05)
+        .is_none()
+        .then(|| straight.driven_backwards())
+}
+
+/// Planned clearance of a reverse path's swept footprint.
+fn back_clearance(map: &NavMap, path: &Path, truck: &forkbench_core::ForkliftSpec) -> f64 {
+    let parts = truck_parts(truck, 0.0);
+    forkbench_nav::smooth::min_clearance(&map.obstacles, &parts, path, 0.1, 2.0)
+}
