@@ -4,6 +4,7 @@ mod batch_cmd;
 mod corridor_cmd;
 mod map_cmd;
 mod map_plot;
+mod mission_report;
 mod plan_cmd;
 mod plot;
 mod record;
@@ -71,39 +72,66 @@ impl RecordFlags {
     }
 }
 
+/// `trial` and `mission`, as parsed.
+#[derive(Debug, clap::Args)]
+struct TrialCli {
+    scenario: PathBuf,
+    /// Case of the scenario (required when it has several).
+    #[arg(long)]
+    case: Option<String>,
+    /// Seed of every random draw (default: the scenario's).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Planner by name: the scenario's own or a registered kind (default: the scenario's).
+    #[arg(long)]
+    planner: Option<String>,
+    /// Tracker by name: the scenario's own or a registered kind (default: the scenario's).
+    #[arg(long)]
+    tracker: Option<String>,
+    /// Turn off NAV350 and pallet-estimate noise.
+    #[arg(long)]
+    no_noise: bool,
+    /// Scale of the pallet-estimate σ (0: perfect estimate, NAV350 noise kept).
+    #[arg(long, allow_hyphen_values = true)]
+    pallet_noise_scale: Option<f64>,
+    /// Re-estimate the pallet at the configured ranges and replan when it moved.
+    #[arg(long)]
+    replan: bool,
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    record: RecordFlags,
+}
+
+impl TrialCli {
+    fn run(self, mission: bool) -> anyhow::Result<Done> {
+        let opts = trial_cmd::options(
+            self.seed,
+            (self.planner, self.tracker),
+            self.no_noise,
+            self.pallet_noise_scale,
+            self.replan,
+        )?;
+        let ok = trial_cmd::run(
+            &self.scenario,
+            self.case.as_deref(),
+            &opts,
+            (self.json, mission),
+            &self.record.args(),
+        )?;
+        Ok(if ok { Done::Ok } else { Done::PickFailed })
+    }
+}
+
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Plan one pick path from a start pose to a pallet pose.
     Plan(plan_cmd::PlanCli),
     /// Run one pick trial from a scenario file (exit status 3 when the pick fails).
-    Trial {
-        scenario: PathBuf,
-        /// Case of the scenario (required when it has several).
-        #[arg(long)]
-        case: Option<String>,
-        /// Seed of every random draw (default: the scenario's).
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Planner by name: the scenario's own or a registered kind (default: the scenario's).
-        #[arg(long)]
-        planner: Option<String>,
-        /// Tracker by name: the scenario's own or a registered kind (default: the scenario's).
-        #[arg(long)]
-        tracker: Option<String>,
-        /// Turn off NAV350 and pallet-estimate noise.
-        #[arg(long)]
-        no_noise: bool,
-        /// Scale of the pallet-estimate σ (0: perfect estimate, NAV350 noise kept).
-        #[arg(long, allow_hyphen_values = true)]
-        pallet_noise_scale: Option<f64>,
-        /// Re-estimate the pallet at the configured ranges and replan when it moved.
-        #[arg(long)]
-        replan: bool,
-        #[arg(long)]
-        json: bool,
-        #[command(flatten)]
-        record: RecordFlags,
-    },
+    Trial(TrialCli),
+    /// Run a warehouse mission (a scenario with a [mission] table): each leg, then the
+    /// pick (exit status 3 when a leg or the pick fails).
+    Mission(TrialCli),
     /// Re-run one trial from its JSON line (in a batch's trials.jsonl) and record it.
     Replay {
         /// File with JSON lines (e.g. DIR/trials.jsonl).
@@ -217,28 +245,8 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             let ok = batch_cmd::regress(&args)?;
             Ok(if ok { Done::Ok } else { Done::Regressed })
         }
-        Command::Trial {
-            scenario,
-            case,
-            seed,
-            planner,
-            tracker,
-            no_noise,
-            pallet_noise_scale,
-            replan,
-            json,
-            record,
-        } => {
-            let opts = trial_cmd::options(
-                seed,
-                (planner, tracker),
-                no_noise,
-                pallet_noise_scale,
-                replan,
-            )?;
-            let ok = trial_cmd::run(&scenario, case.as_deref(), &opts, json, &record.args())?;
-            Ok(if ok { Done::Ok } else { Done::PickFailed })
-        }
+        Command::Trial(t) => t.run(false),
+        Command::Mission(t) => t.run(true),
         Command::Replay {
             file,
             line,

@@ -3,30 +3,25 @@
 use std::path::Path;
 
 use anyhow::Context as _;
-use forkbench_trial::{Scenario, TrialOptions};
+use forkbench_trial::{Scenario, TrialOptions, TrialOutcome};
 
+/// `trial` (a pick, or a whole mission when the scenario has one) and `mission` (which
+/// requires one and prints each leg): runs, records, prints; Ok(success).
 pub fn run(
     file: &Path,
     case: Option<&str>,
     opts: &TrialOptions,
-    json: bool,
+    (json, mission): (bool, bool),
     rec: &crate::record::RecordArgs,
 ) -> anyhow::Result<bool> {
     let scn = Scenario::load(file)?;
-    let case = match case {
-        Some(name) => scn.case(name)?,
-        None if scn.cases.len() == 1 => &scn.cases[0],
-        None => anyhow::bail!(
-            "{}: has {} cases; choose one with --case (cases: {})",
-            file.display(),
-            scn.cases.len(),
-            scn.cases
-                .iter()
-                .map(|c| c.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    };
+    if mission && scn.mission.is_none() {
+        anyhow::bail!(
+            "{}: has no [mission] table; `forkbench trial` runs its pick",
+            file.display()
+        );
+    }
+    let case = pick_case(&scn, file, case)?;
     // Unknown planner or tracker names stop here, before any recording file is made.
     let run = scn.resolve(opts)?;
     // File targets are checked before the run; a viewer that cannot be reached is
@@ -40,18 +35,54 @@ pub fn run(
     }
     // The outcome is printed even when a recording failed (it is computed); the error
     // then makes the exit status non-zero.
-    let finish = |success: bool| -> anyhow::Result<bool> {
-        written.context("writing the recording")?;
-        if viewer_error.is_some() {
-            anyhow::bail!("the requested rerun viewer could not be reached");
-        }
-        Ok(success)
+    let text = if json {
+        json_report(&out)?
+    } else {
+        crate::mission_report::legs_text(&out) + &text_report(&out)
     };
-    if json {
-        let text = serde_json::to_string(&out).context("serialising the outcome")?;
-        crate::emit(&format!("{text}\n"))?;
-        return finish(out.success);
+    crate::emit(&text)?;
+    written.context("writing the recording")?;
+    if viewer_error.is_some() {
+        anyhow::bail!("the requested rerun viewer could not be reached");
     }
+    Ok(out.success)
+}
+
+/// The case to run: the one named, or the only one.
+fn pick_case<'a>(
+    scn: &'a Scenario,
+    file: &Path,
+    case: Option<&str>,
+) -> anyhow::Result<&'a forkbench_trial::Case> {
+    Ok(match case {
+        Some(name) => scn.case(name)?,
+        None if scn.cases.len() == 1 => &scn.cases[0],
+        None => anyhow::bail!(
+            "{}: has {} cases; choose one with --case (cases: {})",
+            file.display(),
+            scn.cases.len(),
+            scn.cases
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    })
+}
+
+/// The outcome as one JSON object; a mission's also carries its `overall` figures.
+fn json_report(out: &TrialOutcome) -> anyhow::Result<String> {
+    let mut v = serde_json::to_value(out).context("serialising the outcome")?;
+    if !out.legs.is_empty()
+        && let Some(map) = v.as_object_mut()
+    {
+        map.insert("overall".into(), crate::mission_report::overall_json(out));
+    }
+    Ok(format!("{v}\n"))
+}
+
+/// The pick's outcome as aligned text lines.
+fn text_report(out: &TrialOutcome) -> String {
     // A trial that failed before driving has no final pose: "–", not "NaN m".
     let num = |v: f64, digits: usize, unit: &str| {
         if v.is_finite() {
@@ -68,59 +99,50 @@ pub fn run(
         (Some(f), false) => format!("FAILED: {}", f.name()),
         (None, false) => "FAILED".to_owned(),
     };
-    let mut s = String::new();
-    use std::fmt::Write as _;
-    let _ = writeln!(
-        s,
-        "scenario             {} / case {} / planner {} / seed {}{}",
-        out.scenario,
-        out.case,
-        out.planner,
-        out.seed,
-        if out.noise { "" } else { " / no noise" }
-    );
-    let _ = writeln!(s, "outcome              {verdict}");
+    let noise = if out.noise { "" } else { " / no noise" };
+    let mut lines = vec![
+        format!(
+            "scenario             {} / case {} / planner {} / seed {}{noise}",
+            out.scenario, out.case, out.planner, out.seed
+        ),
+        format!("outcome              {verdict}"),
+    ];
     if let Some(d) = &out.failure_detail {
-        let _ = writeln!(s, "reason               {d}");
+        lines.push(format!("reason               {d}"));
     }
-    let _ = writeln!(
-        s,
-        "lateral error entry  {}",
-        opt(out.lateral_error_m, 1.0, "m")
-    );
-    let _ = writeln!(
-        s,
-        "heading error entry  {}",
-        opt(out.heading_error_rad, 1.0, "rad")
-    );
-    let _ = writeln!(
-        s,
-        "final lateral error  {}",
-        num(out.final_lateral_error_m, 4, "m")
-    );
-    let _ = writeln!(
-        s,
-        "final heading error  {}",
-        num(out.final_heading_error_rad, 5, "rad")
-    );
-    let _ = writeln!(
-        s,
-        "insertion depth      {}",
-        num(out.insertion_depth_m, 3, "m")
-    );
-    let _ = writeln!(s, "max steering         {:.4} rad", out.max_steer_rad);
-    let _ = writeln!(s, "max contact force    {:.1} N", out.max_contact_force_n);
-    let _ = writeln!(
-        s,
-        "pallet displacement  {:.4} m, {:.3}°",
-        out.pallet_displacement_m,
-        out.pallet_rotation_rad.to_degrees()
-    );
-    let _ = writeln!(s, "replans              {}", out.replans);
-    let _ = writeln!(s, "sim time             {:.2} s", out.sim_time_s);
-    let _ = writeln!(s, "wall time            {:.1} ms", out.wall_time_ms);
-    crate::emit(&s)?;
-    finish(out.success)
+    lines.extend([
+        format!(
+            "lateral error entry  {}",
+            opt(out.lateral_error_m, 1.0, "m")
+        ),
+        format!(
+            "heading error entry  {}",
+            opt(out.heading_error_rad, 1.0, "rad")
+        ),
+        format!(
+            "final lateral error  {}",
+            num(out.final_lateral_error_m, 4, "m")
+        ),
+        format!(
+            "final heading error  {}",
+            num(out.final_heading_error_rad, 5, "rad")
+        ),
+        format!(
+            "insertion depth      {}",
+            num(out.insertion_depth_m, 3, "m")
+        ),
+        format!("max steering         {:.4} rad", out.max_steer_rad),
+        format!("max contact force    {:.1} N", out.max_contact_force_n),
+        format!(
+            "pallet displacement  {:.4} m, {:.3}°",
+            out.pallet_displacement_m,
+            out.pallet_rotation_rad.to_degrees()
+        ),
+        format!("replans              {}", out.replans),
+        format!("sim time             {:.2} s", out.sim_time_s),
+        format!("wall time            {:.1} ms", out.wall_time_ms),
+    ]);
+    lines.join("\n") + "\n"
 }
 
 /// Trial options from the CLI: seed, (planner, tracker) names, noise and replanning.

@@ -35,6 +35,48 @@ pub struct SummaryRow {
     pub heading_error_p95_rad: Option<f64>,
     /// Sum of trial wall times (CPU-side cost, not elapsed time).
     pub wall_time_total_s: f64,
+    /// Missions: success per leg, over the trials that reached the leg.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub legs: Vec<LegSummary>,
+}
+
+/// Success of one mission leg across a row's trials.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LegSummary {
+    pub name: String,
+    /// Trials that reached this leg (earlier legs done).
+    pub attempted: u64,
+    pub done: u64,
+    pub success_rate: f64,
+    pub ci95_low: f64,
+    pub ci95_high: f64,
+}
+
+/// Per-leg counts: (name, attempted, done) by leg index.
+fn count_legs(acc: &mut Vec<(String, u64, u64)>, legs: &[crate::outcome::LegOutcome]) {
+    for (i, l) in legs.iter().enumerate() {
+        if acc.len() <= i {
+            acc.push((l.name.clone(), 0, 0));
+        }
+        acc[i].1 += 1;
+        acc[i].2 += u64::from(l.success);
+    }
+}
+
+fn leg_summaries(acc: Vec<(String, u64, u64)>) -> Vec<LegSummary> {
+    acc.into_iter()
+        .map(|(name, n, k)| {
+            let (lo, hi) = wilson(k, n, Z95);
+            LegSummary {
+                name,
+                attempted: n,
+                done: k,
+                success_rate: k as f64 / n.max(1) as f64,
+                ci95_low: lo,
+                ci95_high: hi,
+            }
+        })
+        .collect()
 }
 
 /// A batch's summary.
@@ -58,6 +100,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
         lat: Vec<f64>,
         head: Vec<f64>,
         wall: Vec<f64>,
+        legs: Vec<(String, u64, u64)>,
     }
     let mut groups: BTreeMap<(String, String, String, bool), Acc> = BTreeMap::new();
     for r in records {
@@ -84,6 +127,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
             a.head.push(v.abs());
         }
         a.wall.push(o.wall_time_ms);
+        count_legs(&mut a.legs, &o.legs);
     }
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     let rows: Vec<SummaryRow> = groups
@@ -109,6 +153,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 heading_error_mean_rad: mean(&a.head),
                 heading_error_p95_rad: percentile_sorted(&a.head, 0.95),
                 wall_time_total_s: a.wall.iter().sum::<f64>() / 1e3,
+                legs: leg_summaries(a.legs),
             }
         })
         .collect();
@@ -178,6 +223,38 @@ impl Summary {
                     "{}: {k} of {n} ({:.1} %)\n",
                     mode_name(m),
                     100.0 * k as f64 / n.max(1) as f64
+                ));
+            }
+        }
+        s.push_str(&self.legs_markdown());
+        s
+    }
+}
+
+impl Summary {
+    /// The mission legs' success table (empty without missions).
+    fn legs_markdown(&self) -> String {
+        let rows: Vec<_> = self.rows.iter().filter(|r| !r.legs.is_empty()).collect();
+        if rows.is_empty() {
+            return String::new();
+        }
+        let mut s = String::from(
+            "\nMission legs (a trial counts for a leg once the legs before it are done):\n\n| scenario | planner | tracker | mode | leg | attempted | done | success rate | 95 % CI (Wilson) |\n|---|---|---|---|---|---|---|---|---|\n",
+        );
+        for r in rows {
+            for l in &r.legs {
+                s.push_str(&format!(
+                    "| {} | {} | {} | {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % |\n",
+                    r.scenario,
+                    r.planner,
+                    r.tracker,
+                    mode_name(r.replan),
+                    l.name,
+                    l.attempted,
+                    l.done,
+                    100.0 * l.success_rate,
+                    100.0 * l.ci95_low,
+                    100.0 * l.ci95_high
                 ));
             }
         }

@@ -343,7 +343,13 @@ fn plan_backout(
             if !sm.clear() {
                 continue;
             }
-            let clearance = forkbench_nav::smooth::min_clearance(&map.obstacles, &true_parts, &sm.path, 0.1, 2.0);
+            let clearance = forkbench_nav::smooth::min_clearance(
+                &map.obstacles,
+                &true_parts,
+                &sm.path,
+                0.1,
+                2.0,
+            );
             let score = clearance + 0.5 * (h - toward).cos();
             if best.as_ref().is_none_or(|(b, _)| score > *b) {
                 best = Some((score, sm.path.driven_backwards()));

@@ -145,7 +145,11 @@ fn run_stages<R: Recorder + ?Sized>(
     };
     if let Some(m) = &scn.mission {
         let staging = crate::scenario::mission::Waypoint {
-            name: format!("staging ({})", case.name),
+            name: if case.name == "default" {
+                "staging".to_owned()
+            } else {
+                format!("staging ({})", case.name)
+            },
             pose: case.start,
         };
         if let Err(why) = trial.run_legs(m, &staging, rec) {
