@@ -17,7 +17,9 @@ pub use map_server::{MapError, read_map, write_map};
 pub use roadmap::{PrmParams, Roadmap, astar, plan_prm};
 pub use rrt::{RrtParams, plan_rrt, plan_rrt_connect};
 pub use smooth::{SmoothError, SmoothParams, Smoothed, SweptHit};
-pub use space::{CollisionModel, FootprintSpace, FreeSpace, grid_obstacles, truck_parts};
+pub use space::{
+    CollisionModel, FootprintSpace, FreeSpace, blocked_rects, grid_obstacles, truck_parts,
+};
 
 /// A query the planners refuse.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

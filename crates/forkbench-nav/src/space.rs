@@ -129,25 +129,24 @@ impl FreeSpace for FootprintSpace<'_> {
     }
 }
 
-/// Obstacles for the footprint checker from a grid's non-free cells: runs of cells along
-/// rows, merged with identical runs in the rows above (a map from SLAM has no shapes).
+/// Obstacles for the footprint checker from a grid's non-free cells (a map from SLAM has
+/// no shapes).
 pub fn grid_obstacles(grid: &OccupancyGrid) -> Obstacles {
+    let mut out = Obstacles::new();
+    for [lo, hi] in blocked_rects(grid) {
+        let centre = Pose2::new((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, 0.0);
+        out.add_rect(&centre, hi[0] - lo[0], hi[1] - lo[1]);
+    }
+    out
+}
+
+/// A grid's non-free cells as few rectangles (lower-left, upper-right): runs of cells
+/// along rows, merged with identical runs in the rows above.
+pub fn blocked_rects(grid: &OccupancyGrid) -> Vec<[[f64; 2]; 2]> {
     let r = grid.resolution_m;
     // Open rectangles keyed by their run: (first cell, last cell) → first row.
     let mut open: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
-    let mut out = Obstacles::new();
-    let close = |(x0, x1): (usize, usize), y0: usize, y1: usize, out: &mut Obstacles| {
-        let lo = [
-            grid.origin_m[0] + x0 as f64 * r,
-            grid.origin_m[1] + y0 as f64 * r,
-        ];
-        let hi = [
-            grid.origin_m[0] + (x1 + 1) as f64 * r,
-            grid.origin_m[1] + y1 as f64 * r,
-        ];
-        let centre = Pose2::new((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, 0.0);
-        out.add_rect(&centre, hi[0] - lo[0], hi[1] - lo[1]);
-    };
+    let mut out = Vec::new();
     for iy in 0..=grid.height {
         let runs = if iy < grid.height {
             row_runs(grid, iy)
@@ -155,9 +154,18 @@ pub fn grid_obstacles(grid: &OccupancyGrid) -> Obstacles {
             Vec::new()
         };
         let ended: Vec<_> = open.keys().filter(|k| !runs.contains(k)).copied().collect();
-        for k in ended {
-            let y0 = open.remove(&k).unwrap_or(iy);
-            close(k, y0, iy, &mut out);
+        for (x0, x1) in ended {
+            let y0 = open.remove(&(x0, x1)).unwrap_or(iy);
+            out.push([
+                [
+                    grid.origin_m[0] + x0 as f64 * r,
+                    grid.origin_m[1] + y0 as f64 * r,
+                ],
+                [
+                    grid.origin_m[0] + (x1 + 1) as f64 * r,
+                    grid.origin_m[1] + iy as f64 * r,
+                ],
+            ]);
         }
         for k in runs {
             open.entry(k).or_insert(iy);

@@ -224,6 +224,19 @@ pub(super) fn line_at(
     }
 }
 
+/// Separate segments (type 2, LINE_LIST): points pair up.
+pub(super) fn line_list(
+    segments: impl IntoIterator<Item = [[f64; 2]; 2]>,
+    rgba: [f64; 4],
+    thickness: f64,
+) -> LinePrimitive {
+    let pts: Vec<[f64; 2]> = segments.into_iter().flatten().collect();
+    LinePrimitive {
+        kind: 2,
+        ..line(&pts, rgba, thickness)
+    }
+}
+
 pub(super) fn entity(t_s: f64, id: &str, lines: Vec<LinePrimitive>) -> SceneEntity {
     entity_in("world", t_s, id, lines)
 }

@@ -35,6 +35,10 @@ const TRAJECTORY_RGBA: [f64; 4] = [0.12, 0.63, 0.24, 1.0];
 const LOOKAHEAD_RGBA: [f64; 4] = [0.85, 0.1, 0.75, 1.0];
 const START_RGBA: [f64; 4] = [0.2, 0.2, 0.2, 1.0];
 const GOAL_RGBA: [f64; 4] = [0.1, 0.4, 0.9, 1.0];
+/// A mission's map: blocked cells, the roadmap, a leg's A* polyline.
+const OCCUPIED_RGBA: [f64; 4] = [0.45, 0.45, 0.45, 0.8];
+const ROADMAP_RGBA: [f64; 4] = [0.45, 0.6, 0.9, 0.3];
+const ROUTE_RGBA: [f64; 4] = [1.0, 0.6, 0.15, 1.0];
 
 /// What the trial thread keeps to draw: the trajectory segment being driven and the plan
 /// on screen.
@@ -311,6 +315,61 @@ impl Recorder for McapRecorder {
             entities: vec![plan, goal],
         };
         self.send("/world", t_s, scene);
+    }
+
+    fn nav_map(&mut self, grid: &forkbench_nav::OccupancyGrid) {
+        let segments = forkbench_nav::blocked_rects(grid)
+            .into_iter()
+            .flat_map(|[lo, hi]| {
+                let c = [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]];
+                (0..4).map(move |i| [c[i], c[(i + 1) % 4]])
+            });
+        let occupied = entity(
+            0.0,
+            "nav/occupied",
+            vec![line_list(segments, OCCUPIED_RGBA, 0.02)],
+        );
+        self.send(
+            "/world",
+            0.0,
+            SceneUpdate {
+                deletions: Vec::new(),
+                entities: vec![occupied],
+            },
+        );
+    }
+
+    fn route(&mut self, t_s: f64, route: &forkbench_trial::recorder::RouteRecord<'_>) {
+        let mut entities = Vec::new();
+        if let Some((nodes, edges)) = route.roadmap {
+            let segments = edges.iter().enumerate().flat_map(|(i, nb)| {
+                nb.iter()
+                    .filter(move |(j, _)| *j > i)
+                    .map(move |(j, _)| [nodes[i], nodes[*j]])
+            });
+            entities.push(entity(
+                t_s,
+                "nav/roadmap",
+                vec![line_list(segments, ROADMAP_RGBA, 0.01)],
+            ));
+        }
+        let path: Vec<[f64; 2]> = route.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect();
+        entities.push(entity(
+            t_s,
+            &format!("nav/route/{}", route.leg),
+            vec![
+                line_at(route.polyline, 0.01, ROUTE_RGBA, 0.02),
+                line_at(&path, 0.02, GOAL_RGBA, 0.04),
+            ],
+        ));
+        self.send(
+            "/world",
+            t_s,
+            SceneUpdate {
+                deletions: Vec::new(),
+                entities,
+            },
+        );
     }
 
     fn step(&mut self, s: &StepRecord) {

@@ -27,6 +27,11 @@ pub(super) const MEASURED_RGB: [u8; 3] = [240, 70, 70];
 pub(super) const COMMAND_RGB: [u8; 3] = [255, 170, 40];
 pub(super) const ACTUAL_RGB: [u8; 3] = [70, 160, 255];
 pub(super) const LIMIT_RGB: [u8; 3] = [235, 60, 60];
+/// A mission's map: blocked cells, the roadmap, a leg's A* polyline and smoothed path.
+pub(super) const OCCUPIED_RGBA: [u8; 4] = [150, 150, 150, 110];
+pub(super) const ROADMAP_RGBA: [u8; 4] = [120, 160, 230, 25];
+pub(super) const ROUTE_RGB: [u8; 3] = [255, 150, 40];
+pub(super) const SMOOTHED_RGB: [u8; 3] = [40, 110, 240];
 
 /// Draw order in the map (higher on top): the driven trajectory over the plans.
 pub(super) const ORDER_GRID: f32 = 0.0;

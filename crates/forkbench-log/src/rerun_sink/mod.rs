@@ -6,6 +6,7 @@
 
 mod columns;
 mod layout;
+mod nav;
 mod recorder;
 mod scene;
 
@@ -75,6 +76,8 @@ pub struct RerunRecorder {
     plans: u32,
     /// The event log so far, for the verdict document.
     events: Vec<String>,
+    /// Rack and wall outlines, redrawn unclipped when a mission's map widens the frame.
+    obstacle_outlines: Vec<[[f64; 2]; 5]>,
     cols: Columns,
     error: Option<String>,
     close: Close,
@@ -190,6 +193,7 @@ impl RerunRecorder {
             limits: [f64::NAN; 2],
             plans: 0,
             events: Vec::new(),
+            obstacle_outlines: Vec::new(),
             cols: Columns::default(),
             error: None,
             close: Close::Open,

@@ -27,6 +27,28 @@ fn strip_of(path: &forkbench_core::Path) -> Vec<[f32; 2]> {
         .collect()
 }
 
+/// A mission's legs as a markdown table (empty for a pick trial).
+fn legs_table(o: &TrialOutcome) -> String {
+    if o.legs.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "| leg | done | planned | clearance | cross-track max | time |\n|---|---|---|---|---|---|\n",
+    );
+    for l in &o.legs {
+        s += &format!(
+            "| {} | {} | {:.1} m | {:.2} m | {:.0} mm | {:.1} s |\n",
+            l.name,
+            if l.success { "yes" } else { "**no**" },
+            l.planned_length_m,
+            l.min_clearance_m,
+            1e3 * l.cross_track_max_m,
+            l.time_s
+        );
+    }
+    s + "\n"
+}
+
 impl RerunRecorder {
     /// Fixed styles and series names, sent with each entity's first columns.
     fn styles(&mut self) {
@@ -35,7 +57,10 @@ impl RerunRecorder {
                 .with_names(plot.series.iter().map(|(n, _)| *n))
                 .with_colors(plot.series.iter().map(|(_, c)| color(*c)))
                 .with_widths(plot.series.iter().map(|(n, _)| series_width(n)));
-            self.set_once(plot.entity, &lines);
+            // Static: a plot showing a late time window (a mission's pick) still finds
+            // its names, which a first-row value outside the window would not give.
+            let r = self.rec.log_static(plot.entity, &lines);
+            self.note(r);
         }
         let trajectory = rerun::LineStrips2D::update_fields()
             .with_colors([color(TRAJECTORY_RGB)])
@@ -75,18 +100,20 @@ impl RerunRecorder {
              | heading | {} | {head_limit}° |\n\
              | fork depth | {:.3} m | |\n\
              | max contact force | {:.0} N | |\n\n\
-             **{}** · case `{}` · planner `{}` · tracker `{}` · seed {} · {:.2} s simulated, {} replans\n\n\
+             {}**{}** · case `{}` · planner `{}` · tracker `{}` · seed {} · {:.2} s simulated, {} replans\n\n\
              Map (y up, 1 m grid): white arrow start · light-blue arrow goal (pre-entry) · \
              blue plan being driven (thin: its control polygon), faded plans superseded · \
              green driven trajectory · \
              magenta look-ahead · yellow truck · orange pallet, faint where it stood · \
-             red pallet estimate · green/red arrows true/measured NAV350 fix\n\n\
+             red pallet estimate · green/red arrows true/measured NAV350 fix · \
+             mission legs: grey blocked cells, faint blue roadmap, orange A* polyline\n\n\
              **Events**\n\n```text\n{}\n```\n\n\
              **Outcome**\n\n```json\n{}\n```\n",
             num(o.lateral_error_m, &|v| format!("{v:.3} m")),
             num(o.heading_error_rad, &|v| format!("{:.2}°", v.to_degrees())),
             o.insertion_depth_m,
             o.max_contact_force_n,
+            legs_table(o),
             o.scenario,
             o.case,
             o.planner,
@@ -190,6 +217,14 @@ impl Recorder for RerunRecorder {
             &[&lines as &dyn rerun::AsComponents, &points, &goal],
         );
         self.note(r);
+    }
+
+    fn nav_map(&mut self, grid: &forkbench_nav::OccupancyGrid) {
+        self.draw_nav_map(grid);
+    }
+
+    fn route(&mut self, t_s: f64, route: &forkbench_trial::recorder::RouteRecord<'_>) {
+        self.draw_route(t_s, route);
     }
 
     fn step(&mut self, s: &StepRecord) {

@@ -37,7 +37,7 @@ impl Frame {
     }
 
     /// Grid lines every metre across the frame.
-    fn grid(&self) -> Vec<Vec<[f32; 2]>> {
+    pub fn grid(&self) -> Vec<Vec<[f32; 2]>> {
         let [x0, y0] = self.min;
         let [x1, y1] = self.max;
         let xs =
@@ -113,20 +113,12 @@ impl RerunRecorder {
             .rec
             .log_static("map", &[&mirror as &dyn rerun::AsComponents, &grid]);
         self.note(r);
-        let racks: Vec<Vec<[f32; 2]>> = s
+        self.obstacle_outlines = s
             .obstacles
             .iter()
-            .filter_map(|o| frame.clip(&rect_outline(&o.centre, o.length_m, o.width_m)))
-            .map(|c| strip(&c))
+            .map(|o| rect_outline(&o.centre, o.length_m, o.width_m))
             .collect();
-        if !racks.is_empty() {
-            let racks = rerun::LineStrips2D::new(racks)
-                .with_colors([color(RACK_RGB)])
-                .with_radii([0.03])
-                .with_draw_order(ORDER_WORLD);
-            let r = self.rec.log_static("map/world/racks", &racks);
-            self.note(r);
-        }
+        self.draw_racks(&frame);
         let pallet = rerun::LineStrips2D::new(pallet0.iter().map(|c| strip(c)))
             .with_colors([rgba(PALLET_INITIAL_RGBA)])
             .with_radii([0.012])
@@ -137,6 +129,26 @@ impl RerunRecorder {
             &[&pallet as &dyn rerun::AsComponents, &start],
         );
         self.note(r);
+    }
+}
+
+impl RerunRecorder {
+    /// The racks and walls, clipped to `frame`.
+    pub(super) fn draw_racks(&mut self, frame: &Frame) {
+        let racks: Vec<Vec<[f32; 2]>> = self
+            .obstacle_outlines
+            .iter()
+            .filter_map(|o| frame.clip(o))
+            .map(|c| strip(&c))
+            .collect();
+        if !racks.is_empty() {
+            let racks = rerun::LineStrips2D::new(racks)
+                .with_colors([color(RACK_RGB)])
+                .with_radii([0.03])
+                .with_draw_order(ORDER_WORLD);
+            let r = self.rec.log_static("map/world/racks", &racks);
+            self.note(r);
+        }
     }
 }
 
