@@ -181,11 +181,14 @@ fn smooth_route(
         &params,
     )
     .map(|mut s| {
-        // Clearance of the true footprint: the grown one's plus the margin (a lower bound
-        // near the grown rectangle's square corners).
-        if s.clear() {
-            s.min_clearance_m += q.margin_m;
-        }
+        // The clearance of the truck itself, not of the footprint grown by the margin.
+        s.min_clearance_m = crate::smooth::min_clearance(
+            &map.obstacles,
+            &truck_parts(&q.truck, 0.0),
+            &s.path,
+            params.check_step_m * 2.0,
+            params.clearance_cap_m,
+        );
         s
     })
 }

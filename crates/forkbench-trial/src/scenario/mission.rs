@@ -38,6 +38,9 @@ pub struct GlobalFile {
     pub resolution_m: f64,
     /// Seeds tried per leg before the leg fails (seed, seed + 1, …).
     pub attempts: u32,
+    /// Refuse a smoothed path whose swept footprint strikes an obstacle. Off, a path is
+    /// driven as planned (as the paper's inflation model does, which never checks it).
+    pub check_swept: bool,
 }
 
 impl Default for GlobalFile {
@@ -52,7 +55,8 @@ impl Default for GlobalFile {
             lead_m: 2.5,
             approach_m: 1.8,
             resolution_m: 0.05,
-            attempts: 5,
+            attempts: 10,
+            check_swept: true,
         }
     }
 }

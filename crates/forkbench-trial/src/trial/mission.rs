@@ -98,7 +98,7 @@ impl Trial<'_> {
             leg.planning_attempts = attempts;
             leg.route_length_m = plan.as_ref().map_or(f64::NAN, |p| p.route.length_m);
             let p = plan?;
-            let s = p.drivable().ok_or_else(|| leg_plan_failure(&p))?;
+            let s = accepted(&p, m).ok_or_else(|| leg_plan_failure(&p))?;
             leg.smoothing = "ok".into();
             leg.planned_length_m = s.path.length_m();
             leg.min_clearance_m = leg.min_clearance_m.min(s.min_clearance_m);
@@ -228,6 +228,15 @@ fn finish_leg(leg: &mut LegOutcome, result: Result<(), String>, s: &DriveStats, 
     }
 }
 
+/// The smoothed path a leg drives: one that clears every obstacle, or with the swept
+/// check off, any that smoothing produced.
+fn accepted<'a>(p: &'a GlobalPlan, m: &MissionSpec) -> Option<&'a forkbench_nav::Smoothed> {
+    match &p.smoothed {
+        Some(Ok(s)) if s.clear() || !m.global.check_swept => Some(s),
+        _ => None,
+    }
+}
+
 /// Why a found route is not drivable.
 fn leg_plan_failure(p: &GlobalPlan) -> String {
     match &p.smoothed {
@@ -289,7 +298,7 @@ fn plan_leg(
             GlobalPlannerKind::Rrt => Algorithm::Rrt(rrt),
             GlobalPlannerKind::RrtConnect => Algorithm::RrtConnect(rrt),
         };
-        for approach in approaches(m, from, to) {
+        for (k, approach) in approaches(m, from, to).into_iter().enumerate() {
             let q = GlobalQuery {
                 start: *from,
                 goal: *to,
@@ -302,9 +311,13 @@ fn plan_leg(
                 margin_m: g.margin_m,
                 truck: truck.clone(),
             };
-            last = plan_global(map, &q).map_err(|e| e.to_string());
-            if last.as_ref().is_ok_and(|p| p.drivable().is_some()) {
-                return (last, a + 1, t0.elapsed().as_secs_f64());
+            let plan = plan_global(map, &q).map_err(|e| e.to_string());
+            if plan.as_ref().is_ok_and(|p| accepted(p, m).is_some()) {
+                return (plan, a + 1, t0.elapsed().as_secs_f64());
+            }
+            // A failure reports why the direct way did not work (the others are fallbacks).
+            if k == 0 {
+                last = plan;
             }
         }
     }
