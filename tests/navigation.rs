@@ -36,7 +36,7 @@ fn tmp(name: &str) -> PathBuf {
 
 /// Charging station to the aisle before a far rack bay, as `reproduce prm` plans it.
 const START: &str = "3,3,90";
-const GOAL: &str = "30.75,9.75,0";
+const GOAL: &str = "30.75,10.25,0";
 
 #[test]
 fn the_warehouse_becomes_a_ros_map_that_plans_like_the_world() {
@@ -54,11 +54,11 @@ fn the_warehouse_becomes_a_ros_map_that_plans_like_the_world() {
     );
     let yaml = dir.join("warehouse.yaml");
     let pgm = std::fs::read(dir.join("warehouse.pgm")).expect("pgm");
-    // 40.4 × 25.4 m (walls 0.2 m thick outside the 40 × 25 m floor) plus 1 m of margin
-    // at 5 cm: 848 × 548 cells.
+    // 40.4 × 26.4 m (walls 0.2 m thick outside the 40 × 26 m floor) plus 1 m of margin
+    // at 5 cm: 848 × 568 cells.
     assert!(pgm.starts_with(b"P5\n"), "binary PGM");
     let text = String::from_utf8_lossy(&pgm[..64]).into_owned();
-    assert!(text.contains("848 548"), "{text}");
+    assert!(text.contains("848 568"), "{text}");
     let plan = |map: &str| {
         json_of(&forkbench(&[
             "plan", "prm", "--map", map, "--start", START, "--goal", GOAL, "--nodes", "500",
@@ -73,7 +73,7 @@ fn the_warehouse_becomes_a_ros_map_that_plans_like_the_world() {
         assert_eq!(v["success"], true, "{v}");
         // At least the straight line from start to goal, which crosses rack row 1.
         assert!(
-            v["length_m"].as_f64().expect("length") > 27.75f64.hypot(6.75),
+            v["length_m"].as_f64().expect("length") > 27.75f64.hypot(7.25),
             "{v}"
         );
         let t = &v["timing_s"];
@@ -102,7 +102,7 @@ fn every_global_planner_finds_the_shelf_and_a_blocked_goal_is_refused() {
         assert_eq!(pts[0], serde_json::json!([3.0, 3.0]), "{planner}");
         assert_eq!(
             pts[pts.len() - 1],
-            serde_json::json!([30.75, 9.75]),
+            serde_json::json!([30.75, 10.25]),
             "{planner}"
         );
     }
@@ -130,7 +130,7 @@ fn every_global_planner_finds_the_shelf_and_a_blocked_goal_is_refused() {
         let size = std::fs::metadata(&file).expect("drawn").len();
         assert!(size > 20_000, "{ext}: {size} bytes");
     }
-    // Inside the row-2 flue wall: refused with the reason, exit 1, no panic.
+    // Inside the row-2 flue wall (y 12.95..13.05): refused with the reason, exit 1, no panic.
     let out = forkbench(&[
         "plan",
         "prm",
@@ -139,7 +139,7 @@ fn every_global_planner_finds_the_shelf_and_a_blocked_goal_is_refused() {
         "--start",
         START,
         "--goal",
-        "15,12.5,0",
+        "15,13.0,0",
     ]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
@@ -151,5 +151,158 @@ fn every_global_planner_finds_the_shelf_and_a_blocked_goal_is_refused() {
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("--map"),
         "map required"
+    );
+}
+
+#[test]
+fn a_footprint_plan_smooths_into_a_drivable_path_with_its_clearance() {
+    let v = json_of(&forkbench(&[
+        "plan",
+        "prm",
+        "--map",
+        &world("warehouse.toml"),
+        "--start",
+        START,
+        "--goal",
+        GOAL,
+        "--seed",
+        "1",
+        "--collision",
+        "footprint",
+        "--smooth",
+        "--json",
+    ]));
+    assert_eq!(v["success"], true, "{v}");
+    assert_eq!(v["collision"], "footprint");
+    let s = &v["smoothing"];
+    assert_eq!(s["ok"], true, "{s}");
+    // The default margin of the footprint model, kept by the true footprint.
+    let clearance = v["min_clearance_m"].as_f64().expect("clearance");
+    assert!(clearance >= 0.15, "{clearance}");
+    let samples = s["samples"].as_array().expect("samples");
+    let k_max = forkbench_core::ForkliftSpec::default().max_curvature_per_m();
+    for p in samples {
+        let k = p[4].as_f64().expect("κ");
+        assert!(k.abs() <= k_max + 1e-9, "{k}");
+    }
+    let last = &samples[samples.len() - 1];
+    assert!(
+        (last[1].as_f64().expect("x") - 30.75).abs() < 1e-3,
+        "{last}"
+    );
+    let t = &v["timing_s"];
+    for stage in ["sampling", "connection", "search", "smoothing", "total"] {
+        assert!(t[stage].as_f64().expect(stage) > 0.0, "{stage}: {t}");
+    }
+}
+
+fn mission_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/warehouse-mission.toml"),
+    )
+    .expect("reads");
+    let text = text.replace(
+        "\"../worlds/warehouse.toml\"",
+        &format!("{:?}", world("warehouse.toml")),
+    );
+    let file = dir.join(name);
+    std::fs::write(&file, edit(text)).expect("writes");
+    file
+}
+
+#[test]
+fn mission_reports_each_leg_and_the_pick() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/warehouse-mission.toml");
+    let file = file.to_str().expect("utf-8");
+    let out = forkbench(&["mission", file, "--seed", "1", "--json"]);
+    let v = json_of(&out);
+    let legs = v["legs"].as_array().expect("legs");
+    assert_eq!(legs.len(), 2, "{v}");
+    for l in legs {
+        for key in [
+            "planned_length_m",
+            "planning_time_s",
+            "min_clearance_m",
+            "cross_track_mean_m",
+            "cross_track_max_m",
+            "time_s",
+        ] {
+            assert!(l[key].as_f64().is_some(), "{key}: {l}");
+        }
+        assert_eq!(l["smoothing"], "ok");
+        assert_eq!(l["collisions"], 0);
+    }
+    let o = &v["overall"];
+    assert_eq!(o["legs_done"], 2, "{o}");
+    assert_eq!(o["success"], v["success"]);
+    // Text: one row per leg, then the pick as `trial` prints it.
+    let out = forkbench(&["mission", file, "--seed", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("charging → sorting") && text.contains("sorting → staging"),
+        "{text}"
+    );
+    assert!(text.contains("outcome "), "{text}");
+    // A pick scenario is not a mission.
+    let out = forkbench(&["mission", &file.replace("warehouse-mission", "field-test")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no [mission] table"));
+}
+
+#[test]
+fn a_mission_batch_records_a_failed_leg_and_goes_on() {
+    let dir = tmp("mission-batch");
+    // The sorting station moved into rack row 3: the first leg cannot be planned.
+    let bad = mission_file(&dir, "blocked.toml", |t| {
+        t.replace(
+            "via = [\"sorting\"]",
+            "via = [{ x_m = 20.0, y_m = 21.5, heading_deg = 90.0 }]",
+        )
+    });
+    let good = mission_file(&dir, "good.toml", |t| {
+        t.replace("name = \"warehouse-mission\"", "name = \"good-mission\"")
+    });
+    let out_dir = dir.join("out");
+    let out = forkbench(&[
+        "batch",
+        bad.to_str().expect("utf-8"),
+        good.to_str().expect("utf-8"),
+        "--trials",
+        "3",
+        "--record",
+        "none",
+        "--out",
+        out_dir.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines = std::fs::read_to_string(out_dir.join("trials.jsonl")).expect("records");
+    let records: Vec<serde_json::Value> = lines
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("json"))
+        .collect();
+    assert_eq!(records.len(), 6);
+    let failed: Vec<_> = records
+        .iter()
+        .filter(|r| r["scenario"] == "warehouse-mission")
+        .collect();
+    assert_eq!(failed.len(), 3);
+    for r in failed {
+        assert_eq!(r["failure"], "leg_failed", "{r}");
+        assert!(
+            r["failure_detail"]
+                .as_str()
+                .expect("detail")
+                .contains("inside an obstacle"),
+            "{r}"
+        );
+    }
+    let summary = std::fs::read_to_string(out_dir.join("summary.md")).expect("summary");
+    assert!(
+        summary.contains("Mission legs") && summary.contains("charging → sorting"),
+        "{summary}"
     );
 }

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use forkbench_nav::{Cell, OccupancyGrid, Roadmap};
+use forkbench_nav::{OccupancyGrid, Roadmap};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -33,29 +33,6 @@ pub fn draw_map(file: &Path, fig: &MapFigure) -> anyhow::Result<()> {
     to_file(file, (width, height), |a| draw(a, fig), |a| draw(a, fig))
 }
 
-/// Each row's runs of non-free cells as rectangles (few, however fine the grid).
-fn runs(g: &OccupancyGrid) -> Vec<[[f64; 2]; 2]> {
-    let r = g.resolution_m;
-    let mut out = Vec::new();
-    for iy in 0..g.height {
-        let mut ix = 0;
-        while ix < g.width {
-            if g.get(ix, iy) == Cell::Free {
-                ix += 1;
-                continue;
-            }
-            let start = ix;
-            while ix < g.width && g.get(ix, iy) != Cell::Free {
-                ix += 1;
-            }
-            let x0 = g.origin_m[0] + start as f64 * r;
-            let y0 = g.origin_m[1] + iy as f64 * r;
-            out.push([[x0, y0], [g.origin_m[0] + ix as f64 * r, y0 + r]]);
-        }
-    }
-    out
-}
-
 fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> anyhow::Result<()> {
     area.fill(&WHITE).map_err(err)?;
     let (lo, hi) = fig.grid.extent();
@@ -76,14 +53,14 @@ fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> an
     let solid = RGBColor(90, 90, 90).filled();
     chart
         .draw_series(
-            runs(fig.inflated)
+            forkbench_nav::blocked_rects(fig.inflated)
                 .into_iter()
                 .map(|[a, b]| Rectangle::new([(a[0], a[1]), (b[0], b[1])], band)),
         )
         .map_err(err)?;
     chart
         .draw_series(
-            runs(fig.grid)
+            forkbench_nav::blocked_rects(fig.grid)
                 .into_iter()
                 .map(|[a, b]| Rectangle::new([(a[0], a[1]), (b[0], b[1])], solid)),
         )
@@ -91,27 +68,14 @@ fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> an
     if let Some(map) = fig.roadmap {
         draw_roadmap(&mut chart, map)?;
     }
-    if let Some(p) = fig.path {
-        let line = RGBColor(220, 40, 40).stroke_width(3);
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>(),
-                line,
-            )))
-            .map_err(err)?
-            .label("path")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
-    }
-    if let Some(p) = fig.smoothed {
-        let line = RGBColor(30, 90, 220).stroke_width(2);
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>(),
-                line,
-            )))
-            .map_err(err)?
-            .label("smoothed")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+    let lines = [
+        (fig.path, "path", RGBColor(220, 40, 40), 3),
+        (fig.smoothed, "smoothed", RGBColor(30, 90, 220), 2),
+    ];
+    for (points, name, colour, width) in lines {
+        if let Some(p) = points {
+            draw_line(&mut chart, p, name, colour.stroke_width(width))?;
+        }
     }
     if let Some(at) = fig.strike {
         chart
@@ -146,6 +110,24 @@ fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> an
         .draw()
         .map_err(err)?;
     area.present().map_err(err)?;
+    Ok(())
+}
+
+/// A polyline with its legend entry.
+fn draw_line<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    points: &[[f64; 2]],
+    name: &str,
+    style: ShapeStyle,
+) -> anyhow::Result<()> {
+    chart
+        .draw_series(std::iter::once(PathElement::new(
+            points.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>(),
+            style,
+        )))
+        .map_err(err)?
+        .label(name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     Ok(())
 }
 

@@ -109,14 +109,7 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
         }
     };
     let (from, to) = if q.smooth {
-        let (from, lead_out) = lead_points(&q.start, &q.goal, q.lead_m);
-        let tail: Vec<[f64; 2]> = q.approach.iter().copied().chain([lead_out]).collect();
-        if tail.windows(2).any(|w| !space.segment_free(w[0], w[1])) {
-            return Err(NavError::Params(
-                "the approach to the goal is blocked".into(),
-            ));
-        }
-        (from, tail[0])
+        lead_in_and_out(map, space, q)?
     } else {
         ([q.start.x_m, q.start.y_m], [q.goal.x_m, q.goal.y_m])
     };
@@ -137,6 +130,38 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
         plan.smoothing_s = t0.elapsed().as_secs_f64();
     }
     Ok(plan)
+}
+
+/// The points the sampler connects when the headings count: the lead-in ahead of the
+/// start, and the first approach point (or the lead-out) before the goal. The start and
+/// goal themselves must be on the map and outside every obstacle.
+fn lead_in_and_out(
+    map: &NavMap,
+    space: &dyn FreeSpace,
+    q: &GlobalQuery,
+) -> Result<([f64; 2], [f64; 2]), NavError> {
+    let ends = ([q.start.x_m, q.start.y_m], [q.goal.x_m, q.goal.y_m]);
+    crate::check_endpoints(&map.grid, ends.0, ends.1)?;
+    let (from, lead_out) = lead_points(&q.start, &q.goal, q.lead_m);
+    let tail: Vec<[f64; 2]> = q.approach.iter().copied().chain([lead_out]).collect();
+    let blocked = |what: &str, p: [f64; 2]| {
+        NavError::Params(format!(
+            "no room for the {what}: ({:.2}, {:.2}) m is too close to an obstacle",
+            p[0], p[1]
+        ))
+    };
+    if !space.point_free(from) {
+        return Err(blocked("lead-in ahead of the start", from));
+    }
+    if let Some(&p) = tail.iter().find(|p| !space.point_free(**p)) {
+        return Err(blocked("approach to the goal", p));
+    }
+    if tail.windows(2).any(|w| !space.segment_free(w[0], w[1])) {
+        return Err(NavError::Params(
+            "the approach to the goal is blocked".into(),
+        ));
+    }
+    Ok((from, tail[0]))
 }
 
 fn run_algorithm(

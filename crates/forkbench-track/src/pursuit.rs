@@ -191,26 +191,7 @@ impl PurePursuit {
         } else {
             self.path.length_m() - near.s_m - along
         };
-        // Look-ahead point: first sample at least ld away; past the end, a point on the
-        // goal heading's extension keeps the forks aligned with the pocket.
-        let mut target = None;
-        for i in best..n {
-            if d2(i) >= ld * ld {
-                target = Some([self.path.samples[i].x_m, self.path.samples[i].y_m]);
-                break;
-            }
-        }
-        let target = target.unwrap_or_else(|| {
-            let ext = ld.max(0.05);
-            // Project onto the extension line at distance ld from the pose.
-            let px = pose.x_m - last.x_m;
-            let py = pose.y_m - last.y_m;
-            let t_along = gc * px + gs * py;
-            let lat = -gs * px + gc * py;
-            let fwd = (ext * ext - lat * lat).max(0.0).sqrt();
-            let t = t_along + fwd;
-            [last.x_m + gc * t, last.y_m + gs * t]
-        });
+        let target = self.lookahead_point(pose, best, ld);
         let vx = target[0] - pose.x_m;
         let vy = target[1] - pose.y_m;
         let dist = vx.hypot(vy).max(1e-6);
@@ -233,6 +214,30 @@ impl PurePursuit {
             steer_rad,
             reverse: self.path.reverse,
         })
+    }
+
+    /// Look-ahead point: the first sample from `from` at least `ld` away; past the end, a
+    /// point on the goal heading's extension, which keeps the forks aligned with the pocket.
+    fn lookahead_point(&self, pose: &Pose2, from: usize, ld: f64) -> [f64; 2] {
+        let Some(last) = self.path.samples.last().copied() else {
+            return [pose.x_m, pose.y_m];
+        };
+        let (gs, gc) = last.heading_rad.sin_cos();
+        let d2 = |p: &forkbench_core::PathSample| {
+            (p.x_m - pose.x_m).powi(2) + (p.y_m - pose.y_m).powi(2)
+        };
+        if let Some(p) = self.path.samples[from..].iter().find(|p| d2(p) >= ld * ld) {
+            return [p.x_m, p.y_m];
+        }
+        let ext = ld.max(0.05);
+        // Project onto the extension line at distance ld from the pose.
+        let px = pose.x_m - last.x_m;
+        let py = pose.y_m - last.y_m;
+        let t_along = gc * px + gs * py;
+        let lat = -gs * px + gc * py;
+        let fwd = (ext * ext - lat * lat).max(0.0).sqrt();
+        let t = t_along + fwd;
+        [last.x_m + gc * t, last.y_m + gs * t]
     }
 }
 

@@ -53,8 +53,8 @@ pub struct RouteRecord<'a> {
     /// Leg index from 0.
     pub leg: usize,
     pub name: &'a str,
-    /// PRM's roadmap: nodes, and per node its neighbours with the edge length.
-    pub roadmap: Option<(&'a [[f64; 2]], &'a [Vec<(usize, f64)>])>,
+    /// PRM's roadmap (the sampling trees leave none).
+    pub roadmap: Option<&'a forkbench_nav::Roadmap>,
     /// The A* polyline after shortcuts, with the lead-in and lead-out.
     pub polyline: &'a [[f64; 2]],
     /// The smoothed path driven.

@@ -341,7 +341,8 @@ impl Recorder for McapRecorder {
 
     fn route(&mut self, t_s: f64, route: &forkbench_trial::recorder::RouteRecord<'_>) {
         let mut entities = Vec::new();
-        if let Some((nodes, edges)) = route.roadmap {
+        if let Some(map) = route.roadmap {
+            let (nodes, edges) = (&map.nodes, &map.edges);
             let segments = edges.iter().enumerate().flat_map(|(i, nb)| {
                 nb.iter()
                     .filter(move |(j, _)| *j > i)

@@ -40,7 +40,8 @@ impl RerunRecorder {
     /// A leg's roadmap (replacing the last leg's), polyline and smoothed path.
     pub(super) fn draw_route(&mut self, t_s: f64, route: &RouteRecord<'_>) {
         self.at(t_s);
-        if let Some((nodes, edges)) = route.roadmap {
+        if let Some(map) = route.roadmap {
+            let (nodes, edges) = (&map.nodes, &map.edges);
             let lines: Vec<Vec<[f32; 2]>> = edges
                 .iter()
                 .enumerate()

@@ -107,7 +107,7 @@ impl Trial<'_> {
                 &RouteRecord {
                     leg: i,
                     name: &leg.name,
-                    roadmap: p.roadmap.as_ref().map(|r| (&r.nodes[..], &r.edges[..])),
+                    roadmap: p.roadmap.as_ref(),
                     polyline: &s.polyline,
                     path: &s.path,
                 },

@@ -55,6 +55,28 @@ impl std::fmt::Debug for Trial<'_> {
     }
 }
 
+/// The physics world of a trial: the truck at its start (a mission's first place, else the
+/// case's start), the pallet where it really stands (jittered on its own random stream).
+fn build_world(
+    scn: &Scenario,
+    case: &Case,
+    seed: u64,
+) -> Result<(Sim, Pose2, Pose2, Vec<forkbench_sim::Obstacle>), String> {
+    let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(seed, 3));
+    let obstacles = scn.world.obstacles();
+    let start = scn.mission.as_ref().map_or(case.start, |m| m.start.pose);
+    let sim = Sim::new(
+        &scn.truck,
+        &start,
+        &scn.pallet,
+        &true_pallet,
+        &obstacles,
+        &scn.sim,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok((sim, start, true_pallet, obstacles))
+}
+
 impl<'a> Trial<'a> {
     /// Builds the world and components and takes the first fix and pallet estimate. A
     /// world that cannot be built ends the trial here, as an `error` outcome.
@@ -81,23 +103,10 @@ impl<'a> Trial<'a> {
                 return Err(Box::new(out));
             }
         };
-        // Per-trial jitter of where the pallet really stands (its own random stream).
-        let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(run.seed, 3));
-        let obstacles = scn.world.obstacles();
-        // A mission starts at its first place; the case's start is where its legs end.
-        let start = scn.mission.as_ref().map_or(case.start, |m| m.start.pose);
-        let sim = Sim::new(
-            &scn.truck,
-            &start,
-            &scn.pallet,
-            &true_pallet,
-            &obstacles,
-            &scn.sim,
-        );
-        let sim = match sim {
-            Ok(s) => s,
+        let (sim, start, true_pallet, obstacles) = match build_world(scn, case, run.seed) {
+            Ok(w) => w,
             Err(e) => {
-                fail(&mut out, e.to_string());
+                fail(&mut out, e);
                 return Err(Box::new(out));
             }
         };
