@@ -7,6 +7,7 @@ mod map_plot;
 mod mission_report;
 mod plan_cmd;
 mod plot;
+mod prm_plot;
 mod record;
 mod report;
 mod reproduce_cmd;
@@ -289,10 +290,10 @@ fn reproduce(
             corridor_cmd::reproduce(json, plot)
         }
         ReproduceArg::Prm => {
-            if table.is_some() || plot.is_some() {
-                anyhow::bail!("reproduce prm: --table and --plot are not supported yet");
+            if table.is_some() {
+                anyhow::bail!("--table: reproduce prm has no reference table file");
             }
-            route_cmd::reproduce(100, json)
+            route_cmd::reproduce(100, json, plot)
         }
     }
 }

@@ -19,6 +19,10 @@ pub struct MapArgs {
     /// Free floor around the world's racks and walls.
     #[arg(long, default_value_t = 1.0)]
     margin_m: f64,
+    /// Grow the obstacles by this radius before writing (e.g. 0.815, Luo's half
+    /// wheelbase: the map a point planner searches, as `plan --collision inflate` does).
+    #[arg(long)]
+    inflate_m: Option<f64>,
 }
 
 pub fn run(a: &MapArgs) -> anyhow::Result<()> {
@@ -27,6 +31,13 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     let grid =
         OccupancyGrid::from_obstacles(&world.obstacles(), &slots, a.resolution_m, a.margin_m)
             .with_context(|| format!("{}: rasterising", a.world.display()))?;
+    let grid = match a.inflate_m {
+        Some(r) if !(r.is_finite() && r >= 0.0) => {
+            anyhow::bail!("--inflate-m {r}: must be a finite distance ≥ 0")
+        }
+        Some(r) => grid.inflated(r),
+        None => grid,
+    };
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let name = crate::record::safe_file_stem(&world.name);
     let yaml = write_map(&grid, &a.out, &name)?;

@@ -257,7 +257,7 @@ fn study_leg(world: &forkbench_trial::World) -> anyhow::Result<([f64; 2], [f64; 
 }
 
 /// `reproduce prm`: Luo's studies on the embedded warehouse over `runs` seeds.
-pub fn reproduce(runs: u64, json: bool) -> anyhow::Result<()> {
+pub fn reproduce(runs: u64, json: bool, plot: Option<&Path>) -> anyhow::Result<()> {
     let world = forkbench_trial::defaults::embedded_world("warehouse.toml")?;
     let truck = ForkliftSpec::default();
     let inflate_m = forkbench_nav::luo_inflation_m(&truck);
@@ -266,6 +266,9 @@ pub fn reproduce(runs: u64, json: bool) -> anyhow::Result<()> {
         .inflated(inflate_m);
     let ends = study_leg(&world)?;
     let rows = forkbench_nav::reproduce::studies(&grid, ends, runs)?;
+    if let Some(file) = plot {
+        crate::prm_plot::draw(file, &rows)?;
+    }
     if json {
         let rows: Vec<_> = rows
             .iter()
@@ -278,7 +281,7 @@ pub fn reproduce(runs: u64, json: bool) -> anyhow::Result<()> {
     }
     // Times are planning only: the grid is rasterised and inflated once, before.
     let mut out = format!(
-        "Luo PRM + A* on worlds/warehouse.toml (40 × 25 m, 5 cm cells, obstacles inflated by {inflate_m:.3} m = 0.5 × wheelbase), \
+        "Luo PRM + A* on worlds/warehouse.toml (40 × 26 m, 5 cm cells, obstacles inflated by {inflate_m:.3} m = 0.5 × wheelbase), \
          charging station ({:.1}, {:.1}) → aisle before row2b bay 3 ({:.2}, {:.2}), seeds 0..{runs}\n\n\
          | planner | nodes | connection | success | median time | median length | paper |\n|---|---|---|---|---|---|---|\n",
         ends.0[0], ends.0[1], ends.1[0], ends.1[1]
