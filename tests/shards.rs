@@ -48,6 +48,10 @@ fn records(dir: &Path) -> Vec<serde_json::Value> {
         .map(|l| {
             let mut r: serde_json::Value = serde_json::from_str(l).expect("json");
             r.as_object_mut().expect("object").remove("wall_time_ms");
+            // A mission's legs carry their planning wall time.
+            for leg in r["legs"].as_array_mut().into_iter().flatten() {
+                leg.as_object_mut().expect("leg").remove("planning_time_s");
+            }
             r
         })
         .collect();

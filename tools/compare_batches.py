@@ -9,6 +9,8 @@ def records(d):
     for line in open(f"{d}/trials.jsonl"):
         r = json.loads(line)
         r.pop("wall_time_ms", None)
+        for leg in r.get("legs", []):
+            leg.pop("planning_time_s", None)
         out.append(r)
     return sorted(out, key=lambda r: (r["scenario"], r["case"], r["planner"], r.get("tracker", ""), bool(r.get("replan")), r["trial"]))
 

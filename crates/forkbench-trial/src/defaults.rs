@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::TrialError;
 use crate::scenario::{Scenario, World};
 
-const SCENARIOS: [(&str, &str); 4] = [
+const SCENARIOS: [(&str, &str); 5] = [
     (
         "scenarios/field-test.toml",
         include_str!("../data/scenarios/field-test.toml"),
@@ -21,6 +21,10 @@ const SCENARIOS: [(&str, &str); 4] = [
     (
         "scenarios/spiral-table2.toml",
         include_str!("../data/scenarios/spiral-table2.toml"),
+    ),
+    (
+        "scenarios/warehouse-mission.toml",
+        include_str!("../data/scenarios/warehouse-mission.toml"),
     ),
 ];
 

@@ -167,6 +167,17 @@ impl TrialOutcome {
 }
 
 impl TrialOutcome {
+    /// The outcome with its wall times zeroed (the trial's and each leg's planning time):
+    /// all that may differ between two runs of the same trial.
+    pub fn without_wall_times(&self) -> TrialOutcome {
+        let mut o = self.clone();
+        o.wall_time_ms = 0.0;
+        for l in &mut o.legs {
+            l.planning_time_s = 0.0;
+        }
+        o
+    }
+
     /// Marks the trial failed on `failure` with its detail.
     pub fn fail(&mut self, failure: Failure, detail: String) {
         self.success = false;

@@ -26,12 +26,7 @@ fn run(scn: &Scenario, seed: u64) -> TrialOutcome {
 
 /// The outcome without its wall times, which differ between runs.
 fn comparable(o: &TrialOutcome) -> serde_json::Value {
-    let mut o = o.clone();
-    o.wall_time_ms = 0.0;
-    for l in &mut o.legs {
-        l.planning_time_s = 0.0;
-    }
-    serde_json::to_value(o).expect("serialises")
+    serde_json::to_value(o.without_wall_times()).expect("serialises")
 }
 
 #[test]
