@@ -1,22 +1,29 @@
-//! PRM on the warehouse map: roadmap build and A* query, 500 nodes at 10 m (target: median ≤ 5 ms), RRT-Connect beside it.
+//! PRM on the warehouse map: roadmap build and A* query, 500 nodes at 10 m (target: median ≤ 5 ms), RRT-Connect beside it, and a footprint-checked, smoothed plan.
 
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use forkbench_nav::{OccupancyGrid, PrmParams, RrtParams, plan_prm, plan_rrt_connect};
+use forkbench_core::Pose2;
+use forkbench_nav::{
+    Algorithm, CollisionModel, GlobalQuery, NavMap, OccupancyGrid, PrmParams, RrtParams,
+    plan_global, plan_prm, plan_rrt_connect,
+};
 
-fn warehouse() -> OccupancyGrid {
+fn warehouse() -> NavMap {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../worlds/warehouse.toml");
     let world = forkbench_trial::World::load(&file).expect("warehouse world");
+    NavMap::from_world(&world.obstacles(), 0.05).expect("map")
+}
+
+fn inflated(map: &NavMap) -> OccupancyGrid {
     let truck = forkbench_core::ForkliftSpec::default();
-    OccupancyGrid::from_obstacles(&world.obstacles(), &[], 0.05, 0.0)
-        .expect("grid")
-        .inflated(forkbench_nav::luo_inflation_m(&truck))
+    map.grid.inflated(forkbench_nav::luo_inflation_m(&truck))
 }
 
 fn bench(c: &mut Criterion) {
-    let grid = warehouse();
-    let (start, goal) = ([3.0, 3.0], [30.75, 9.75]);
+    let map = warehouse();
+    let grid = inflated(&map);
+    let (start, goal) = ([3.0, 3.0], [30.75, 10.25]);
     let mut g = c.benchmark_group("warehouse");
     // A new seed per iteration: the cost of a typical roadmap, not of one lucky sample.
     let mut seed = 0;
@@ -39,6 +46,28 @@ fn bench(c: &mut Criterion) {
                 ..RrtParams::default()
             };
             plan_rrt_connect(&grid, start, goal, &p).expect("plans")
+        })
+    });
+    g.bench_function("prm-500-10m-footprint-smoothed", |b| {
+        b.iter(|| {
+            seed += 1;
+            let q = GlobalQuery {
+                start: Pose2::new(3.0, 3.0, std::f64::consts::FRAC_PI_2),
+                goal: Pose2::new(30.75, 10.25, 0.0),
+                algorithm: Algorithm::Prm(PrmParams {
+                    nodes: 500,
+                    connect_m: Some(10.0),
+                    seed,
+                }),
+                collision: CollisionModel::Footprint,
+                inflate_m: 0.0,
+                smooth: true,
+                lead_m: [2.5, 2.5],
+                approach: Vec::new(),
+                margin_m: 0.15,
+                truck: forkbench_core::ForkliftSpec::default(),
+            };
+            plan_global(&map, &q).expect("plans")
         })
     });
     g.finish();
