@@ -230,3 +230,41 @@ fn a_leg_that_cannot_be_planned_fails_the_trial_and_says_why() {
     assert!(!out.legs[0].success);
     assert_eq!(out.legs.len(), 1, "the mission stops at the failed leg");
 }
+
+#[test]
+fn a_ros_map_is_a_world_a_mission_drives_in() {
+    // The warehouse as a map file, as a user's SLAM map would come.
+    let dir = std::env::temp_dir().join(format!("forkbench-map-world-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let world = forkbench_trial::World::load(&data("data/worlds/warehouse.toml")).expect("world");
+    let map = forkbench_nav::NavMap::from_world(&world.obstacles(), 0.05).expect("map");
+    let yaml = forkbench_nav::write_map(&map.grid, &dir, "site").expect("written");
+    let from_map = forkbench_trial::World::load(&yaml).expect("a map loads as a world");
+    assert!(from_map.rack.len() > 10 && from_map.station.is_empty());
+    // Places are poses: a map has no named stations or slots.
+    let text = format!(
+        r#"name = "map-mission"
+world = {yaml:?}
+planner = "bspline"
+start = {{ x_m = 6.0, y_m = 9.05, heading_deg = 180.0 }}
+pallet = {{ x_m = 1.4, y_m = 8.75, heading_deg = 180.0 }}
+
+[mission]
+start = {{ x_m = 3.0, y_m = 3.0, heading_deg = 90.0 }}
+via = [{{ x_m = 6.5, y_m = 21.5, heading_deg = 90.0 }}]
+"#
+    );
+    let scn = Scenario::parse(&text, "map-mission.toml", |p: &Path| {
+        forkbench_trial::World::load(p)
+    })
+    .expect("parses");
+    let out = run(&scn, 1);
+    assert_eq!(out.legs.len(), 2, "{:?}", out.failure_detail);
+    assert!(out.legs.iter().all(|l| l.success), "{:?}", out.legs);
+    assert_ne!(out.failure, Some(Failure::LegFailed));
+    // A broken map file is an error naming it.
+    std::fs::write(dir.join("site.pgm"), b"P5\n1 1\n255\n").expect("truncated");
+    let e = forkbench_trial::World::load(&yaml).expect_err("truncated image");
+    assert!(e.to_string().contains("site"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

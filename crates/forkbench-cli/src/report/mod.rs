@@ -64,6 +64,13 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
     }
     h.push_str("<h2>Success per scenario × planner × tracker</h2>");
     h.push_str(&sections::success_table(&summary));
+    let legs = sections::mission_legs(&summary);
+    if !legs.is_empty() {
+        h.push_str(
+            "<h2>Mission legs (a trial counts for a leg once the legs before it are done)</h2>",
+        );
+        h.push_str(&legs);
+    }
     h.push_str("<h2>Failures by first failed criterion</h2>");
     h.push_str(&sections::failure_breakdown(&summary));
     let maps = sections::heatmaps(&manifest, &records);

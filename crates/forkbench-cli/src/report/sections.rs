@@ -52,6 +52,34 @@ pub fn success_table(s: &Summary) -> String {
     h + "</table>"
 }
 
+/// Mission legs: success per leg over the trials that reached it (empty without missions).
+pub fn mission_legs(s: &Summary) -> String {
+    let mut h = String::from(
+        "<table><tr><th>scenario</th><th>planner</th><th>tracker</th><th>mode</th><th>leg</th><th>attempted</th><th>done</th><th>success rate</th><th>95 % CI (Wilson)</th></tr>",
+    );
+    let mut any = false;
+    for r in &s.rows {
+        for l in &r.legs {
+            any = true;
+            let _ = write!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}–{}</td></tr>",
+                esc(&r.scenario),
+                esc(&r.planner),
+                esc(&r.tracker),
+                batch::mode_name(r.replan),
+                esc(&l.name),
+                l.attempted,
+                l.done,
+                pct(l.success_rate),
+                pct(l.ci95_low),
+                pct(l.ci95_high)
+            );
+        }
+    }
+    if any { h + "</table>" } else { String::new() }
+}
+
 /// Successes and failures by first failed criterion, one bar per row.
 pub fn failure_breakdown(s: &Summary) -> String {
     let mut kinds: Vec<String> = vec!["success".into()];

@@ -105,9 +105,45 @@ pub struct World {
 }
 
 impl World {
+    /// A world file (TOML), or a ROS map_server map (`.yaml`/`.yml` with its image).
     pub fn load(path: &FsPath) -> Result<Self, TrialError> {
         let file = path.display().to_string();
+        if path.extension().is_some_and(|e| e == "yaml" || e == "yml") {
+            return Self::from_map(path);
+        }
         Self::parse(&read(path)?, &file)
+    }
+
+    /// A map from SLAM or Nav2 as a world: its occupied and unknown cells, merged into
+    /// rectangles, are the racks (the physics and the planners see the same cells). A map
+    /// has no named places: scenarios give poses.
+    pub fn from_map(path: &FsPath) -> Result<Self, TrialError> {
+        let file = path.display().to_string();
+        let grid = forkbench_nav::read_map(path).map_err(|e| TrialError::Parse {
+            file: file.clone(),
+            message: e.to_string(),
+        })?;
+        let rack = forkbench_nav::blocked_rects(&grid)
+            .into_iter()
+            .enumerate()
+            .map(|(i, [lo, hi])| RectFile {
+                name: format!("cells {i}"),
+                x_m: (lo[0] + hi[0]) / 2.0,
+                y_m: (lo[1] + hi[1]) / 2.0,
+                heading_deg: 0.0,
+                length_m: hi[0] - lo[0],
+                width_m: hi[1] - lo[1],
+            })
+            .collect();
+        let name = path
+            .file_stem()
+            .map_or("map".to_owned(), |s| s.to_string_lossy().into_owned());
+        Ok(World {
+            name,
+            description: format!("occupancy map {file}"),
+            rack,
+            ..World::default()
+        })
     }
 
     pub fn parse(text: &str, file: &str) -> Result<Self, TrialError> {
