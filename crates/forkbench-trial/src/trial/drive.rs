@@ -8,7 +8,7 @@ use super::judge::{in_pallet_frame, insertion_depth};
 use super::setup::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
 
-impl Trial<'_> {
+impl<'a> Trial<'a> {
     /// Drives until the tracker reports the goal reached and the truck stands, or the
     /// scenario's time limit. Err: the state went non-finite.
     pub(super) fn drive<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), String> {
@@ -32,13 +32,7 @@ impl Trial<'_> {
                 reestimates.remove(0);
                 self.reestimate(&pose, rec);
             }
-            let cmd = self.tracker.command(&TrackerInput {
-                t_s: self.sim.time_s(),
-                pose,
-                speed_mps: self.sim.speed_mps(),
-                steer_rad: self.sim.steer_rad(),
-                truck: &self.scn.truck,
-            });
+            let cmd = self.tracker.command(&self.tracker_input(pose));
             if cmd.done && self.sim.speed_mps().abs() < 0.01 {
                 self.timed_out = false;
                 break;
@@ -58,6 +52,17 @@ impl Trial<'_> {
     ) {
         self.physics_step(cmd, fix, pose, rec);
         self.check_entry(rec);
+    }
+
+    /// What a tracker sees now, at the measured `pose`.
+    pub(super) fn tracker_input(&self, pose: Pose2) -> TrackerInput<'a> {
+        TrackerInput {
+            t_s: self.sim.time_s(),
+            pose,
+            speed_mps: self.sim.speed_mps(),
+            steer_rad: self.sim.steer_rad(),
+            truck: &self.scn.truck,
+        }
     }
 
     /// The NAV350 fix at this instant (if one is due) and the predicted pose; Err when the

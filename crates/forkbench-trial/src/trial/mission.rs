@@ -8,7 +8,7 @@ use forkbench_nav::smooth::{SmoothParams, smooth};
 use forkbench_nav::{
     Algorithm, GlobalPlan, GlobalQuery, NavMap, PrmParams, RrtParams, plan_global, truck_parts,
 };
-use forkbench_track::{PurePursuit, Tracker, TrackerInput};
+use forkbench_track::{PurePursuit, Tracker};
 
 use super::setup::Trial;
 use crate::outcome::LegOutcome;
@@ -153,16 +153,7 @@ impl Trial<'_> {
         let deadline_s = self.sim.time_s() + m.leg_timeout_s;
         while self.sim.time_s() < deadline_s {
             let (fix, pose) = self.sense()?;
-            let cmd = Tracker::command(
-                &mut tracker,
-                &TrackerInput {
-                    t_s: self.sim.time_s(),
-                    pose,
-                    speed_mps: self.sim.speed_mps(),
-                    steer_rad: self.sim.steer_rad(),
-                    truck: &self.scn.truck,
-                },
-            );
+            let cmd = Tracker::command(&mut tracker, &self.tracker_input(pose));
             if cmd.done && self.sim.speed_mps().abs() < 0.01 {
                 return Ok(());
             }
