@@ -26,6 +26,8 @@ def main() -> None:
     if "--mission" in sys.argv[3:]:
         entities += ["/map/nav/occupied", "/map/nav/roadmap"]
         entities += [f"/map/nav/route/{i}" for i in range(len(out["legs"]))]
+        entities += [f"/map/nav/route/{i}/reverse" for i, leg in enumerate(out["legs"])
+                     if leg["reverse_length_m"] > 0]
     subprocess.run(["rerun", "rrd", "verify", rrd], check=True)
     printed = subprocess.run(
         ["rerun", "rrd", "print", "-vvv", rrd], check=True, capture_output=True, text=True

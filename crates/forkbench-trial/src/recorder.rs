@@ -55,9 +55,11 @@ pub struct RouteRecord<'a> {
     pub name: &'a str,
     /// PRM's roadmap (the sampling trees leave none).
     pub roadmap: Option<&'a forkbench_nav::Roadmap>,
-    /// The A* polyline after shortcuts, with the lead-in and lead-out.
+    /// The A* polyline after shortcuts, with the lead-in and lead-out (empty for the
+    /// reverse segment out of a station).
     pub polyline: &'a [[f64; 2]],
-    /// The smoothed path driven.
+    /// The smoothed path driven; a `reverse` one is the leg's backing out, sent before
+    /// the forward route.
     pub path: &'a Path,
 }
 

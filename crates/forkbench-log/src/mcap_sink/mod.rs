@@ -39,6 +39,7 @@ const GOAL_RGBA: [f64; 4] = [0.1, 0.4, 0.9, 1.0];
 const OCCUPIED_RGBA: [f64; 4] = [0.45, 0.45, 0.45, 0.8];
 const ROADMAP_RGBA: [f64; 4] = [0.45, 0.6, 0.9, 0.3];
 const ROUTE_RGBA: [f64; 4] = [1.0, 0.6, 0.15, 1.0];
+const REVERSE_RGBA: [f64; 4] = [0.67, 0.35, 0.9, 1.0];
 
 /// What the trial thread keeps to draw: the trajectory segment being driven and the plan
 /// on screen.
@@ -355,14 +356,22 @@ impl Recorder for McapRecorder {
             ));
         }
         let path: Vec<[f64; 2]> = route.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect();
-        entities.push(entity(
-            t_s,
-            &format!("nav/route/{}", route.leg),
-            vec![
-                line_at(route.polyline, 0.01, ROUTE_RGBA, 0.02),
-                line_at(&path, 0.02, GOAL_RGBA, 0.04),
-            ],
-        ));
+        if route.path.reverse {
+            entities.push(entity(
+                t_s,
+                &format!("nav/route/{}/reverse", route.leg),
+                vec![line_at(&path, 0.02, REVERSE_RGBA, 0.04)],
+            ));
+        } else {
+            entities.push(entity(
+                t_s,
+                &format!("nav/route/{}", route.leg),
+                vec![
+                    line_at(route.polyline, 0.01, ROUTE_RGBA, 0.02),
+                    line_at(&path, 0.02, GOAL_RGBA, 0.04),
+                ],
+            ));
+        }
         self.send(
             "/world",
             t_s,

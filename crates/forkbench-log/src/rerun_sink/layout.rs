@@ -32,6 +32,7 @@ pub(super) const OCCUPIED_RGBA: [u8; 4] = [150, 150, 150, 110];
 pub(super) const ROADMAP_RGBA: [u8; 4] = [120, 160, 230, 25];
 pub(super) const ROUTE_RGB: [u8; 3] = [255, 150, 40];
 pub(super) const SMOOTHED_RGB: [u8; 3] = [40, 110, 240];
+pub(super) const REVERSE_RGB: [u8; 3] = [170, 90, 230];
 
 /// Draw order in the map (higher on top): the driven trajectory over the plans.
 pub(super) const ORDER_GRID: f32 = 0.0;

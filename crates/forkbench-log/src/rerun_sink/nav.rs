@@ -66,6 +66,17 @@ impl RerunRecorder {
             self.note(r);
         }
         let path: Vec<[f64; 2]> = route.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect();
+        if route.path.reverse {
+            let lines = rerun::LineStrips2D::new([strip(&path)])
+                .with_colors([color(REVERSE_RGB)])
+                .with_radii([0.03])
+                .with_draw_order(ORDER_PLAN);
+            let r = self
+                .rec
+                .log(format!("map/nav/route/{}/reverse", route.leg), &lines);
+            self.note(r);
+            return;
+        }
         let lines = rerun::LineStrips2D::new([strip(route.polyline), strip(&path)])
             .with_colors([color(ROUTE_RGB), color(SMOOTHED_RGB)])
             .with_radii([0.012, 0.03])

@@ -106,7 +106,7 @@ impl RerunRecorder {
              green driven trajectory · \
              magenta look-ahead · yellow truck · orange pallet, faint where it stood · \
              red pallet estimate · green/red arrows true/measured NAV350 fix · \
-             mission legs: grey blocked cells, faint blue roadmap, orange A* polyline\n\n\
+             mission legs: grey blocked cells, faint blue roadmap, orange A* polyline, purple backing out\n\n\
              **Events**\n\n```text\n{}\n```\n\n\
              **Outcome**\n\n```json\n{}\n```\n",
             num(o.lateral_error_m, &|v| format!("{v:.3} m")),

@@ -83,6 +83,16 @@ impl Trial<'_> {
                         )
                     })?;
                 leg.reverse_length_m = back.length_m();
+                rec.route(
+                    self.sim.time_s(),
+                    &RouteRecord {
+                        leg: i,
+                        name: &leg.name,
+                        roadmap: None,
+                        polyline: &[],
+                        path: &back,
+                    },
+                );
                 leg.min_clearance_m = back_clearance(map, &back, &self.scn.truck);
                 self.drive_path(&back, m, &mut stats, rec)?;
             }
