@@ -43,12 +43,27 @@ impl Footprint {
     }
 }
 
-/// Fixed rectangular obstacles (racks, walls). Each keeps its axis-aligned bounds, so a
-/// query tests only the shapes near it (a map's cell runs give thousands of shapes).
+/// Fixed rectangular obstacles (racks, walls). Each keeps its axis-aligned bounds in a
+/// uniform grid of buckets, so a query tests only the shapes near it (a SLAM map's cell
+/// runs give tens of thousands of shapes).
 #[derive(Default)]
 pub struct Obstacles {
     shapes: Vec<(Pose, Box<dyn Shape>)>,
     bounds: Vec<Bounds>,
+    buckets: std::collections::HashMap<(i64, i64), Vec<usize>>,
+    /// Shapes too large to bucket, tested by every query.
+    large: Vec<usize>,
+}
+
+/// Side of a bucket.
+const BUCKET_M: f64 = 2.0;
+/// Shapes spanning more buckets than this go to the always-tested list.
+const MAX_BUCKETS_PER_SHAPE: i64 = 4096;
+
+/// The bucket range (inclusive) that `b` overlaps.
+fn bucket_range(b: &Bounds) -> ([i64; 2], [i64; 2]) {
+    let cell = |v: f64| (v / BUCKET_M).floor().clamp(-1e12, 1e12) as i64;
+    ([cell(b[0]), cell(b[1])], [cell(b[2]), cell(b[3])])
 }
 
 /// Axis-aligned bounds: min x, min y, max x, max y.
@@ -110,7 +125,7 @@ impl Obstacles {
     /// Adds a rectangle given by its centre pose and full side lengths.
     pub fn add_rect(&mut self, centre: &Pose2, length_m: f64, width_m: f64) {
         let corners = forkbench_core::geometry::rect_corners(centre, length_m, width_m);
-        self.bounds.push(bounds_of(&corners));
+        self.register(bounds_of(&corners));
         self.shapes.push((
             pose(centre),
             Box::new(Cuboid::new(Vector::new(
@@ -128,13 +143,58 @@ impl Obstacles {
             .collect();
         match ConvexPolygon::from_convex_hull(&pts) {
             Some(poly) => {
-                self.bounds.push(bounds_of(points));
+                self.register(bounds_of(points));
                 self.shapes
                     .push((Pose::translation(0.0, 0.0), Box::new(poly)));
                 true
             }
             None => false,
         }
+    }
+
+    /// Files the next shape's bounds into the buckets it overlaps.
+    fn register(&mut self, b: Bounds) {
+        let i = self.bounds.len();
+        self.bounds.push(b);
+        let (lo, hi) = bucket_range(&b);
+        let span = (hi[0] - lo[0] + 1).saturating_mul(hi[1] - lo[1] + 1);
+        if !(b.iter().all(|v| v.is_finite()) && span <= MAX_BUCKETS_PER_SHAPE) {
+            self.large.push(i);
+            return;
+        }
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                self.buckets.entry((x, y)).or_default().push(i);
+            }
+        }
+    }
+
+    /// Shapes whose buckets overlap `b` grown by `reach_m`, in insertion order.
+    fn near(&self, b: &Bounds, reach_m: f64) -> Vec<usize> {
+        let grown = [
+            b[0] - reach_m,
+            b[1] - reach_m,
+            b[2] + reach_m,
+            b[3] + reach_m,
+        ];
+        let (lo, hi) = bucket_range(&grown);
+        let mut out = self.large.clone();
+        let span = (hi[0] - lo[0] + 1).saturating_mul(hi[1] - lo[1] + 1);
+        if span > self.buckets.len() as i64 {
+            // A query wider than the map: every bucketed shape.
+            out.extend(self.buckets.values().flatten());
+        } else {
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    if let Some(v) = self.buckets.get(&(x, y)) {
+                        out.extend(v);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
     }
 
     pub fn len(&self) -> usize {
@@ -150,7 +210,7 @@ impl Obstacles {
         let body = fp.cuboid();
         let at = pose(&fp.centre(reference));
         let near = bounds_of(&fp.corners(reference));
-        (0..self.shapes.len()).find(|&i| {
+        self.near(&near, 0.0).into_iter().find(|&i| {
             let (p, s) = &self.shapes[i];
             // Convex–cuboid pairs are always supported; an unsupported pair would be a bug here.
             bounds_gap(&near, &self.bounds[i]) <= 0.0
@@ -165,7 +225,8 @@ impl Obstacles {
         let at = pose(&fp.centre(reference));
         let near = bounds_of(&fp.corners(reference));
         let mut best = cap_m;
-        for ((p, s), b) in self.shapes.iter().zip(&self.bounds) {
+        for i in self.near(&near, cap_m) {
+            let ((p, s), b) = (&self.shapes[i], &self.bounds[i]);
             if bounds_gap(&near, b) >= best {
                 continue;
             }

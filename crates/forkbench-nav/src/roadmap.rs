@@ -11,6 +11,11 @@ use rand_chacha::ChaCha8Rng;
 use crate::space::FreeSpace;
 use crate::{NavError, Route, Timing};
 
+/// Most samples a roadmap may draw.
+pub const MAX_NODES: usize = 100_000;
+/// Most samples with unlimited connection distance.
+pub const MAX_NODES_UNLIMITED: usize = 5_000;
+
 /// PRM settings: sample count, connection distance (`None`: unlimited) and seed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PrmParams {
@@ -41,6 +46,23 @@ pub fn plan_prm<S: FreeSpace + ?Sized>(
     p: &PrmParams,
 ) -> Result<(Route, Roadmap), NavError> {
     crate::check_endpoints(grid, start, goal)?;
+    if p.nodes > MAX_NODES {
+        return Err(NavError::Params(format!(
+            "{} nodes: at most {MAX_NODES} (the roadmap's edges grow with their square)",
+            p.nodes
+        )));
+    }
+    if p.connect_m.is_none() && p.nodes > MAX_NODES_UNLIMITED {
+        return Err(NavError::Params(format!(
+            "{} nodes with unlimited connections: at most {MAX_NODES_UNLIMITED} (every pair is checked)",
+            p.nodes
+        )));
+    }
+    if p.connect_m.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
+        return Err(NavError::Params(
+            "the connection distance must be a positive number of metres".into(),
+        ));
+    }
     let t0 = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
     let (lo, hi) = grid.extent();
