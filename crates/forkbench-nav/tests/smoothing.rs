@@ -210,3 +210,18 @@ fn a_footprint_plan_is_drivable_and_clears_the_truck_by_its_margin() {
     let again = plan_global(&map, &q).expect("plans");
     assert_eq!(again.drivable().expect("drivable").path, s.path);
 }
+
+#[test]
+fn roadmaps_that_would_not_finish_are_refused() {
+    let map = room();
+    let grid = map.grid.inflated(0.8);
+    for (nodes, connect_m) in [(100_001, Some(10.0)), (5_001, None)] {
+        let p = PrmParams {
+            nodes,
+            connect_m,
+            seed: 0,
+        };
+        let e = forkbench_nav::plan_prm(&grid, [3.0, 3.0], [26.0, 16.0], &p).expect_err("refused");
+        assert!(e.to_string().contains("at most"), "{e}");
+    }
+}
