@@ -74,27 +74,7 @@ impl Trial<'_> {
         let mut stats = DriveStats::default();
         let mut run = || -> Result<(), String> {
             if i > 0 {
-                let here = self.sense()?.1;
-                let back =
-                    plan_backout(map, m, &here, &to.pose, &self.scn.truck).ok_or_else(|| {
-                        format!(
-                            "no clear way to back {:.1} m out of {}",
-                            m.backout_m, from.name
-                        )
-                    })?;
-                leg.reverse_length_m = back.length_m();
-                rec.route(
-                    self.sim.time_s(),
-                    &RouteRecord {
-                        leg: i,
-                        name: &leg.name,
-                        roadmap: None,
-                        polyline: &[],
-                        path: &back,
-                    },
-                );
-                leg.min_clearance_m = back_clearance(map, &back, &self.scn.truck);
-                self.drive_path(&back, m, &mut stats, rec)?;
+                self.back_out(map, m, (i, from, to), (&mut leg, &mut stats), rec)?;
             }
             let here = self.sense()?.1;
             let (plan, attempts, secs) = plan_leg(
@@ -128,24 +108,40 @@ impl Trial<'_> {
         let result = run();
         finish_leg(&mut leg, result, &stats, self.sim.time_s() - t0);
         if leg.success {
-            let truth = self.sim.fork_root_pose();
-            leg.final_position_error_m = truth.distance_to(&to.pose);
-            leg.final_heading_error_rad = wrap_angle(truth.heading_rad - to.pose.heading_rad);
-            if leg.final_position_error_m > m.arrive_tolerance_m
-                || leg.final_heading_error_rad.abs() > m.arrive_tolerance_rad
-            {
-                leg.success = false;
-                leg.failure_detail = Some(format!(
-                    "stopped {:.3} m and {:.1}° from {} (limits {} m, {:.1}°)",
-                    leg.final_position_error_m,
-                    leg.final_heading_error_rad.to_degrees(),
-                    to.name,
-                    m.arrive_tolerance_m,
-                    m.arrive_tolerance_rad.to_degrees()
-                ));
-            }
+            check_arrival(&mut leg, m, to, &self.sim.fork_root_pose());
         }
         leg
+    }
+
+    /// Backs out of the place a leg starts at, the way `plan_backout` finds, and drives it.
+    fn back_out<R: Recorder + ?Sized>(
+        &mut self,
+        map: &NavMap,
+        m: &MissionSpec,
+        (i, from, to): (usize, &Waypoint, &Waypoint),
+        (leg, stats): (&mut LegOutcome, &mut DriveStats),
+        rec: &mut R,
+    ) -> Result<(), String> {
+        let here = self.sense()?.1;
+        let back = plan_backout(map, m, &here, &to.pose, &self.scn.truck).ok_or_else(|| {
+            format!(
+                "no clear way to back {:.1} m out of {}",
+                m.backout_m, from.name
+            )
+        })?;
+        leg.reverse_length_m = back.length_m();
+        rec.route(
+            self.sim.time_s(),
+            &RouteRecord {
+                leg: i,
+                name: &leg.name,
+                roadmap: None,
+                polyline: &[],
+                path: &back,
+            },
+        );
+        leg.min_clearance_m = back_clearance(map, &back, &self.scn.truck);
+        self.drive_path(&back, m, stats, rec)
     }
 
     /// Follows `path` (forward or reverse) with the mission's pure pursuit until it stops at
@@ -184,6 +180,25 @@ impl Trial<'_> {
             "not stopped at the end of the path within {} s",
             m.leg_timeout_s
         ))
+    }
+}
+
+/// Where the truck stopped against the leg's goal; too far off fails the leg.
+fn check_arrival(leg: &mut LegOutcome, m: &MissionSpec, to: &Waypoint, truth: &Pose2) {
+    leg.final_position_error_m = truth.distance_to(&to.pose);
+    leg.final_heading_error_rad = wrap_angle(truth.heading_rad - to.pose.heading_rad);
+    if leg.final_position_error_m > m.arrive_tolerance_m
+        || leg.final_heading_error_rad.abs() > m.arrive_tolerance_rad
+    {
+        leg.success = false;
+        leg.failure_detail = Some(format!(
+            "stopped {:.3} m and {:.1}° from {} (limits {} m, {:.1}°)",
+            leg.final_position_error_m,
+            leg.final_heading_error_rad.to_degrees(),
+            to.name,
+            m.arrive_tolerance_m,
+            m.arrive_tolerance_rad.to_degrees()
+        ));
     }
 }
 
