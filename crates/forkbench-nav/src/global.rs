@@ -199,21 +199,10 @@ fn smooth_route(
     let anchors: Vec<usize> = std::iter::once(1).chain(fixed_from..n - 1).collect();
     let short = shortcut(space, &pts, &anchors);
     let params = SmoothParams::for_curvature(q.truck.max_curvature_per_m());
-    smooth(
-        &short,
-        &map.obstacles,
-        &truck_parts(&q.truck, q.margin_m),
-        &params,
-    )
-    .map(|mut s| {
-        // The clearance of the truck itself, not of the footprint grown by the margin.
-        s.min_clearance_m = crate::smooth::min_clearance(
-            &map.obstacles,
-            &truck_parts(&q.truck, 0.0),
-            &s.path,
-            params.check_step_m * 2.0,
-            params.clearance_cap_m,
-        );
-        s
-    })
+    // Checked with the footprint grown by the margin; the clearance is the truck's own.
+    let parts = (
+        truck_parts(&q.truck, q.margin_m),
+        truck_parts(&q.truck, 0.0),
+    );
+    smooth(&short, &map.obstacles, (&parts.0, &parts.1), &params)
 }

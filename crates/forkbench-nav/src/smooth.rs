@@ -348,12 +348,13 @@ pub fn min_clearance(
 }
 
 /// Smooths `polyline` (already shortcut) into a curvature-continuous path and checks its
-/// swept footprint. A corner that strikes an obstacle is retried at κ_max (it then cuts
-/// less of the corner) before the strike is reported.
+/// swept footprint `parts`. A corner that strikes an obstacle is retried at κ_max (it then
+/// cuts less of the corner) before the strike is reported. The clearance reported is that
+/// of `clearance_parts` (the truck itself, where `parts` are grown by a margin).
 pub fn smooth(
     polyline: &[[f64; 2]],
     obstacles: &Obstacles,
-    parts: &[Footprint],
+    (parts, clearance_parts): (&[Footprint], &[Footprint]),
     p: &SmoothParams,
 ) -> Result<Smoothed, SmoothError> {
     let pts: Vec<[f64; 2]> = dedup(polyline);
@@ -379,7 +380,7 @@ pub fn smooth(
         } else {
             min_clearance(
                 obstacles,
-                parts,
+                clearance_parts,
                 &path,
                 p.check_step_m * 2.0,
                 p.clearance_cap_m,

@@ -40,7 +40,7 @@ fn room() -> NavMap {
 fn smoothed_corners_keep_the_curvature_limit_and_are_continuous() {
     let p = params();
     let poly = [[0.0, 0.0], [10.0, 0.0], [10.0, 8.0], [3.0, 12.0]];
-    let s = smooth(&poly, &Obstacles::new(), &[], &p).expect("smooths");
+    let s = smooth(&poly, &Obstacles::new(), (&[], &[]), &p).expect("smooths");
     let k_max = p.max_curvature_per_m;
     assert!(
         s.max_curvature_per_m <= k_max + 1e-9,
@@ -71,7 +71,7 @@ fn a_corner_without_room_for_its_clothoids_is_reported_where_it_is() {
     let e = smooth(
         &[[0.0, 0.0], [5.0, 0.0], [5.0, 0.5]],
         &Obstacles::new(),
-        &[],
+        (&[], &[]),
         &params(),
     )
     .expect_err("too tight");
@@ -95,7 +95,7 @@ fn e_text() -> String {
     smooth(
         &[[0.0, 0.0], [5.0, 0.0], [5.0, 0.5]],
         &Obstacles::new(),
-        &[],
+        (&[], &[]),
         &params(),
     )
     .expect_err("too tight")
@@ -108,7 +108,7 @@ fn the_swept_footprint_strike_is_found_and_located() {
     let poly = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]];
     // A post 0.4 m inside the point where the path passes closest to the corner: under
     // the truck's 1.2 m wide body.
-    let free = smooth(&poly, &Obstacles::new(), &[], &params()).expect("smooths");
+    let free = smooth(&poly, &Obstacles::new(), (&[], &[]), &params()).expect("smooths");
     let near = free
         .path
         .samples
@@ -123,7 +123,13 @@ fn the_swept_footprint_strike_is_found_and_located() {
     let post = [near.x_m + 0.4 * away[0] / n, near.y_m + 0.4 * away[1] / n];
     let mut obs = Obstacles::new();
     obs.add_rect(&Pose2::new(post[0], post[1], 0.0), 0.1, 0.1);
-    let s = smooth(&poly, &obs, &truck_parts(&truck, 0.0), &params()).expect("smooths");
+    let s = smooth(
+        &poly,
+        &obs,
+        (&truck_parts(&truck, 0.0), &truck_parts(&truck, 0.0)),
+        &params(),
+    )
+    .expect("smooths");
     let hit = s.hit.expect("the chassis swings over the post");
     assert_eq!(hit.obstacle, 0);
     assert!(hit.s_m > 5.0 && hit.s_m < near.s_m + 1.0, "{hit:?}");

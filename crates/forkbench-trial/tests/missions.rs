@@ -109,7 +109,7 @@ fn a_reverse_path_is_driven_backwards_in_the_physics() {
     let sm = smooth(
         &[[-3.0, -3.0], [-3.0, 0.0], [0.0, 0.0]],
         &forkbench_geom::Obstacles::new(),
-        &[],
+        (&[], &[]),
         &SmoothParams::for_curvature(truck.max_curvature_per_m()),
     )
     .expect("smooths");

@@ -123,12 +123,13 @@ impl Trial<'_> {
         rec: &mut R,
     ) -> Result<(), String> {
         let here = self.sense()?.1;
-        let back = plan_backout(map, m, &here, &to.pose, &self.scn.truck).ok_or_else(|| {
-            format!(
-                "no clear way to back {:.1} m out of {}",
-                m.backout_m, from.name
-            )
-        })?;
+        let (back, clearance) =
+            plan_backout(map, m, &here, &to.pose, &self.scn.truck).ok_or_else(|| {
+                format!(
+                    "no clear way to back {:.1} m out of {}",
+                    m.backout_m, from.name
+                )
+            })?;
         leg.reverse_length_m = back.length_m();
         rec.route(
             self.sim.time_s(),
@@ -140,7 +141,7 @@ impl Trial<'_> {
                 path: &back,
             },
         );
-        leg.min_clearance_m = back_clearance(map, &back, &self.scn.truck);
+        leg.min_clearance_m = clearance;
         self.drive_path(&back, m, stats, rec)
     }
 
@@ -343,21 +344,21 @@ fn plan_leg(
 /// A reverse path out of a station: back and turn a quarter either way, backing up to
 /// `backout_m`; of the tracks whose swept footprint clears every obstacle, the one with
 /// the most clearance, half a metre of it traded for the forks facing the next goal.
-/// Straight back when no turn is clear.
+/// Straight back when no turn is clear. With the path, the truck's clearance along it.
 fn plan_backout(
     map: &NavMap,
     m: &MissionSpec,
     at: &Pose2,
     next: &Pose2,
     truck: &forkbench_core::ForkliftSpec,
-) -> Option<Path> {
+) -> Option<(Path, f64)> {
     let (s, c) = at.heading_rad.sin_cos();
     let toward = (next.y_m - at.y_m).atan2(next.x_m - at.x_m);
     let params = SmoothParams::for_curvature(truck.max_curvature_per_m());
     let parts = truck_parts(truck, m.global.margin_m);
     let true_parts = truck_parts(truck, 0.0);
     let quarter = std::f64::consts::FRAC_PI_2;
-    let mut best: Option<(f64, Path)> = None;
+    let mut best: Option<(f64, Path, f64)> = None;
     for turn in [quarter, -quarter] {
         for k in 1..=4 {
             let d = m.backout_m * f64::from(k) / 4.0;
@@ -366,38 +367,33 @@ fn plan_backout(
             // Driven forward, the track runs from the backed-out pose to the station.
             let out = [corner[0] - d * h.cos(), corner[1] - d * h.sin()];
             let poly = [out, corner, [at.x_m, at.y_m]];
-            let Ok(sm) = smooth(&poly, &map.obstacles, &parts, &params) else {
+            let Ok(sm) = smooth(&poly, &map.obstacles, (&parts, &true_parts), &params) else {
                 continue;
             };
             if !sm.clear() {
                 continue;
             }
-            let clearance = forkbench_nav::smooth::min_clearance(
-                &map.obstacles,
-                &true_parts,
-                &sm.path,
-                0.1,
-                2.0,
-            );
-            let score = clearance + 0.5 * (h - toward).cos();
-            if best.as_ref().is_none_or(|(b, _)| score > *b) {
-                best = Some((score, sm.path.driven_backwards()));
+            let score = sm.min_clearance_m + 0.5 * (h - toward).cos();
+            if best.as_ref().is_none_or(|(b, _, _)| score > *b) {
+                best = Some((score, sm.path.driven_backwards(), sm.min_clearance_m));
             }
         }
     }
-    if let Some((_, path)) = best {
-        return Some(path);
+    if let Some((_, path, clearance)) = best {
+        return Some((path, clearance));
     }
     let d = m.backout_m;
     let back = Pose2::new(at.x_m - d * c, at.y_m - d * s, at.heading_rad);
     let straight = Path::straight(&back, d, 0.02);
-    forkbench_nav::smooth::first_strike(&map.obstacles, &parts, &straight, 0.05)
-        .is_none()
-        .then(|| straight.driven_backwards())
-}
-
-/// Planned clearance of a reverse path's swept footprint.
-fn back_clearance(map: &NavMap, path: &Path, truck: &forkbench_core::ForkliftSpec) -> f64 {
-    let parts = truck_parts(truck, 0.0);
-    forkbench_nav::smooth::min_clearance(&map.obstacles, &parts, path, 0.1, 2.0)
+    if forkbench_nav::smooth::first_strike(&map.obstacles, &parts, &straight, 0.05).is_some() {
+        return None;
+    }
+    let clearance = forkbench_nav::smooth::min_clearance(
+        &map.obstacles,
+        &true_parts,
+        &straight,
+        params.check_step_m * 2.0,
+        params.clearance_cap_m,
+    );
+    Some((straight.driven_backwards(), clearance))
 }
