@@ -464,7 +464,7 @@ fn batch_writes_results_and_regress_gates_them() {
     // was never run is a failure.
     std::fs::write(&base, r#"{"description":"x","rows":[{"scenario":"gone","planner":"spiral","trials":10,"successes":9}]}"#).expect("write");
     let missing = forkbench(&["regress", "--baseline", base.to_str().expect("utf8"), dir]);
-    assert_eq!(missing.status.code(), Some(1));
+    assert_eq!(missing.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&missing.stdout).contains("missing"));
 }
 
@@ -988,4 +988,41 @@ fn error_messages_are_polished() {
         !shown.contains("NaN") && shown.contains("plan_failed"),
         "{shown}"
     );
+}
+
+/// `replay` of a mission trial and of a replanning trial from a batch reproduces them
+/// (the legs' planning wall times used to make every mission replay "DIFFERS").
+#[test]
+fn replay_reproduces_mission_and_replanning_trials_from_a_batch() {
+    let scn = repo_root().join("scenarios/warehouse-mission.toml");
+    let dir = tmp("replay-batch");
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().expect("utf8");
+    let args = [
+        "batch",
+        scn.to_str().expect("utf8"),
+        "--trials",
+        "1",
+        "--modes",
+        "both",
+    ];
+    let out = forkbench(&[&args[..], &["--record", "none", "--out", d]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let file = dir.join("trials.jsonl");
+    let text = std::fs::read_to_string(&file).expect("records");
+    assert!(text.contains("\"replan\":true") && text.contains("\"legs\""));
+    for line in ["1", "2"] {
+        let out = forkbench(&["replay", file.to_str().expect("utf8"), "--line", line]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            matches!(out.status.code(), Some(0 | 3))
+                && stdout.contains("identical to the recorded outcome"),
+            "line {line}: {stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
 }

@@ -1,11 +1,11 @@
-//! `forkbench batch`, `merge`, `baseline`, `regress`: Monte-Carlo batches and the success-rate gate.
+//! `forkbench batch`, `merge` and `replay`: Monte-Carlo batches, their shards and single trials from them.
 
 use std::io::IsTerminal as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context as _, bail};
-use forkbench_trial::batch::{self, Baseline, BatchSpec, RecordChoice, Summary, TrialRecord};
+use forkbench_trial::batch::{self, BatchSpec, RecordChoice, Summary, TrialRecord};
 use forkbench_trial::{Scenario, defaults};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -106,25 +106,37 @@ pub struct BatchArgs {
     /// Also write OUT/report.html (see `forkbench report`).
     #[arg(long)]
     pub report: bool,
+    /// The drop (0–1, e.g. 0.05) the regression gate must see with 80 % power: refuse to
+    /// run when a row has fewer trials than a paired gate needs for it.
+    #[arg(long)]
+    pub min_detectable_drop: Option<f64>,
 }
 
-/// `forkbench regress`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct RegressArgs {
-    #[arg(long)]
-    pub baseline: PathBuf,
-    pub results: PathBuf,
-    /// Significance level of the one-sided two-proportion test.
-    #[arg(long, default_value_t = 0.05)]
-    pub alpha: f64,
-    /// Absolute floor on every row's success rate (0–1).
-    #[arg(long)]
-    pub floor: Option<f64>,
-    #[arg(long)]
-    pub json: bool,
-    /// Also write the verdicts as JUnit XML to FILE (a failing case per dropped row).
-    #[arg(long)]
-    pub junit: Option<PathBuf>,
+/// Refuses a batch whose rows are too small for the gate to see `drop` (paired, a change
+/// that only breaks trials: the fewest trials any gate needs).
+fn check_power(spec: &BatchSpec, drop: f64) -> anyhow::Result<()> {
+    if !(drop > 0.0 && drop <= 1.0) {
+        bail!("--min-detectable-drop {drop}: must be a drop in success rate in (0, 1]");
+    }
+    let rows = spec.row_sizes();
+    let need = batch::paired_trials_needed(drop, batch::DEFAULT_ALPHA, rows.len())
+        .context("--min-detectable-drop: no trial count up to a million is enough")?;
+    let short: Vec<String> = rows
+        .iter()
+        .filter(|(_, n)| *n < need)
+        .map(|(name, n)| format!("{name} ({n})"))
+        .collect();
+    if !short.is_empty() {
+        bail!(
+            "--min-detectable-drop {drop}: a paired gate over {} rows (α {} Holm) needs at least \
+             {need} trials per row to see that drop with 80 % power (a change that only breaks \
+             trials; more when it also fixes some), and these rows have fewer: {}. Raise --trials.",
+            rows.len(),
+            batch::DEFAULT_ALPHA,
+            short.join(", ")
+        );
+    }
+    Ok(())
 }
 
 /// `--sweep pallet_noise=0,0.5,1`: the knob and its values.
@@ -237,6 +249,9 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
 
 pub fn run(a: BatchArgs) -> anyhow::Result<()> {
     let (spec, a) = prepare(a)?;
+    if let Some(d) = a.min_detectable_drop {
+        check_power(&spec, d)?;
+    }
     if let Some(sweep) = &a.sweep {
         return run_sweep(&spec, &a, sweep);
     }
@@ -335,65 +350,6 @@ pub fn merge(dirs: &[PathBuf], out: &Path, json: bool) -> anyhow::Result<()> {
     ))
 }
 
-fn load_summary(dir: &Path) -> anyhow::Result<Summary> {
-    Ok(batch::load_results(dir)?)
-}
-
-pub fn baseline(dir: &Path, out: &Path) -> anyhow::Result<()> {
-    let s = load_summary(dir)?;
-    let b = Baseline::from_summary(&s, format!("success counts from {}", dir.display()));
-    std::fs::write(out, serde_json::to_string_pretty(&b)? + "\n")
-        .with_context(|| format!("writing {}", out.display()))?;
-    crate::emit(&format!(
-        "baseline with {} rows written to {}\n",
-        b.rows.len(),
-        out.display()
-    ))
-}
-
-/// Returns whether the gate passed.
-pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
-    if !(a.alpha > 0.0 && a.alpha < 1.0) {
-        bail!("--alpha {}: must lie strictly between 0 and 1", a.alpha);
-    }
-    if let Some(f) = a.floor
-        && !(0.0..=1.0).contains(&f)
-    {
-        bail!("--floor {f}: must be a success rate between 0 and 1");
-    }
-    let b = Baseline::load(&a.baseline)?;
-    let s = load_summary(&a.results)?;
-    // A baseline made with other tolerances or sensors is not comparable row for row.
-    let changed =
-        batch::Manifest::read(&a.results)?.map_or_else(Vec::new, |m| b.setting_differences(&m));
-    for c in &changed {
-        eprintln!("warning: scenario settings differ from the baseline's batch: {c}");
-    }
-    let (rows, failed) = batch::regress(&b, &s, a.alpha, a.floor);
-    if let Some(file) = &a.junit {
-        let cases = batch::junit::regress_cases(&rows, a.alpha, a.floor);
-        let xml = batch::junit::junit_xml("forkbench regress", &cases, s.provenance.as_ref());
-        std::fs::write(file, xml).with_context(|| format!("writing {}", file.display()))?;
-    }
-    if a.json {
-        crate::emit(&format!(
-            "{}\n",
-            serde_json::json!({"passed": !failed, "alpha": a.alpha, "floor": a.floor, "rows": rows, "setting_differences": changed})
-        ))?;
-    } else {
-        crate::emit(&format!(
-            "{}\n{}\n",
-            batch::regress_markdown(&rows, a.alpha),
-            if failed {
-                "REGRESSION: at least one row dropped"
-            } else {
-                "no significant drop"
-            }
-        ))?;
-    }
-    Ok(!failed)
-}
-
 /// Records the trials the library picks (failures, or all) as .rrd and .mcap.
 fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
     let choice = RecordChoice::from(a.record);
@@ -418,8 +374,7 @@ pub fn replay(
     scenario: Option<&Path>,
     rec: &crate::record::RecordArgs,
 ) -> anyhow::Result<bool> {
-    let text =
-        std::fs::read_to_string(file).with_context(|| format!("reading {}", file.display()))?;
+    let text = batch::read_regular(file, batch::MAX_RECORDS_BYTES)?;
     if line == 0 {
         bail!("--line 0: lines are numbered from 1");
     }
@@ -446,15 +401,14 @@ pub fn replay(
     let run = scn.resolve(&opts)?;
     let mut sinks =
         crate::record::Sinks::open(rec, crate::record::metadata(&scn.name, &case.name, &run))?;
-    let (mut out, written) =
-        sinks.record(|r| forkbench_trial::run_trial_recorded(scn, case, &opts, r));
+    let (out, written) = sinks.record(|r| forkbench_trial::run_trial_recorded(scn, case, &opts, r));
     let viewer_error = sinks.viewer_error.take();
     if let Some(e) = &viewer_error {
         eprintln!("error: {e} (the trial ran without the viewer)");
     }
-    let mut expected = record.outcome.clone();
-    (out.wall_time_ms, expected.wall_time_ms) = (0.0, 0.0);
-    let same = serde_json::to_value(&out)? == serde_json::to_value(&expected)?;
+    // Wall-clock times (the trial's and each leg's planning) are all a rerun may change.
+    let same = serde_json::to_value(out.without_wall_times())?
+        == serde_json::to_value(record.outcome.without_wall_times())?;
     crate::emit(&format!(
         "replayed {} / case {} / {} / {} / seed {}: {} ({})\n",
         out.scenario,

@@ -2,6 +2,7 @@
 
 mod batch_cmd;
 mod corridor_cmd;
+mod gate_cmd;
 mod map_cmd;
 mod map_plot;
 mod mission_report;
@@ -25,7 +26,9 @@ use forkbench_core::{ForkliftSpec, Pose2};
 #[command(
     name = "forkbench",
     version,
-    about = "Physics test bench for autonomous forklift pallet picking"
+    about = "Physics test bench for autonomous forklift pallet picking",
+    after_help = "Exit status: 0 ok; 1 error or bad input; 2 usage; 3 the run worked and its \
+                  result is a failure (a failed pick or mission, a regression in `regress`)."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -157,14 +160,24 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Write a baseline (success counts) from a results directory.
+    /// Write a baseline from a results directory: success counts per row and every
+    /// trial's key, seed and outcome (so a batch with the same seed compares pair by pair).
     Baseline {
         results: PathBuf,
         #[arg(long)]
         out: PathBuf,
+        /// What the baseline is (default: "success counts from RESULTS").
+        #[arg(long)]
+        description: Option<String>,
     },
-    /// Compare results with a baseline; exit 1 on a significant drop.
-    Regress(batch_cmd::RegressArgs),
+    /// The regression gate: results against a baseline, paired on common random numbers
+    /// when the batch seed and settings match (McNemar's exact test), Holm-corrected over
+    /// the rows at α 0.05. Exit 0 passed, 3 a row dropped (or failed the floor, is
+    /// missing, or is underpowered), 1 bad input.
+    Regress(gate_cmd::RegressArgs),
+    /// A against B (two planners or two trackers run in one batch on shared seeds): a
+    /// paired comparison per scenario and every trial they ended differently.
+    Compare(gate_cmd::CompareArgs),
     /// Write a self-contained HTML report of a batch (or sweep) directory: DIR/report.html.
     Report {
         dir: PathBuf,
@@ -221,7 +234,9 @@ pub(crate) fn load_truck(path: Option<&PathBuf>) -> anyhow::Result<ForkliftSpec>
     Ok(spec)
 }
 
-/// What a successful run reports: whether the work itself succeeded (a failed pick).
+/// What a successful run reports: whether the work itself succeeded. Exit codes: 0 ok,
+/// 1 error or bad input, 2 usage, 3 the run worked and its result is a failure (a failed
+/// pick or mission, a regression).
 enum Done {
     Ok,
     PickFailed,
@@ -239,13 +254,16 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Merge { dirs, out, json } => {
             batch_cmd::merge(&dirs, &out, json).map(|()| Done::Ok)
         }
-        Command::Baseline { results, out } => {
-            batch_cmd::baseline(&results, &out).map(|()| Done::Ok)
-        }
+        Command::Baseline {
+            results,
+            out,
+            description,
+        } => gate_cmd::baseline(&results, &out, description).map(|()| Done::Ok),
         Command::Regress(args) => {
-            let ok = batch_cmd::regress(&args)?;
+            let ok = gate_cmd::regress(&args)?;
             Ok(if ok { Done::Ok } else { Done::Regressed })
         }
+        Command::Compare(args) => gate_cmd::compare(&args).map(|()| Done::Ok),
         Command::Trial(t) => t.run(false),
         Command::Mission(t) => t.run(true),
         Command::Replay {
@@ -303,7 +321,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(Done::Ok) => ExitCode::SUCCESS,
         Ok(Done::PickFailed) => ExitCode::from(3),
-        Ok(Done::Regressed) => ExitCode::from(1),
+        Ok(Done::Regressed) => ExitCode::from(3),
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

@@ -7,6 +7,7 @@ pub mod outcome;
 pub mod recorder;
 pub mod scenario;
 pub mod stats;
+pub mod text;
 pub mod trial;
 
 pub use components::{ComponentSpec, Registry, Role};

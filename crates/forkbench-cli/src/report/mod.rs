@@ -6,7 +6,7 @@ mod svg;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
-use forkbench_trial::batch::{self, Baseline, Manifest, Summary};
+use forkbench_trial::batch::{self, Baseline, GateOptions, Manifest, Summary};
 
 const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1300px;color:#222}\
 h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccc}\
@@ -30,7 +30,7 @@ pub fn write_to(dir: &Path, baseline: Option<&Path>, out: &Path) -> anyhow::Resu
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>forkbench report: {0}</title><style>{STYLE}</style></head><body><h1>forkbench report: {0}</h1>{body}</body></html>\n",
         svg::esc(&dir.display().to_string())
     );
-    std::fs::write(out, page).with_context(|| format!("writing {}", out.display()))?;
+    batch::write_atomic(out, page.as_bytes())?;
     Ok(out.to_path_buf())
 }
 
@@ -46,21 +46,20 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
     );
     if let Some(b) = baseline {
         let base = Baseline::load(b)?;
-        let (rows, failed) = batch::regress(&base, &summary, 0.05, None);
-        let verdict = if failed {
-            "<span class=\"bad\">REGRESSION</span>"
-        } else {
-            "<span class=\"ok\">no significant drop</span>"
-        };
+        let gate = batch::regress(
+            &base,
+            &summary,
+            &records,
+            Some(&manifest),
+            &GateOptions::default(),
+        );
+        let class = if gate.passed { "ok" } else { "bad" };
         h.push_str(&format!(
-            "<h2>Against the baseline {}: {verdict}</h2>",
-            svg::esc(&b.display().to_string())
+            "<h2>Against the baseline {}: <span class=\"{class}\">{}</span></h2>",
+            svg::esc(&b.display().to_string()),
+            svg::esc(&gate.verdict_text())
         ));
-        h.push_str(&sections::baseline_comparison(
-            &rows,
-            0.05,
-            &base.setting_differences(&manifest),
-        ));
+        h.push_str(&sections::baseline_comparison(&gate));
     }
     h.push_str("<h2>Success per scenario × planner × tracker</h2>");
     h.push_str(&sections::success_table(&summary));

@@ -4,7 +4,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use forkbench_trial::batch::{self, Manifest, Provenance, RegressRow, Summary, TrialRecord};
+use forkbench_trial::batch::{
+    self, GateReport, Manifest, Provenance, Summary, TrialRecord, Verdict,
+};
 use serde_json::Value;
 
 use super::svg::{self, esc};
@@ -291,36 +293,46 @@ pub fn failed_trials(dir: &Path, records: &[TrialRecord]) -> String {
     h
 }
 
-/// The comparison with a baseline, a verdict per row.
-pub fn baseline_comparison(rows: &[RegressRow], alpha: f64, differences: &[String]) -> String {
-    let mut h = String::new();
-    if !differences.is_empty() {
+/// The comparison with a baseline, a verdict per row: pairing, discordant pairs, raw and
+/// adjusted p, and the drop each row can see.
+pub fn baseline_comparison(g: &GateReport) -> String {
+    let mut h = format!("<p>{}</p>", esc(&g.pairing_text()));
+    if !g.setting_differences.is_empty() {
         h.push_str("<p class=\"warn\">The baseline's batch had other scenario settings (not comparable row for row):</p><ul>");
-        for d in differences {
+        for d in &g.setting_differences {
             let _ = write!(h, "<li>{}</li>", esc(d));
         }
         h.push_str("</ul>");
     }
-    h.push_str("<table><tr><th>scenario / planner / tracker</th><th>baseline</th><th>now</th><th>p (one-sided drop)</th><th>verdict</th></tr>");
-    for r in rows {
-        let class = if r.verdict == "ok" { "ok" } else { "bad" };
+    h.push_str("<table><tr><th>scenario / planner / tracker</th><th>baseline</th><th>now</th><th>broke / fixed</th><th>p (drop)</th><th>p adjusted</th><th>detectable drop (80 % power)</th><th>verdict</th></tr>");
+    let p = |v: Option<f64>| v.map_or("–".into(), |p| format!("{p:.4}"));
+    for r in &g.rows {
+        let class = match r.verdict {
+            Verdict::Ok => "ok",
+            Verdict::New => "warn",
+            _ => "bad",
+        };
+        let rate =
+            |v: Option<f64>, n: u64| v.map_or("–".into(), |v| format!("{} (n={n})", pct(v)));
         let _ = write!(
             h,
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{class}\">{}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{class}\">{}</td></tr>",
             esc(&row_label(&r.scenario, &r.planner, &r.tracker, r.replan)),
-            pct(r.baseline_rate),
-            r.now_rate.map_or("missing".into(), |v| format!(
-                "{} (n={})",
-                pct(v),
-                r.now_trials
-            )),
-            r.p_value.map_or("–".into(), |p| format!("{p:.4}")),
-            esc(&r.verdict)
+            rate(r.baseline_rate, r.baseline_trials),
+            rate(r.now_rate, r.now_trials),
+            esc(&r.pairs_text()),
+            p(r.p_value),
+            p(r.p_adjusted),
+            esc(&r.detectable_text()),
+            esc(r.verdict.name())
         );
     }
     let _ = write!(
         h,
-        "</table><p>α = {alpha}: a row fails on p &lt; α or when missing.</p>"
+        "</table><p>α = {} over all rows, {} correction; a row fails on adjusted p &lt; α, a rate below the floor, or when missing. Detectable drop: at level α/m = {:.4}.</p>",
+        g.alpha,
+        esc(g.correction.name()),
+        g.power_level
     );
     h
 }

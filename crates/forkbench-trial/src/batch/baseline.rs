@@ -1,11 +1,14 @@
-//! Committed baselines and the regression gate: a one-sided two-proportion test per row.
+//! Committed baselines: success counts per row and, for paired comparisons, every trial's key, seed and outcome.
 
+use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{BatchError, Summary, io};
-use crate::stats::drop_p_value;
+use super::{BatchError, Summary, TrialRecord};
+
+/// Largest baseline file read (a baseline of 100,000 trials is about 17 MB).
+pub const MAX_BASELINE_BYTES: u64 = 256 << 20;
 
 /// Committed success counts to compare new results against.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -16,6 +19,10 @@ pub struct Baseline {
     /// The provenance of the results it was made from.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub provenance: Option<super::Provenance>,
+    /// Every trial of the rows, so a batch run with the same seed is compared pair by
+    /// pair; baselines made before pairing have none and compare unpaired.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub trials: Vec<BaselineTrial>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -34,8 +41,56 @@ pub struct BaselineRow {
     pub successes: u64,
 }
 
+/// One trial of a baseline: its identity, seed and outcome.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaselineTrial {
+    pub scenario: String,
+    pub case: String,
+    pub planner: String,
+    pub tracker: String,
+    pub replan: bool,
+    pub trial: u64,
+    pub seed: u64,
+    pub success: bool,
+    /// First failed criterion (none on success).
+    pub failure: Option<String>,
+}
+
+impl BaselineTrial {
+    pub fn of(r: &TrialRecord) -> Self {
+        let o = &r.outcome;
+        Self {
+            scenario: o.scenario.clone(),
+            case: o.case.clone(),
+            planner: o.planner.clone(),
+            tracker: o.tracker.clone(),
+            replan: r.replan.unwrap_or(false),
+            trial: r.trial,
+            seed: o.seed,
+            success: o.success,
+            failure: o.failure.map(|f| f.name().to_owned()),
+        }
+    }
+
+    /// The trial's identity, as [`TrialRecord::key`].
+    pub fn key(&self) -> super::TrialKey {
+        (
+            self.scenario.clone(),
+            self.case.clone(),
+            self.planner.clone(),
+            self.tracker.clone(),
+            self.replan,
+            self.trial,
+        )
+    }
+}
+
 impl Baseline {
-    pub fn from_summary(s: &Summary, description: String) -> Self {
+    /// A baseline of a batch's summary and its trial records.
+    pub fn from_results(s: &Summary, records: &[TrialRecord], description: String) -> Self {
+        let mut trials: Vec<BaselineTrial> = records.iter().map(BaselineTrial::of).collect();
+        trials.sort_by_key(BaselineTrial::key);
         Self {
             description,
             rows: s
@@ -51,7 +106,13 @@ impl Baseline {
                 })
                 .collect(),
             provenance: s.provenance.clone(),
+            trials,
         }
+    }
+
+    /// Success counts only (no per-trial results: compared unpaired).
+    pub fn from_summary(s: &Summary, description: String) -> Self {
+        Self::from_results(s, &[], description)
     }
 
     /// Scenarios whose resolved settings (tolerances, truck, sensors, cases) differ between
@@ -62,157 +123,137 @@ impl Baseline {
             .map_or_else(Vec::new, |p| super::scenario_differences(&p.manifest, now))
     }
 
+    /// The file's text: pretty JSON with one line per trial, so a diff of two baselines
+    /// shows which trials changed.
+    pub fn to_text(&self) -> Result<String, BatchError> {
+        let head = Baseline {
+            trials: Vec::new(),
+            ..self.clone()
+        };
+        let mut text =
+            serde_json::to_string_pretty(&head).map_err(|e| BatchError::Invalid(e.to_string()))?;
+        if !self.trials.is_empty() {
+            text.truncate(text.trim_end().len() - 1);
+            text.truncate(text.trim_end().len());
+            text.push_str(",\n  \"trials\": [\n");
+            for (i, t) in self.trials.iter().enumerate() {
+                let line =
+                    serde_json::to_string(t).map_err(|e| BatchError::Invalid(e.to_string()))?;
+                let sep = if i + 1 < self.trials.len() { "," } else { "" };
+                text.push_str(&format!("    {line}{sep}\n"));
+            }
+            text.push_str("  ]\n}");
+        }
+        Ok(text + "\n")
+    }
+
+    /// Writes the baseline atomically.
+    pub fn write(&self, path: &Path) -> Result<(), BatchError> {
+        super::write_atomic(path, self.to_text()?.as_bytes())
+    }
+
     pub fn load(path: &Path) -> Result<Self, BatchError> {
-        let text = std::fs::read_to_string(path).map_err(io(path))?;
+        let text = super::read_regular(path, MAX_BASELINE_BYTES)?;
         let b: Baseline = serde_json::from_str(&text).map_err(|e| BatchError::Record {
             path: path.display().to_string(),
             line: e.line(),
             message: e.to_string(),
         })?;
-        if b.rows.is_empty() {
-            return Err(BatchError::Invalid(format!(
-                "{}: rows is empty; a baseline without rows would pass every result",
-                path.display()
-            )));
+        b.check()
+            .map_err(|reason| BatchError::Invalid(format!("{}: {reason}", path.display())))?;
+        Ok(b)
+    }
+
+    fn check(&self) -> Result<(), String> {
+        if self.rows.is_empty() {
+            return Err("rows is empty; a baseline without rows would pass every result".into());
         }
-        for (i, r) in b.rows.iter().enumerate() {
-            if let Some(j) = b.rows[..i].iter().position(|o| o.key() == r.key()) {
-                return Err(BatchError::Invalid(format!(
-                    "{}: rows[{i}] repeats rows[{j}] ({} / {} / {}); each scenario × planner × \
-                     tracker once",
-                    path.display(),
-                    r.scenario,
-                    r.planner,
-                    r.tracker
-                )));
+        for (i, r) in self.rows.iter().enumerate() {
+            if let Some(j) = self.rows[..i].iter().position(|o| o.key() == r.key()) {
+                return Err(format!(
+                    "rows[{i}] repeats rows[{j}] ({} / {} / {}); each scenario × planner × \
+                     tracker × mode once",
+                    r.scenario, r.planner, r.tracker
+                ));
             }
             if r.trials == 0 || r.successes > r.trials {
-                return Err(BatchError::Invalid(format!(
-                    "{}: rows[{i}] ({} / {}): successes {} of {} trials is impossible",
-                    path.display(),
-                    r.scenario,
-                    r.planner,
-                    r.successes,
-                    r.trials
-                )));
+                return Err(format!(
+                    "rows[{i}] ({} / {}): successes {} of {} trials is impossible",
+                    r.scenario, r.planner, r.successes, r.trials
+                ));
             }
         }
-        Ok(b)
+        self.check_trials()
+    }
+
+    /// Per-trial results must add up to the rows' counts, once per trial.
+    fn check_trials(&self) -> Result<(), String> {
+        if self.trials.is_empty() {
+            return Ok(());
+        }
+        let mut seen = HashSet::new();
+        let mut counts: BTreeMap<(&str, &str, &str, bool), (u64, u64)> = BTreeMap::new();
+        for (i, t) in self.trials.iter().enumerate() {
+            if !seen.insert(t.key()) {
+                return Err(format!("trials[{i}] repeats a trial ({:?})", t.key()));
+            }
+            if t.success != t.failure.is_none() {
+                return Err(format!(
+                    "trials[{i}]: success {} with failure {:?} is contradictory",
+                    t.success, t.failure
+                ));
+            }
+            let c = counts
+                .entry((&t.scenario, &t.planner, &t.tracker, t.replan))
+                .or_default();
+            c.0 += 1;
+            c.1 += u64::from(t.success);
+        }
+        for (i, r) in self.rows.iter().enumerate() {
+            let key = (
+                r.scenario.as_str(),
+                r.planner.as_str(),
+                r.tracker.as_str(),
+                r.replan.unwrap_or(false),
+            );
+            let (n, k) = counts.remove(&key).unwrap_or_default();
+            if (n, k) != (r.trials, r.successes) {
+                return Err(format!(
+                    "rows[{i}] ({} / {} / {}) counts {} of {} but its trials hold {k} of {n}: \
+                     the file was edited or truncated",
+                    r.scenario, r.planner, r.tracker, r.successes, r.trials
+                ));
+            }
+        }
+        if let Some((k, _)) = counts.into_iter().next() {
+            return Err(format!("trials of {k:?} belong to no row"));
+        }
+        Ok(())
     }
 }
 
 impl BaselineRow {
-    fn key(&self) -> (&str, &str, &str, Option<bool>) {
+    pub(super) fn key(&self) -> (&str, &str, &str, Option<bool>) {
         (&self.scenario, &self.planner, &self.tracker, self.replan)
     }
 
-    /// The result row this baseline row compares with: same scenario × planner × tracker
-    /// and mode; without a mode, the only row of that triple (none when there are several).
-    fn find<'a>(&self, rows: &'a [super::SummaryRow]) -> Option<&'a super::SummaryRow> {
-        let mut same = rows.iter().filter(|r| {
-            (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str())
-                == (
-                    self.scenario.as_str(),
-                    self.planner.as_str(),
-                    self.tracker.as_str(),
-                )
-        });
-        match self.replan {
-            Some(m) => same.find(|r| r.replan == m),
-            None => same.next().filter(|_| same.next().is_none()),
-        }
+    /// Whether a result row is this row: same scenario × planner × tracker, and the same
+    /// mode when the baseline row has one.
+    pub(super) fn matches(&self, r: &super::SummaryRow) -> bool {
+        (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str())
+            == (
+                self.scenario.as_str(),
+                self.planner.as_str(),
+                self.tracker.as_str(),
+            )
+            && self.replan.is_none_or(|m| r.replan == m)
     }
-}
 
-/// One compared row.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RegressRow {
-    pub scenario: String,
-    pub planner: String,
-    pub tracker: String,
-    pub replan: Option<bool>,
-    pub baseline_rate: f64,
-    pub now_rate: Option<f64>,
-    pub now_trials: u64,
-    pub p_value: Option<f64>,
-    /// `ok`, `drop` (significant), `below_floor`, or `missing` (not in the results).
-    pub verdict: String,
-}
-
-/// Compares results with a baseline: a row fails on a significant one-sided drop
-/// (p < alpha) or a rate below the absolute floor, or when it is missing.
-pub fn regress(
-    base: &Baseline,
-    now: &Summary,
-    alpha: f64,
-    floor: Option<f64>,
-) -> (Vec<RegressRow>, bool) {
-    let mut failed = false;
-    let rows = base
-        .rows
-        .iter()
-        .map(|b| {
-            let r = b.find(&now.rows);
-            let base_rate = b.successes as f64 / b.trials as f64;
-            let (now_rate, n, p, verdict) = match r {
-                None => (None, 0, None, "missing"),
-                Some(r) => {
-                    let p = drop_p_value(b.successes, b.trials, r.successes, r.trials);
-                    let v = if p < alpha {
-                        "drop"
-                    } else if floor.is_some_and(|f| r.success_rate < f) {
-                        "below_floor"
-                    } else {
-                        "ok"
-                    };
-                    (Some(r.success_rate), r.trials, Some(p), v)
-                }
-            };
-            failed |= verdict != "ok";
-            RegressRow {
-                scenario: b.scenario.clone(),
-                planner: b.planner.clone(),
-                tracker: b.tracker.clone(),
-                replan: b.replan,
-                baseline_rate: base_rate,
-                now_rate,
-                now_trials: n,
-                p_value: p,
-                verdict: verdict.to_owned(),
-            }
-        })
-        .collect();
-    (rows, failed)
-}
-
-/// The regression report as markdown.
-pub fn regress_markdown(rows: &[RegressRow], alpha: f64) -> String {
-    let mut s = String::from(
-        "| scenario | planner | tracker | mode | baseline | now | difference | p (one-sided drop) | verdict |\n|---|---|---|---|---|---|---|---|---|\n",
-    );
-    for r in rows {
-        let now = r.now_rate.map_or("–".to_owned(), |v| {
-            format!("{:.1} % (n={})", 100.0 * v, r.now_trials)
-        });
-        let diff = r.now_rate.map_or("–".to_owned(), |v| {
-            format!("{:+.1} pp", 100.0 * (v - r.baseline_rate))
-        });
-        let p = r.p_value.map_or("–".to_owned(), |p| format!("{p:.4}"));
-        s.push_str(&format!(
-            "| {} | {} | {} | {} | {:.1} % | {} | {} | {} | {} |\n",
-            r.scenario,
-            r.planner,
-            r.tracker,
-            r.replan.map_or("any", super::summary::mode_name),
-            100.0 * r.baseline_rate,
-            now,
-            diff,
-            p,
-            r.verdict
-        ));
+    /// The result row this baseline row compares with; without a mode, the only row of
+    /// that triple (none when there are several).
+    pub(super) fn find<'a>(&self, rows: &'a [super::SummaryRow]) -> Option<&'a super::SummaryRow> {
+        let mut same = rows.iter().filter(|r| self.matches(r));
+        let first = same.next()?;
+        (self.replan.is_some() || same.next().is_none()).then_some(first)
     }
-    s.push_str(&format!(
-        "\nα = {alpha}; a row fails on p < α, a rate below the floor, or a missing row.\n"
-    ));
-    s
 }

@@ -1,6 +1,6 @@
 //! JUnit XML (the schema GitLab, GitHub Actions and Jenkins read): one test case per result row.
 
-use super::{Provenance, RegressRow, Summary};
+use super::{GateReport, Provenance, Summary, Verdict};
 
 /// One test case: a result row, failed with a message or passed.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,34 +99,30 @@ fn case_name(
     )
 }
 
-/// `regress` as JUnit: a case per baseline row, failing on a significant drop, a rate
-/// below the floor, or a missing row, with the numbers in the message.
-pub fn regress_cases(rows: &[RegressRow], alpha: f64, floor: Option<f64>) -> Vec<Case> {
-    rows.iter()
+/// `regress` as JUnit: a case per row (baseline rows, then new ones), failing on a
+/// significant drop after the correction, a rate below the floor, a missing row, too few
+/// trials, or a new row with `--fail-on-new`; the numbers (adjusted p included) in the
+/// message.
+pub fn regress_cases(report: &GateReport, fail_on_new: bool) -> Vec<Case> {
+    report
+        .rows
+        .iter()
         .map(|r| {
             let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker, r.replan);
-            let now = r.now_rate.map_or("missing".to_owned(), |v| {
-                format!("{:.1} % (n={})", 100.0 * v, r.now_trials)
-            });
-            let p = r.p_value.map_or("–".to_owned(), |p| format!("{p:.4}"));
-            let floor_text = floor.map_or(String::new(), |f| format!(", floor {:.1} %", 100.0 * f));
-            let numbers = format!(
-                "baseline {:.1} %, now {now}, p = {p} (one-sided drop), α = {alpha}{floor_text}",
-                100.0 * r.baseline_rate
-            );
-            let failure = (r.verdict != "ok").then(|| {
-                let what = match r.verdict.as_str() {
-                    "drop" => "significant drop in fork-entry success",
-                    "below_floor" => "success rate below the floor",
-                    "missing" => "row missing from the results",
-                    _ => "failed",
-                };
-                (format!("{what}: {numbers}"), numbers.clone())
-            });
+            let numbers = r.numbers(report);
+            let what = match r.verdict {
+                Verdict::Ok => None,
+                Verdict::New if !fail_on_new => None,
+                Verdict::New => Some("new row, not in the baseline (--fail-on-new)"),
+                Verdict::Drop => Some("significant drop in fork-entry success"),
+                Verdict::BelowFloor => Some("success rate below the floor"),
+                Verdict::Missing => Some("row missing from the results"),
+                Verdict::Underpowered => Some("too few trials for --min-detectable-drop"),
+            };
             Case {
                 name,
                 classname,
-                failure,
+                failure: what.map(|w| (format!("{w}: {numbers}"), numbers.clone())),
             }
         })
         .collect()

@@ -15,6 +15,10 @@ use super::{BatchError, BatchSpec, io};
 pub struct Manifest {
     pub forkbench_version: String,
     pub seed: u64,
+    /// How trial seeds derive from `seed` ([`super::SEED_SCHEME`]); manifests written
+    /// before the scheme was named used scheme 1.
+    #[serde(default = "scheme_one")]
+    pub seed_scheme: u32,
     pub trials: u64,
     /// [index, count]; [0, 1] for an unsharded batch or a merge.
     pub shard: [u64; 2],
@@ -46,6 +50,10 @@ pub struct ScenarioEntry {
 
 pub(super) const FILE: &str = "manifest.json";
 
+fn scheme_one() -> u32 {
+    1
+}
+
 impl Manifest {
     /// The manifest of a batch spec.
     pub fn of(spec: &BatchSpec) -> Result<Self, BatchError> {
@@ -69,6 +77,7 @@ impl Manifest {
         Ok(Manifest {
             forkbench_version: env!("CARGO_PKG_VERSION").to_owned(),
             seed: spec.seed,
+            seed_scheme: super::SEED_SCHEME,
             trials: spec.trials,
             shard: [spec.shard.0, spec.shard.1],
             planners: spec.planners.clone(),
@@ -101,7 +110,7 @@ impl Manifest {
         let path = dir.join(FILE);
         let text =
             serde_json::to_string_pretty(self).map_err(|e| BatchError::Invalid(e.to_string()))?;
-        std::fs::write(&path, text + "\n").map_err(io(&path))
+        super::write_atomic(&path, (text + "\n").as_bytes())
     }
 
     /// Where two manifests differ, as `field: ours → theirs` lines (paths into the JSON;

@@ -10,21 +10,31 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod baseline;
+mod compare;
 mod export;
+mod gate;
+mod gate_text;
 pub mod junit;
 mod manifest;
 mod provenance;
+mod seed;
 mod shard;
 mod store;
 mod summary;
 mod sweep;
 
-pub use baseline::{Baseline, BaselineRow, RegressRow, regress, regress_markdown};
+pub use baseline::{Baseline, BaselineRow, BaselineTrial, MAX_BASELINE_BYTES};
+pub use compare::{CompareOptions, CompareReport, CompareRow, Discordant, compare};
 pub use export::write_csv;
+pub use gate::{
+    DEFAULT_ALPHA, GateOptions, GateReport, PairCounts, Pairing, RegressRow, Verdict,
+    paired_trials_needed, regress,
+};
 pub use manifest::{DirLock, Manifest};
 pub use provenance::{Provenance, rfc3339, scenario_differences};
+pub use seed::{SEED_SCHEME, trial_seed};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
-pub use store::{load_results, merge, read_records};
+pub use store::{load_results, merge, read_numbered, read_records};
 pub use summary::{Summary, SummaryRow, mode_name, summarize};
 pub use sweep::{
     RecordChoice, RecordJob, SweepPoint, sweep_markdown, sweep_points, trials_to_record,
@@ -36,6 +46,9 @@ use summary::write_summary;
 use crate::outcome::{Failure, TrialOutcome};
 use crate::scenario::Scenario;
 use crate::trial::{TrialOptions, run_trial};
+
+/// Largest `trials.jsonl` read whole (by `replay`).
+pub const MAX_RECORDS_BYTES: u64 = 1 << 30;
 
 /// Most worker threads a batch starts.
 pub const MAX_JOBS: usize = 256;
@@ -77,6 +90,18 @@ pub enum BatchError {
     },
     #[error("{0}")]
     Invalid(String),
+    #[error(transparent)]
+    File(#[from] forkbench_core::files::FileError),
+}
+
+/// Writes an output file atomically (see [`forkbench_core::files::write_atomic`]).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), BatchError> {
+    Ok(forkbench_core::files::write_atomic(path, bytes)?)
+}
+
+/// Reads an input file that must be a regular file of at most `max` bytes.
+pub fn read_regular(path: &Path, max: u64) -> Result<String, BatchError> {
+    Ok(forkbench_core::files::read_text(path, max)?)
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> BatchError + '_ {
@@ -128,30 +153,6 @@ impl TrialRecord {
             self.trial,
         )
     }
-}
-
-/// Seed of one trial from its identity alone, so results do not depend on `--jobs`,
-/// sharding or order (FNV-1a over the key, finished with SplitMix64). The tracker is not
-/// part of it: trackers compared in one batch see the same noise draws.
-pub fn trial_seed(batch_seed: u64, scenario: &str, case: &str, planner: &str, trial: u64) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut eat = |bytes: &[u8]| {
-        for b in bytes {
-            h ^= u64::from(*b);
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        h ^= 0xff;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    };
-    eat(&batch_seed.to_le_bytes());
-    eat(scenario.as_bytes());
-    eat(case.as_bytes());
-    eat(planner.as_bytes());
-    eat(&trial.to_le_bytes());
-    let mut z = h.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// One unit of work.
@@ -208,6 +209,27 @@ impl BatchSpec {
         }
     }
 
+    /// Every result row this batch makes (scenario / planner / tracker / mode) and its
+    /// trial count.
+    pub fn row_sizes(&self) -> Vec<(String, u64)> {
+        let mut out = Vec::new();
+        for s in &self.scenarios {
+            let (planners, trackers) = self.components_of(s);
+            for p in &planners {
+                for t in &trackers {
+                    for m in self.replan_modes() {
+                        let mode = mode_name(m.unwrap_or(s.replan.enabled));
+                        out.push((
+                            format!("{} / {p} / {t} / {mode}", s.name),
+                            s.cases.len() as u64 * self.trials,
+                        ));
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// The planner and tracker names a scenario runs with in this batch.
     fn components_of(&self, s: &Scenario) -> (Vec<String>, Vec<String>) {
         let or_own = |list: &Vec<String>, own: &str| {
@@ -239,7 +261,7 @@ impl BatchSpec {
     pub fn run_job(&self, j: &Job) -> TrialRecord {
         let s = &self.scenarios[j.scenario];
         let case = &s.cases[j.case];
-        let seed = trial_seed(self.seed, &s.name, &case.name, &j.planner, j.trial);
+        let seed = trial_seed(self.seed, &s.name, &case.name, j.trial);
         let opts = TrialOptions {
             seed: Some(seed),
             planner: Some(j.planner.clone()),

@@ -2,7 +2,7 @@
 
 use std::collections::{BTreeMap, HashSet};
 use std::fs::File;
-use std::io::{BufRead as _, BufReader, BufWriter, Write as _};
+use std::io::{BufRead as _, BufReader};
 use std::path::{Path, PathBuf};
 
 use super::{BatchError, DirLock, Manifest, Summary, TrialRecord, io, summarize, write_summary};
@@ -13,8 +13,18 @@ pub fn read_records(path: &Path) -> Result<Vec<TrialRecord>, BatchError> {
     read_records_torn(path).map(|(records, _)| records)
 }
 
+/// [`read_records`], each record with its 1-based line in the file (for `replay --line`).
+pub fn read_numbered(path: &Path) -> Result<Vec<(usize, TrialRecord)>, BatchError> {
+    read_numbered_torn(path).map(|(records, _)| records)
+}
+
 /// [`read_records`], also saying whether a torn last line was skipped.
 pub(super) fn read_records_torn(path: &Path) -> Result<(Vec<TrialRecord>, bool), BatchError> {
+    let (numbered, torn) = read_numbered_torn(path)?;
+    Ok((numbered.into_iter().map(|(_, r)| r).collect(), torn))
+}
+
+fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), BatchError> {
     let file = match File::open(path) {
         Ok(f) => f,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((Vec::new(), false)),
@@ -32,7 +42,7 @@ pub(super) fn read_records_torn(path: &Path) -> Result<(Vec<TrialRecord>, bool),
             continue;
         }
         match serde_json::from_str::<TrialRecord>(line) {
-            Ok(r) => out.push(r),
+            Ok(r) => out.push((i + 1, r)),
             Err(_) if Some(i) == last => torn = true, // torn or corrupt final write
             Err(e) => {
                 return Err(BatchError::Record {
@@ -62,14 +72,15 @@ pub(super) fn check_unique(records: &[TrialRecord], path: &Path) -> Result<(), B
     Ok(())
 }
 
-/// Rewrites `trials.jsonl` with exactly `records` (dropping a torn last line).
+/// Rewrites `trials.jsonl` with exactly `records` (dropping a torn last line), atomically:
+/// a kill mid-rewrite leaves the old file.
 pub(super) fn rewrite_records(path: &Path, records: &[TrialRecord]) -> Result<(), BatchError> {
-    let mut w = BufWriter::new(File::create(path).map_err(io(path))?);
+    let mut text = String::new();
     for r in records {
-        let line = serde_json::to_string(r).map_err(|e| BatchError::Invalid(e.to_string()))?;
-        writeln!(w, "{line}").map_err(io(path))?;
+        text.push_str(&serde_json::to_string(r).map_err(|e| BatchError::Invalid(e.to_string()))?);
+        text.push('\n');
     }
-    w.flush().map_err(io(path))
+    super::write_atomic(path, text.as_bytes())
 }
 
 pub(super) fn remove_if_present(path: &Path) -> Result<(), BatchError> {

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{BatchError, TrialRecord, io};
+use super::{BatchError, TrialRecord};
 use crate::outcome::Failure;
 use crate::stats::{Z95, percentile_sorted, wilson};
 
@@ -272,12 +272,8 @@ pub(super) fn pure_pursuit() -> String {
 }
 
 pub(super) fn write_summary(dir: &Path, s: &Summary) -> Result<(), BatchError> {
-    let json = dir.join("summary.json");
-    std::fs::write(
-        &json,
-        serde_json::to_string_pretty(s).map_err(|e| BatchError::Invalid(e.to_string()))? + "\n",
-    )
-    .map_err(io(&json))?;
-    let md = dir.join("summary.md");
-    std::fs::write(&md, s.markdown()).map_err(io(&md))
+    let text =
+        serde_json::to_string_pretty(s).map_err(|e| BatchError::Invalid(e.to_string()))? + "\n";
+    super::write_atomic(&dir.join("summary.json"), text.as_bytes())?;
+    super::write_atomic(&dir.join("summary.md"), s.markdown().as_bytes())
 }

@@ -1,0 +1,171 @@
+//! `forkbench baseline`, `regress` and `compare`: the regression gate and A/B comparisons on common random numbers.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+use forkbench_trial::batch::{self, Baseline, CompareOptions, GateOptions, Manifest};
+use forkbench_trial::stats::Correction;
+
+/// How rows tested together are corrected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CorrectionArg {
+    /// Holm's step-down (family-wise error ≤ α).
+    Holm,
+    /// Benjamini–Hochberg (false discovery rate ≤ α).
+    Bh,
+    /// None: each row at α on its own.
+    None,
+}
+
+impl From<CorrectionArg> for Correction {
+    fn from(c: CorrectionArg) -> Self {
+        match c {
+            CorrectionArg::Holm => Correction::Holm,
+            CorrectionArg::Bh => Correction::BenjaminiHochberg,
+            CorrectionArg::None => Correction::None,
+        }
+    }
+}
+
+/// `forkbench regress`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RegressArgs {
+    #[arg(long)]
+    pub baseline: PathBuf,
+    pub results: PathBuf,
+    /// Level of the whole gate (all rows together, after --correction).
+    #[arg(long, default_value_t = batch::DEFAULT_ALPHA)]
+    pub alpha: f64,
+    /// Multiplicity correction over the rows.
+    #[arg(long, value_enum, default_value_t = CorrectionArg::Holm)]
+    pub correction: CorrectionArg,
+    /// Absolute floor on every row's success rate (0–1).
+    #[arg(long)]
+    pub floor: Option<f64>,
+    /// Fail on rows the baseline does not have (default: listed as new, unchecked).
+    #[arg(long)]
+    pub fail_on_new: bool,
+    /// The drop (0–1, e.g. 0.05) the gate must see with 80 % power: each row says how
+    /// many trials that needs, and rows with fewer fail as underpowered.
+    #[arg(long)]
+    pub min_detectable_drop: Option<f64>,
+    #[arg(long)]
+    pub json: bool,
+    /// Also write the verdicts as JUnit XML to FILE (a failing case per failed row).
+    #[arg(long)]
+    pub junit: Option<PathBuf>,
+}
+
+/// `forkbench compare`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CompareArgs {
+    /// A batch directory that ran both components (e.g. `batch --planner A B`).
+    pub results: PathBuf,
+    /// Planner or tracker A, by name.
+    #[arg(long)]
+    pub a: String,
+    /// Planner or tracker B, by name.
+    #[arg(long)]
+    pub b: String,
+    #[arg(long, default_value_t = batch::DEFAULT_ALPHA)]
+    pub alpha: f64,
+    #[arg(long, value_enum, default_value_t = CorrectionArg::Holm)]
+    pub correction: CorrectionArg,
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn check_alpha(alpha: f64) -> anyhow::Result<()> {
+    if !(alpha > 0.0 && alpha < 1.0) {
+        bail!("--alpha {alpha}: must lie strictly between 0 and 1");
+    }
+    Ok(())
+}
+
+/// `forkbench baseline`: success counts and every trial's outcome, written atomically.
+pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::Result<()> {
+    let s = batch::load_results(dir)?;
+    let records = batch::read_records(&dir.join("trials.jsonl"))?;
+    let description =
+        description.unwrap_or_else(|| format!("success counts from {}", dir.display()));
+    let b = Baseline::from_results(&s, &records, description);
+    b.write(out)?;
+    crate::emit(&format!(
+        "baseline with {} rows and {} trials written to {}\n",
+        b.rows.len(),
+        b.trials.len(),
+        out.display()
+    ))
+}
+
+/// The gate over a results directory.
+pub fn gate(base: &Baseline, dir: &Path, o: &GateOptions) -> anyhow::Result<batch::GateReport> {
+    let s = batch::load_results(dir)?;
+    let records = batch::read_records(&dir.join("trials.jsonl"))?;
+    let manifest = Manifest::read(dir)?;
+    Ok(batch::regress(base, &s, &records, manifest.as_ref(), o))
+}
+
+/// Returns whether the gate passed.
+pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
+    check_alpha(a.alpha)?;
+    if let Some(f) = a.floor
+        && !(0.0..=1.0).contains(&f)
+    {
+        bail!("--floor {f}: must be a success rate between 0 and 1");
+    }
+    if let Some(d) = a.min_detectable_drop
+        && !(d > 0.0 && d <= 1.0)
+    {
+        bail!("--min-detectable-drop {d}: must be a drop in success rate in (0, 1]");
+    }
+    let b = Baseline::load(&a.baseline)?;
+    let o = GateOptions {
+        alpha: a.alpha,
+        correction: a.correction.into(),
+        floor: a.floor,
+        fail_on_new: a.fail_on_new,
+        min_detectable_drop: a.min_detectable_drop,
+    };
+    let report = gate(&b, &a.results, &o)?;
+    if let batch::Pairing::Unpaired { reason } = &report.pairing {
+        eprintln!("warning: compared unpaired: {reason}");
+    }
+    for c in &report.setting_differences {
+        eprintln!("warning: scenario settings differ from the baseline's batch: {c}");
+    }
+    if let Some(file) = &a.junit {
+        let s = batch::load_results(&a.results)?;
+        let cases = batch::junit::regress_cases(&report, a.fail_on_new);
+        let xml = batch::junit::junit_xml("forkbench regress", &cases, s.provenance.as_ref());
+        batch::write_atomic(file, xml.as_bytes())?;
+    }
+    if a.json {
+        crate::emit(&format!("{}\n", serde_json::to_string(&report)?))?;
+    } else {
+        crate::emit(&report.markdown())?;
+    }
+    Ok(report.passed)
+}
+
+/// `forkbench compare`: A against B in one batch, pair by pair.
+pub fn compare(a: &CompareArgs) -> anyhow::Result<()> {
+    check_alpha(a.alpha)?;
+    let file = a.results.join("trials.jsonl");
+    if !file.is_file() {
+        bail!(
+            "{}: no trials.jsonl (not a batch directory)",
+            a.results.display()
+        );
+    }
+    let records = batch::read_numbered(&file)?;
+    let o = CompareOptions {
+        alpha: a.alpha,
+        correction: a.correction.into(),
+    };
+    let report = batch::compare(&records, &a.a, &a.b, &o)?;
+    if a.json {
+        return crate::emit(&format!("{}\n", serde_json::to_string(&report)?));
+    }
+    crate::emit(&report.markdown(&file.display().to_string()))
+}

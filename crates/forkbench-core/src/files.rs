@@ -1,0 +1,135 @@
+//! Reading input files safely (regular files only, size-capped) and writing outputs atomically.
+
+use std::io::{Read as _, Write as _};
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Why an input file could not be read, or an output written. Messages name the file and
+/// the reason, never the file's contents.
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    #[error("{path}: {cause}")]
+    Io { path: String, cause: std::io::Error },
+    #[error("{path}: not a regular file ({kind}); give a file's path")]
+    NotRegular { path: String, kind: &'static str },
+    #[error("{path}: larger than {max} bytes, the most read for this kind of file")]
+    TooLarge { path: String, max: u64 },
+    #[error("{path}: not UTF-8 text")]
+    NotText { path: String },
+}
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> FileError + '_ {
+    move |cause| FileError::Io {
+        path: path.display().to_string(),
+        cause,
+    }
+}
+
+fn kind_of(t: std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt as _;
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_fifo() {
+        "a FIFO"
+    } else if t.is_char_device() || t.is_block_device() {
+        "a device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "not a file"
+    }
+}
+
+/// Reads at most `max` bytes of `path`, which must be a regular file (a FIFO would block,
+/// a device never end).
+pub fn read_bytes(path: &Path, max: u64) -> Result<Vec<u8>, FileError> {
+    let meta = std::fs::metadata(path).map_err(io_err(path))?;
+    if !meta.is_file() {
+        return Err(FileError::NotRegular {
+            path: path.display().to_string(),
+            kind: kind_of(meta.file_type()),
+        });
+    }
+    if meta.len() > max {
+        return Err(FileError::TooLarge {
+            path: path.display().to_string(),
+            max,
+        });
+    }
+    let file = std::fs::File::open(path).map_err(io_err(path))?;
+    let mut bytes = Vec::new();
+    file.take(max + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io_err(path))?;
+    if bytes.len() as u64 > max {
+        return Err(FileError::TooLarge {
+            path: path.display().to_string(),
+            max,
+        });
+    }
+    Ok(bytes)
+}
+
+/// [`read_bytes`] as UTF-8 text.
+pub fn read_text(path: &Path, max: u64) -> Result<String, FileError> {
+    String::from_utf8(read_bytes(path, max)?).map_err(|_| FileError::NotText {
+        path: path.display().to_string(),
+    })
+}
+
+/// Writes `bytes` to `path` so that a reader sees the old file or the new one, never a
+/// part: a temporary file in the same folder, flushed to disk, then renamed over `path`.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .map_or_else(|| "output".to_owned(), |n| n.to_string_lossy().into_owned());
+    let tmp = dir.join(format!(
+        ".{name}.tmp-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(cause) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io_err(path)(cause));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn special_files_are_refused_and_sizes_capped() {
+        let e = read_text(Path::new("/dev/zero"), 1 << 20).expect_err("device");
+        assert!(
+            e.to_string().contains("not a regular file (a device)"),
+            "{e}"
+        );
+        let e = read_text(Path::new("/tmp"), 1 << 20).expect_err("dir");
+        assert!(e.to_string().contains("a directory"), "{e}");
+        let dir = std::env::temp_dir().join(format!("fb-files-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let f = dir.join("big.txt");
+        write_atomic(&f, &[b'x'; 100]).expect("write");
+        assert_eq!(read_text(&f, 100).expect("fits").len(), 100);
+        let e = read_text(&f, 99).expect_err("too large");
+        assert!(e.to_string().contains("larger than 99 bytes"), "{e}");
+        write_atomic(&f, b"new").expect("rewrite");
+        assert_eq!(read_text(&f, 99).expect("read"), "new");
+        let left: Vec<_> = std::fs::read_dir(&dir).expect("ls").collect();
+        assert_eq!(left.len(), 1, "no temporary file left behind");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

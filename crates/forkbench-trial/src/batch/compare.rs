@@ -1,0 +1,296 @@
+//! A/B in one batch: two planners (or two trackers) that ran the same trials on shared seeds, compared pair by pair per scenario.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use serde::{Deserialize, Serialize};
+
+use super::{BatchError, TrialRecord};
+use crate::stats::{Correction, mcnemar_two_sided_p};
+
+/// How the comparison decides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareOptions {
+    pub alpha: f64,
+    pub correction: Correction,
+}
+
+/// One scenario × the other component × mode.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompareRow {
+    pub scenario: String,
+    /// The component held fixed (the tracker when planners are compared, and vice versa).
+    pub other: String,
+    pub replan: bool,
+    pub pairs: u64,
+    pub a_successes: u64,
+    pub b_successes: u64,
+    /// Pairs A passed and B failed, and the reverse.
+    pub a_only: u64,
+    pub b_only: u64,
+    /// McNemar's exact two-sided test, and after the multiplicity correction.
+    pub p_value: f64,
+    pub p_adjusted: f64,
+    pub significant: bool,
+}
+
+/// One trial A and B ended differently: enough to replay either.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Discordant {
+    pub scenario: String,
+    pub case: String,
+    pub other: String,
+    pub replan: bool,
+    pub trial: u64,
+    pub seed: u64,
+    /// Which of the two succeeded, the other's first failed criterion.
+    pub winner: String,
+    pub loser_failure: Option<String>,
+    /// 1-based lines of the two trials in `trials.jsonl` (`forkbench replay --line`).
+    pub a_line: usize,
+    pub b_line: usize,
+}
+
+/// The whole comparison.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompareReport {
+    /// "planner" or "tracker".
+    pub kind: String,
+    pub a: String,
+    pub b: String,
+    pub alpha: f64,
+    pub correction: Correction,
+    pub rows: Vec<CompareRow>,
+    pub discordant: Vec<Discordant>,
+    /// Trials of A or B with no partner at the same seed.
+    pub unpaired: u64,
+}
+
+type PairKey = (String, String, bool, String, u64);
+
+/// The trials of one component, keyed by everything but that component.
+fn side<'a>(
+    records: &'a [(usize, TrialRecord)],
+    name: &str,
+    planners: bool,
+) -> BTreeMap<PairKey, (usize, &'a TrialRecord)> {
+    records
+        .iter()
+        .filter(|(_, r)| {
+            let c = if planners {
+                &r.outcome.planner
+            } else {
+                &r.outcome.tracker
+            };
+            c == name
+        })
+        .map(|(line, r)| {
+            let other = if planners {
+                &r.outcome.tracker
+            } else {
+                &r.outcome.planner
+            };
+            let key = (
+                r.outcome.scenario.clone(),
+                other.clone(),
+                r.replan.unwrap_or(false),
+                r.outcome.case.clone(),
+                r.trial,
+            );
+            (key, (*line, r))
+        })
+        .collect()
+}
+
+/// Whether A and B are planners or trackers of this batch.
+fn kind_of(records: &[(usize, TrialRecord)], a: &str, b: &str) -> Result<bool, BatchError> {
+    let planners: BTreeSet<&str> = records
+        .iter()
+        .map(|(_, r)| r.outcome.planner.as_str())
+        .collect();
+    let trackers: BTreeSet<&str> = records
+        .iter()
+        .map(|(_, r)| r.outcome.tracker.as_str())
+        .collect();
+    if a == b {
+        return Err(BatchError::Invalid(format!("--a and --b are both {a:?}")));
+    }
+    if planners.contains(a) && planners.contains(b) {
+        Ok(true)
+    } else if trackers.contains(a) && trackers.contains(b) {
+        Ok(false)
+    } else {
+        let list = |s: &BTreeSet<&str>| s.iter().copied().collect::<Vec<_>>().join(", ");
+        Err(BatchError::Invalid(format!(
+            "{a:?} and {b:?} are not two planners or two trackers of this batch (planners: {}; \
+             trackers: {})",
+            list(&planners),
+            list(&trackers)
+        )))
+    }
+}
+
+/// Per row (scenario, other component, mode): pairs, A's and B's successes, A only,
+/// B only; then the discordant trials and the number of pairs.
+type Tally = (
+    BTreeMap<(String, String, bool), [u64; 5]>,
+    Vec<Discordant>,
+    u64,
+);
+
+/// Pairs A's trials with B's (same key and seed) and counts them per row.
+fn tally(
+    sa: &BTreeMap<PairKey, (usize, &TrialRecord)>,
+    sb: &BTreeMap<PairKey, (usize, &TrialRecord)>,
+    (a, b): (&str, &str),
+) -> Tally {
+    let mut counts: BTreeMap<(String, String, bool), [u64; 5]> = BTreeMap::new();
+    let mut discordant = Vec::new();
+    let mut paired = 0_u64;
+    for (key, (la, ra)) in sa {
+        let Some((lb, rb)) = sb
+            .get(key)
+            .filter(|(_, rb)| rb.outcome.seed == ra.outcome.seed)
+        else {
+            continue;
+        };
+        paired += 1;
+        let (ok_a, ok_b) = (ra.outcome.success, rb.outcome.success);
+        let c = counts
+            .entry((key.0.clone(), key.1.clone(), key.2))
+            .or_default();
+        *c = [
+            c[0] + 1,
+            c[1] + u64::from(ok_a),
+            c[2] + u64::from(ok_b),
+            c[3] + u64::from(ok_a && !ok_b),
+            c[4] + u64::from(ok_b && !ok_a),
+        ];
+        if ok_a != ok_b {
+            let loser = if ok_a { rb } else { ra };
+            discordant.push(Discordant {
+                scenario: key.0.clone(),
+                case: key.3.clone(),
+                other: key.1.clone(),
+                replan: key.2,
+                trial: key.4,
+                seed: ra.outcome.seed,
+                winner: if ok_a { a } else { b }.to_owned(),
+                loser_failure: loser.outcome.failure.map(|f| f.name().to_owned()),
+                a_line: *la,
+                b_line: *lb,
+            });
+        }
+    }
+    (counts, discordant, paired)
+}
+
+/// Compares A with B over the trials they share (same key and seed).
+pub fn compare(
+    records: &[(usize, TrialRecord)],
+    a: &str,
+    b: &str,
+    o: &CompareOptions,
+) -> Result<CompareReport, BatchError> {
+    let planners = kind_of(records, a, b)?;
+    let (sa, sb) = (side(records, a, planners), side(records, b, planners));
+    let (counts, discordant, paired) = tally(&sa, &sb, (a, b));
+    if paired == 0 {
+        return Err(BatchError::Invalid(format!(
+            "{a} and {b} share no trial at the same seed: run them in one batch \
+             (`--{} {a} {b}`) by a forkbench whose seeds leave the components out",
+            if planners { "planner" } else { "tracker" }
+        )));
+    }
+    let p: Vec<f64> = counts
+        .values()
+        .map(|c| mcnemar_two_sided_p(c[3], c[4]))
+        .collect();
+    let adjusted = o.correction.adjust(&p);
+    let rows = counts
+        .into_iter()
+        .zip(p.iter().zip(adjusted))
+        .map(|((k, c), (&p, adj))| CompareRow {
+            scenario: k.0,
+            other: k.1,
+            replan: k.2,
+            pairs: c[0],
+            a_successes: c[1],
+            b_successes: c[2],
+            a_only: c[3],
+            b_only: c[4],
+            p_value: p,
+            p_adjusted: adj,
+            significant: adj < o.alpha,
+        })
+        .collect();
+    Ok(CompareReport {
+        kind: if planners { "planner" } else { "tracker" }.to_owned(),
+        a: a.to_owned(),
+        b: b.to_owned(),
+        alpha: o.alpha,
+        correction: o.correction,
+        rows,
+        discordant,
+        unpaired: (sa.len() + sb.len()) as u64 - 2 * paired,
+    })
+}
+
+impl CompareReport {
+    /// The comparison as Markdown, with every discordant trial and its replay lines.
+    pub fn markdown(&self, trials_file: &str) -> String {
+        use crate::text::md_cell;
+        let mut s = format!(
+            "{} {} (A) against {} (B), paired trial by trial on shared seeds; McNemar's exact \
+             two-sided test per row, {} correction at α = {}.\n\n| scenario | {} | mode | pairs | A | B | A only | B only | p | p adjusted | |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+            self.kind,
+            md_cell(&self.a),
+            md_cell(&self.b),
+            self.correction.name(),
+            self.alpha,
+            if self.kind == "planner" {
+                "tracker"
+            } else {
+                "planner"
+            }
+        );
+        for r in &self.rows {
+            let pct = |k: u64| format!("{:.1} %", 100.0 * k as f64 / r.pairs.max(1) as f64);
+            s.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {} |\n",
+                md_cell(&r.scenario),
+                md_cell(&r.other),
+                super::mode_name(r.replan),
+                r.pairs,
+                pct(r.a_successes),
+                pct(r.b_successes),
+                r.a_only,
+                r.b_only,
+                r.p_value,
+                r.p_adjusted,
+                if r.significant { "differ" } else { "" }
+            ));
+        }
+        if self.unpaired > 0 {
+            s.push_str(&format!(
+                "\n{} trials had no partner at the same seed and were left out.\n",
+                self.unpaired
+            ));
+        }
+        s.push_str(&format!("\nDiscordant trials ({}): replay with `forkbench replay {trials_file} --line N`\n\n| scenario | case | mode | trial | seed | succeeded | the other failed on | line A | line B |\n|---|---|---|---|---|---|---|---|---|\n", self.discordant.len()));
+        for d in &self.discordant {
+            s.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                md_cell(&d.scenario),
+                md_cell(&d.case),
+                super::mode_name(d.replan),
+                d.trial,
+                d.seed,
+                md_cell(&d.winner),
+                d.loser_failure.as_deref().unwrap_or("–"),
+                d.a_line,
+                d.b_line
+            ));
+        }
+        s
+    }
+}

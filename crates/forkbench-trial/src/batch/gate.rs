@@ -1,0 +1,392 @@
+//! The regression gate: each result row against its baseline row, paired on common random numbers when the seeds match, with multiplicity control and stated power.
+
+use std::collections::HashMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::{Baseline, BaselineRow, Manifest, Summary, SummaryRow, TrialKey, TrialRecord};
+use crate::stats::{
+    Correction, drop_p_value, mcnemar_drop_p, min_detectable_drop, paired_power, trials_needed,
+    unpaired_power,
+};
+
+/// The gate's significance level unless told otherwise: one α for the whole family of
+/// rows, in the README, `--help` and CI alike.
+pub const DEFAULT_ALPHA: f64 = 0.05;
+
+/// Most trials a `--min-detectable-drop` answer searches.
+const MAX_TRIALS_SEARCHED: u64 = 1_000_000;
+
+/// How the gate decides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GateOptions {
+    /// Family-wise (Holm) or false-discovery (Benjamini–Hochberg) level over all rows.
+    pub alpha: f64,
+    pub correction: Correction,
+    /// Absolute floor on every row's success rate.
+    pub floor: Option<f64>,
+    /// Rows the baseline does not have fail instead of being listed as unchecked.
+    pub fail_on_new: bool,
+    /// The drop the gate must see with 80 % power: rows with too few trials fail.
+    pub min_detectable_drop: Option<f64>,
+}
+
+impl Default for GateOptions {
+    fn default() -> Self {
+        Self {
+            alpha: DEFAULT_ALPHA,
+            correction: Correction::Holm,
+            floor: None,
+            fail_on_new: false,
+            min_detectable_drop: None,
+        }
+    }
+}
+
+/// A row's verdict.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    Ok,
+    /// A significant drop after the multiplicity correction.
+    Drop,
+    BelowFloor,
+    /// In the baseline, not in the results.
+    Missing,
+    /// In the results, not in the baseline: unchecked.
+    New,
+    /// Fewer trials than `--min-detectable-drop` needs.
+    Underpowered,
+}
+
+impl Verdict {
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Drop => "drop",
+            Verdict::BelowFloor => "below_floor",
+            Verdict::Missing => "missing",
+            Verdict::New => "new, unchecked",
+            Verdict::Underpowered => "underpowered",
+        }
+    }
+}
+
+/// Trials present in both the baseline and the results with the same seed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PairCounts {
+    pub pairs: u64,
+    /// Passed in the baseline, fail now.
+    pub broke: u64,
+    /// Failed in the baseline, pass now.
+    pub fixed: u64,
+}
+
+/// One compared row.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RegressRow {
+    pub scenario: String,
+    pub planner: String,
+    pub tracker: String,
+    pub replan: Option<bool>,
+    pub baseline_trials: u64,
+    pub baseline_rate: Option<f64>,
+    pub now_trials: u64,
+    pub now_rate: Option<f64>,
+    /// Present when the row was compared pair by pair (McNemar's exact test).
+    pub paired: Option<PairCounts>,
+    /// One-sided p-value of a drop, and after the multiplicity correction.
+    pub p_value: Option<f64>,
+    pub p_adjusted: Option<f64>,
+    /// Smallest drop (success-rate fraction) the gate sees with 80 % power at this n;
+    /// none when even a drop to zero is not seen.
+    pub detectable_drop: Option<f64>,
+    /// With `--min-detectable-drop`: trials (pairs, when paired) that drop needs.
+    pub trials_needed: Option<u64>,
+    pub verdict: Verdict,
+}
+
+/// Whether the comparison is paired, and why not.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "mode", rename_all = "snake_case")]
+pub enum Pairing {
+    Paired { pairs: u64 },
+    Unpaired { reason: String },
+}
+
+/// The gate's whole answer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GateReport {
+    pub passed: bool,
+    pub alpha: f64,
+    pub correction: Correction,
+    pub floor: Option<f64>,
+    /// The level each row's power is stated at (α over the tested rows: Holm's first step).
+    pub power_level: f64,
+    pub pairing: Pairing,
+    pub setting_differences: Vec<String>,
+    pub rows: Vec<RegressRow>,
+}
+
+/// Trials a row needs for the paired gate to see `drop` with 80 % power at level
+/// α / `rows` when a change only breaks trials: the best case (a change that also flips
+/// trials both ways needs more, the unpaired test far more).
+pub fn paired_trials_needed(drop: f64, alpha: f64, rows: usize) -> Option<u64> {
+    let level = alpha / rows.max(1) as f64;
+    trials_needed(MAX_TRIALS_SEARCHED, |n| paired_power(n, drop, drop, level))
+}
+
+/// Why the results cannot be paired with the baseline trial by trial, if they cannot.
+fn unpaired_reason(
+    base: &Baseline,
+    now: Option<&Manifest>,
+    differences: &[String],
+) -> Option<String> {
+    if base.trials.is_empty() {
+        return Some(
+            "the baseline has no per-trial results (made by an older forkbench or from counts \
+             only); re-make it with `forkbench baseline` to compare pair by pair"
+                .into(),
+        );
+    }
+    let Some(then) = base.provenance.as_ref().map(|p| &p.manifest) else {
+        return Some("the baseline has no provenance, so its batch seed is unknown".into());
+    };
+    let Some(now) = now else {
+        return Some("the results have no manifest.json, so their batch seed is unknown".into());
+    };
+    let mut why = Vec::new();
+    if then.seed != now.seed {
+        why.push(format!(
+            "batch seed {} ≠ the baseline's {}",
+            now.seed, then.seed
+        ));
+    }
+    if then.seed_scheme != now.seed_scheme {
+        why.push(format!(
+            "trial seeds derived by scheme {} ≠ the baseline's {}",
+            now.seed_scheme, then.seed_scheme
+        ));
+    }
+    if then.pallet_noise_scale != now.pallet_noise_scale {
+        why.push(format!(
+            "pallet noise scale {:?} ≠ the baseline's {:?}",
+            now.pallet_noise_scale, then.pallet_noise_scale
+        ));
+    }
+    if !differences.is_empty() {
+        why.push(format!(
+            "scenario settings differ ({})",
+            differences.join("; ")
+        ));
+    }
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
+/// Pair counts of one row: baseline trials matched by key and seed in the results.
+fn pair_row(
+    base: &Baseline,
+    row: &BaselineRow,
+    now: &HashMap<TrialKey, (u64, bool)>,
+) -> Option<PairCounts> {
+    let mut c = PairCounts {
+        pairs: 0,
+        broke: 0,
+        fixed: 0,
+    };
+    let mode = row.replan.unwrap_or(false);
+    for t in base.trials.iter().filter(|t| {
+        (
+            t.scenario.as_str(),
+            t.planner.as_str(),
+            t.tracker.as_str(),
+            t.replan,
+        ) == (
+            row.scenario.as_str(),
+            row.planner.as_str(),
+            row.tracker.as_str(),
+            mode,
+        )
+    }) {
+        if let Some(&(seed, ok)) = now.get(&t.key())
+            && seed == t.seed
+        {
+            c.pairs += 1;
+            c.broke += u64::from(t.success && !ok);
+            c.fixed += u64::from(!t.success && ok);
+        }
+    }
+    (c.pairs > 0).then_some(c)
+}
+
+fn blank_row(s: (&str, &str, &str, Option<bool>), verdict: Verdict) -> RegressRow {
+    RegressRow {
+        scenario: s.0.to_owned(),
+        planner: s.1.to_owned(),
+        tracker: s.2.to_owned(),
+        replan: s.3,
+        baseline_trials: 0,
+        baseline_rate: None,
+        now_trials: 0,
+        now_rate: None,
+        paired: None,
+        p_value: None,
+        p_adjusted: None,
+        detectable_drop: None,
+        trials_needed: None,
+        verdict,
+    }
+}
+
+/// One baseline row against its result row (no verdict on significance yet).
+fn compare_row(b: &BaselineRow, now: Option<&SummaryRow>, pairs: Option<PairCounts>) -> RegressRow {
+    let key = (
+        b.scenario.as_str(),
+        b.planner.as_str(),
+        b.tracker.as_str(),
+        b.replan,
+    );
+    let Some(r) = now else {
+        let mut row = blank_row(key, Verdict::Missing);
+        row.baseline_trials = b.trials;
+        row.baseline_rate = Some(b.successes as f64 / b.trials as f64);
+        return row;
+    };
+    let mut row = blank_row(key, Verdict::Ok);
+    row.baseline_trials = b.trials;
+    row.baseline_rate = Some(b.successes as f64 / b.trials as f64);
+    row.now_trials = r.trials;
+    row.now_rate = Some(r.success_rate);
+    row.paired = pairs;
+    row.p_value = Some(match pairs {
+        Some(c) => mcnemar_drop_p(c.broke, c.fixed),
+        None => drop_p_value(b.successes, b.trials, r.successes, r.trials),
+    });
+    row
+}
+
+/// The smallest drop seen with 80 % power, and the trials `want` needs, at `level`.
+fn power_of(row: &RegressRow, level: f64, want: Option<f64>) -> (Option<f64>, Option<u64>) {
+    let p0 = row.baseline_rate.unwrap_or(0.0);
+    match row.paired {
+        Some(c) => {
+            let psi = (c.broke + c.fixed) as f64 / c.pairs as f64;
+            let mdd = min_detectable_drop(p0, |d| paired_power(c.pairs, d, psi, level));
+            let need = want.and_then(|d| {
+                trials_needed(MAX_TRIALS_SEARCHED, |n| paired_power(n, d, psi, level))
+            });
+            (mdd, need)
+        }
+        None => {
+            let (n0, n1) = (row.baseline_trials, row.now_trials);
+            let mdd = min_detectable_drop(p0, |d| unpaired_power(p0, n0, n1, d, level));
+            let need = want.and_then(|d| {
+                trials_needed(MAX_TRIALS_SEARCHED, |n| unpaired_power(p0, n0, n, d, level))
+            });
+            (mdd, need)
+        }
+    }
+}
+
+/// Result rows the baseline does not have: new, unchecked.
+fn new_rows(base: &Baseline, now: &Summary) -> Vec<RegressRow> {
+    now.rows
+        .iter()
+        .filter(|r| !base.rows.iter().any(|b| b.matches(r)))
+        .map(|r| {
+            let key = (
+                r.scenario.as_str(),
+                r.planner.as_str(),
+                r.tracker.as_str(),
+                Some(r.replan),
+            );
+            let mut row = blank_row(key, Verdict::New);
+            row.now_trials = r.trials;
+            row.now_rate = Some(r.success_rate);
+            row
+        })
+        .collect()
+}
+
+/// Adjusts the tested rows' p-values together, states each row's power and gives its
+/// verdict; returns the level power is stated at.
+fn judge(rows: &mut [RegressRow], o: &GateOptions) -> f64 {
+    let tested: Vec<usize> = (0..rows.len())
+        .filter(|&i| rows[i].p_value.is_some())
+        .collect();
+    let p: Vec<f64> = tested.iter().filter_map(|&i| rows[i].p_value).collect();
+    for (&i, adj) in tested.iter().zip(o.correction.adjust(&p)) {
+        rows[i].p_adjusted = Some(adj);
+    }
+    let power_level = match o.correction {
+        Correction::None => o.alpha,
+        _ => o.alpha / tested.len().max(1) as f64,
+    };
+    for &i in &tested {
+        let (mdd, need) = power_of(&rows[i], power_level, o.min_detectable_drop);
+        let r = &mut rows[i];
+        r.detectable_drop = mdd;
+        r.trials_needed = need;
+        let have = r.paired.map_or(r.now_trials, |c| c.pairs);
+        r.verdict = if r.p_adjusted.is_some_and(|p| p < o.alpha) {
+            Verdict::Drop
+        } else if o.floor.is_some_and(|f| r.now_rate.is_some_and(|v| v < f)) {
+            Verdict::BelowFloor
+        } else if o.min_detectable_drop.is_some() && need.is_none_or(|n| n > have) {
+            Verdict::Underpowered
+        } else {
+            Verdict::Ok
+        };
+    }
+    power_level
+}
+
+/// Compares results with a baseline. `records` and `manifest` are the results' trials
+/// and manifest; with the baseline's per-trial results and the same batch seed and
+/// settings, rows are compared pair by pair.
+pub fn regress(
+    base: &Baseline,
+    now: &Summary,
+    records: &[TrialRecord],
+    manifest: Option<&Manifest>,
+    o: &GateOptions,
+) -> GateReport {
+    let differences = manifest.map_or_else(Vec::new, |m| base.setting_differences(m));
+    let reason = unpaired_reason(base, manifest, &differences);
+    let index: HashMap<TrialKey, (u64, bool)> = records
+        .iter()
+        .map(|r| (r.key(), (r.outcome.seed, r.outcome.success)))
+        .collect();
+    let mut rows: Vec<RegressRow> = base
+        .rows
+        .iter()
+        .map(|b| {
+            let pairs = reason
+                .is_none()
+                .then(|| pair_row(base, b, &index))
+                .flatten();
+            compare_row(b, b.find(&now.rows), pairs)
+        })
+        .collect();
+    rows.extend(new_rows(base, now));
+    let power_level = judge(&mut rows, o);
+    let passed = rows
+        .iter()
+        .all(|r| r.verdict == Verdict::Ok || (r.verdict == Verdict::New && !o.fail_on_new));
+    let pairing = match reason {
+        Some(reason) => Pairing::Unpaired { reason },
+        None => Pairing::Paired {
+            pairs: rows.iter().filter_map(|r| r.paired.map(|c| c.pairs)).sum(),
+        },
+    };
+    GateReport {
+        passed,
+        alpha: o.alpha,
+        correction: o.correction,
+        floor: o.floor,
+        power_level,
+        pairing,
+        setting_differences: differences,
+        rows,
+    }
+}
