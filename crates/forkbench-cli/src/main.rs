@@ -318,7 +318,10 @@ fn reproduce(
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
+    let result = run(cli);
+    // No external process (or its children) outlives the command.
+    forkbench_ipc::kill_all();
+    match result {
         Ok(Done::Ok) => ExitCode::SUCCESS,
         Ok(Done::PickFailed) => ExitCode::from(3),
         Ok(Done::Regressed) => ExitCode::from(3),

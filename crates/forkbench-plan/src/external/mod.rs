@@ -7,14 +7,17 @@ pub mod protocol;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::LazyLock;
 use std::time::Duration;
+
+use forkbench_ipc::Breaker;
 
 use forkbench_core::settings::{self, Settings, SettingsError};
 use serde::Deserialize;
 
 pub use check::{ENDPOINT_TOLERANCE_M, ENDPOINT_TOLERANCE_RAD, MAX_SPACING_M, path_violation};
 pub use process::dir_of;
-use process::{Process, clip};
+use process::{EnvPolicy, Process, clip};
 use protocol::{RequestMsg, ResponseMsg, to_path};
 
 use crate::{Plan, PlanError, PlanParams, PlanRequest, Planner};
@@ -28,10 +31,14 @@ pub const MAX_TIMEOUT_S: f64 = 600.0;
 pub struct ExternalConfig {
     /// Program and arguments, run in the directory of the file that names them.
     pub command: Vec<String>,
-    /// Longest wait for the hello and for each plan; past it the process is stopped and
-    /// the trial's plan fails.
+    /// Longest wait for the hello and for each plan (sending the request included); past
+    /// it the process group is killed and the trial's plan fails.
     #[serde(default = "default_timeout")]
     pub timeout_s: f64,
+    /// Environment variables passed to the planner: all of forkbench's when absent, only
+    /// these when given (an allow-list, e.g. `["PATH", "HOME"]`).
+    #[serde(default)]
+    pub pass_env: Option<Vec<String>>,
 }
 
 fn default_timeout() -> f64 {
@@ -39,12 +46,21 @@ fn default_timeout() -> f64 {
 }
 
 /// A planner process per worker thread, started on first use and restarted after it
-/// misbehaves. Keyed by command and directory.
-type Pool = HashMap<(Vec<String>, PathBuf), (Process, u64)>;
+/// misbehaves. Keyed by command, directory and environment.
+type Pool = HashMap<(Vec<String>, PathBuf, EnvPolicy), (Process, u64)>;
 
 thread_local! {
     static POOL: RefCell<Pool> = RefCell::new(HashMap::new());
 }
+
+/// Ends this thread's pooled planner processes (each process group killed): called on
+/// every worker when a batch ends, so no planner outlives the batch.
+pub fn release_pooled() {
+    POOL.with(|p| p.borrow_mut().clear());
+}
+
+/// Consecutive timeouts per command, across worker threads.
+static BREAKER: LazyLock<Breaker> = LazyLock::new(Breaker::default);
 
 /// An external planner, as configured; the process lives in this thread's pool.
 #[derive(Debug, Clone)]
@@ -88,18 +104,51 @@ impl ExternalPlanner {
         Duration::from_secs_f64(self.cfg.timeout_s)
     }
 
+    fn env(&self) -> EnvPolicy {
+        self.cfg
+            .pass_env
+            .clone()
+            .map_or(EnvPolicy::Inherit, EnvPolicy::Only)
+    }
+
+    /// The command as the circuit breaker knows it.
+    fn breaker_key(&self) -> String {
+        format!("{:?} in {}", self.cfg.command, self.dir.display())
+    }
+
+    /// This thread's process for the planner, or a new one: one that printed while it
+    /// waited in the pool broke the protocol and is retired (its group killed).
+    fn take_process(&self) -> Result<(Process, u64), String> {
+        let key = (self.cfg.command.clone(), self.dir.clone(), self.env());
+        let taken = POOL.with(|p| p.borrow_mut().remove(&key));
+        if let Some((mut p, id)) = taken
+            && p.idle_output() == 0
+        {
+            return Ok((p, id));
+        }
+        Ok((
+            Process::start(&self.cfg.command, &self.dir, &self.env(), self.timeout())?,
+            0,
+        ))
+    }
+
+    /// One request, counted by the circuit breaker.
+    fn request(&self, req: &PlanRequest) -> Result<ResponseMsg, String> {
+        let key = self.breaker_key();
+        BREAKER.check(&key)?;
+        let r = self.exchange(req);
+        BREAKER.record(
+            &key,
+            r.as_ref()
+                .is_err_and(|e| forkbench_ipc::Process::is_timeout(e)),
+        );
+        r
+    }
+
     /// One request on a (possibly new) process; the process goes back to the pool only
     /// when the exchange kept to the protocol.
-    fn request(&self, req: &PlanRequest) -> Result<ResponseMsg, String> {
-        let key = (self.cfg.command.clone(), self.dir.clone());
-        let taken = POOL.with(|p| p.borrow_mut().remove(&key));
-        let (mut proc, id) = match taken {
-            Some(p) => p,
-            None => (
-                Process::start(&self.cfg.command, &self.dir, self.timeout())?,
-                0,
-            ),
-        };
+    fn exchange(&self, req: &PlanRequest) -> Result<ResponseMsg, String> {
+        let (mut proc, id) = self.take_process()?;
         let line = serde_json::to_string(&RequestMsg::new(id, req)).map_err(|e| e.to_string())?;
         let answer = proc.exchange(&line, self.timeout())?;
         let msg: ResponseMsg = serde_json::from_str(&answer).map_err(|e| {
@@ -123,6 +172,7 @@ impl ExternalPlanner {
         if got != id {
             return Err(format!("answered request {got}, expected {id}"));
         }
+        let key = (self.cfg.command.clone(), self.dir.clone(), self.env());
         POOL.with(|p| p.borrow_mut().insert(key, (proc, id + 1)));
         Ok(msg)
     }

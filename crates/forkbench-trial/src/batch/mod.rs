@@ -473,6 +473,8 @@ pub fn run_batch(
             on_done(&rec);
         });
     });
+    // Pooled external planners live in the workers' thread-locals: end them with the batch.
+    pool.broadcast(|_| forkbench_plan::external::release_pooled());
     if let Some(e) = write_error
         .into_inner()
         .unwrap_or_else(std::sync::PoisonError::into_inner)

@@ -3,7 +3,13 @@
 
 Modes: good, crash, hang, bad_json, nan, off_start, off_goal, curvature, wrong_version,
 silent_hello, crash_once (crashes on its first plan if the marker file argv[2] does not
-exist yet, then behaves).
+exist yet, then behaves), and the hostile ones:
+- deaf: answers the hello, then stops reading (a large request blocks forkbench's write);
+- chatty: answers, then leaves a child writing 1 KB lines to stdout forever;
+- forks_sleeper: answers, leaving a child `sleep argv[3]` behind;
+- ignores_eof: answers, and keeps running after its input closes;
+- exit_child_holds_stdout: leaves a child holding stdout, says "bye" on stderr, exits 7;
+- exit_mid_line: writes half an answer, says "oops" on stderr, exits 3.
 """
 import json
 import math
@@ -28,7 +34,38 @@ def straight(req):
     return out
 
 
+def spawn(argv):
+    """A child in the planner's process group that keeps its stdout."""
+    import subprocess
+    return subprocess.Popen(argv, stdin=subprocess.DEVNULL)
+
+
+def hostile(req):
+    """The hostile modes' behaviour around a good answer."""
+    good = json.dumps({"type": "path", "id": req["id"], "samples": straight(req)})
+    if mode == "chatty":
+        print(good, flush=True)
+        spawn([sys.executable, "-c", "import sys\nwhile True: sys.stdout.write('x' * 1000 + '\\n')"])
+        return None
+    if mode == "forks_sleeper":
+        spawn(["sleep", sys.argv[3]])
+    if mode == "exit_child_holds_stdout":
+        spawn(["sleep", "1000"])
+        sys.stderr.write("bye\n")
+        sys.stderr.flush()
+        os._exit(7)
+    if mode == "exit_mid_line":
+        sys.stdout.write(good[: len(good) // 2])
+        sys.stdout.flush()
+        sys.stderr.write("oops\n")
+        sys.stderr.flush()
+        os._exit(3)
+    return good
+
+
 def answer(req):
+    if mode in ("chatty", "forks_sleeper", "exit_child_holds_stdout", "exit_mid_line", "ignores_eof"):
+        return hostile(req)
     samples = straight(req)
     if mode == "crash" or (mode == "crash_once" and not os.path.exists(sys.argv[2])):
         if mode == "crash_once":
@@ -62,5 +99,13 @@ for line in sys.stdin:
             continue
         version = 99 if mode == "wrong_version" else 1
         print(json.dumps({"type": "hello", "protocol": "forkbench-planner", "version": version}), flush=True)
+        if mode == "deaf":
+            import time
+            time.sleep(1000)
     else:
-        print(answer(msg), flush=True)
+        out = answer(msg)
+        if out is not None:
+            print(out, flush=True)
+if mode == "ignores_eof":
+    import time
+    time.sleep(1000)

@@ -1,0 +1,7 @@
+//! Child processes speaking newline-delimited text (external planners and, later, detectors and trackers): each in its own process group, one deadline over writing a request and reading the answer, bounded output, the group killed when done, exit status and stderr in every failure, and a circuit breaker for commands that keep timing out.
+
+mod breaker;
+mod process;
+
+pub use breaker::{BREAKER_THRESHOLD, Breaker};
+pub use process::{EnvPolicy, MAX_LINE_BYTES, Process, Spawn, clip, kill_all};
