@@ -258,45 +258,67 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
     let t0 = std::time::Instant::now();
     let summary = run_one(&spec, &a.out, a.jobs)?;
     let elapsed = t0.elapsed().as_secs_f64();
-    let recorded = record_batch(&spec, &a)?;
-    let extras = write_extras(&summary, &a)?;
-    if a.json {
-        return crate::emit(&format!("{}\n", serde_json::to_string(&summary)?));
+    // Every output is attempted, whatever failed before it (a full disk while recording
+    // must not cost the table, JUnit, CSV or report); the failures are reported together.
+    let mut failed: Vec<String> = Vec::new();
+    let extras = write_extras(&summary, &a, &mut failed);
+    let recorded = record_batch(&spec, &a).unwrap_or_else(|e| {
+        failed.push(format!("recordings: {e:#}"));
+        0
+    });
+    let shown = if a.json {
+        crate::emit(&format!("{}\n", serde_json::to_string(&summary)?))
+    } else {
+        crate::emit(&format!(
+            "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md{extras}){}\n",
+            summary.markdown(),
+            elapsed,
+            a.jobs,
+            a.out.display(),
+            if recorded > 0 {
+                format!("; {recorded} trials recorded in recordings/")
+            } else {
+                String::new()
+            }
+        ))
+    };
+    if !failed.is_empty() {
+        bail!(
+            "the trials are intact in {}, but {}",
+            a.out.display(),
+            failed.join("; ")
+        );
     }
-    crate::emit(&format!(
-        "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md{extras}){}\n",
-        summary.markdown(),
-        elapsed,
-        a.jobs,
-        a.out.display(),
-        if recorded > 0 {
-            format!("; {recorded} trials recorded in recordings/")
-        } else {
-            String::new()
-        }
-    ))
+    shown
 }
 
-/// The outputs asked for beside the results (CSV, JUnit, HTML report), named for the
-/// closing line.
-fn write_extras(summary: &Summary, a: &BatchArgs) -> anyhow::Result<String> {
+/// The outputs asked for beside the results (CSV, JUnit, HTML report), each attempted,
+/// named for the closing line; failures go to `failed`.
+fn write_extras(summary: &Summary, a: &BatchArgs, failed: &mut Vec<String>) -> String {
     let mut written = String::new();
     if a.csv {
-        let records = batch::read_records(&a.out.join("trials.jsonl"))?;
-        batch::write_csv(&records, &a.out.join("trials.csv"))?;
-        written.push_str(", trials.csv");
+        let r = batch::read_records(&a.out.join("trials.jsonl"))
+            .and_then(|records| batch::write_csv(&records, &a.out.join("trials.csv")));
+        match r {
+            Ok(()) => written.push_str(", trials.csv"),
+            Err(e) => failed.push(format!("trials.csv: {e}")),
+        }
     }
     if let Some(file) = &a.junit {
         let cases = batch::junit::batch_cases(summary, a.floor);
         let xml = batch::junit::junit_xml("forkbench batch", &cases, summary.provenance.as_ref());
-        std::fs::write(file, xml).with_context(|| format!("writing {}", file.display()))?;
-        written.push_str(&format!(", JUnit {}", file.display()));
+        match batch::write_atomic(file, xml.as_bytes()) {
+            Ok(()) => written.push_str(&format!(", JUnit {}", file.display())),
+            Err(e) => failed.push(format!("JUnit: {e}")),
+        }
     }
     if a.report {
-        crate::report::write(&a.out, None)?;
-        written.push_str(", report.html");
+        match crate::report::write(&a.out, None) {
+            Ok(_) => written.push_str(", report.html"),
+            Err(e) => failed.push(format!("report.html: {e:#}")),
+        }
     }
-    Ok(written)
+    written
 }
 
 fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()> {
@@ -306,15 +328,14 @@ fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()>
         points.push((p.pallet_noise, run_one(&p.spec, &p.dir, a.jobs)?));
     }
     let text = batch::sweep_markdown(&points);
-    std::fs::write(a.out.join("sweep.md"), &text)
-        .with_context(|| format!("writing {}", a.out.display()))?;
+    batch::write_atomic(&a.out.join("sweep.md"), text.as_bytes())?;
     let json: Vec<_> = points
         .iter()
         .map(|(v, s)| serde_json::json!({"pallet_noise": v, "summary": s}))
         .collect();
-    std::fs::write(
-        a.out.join("sweep.json"),
-        serde_json::to_string_pretty(&json)? + "\n",
+    batch::write_atomic(
+        &a.out.join("sweep.json"),
+        (serde_json::to_string_pretty(&json)? + "\n").as_bytes(),
     )?;
     let mut planners: Vec<String> = points
         .iter()

@@ -326,7 +326,10 @@ fn main() -> ExitCode {
         Ok(Done::PickFailed) => ExitCode::from(3),
         Ok(Done::Regressed) => ExitCode::from(3),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!(
+                "error: {}",
+                forkbench_trial::text::compact_numbers(&format!("{e:#}"))
+            );
             ExitCode::FAILURE
         }
     }

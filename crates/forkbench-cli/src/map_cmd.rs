@@ -32,8 +32,11 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         OccupancyGrid::from_obstacles(&world.obstacles(), &slots, a.resolution_m, a.margin_m)
             .with_context(|| format!("{}: rasterising", a.world.display()))?;
     let grid = match a.inflate_m {
-        Some(r) if !(r.is_finite() && r >= 0.0) => {
-            anyhow::bail!("--inflate-m {r}: must be a finite distance ≥ 0")
+        Some(r) if !(r.is_finite() && (0.0..=forkbench_nav::MAX_INFLATION_M).contains(&r)) => {
+            anyhow::bail!(
+                "--inflate-m {r}: must lie within 0..{} m (the work grows with its square)",
+                forkbench_nav::MAX_INFLATION_M
+            )
         }
         Some(r) => grid.inflated(r),
         None => grid,

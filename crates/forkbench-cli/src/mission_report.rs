@@ -1,6 +1,7 @@
 //! A mission's legs as a text table and its overall figures as JSON.
 
 use forkbench_trial::TrialOutcome;
+use forkbench_trial::text::one_line;
 use serde_json::json;
 
 /// One line per leg, then the totals; empty for a pick trial.
@@ -21,7 +22,7 @@ pub fn legs_text(out: &TrialOutcome) -> String {
     for l in &out.legs {
         s += &format!(
             "{:<32} {:<4} {:<8} {:<8} {:<10} {:<10} {:<11} {:<21} {:<8} {}\n",
-            l.name,
+            one_line(&l.name),
             if l.success { "yes" } else { "NO" },
             num(l.reverse_length_m, "m"),
             num(l.planned_length_m, "m"),
@@ -34,12 +35,17 @@ pub fn legs_text(out: &TrialOutcome) -> String {
                 num(1e3 * l.cross_track_max_m, "mm")
             ),
             num(l.time_s, "s"),
-            l.failure_detail.as_deref().unwrap_or(&l.smoothing),
+            one_line(l.failure_detail.as_deref().unwrap_or(&l.smoothing)),
         );
     }
     let o = overall_json(out);
+    let next = if o["legs_done"] == o["legs"] {
+        "the pick follows"
+    } else {
+        "a leg failed, so the trial ends without the pick"
+    };
     s += &format!(
-        "legs: {} of {} done, {:.1} m driven in {:.1} s; the pick follows\n\n",
+        "legs: {} of {} done, {:.1} m driven in {:.1} s; {next}\n\n",
         o["legs_done"],
         o["legs"],
         o["driven_m"].as_f64().unwrap_or(f64::NAN),

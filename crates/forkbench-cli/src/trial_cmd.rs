@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use anyhow::Context as _;
+use forkbench_trial::text::one_line;
 use forkbench_trial::{Scenario, TrialOptions, TrialOutcome};
 
 /// `trial` (a pick, or a whole mission when the scenario has one) and `mission` (which
@@ -103,12 +104,16 @@ fn text_report(out: &TrialOutcome) -> String {
     let mut lines = vec![
         format!(
             "scenario             {} / case {} / planner {} / seed {}{noise}",
-            out.scenario, out.case, out.planner, out.seed
+            one_line(&out.scenario),
+            one_line(&out.case),
+            one_line(&out.planner),
+            out.seed
         ),
         format!("outcome              {verdict}"),
     ];
     if let Some(d) = &out.failure_detail {
-        lines.push(format!("reason               {d}"));
+        // A planner's message may carry terminal escapes: shown, never obeyed.
+        lines.push(format!("reason               {}", one_line(d)));
     }
     lines.extend([
         format!(

@@ -96,6 +96,13 @@ impl GlobalPlan {
 
 /// Plans `q` on `map`.
 pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError> {
+    if !(q.inflate_m.is_finite() && (0.0..=crate::MAX_INFLATION_M).contains(&q.inflate_m)) {
+        return Err(NavError::Params(format!(
+            "inflation {} m: must lie within 0..{} m",
+            q.inflate_m,
+            crate::MAX_INFLATION_M
+        )));
+    }
     let inflated;
     let footprint;
     let space: &dyn FreeSpace = match q.collision {

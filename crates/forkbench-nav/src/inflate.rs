@@ -4,6 +4,9 @@ use forkbench_core::ForkliftSpec;
 
 use crate::grid::{Cell, OccupancyGrid};
 
+/// Largest inflation radius: several truck widths; the work grows with its square.
+pub const MAX_INFLATION_M: f64 = 5.0;
+
 /// Luo's robot-size model: obstacles inflated by half the wheelbase.
 pub fn luo_inflation_m(truck: &ForkliftSpec) -> f64 {
     0.5 * truck.wheelbase_m

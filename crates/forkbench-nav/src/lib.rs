@@ -12,9 +12,9 @@ pub mod space;
 
 pub use global::{Algorithm, GlobalPlan, GlobalQuery, NavMap, plan_global};
 pub use grid::{Cell, GridError, OccupancyGrid};
-pub use inflate::luo_inflation_m;
+pub use inflate::{MAX_INFLATION_M, luo_inflation_m};
 pub use map_server::{MapError, read_map, write_map};
-pub use roadmap::{PrmParams, Roadmap, astar, plan_prm};
+pub use roadmap::{MAX_CANDIDATE_EDGES, PrmParams, Roadmap, astar, candidate_edges, plan_prm};
 pub use rrt::{RrtParams, plan_rrt, plan_rrt_connect};
 pub use smooth::{SmoothError, SmoothParams, Smoothed, SweptHit};
 pub use space::{

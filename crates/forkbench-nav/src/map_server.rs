@@ -27,6 +27,9 @@ pub enum MapError {
     Image { path: String, reason: String },
     #[error("{path}: {source}")]
     Grid { path: String, source: GridError },
+    /// Not a regular file, too large, or an I/O error; names the file, never its contents.
+    #[error(transparent)]
+    File(#[from] forkbench_core::files::FileError),
 }
 
 /// The map's YAML, as map_server reads it (unknown fields are allowed: Nav2 adds some).
@@ -80,36 +83,32 @@ pub fn write_map(grid: &OccupancyGrid, dir: &Path, name: &str) -> Result<PathBuf
             Cell::Unknown => UNKNOWN_GREY,
         }));
     }
-    let io = |p: &Path, e: std::io::Error| MapError::Io {
-        path: p.display().to_string(),
-        message: e.to_string(),
-    };
-    std::fs::write(&pgm_path, pgm).map_err(|e| io(&pgm_path, e))?;
+    forkbench_core::files::write_atomic(&pgm_path, &pgm)?;
     let yaml = serde_norway::to_string(&meta).map_err(|e| MapError::Yaml {
         path: yaml_path.display().to_string(),
         message: e.to_string(),
     })?;
-    std::fs::write(&yaml_path, yaml).map_err(|e| io(&yaml_path, e))?;
+    forkbench_core::files::write_atomic(&yaml_path, yaml.as_bytes())?;
     Ok(yaml_path)
 }
+
+/// Largest map YAML read.
+pub const MAX_YAML_BYTES: u64 = 1 << 20;
+
+/// Largest PGM image read: 16,384 × 16,384 cells (820 × 820 m at 5 cm).
+pub const MAX_IMAGE_BYTES: u64 = 256 << 20;
 
 /// Reads a map_server map: the YAML at `path` and the PGM it names (relative to the YAML).
 pub fn read_map(path: &Path) -> Result<OccupancyGrid, MapError> {
     let p = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| MapError::Io {
-        path: p.clone(),
-        message: e.to_string(),
-    })?;
+    let text = forkbench_core::files::read_text(path, MAX_YAML_BYTES)?;
     let meta: MapYaml = serde_norway::from_str(&text).map_err(|e| MapError::Yaml {
         path: p.clone(),
         message: e.to_string(),
     })?;
     check(&meta, &p)?;
     let image = path.parent().unwrap_or(Path::new(".")).join(&meta.image);
-    let bytes = std::fs::read(&image).map_err(|e| MapError::Io {
-        path: image.display().to_string(),
-        message: e.to_string(),
-    })?;
+    let bytes = forkbench_core::files::read_bytes(&image, MAX_IMAGE_BYTES)?;
     let pgm = parse_pgm(&bytes).map_err(|reason| MapError::Image {
         path: image.display().to_string(),
         reason,
@@ -209,14 +208,14 @@ fn parse_pgm(bytes: &[u8]) -> Result<Pgm, String> {
             return Ok(String::from_utf8_lossy(&bytes[start..pos]).into_owned());
         }
     };
-    let magic = token()?;
-    if magic != "P5" {
-        return Err(format!("magic {magic:?}, expected P5 (binary greyscale)"));
+    // Messages name what is wrong, never the file's bytes: the path may be any file.
+    if token()? != "P5" {
+        return Err("it does not start with P5 (a binary greyscale PGM)".into());
     }
     let mut number = |what: &str| -> Result<usize, String> {
-        let t = token()?;
-        t.parse::<usize>()
-            .map_err(|_| format!("{what} {t:?} is not a number"))
+        token()?
+            .parse::<usize>()
+            .map_err(|_| format!("its {what} is not a whole number"))
     };
     let (width, height, max) = (number("width")?, number("height")?, number("maxval")?);
     if width == 0 || height == 0 || !(1..=255).contains(&max) {

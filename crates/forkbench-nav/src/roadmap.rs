@@ -15,6 +15,19 @@ use crate::{NavError, Route, Timing};
 pub const MAX_NODES: usize = 100_000;
 /// Most samples with unlimited connection distance.
 pub const MAX_NODES_UNLIMITED: usize = 5_000;
+/// Most candidate edges (node pairs within the connection distance) one roadmap may
+/// check: what 5,000 nodes with unlimited connections check. Bounds time and memory.
+pub const MAX_CANDIDATE_EDGES: f64 = 12_500_000.0;
+
+/// Expected candidate edges of a roadmap of `nodes` samples over `area_m2`: pairs whose
+/// distance is within `connect_m` (every pair when unlimited).
+pub fn candidate_edges(nodes: usize, connect_m: Option<f64>, area_m2: f64) -> f64 {
+    let n = nodes as f64;
+    let share = connect_m.map_or(1.0, |r| {
+        (std::f64::consts::PI * r * r / area_m2.max(1e-9)).min(1.0)
+    });
+    n * n / 2.0 * share
+}
 
 /// PRM settings: sample count, connection distance (`None`: unlimited) and seed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,9 +76,19 @@ pub fn plan_prm<S: FreeSpace + ?Sized>(
             "the connection distance must be a positive number of metres".into(),
         ));
     }
+    let (lo, hi) = grid.extent();
+    let edges = candidate_edges(p.nodes, p.connect_m, (hi[0] - lo[0]) * (hi[1] - lo[1]));
+    if edges > MAX_CANDIDATE_EDGES {
+        return Err(NavError::Params(format!(
+            "{} nodes within {} of each other on this map: about {edges:.3e} candidate edges, \
+             at most {MAX_CANDIDATE_EDGES:.3e} (fewer nodes or a shorter connection distance)",
+            p.nodes,
+            p.connect_m
+                .map_or("any distance".to_owned(), |c| format!("{c} m"))
+        )));
+    }
     let t0 = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
-    let (lo, hi) = grid.extent();
     let mut nodes = vec![start, goal];
     // n uniform samples over the map; those in obstacles are dropped, as in the paper.
     for _ in 0..p.nodes {

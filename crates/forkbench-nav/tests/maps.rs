@@ -138,7 +138,11 @@ fn bad_maps_name_the_file_and_the_reason() {
     let full = std::fs::read(&pgm).expect("pgm");
     for (what, bytes, want) in [
         ("truncated", full[..full.len() / 2].to_vec(), "pixel bytes"),
-        ("ascii", b"P2\n2 2\n255\n0 0 0 0\n".to_vec(), "expected P5"),
+        (
+            "ascii",
+            b"P2\n2 2\n255\n0 0 0 0\n".to_vec(),
+            "does not start with P5",
+        ),
         ("16-bit", b"P5\n2 2\n65535\n".to_vec(), "8-bit"),
     ] {
         std::fs::write(&pgm, bytes).expect("write");

@@ -182,7 +182,7 @@ impl TrialOutcome {
     pub fn fail(&mut self, failure: Failure, detail: String) {
         self.success = false;
         self.failure = Some(failure);
-        self.failure_detail = Some(detail);
+        self.failure_detail = Some(crate::text::compact_numbers(&detail));
     }
 }
 

@@ -51,6 +51,46 @@ pub fn csv_text(text: &str) -> String {
     }
 }
 
+/// Numbers written out with more than 20 digits (`1e300` printed in full, as Rust and
+/// serde print floats) in scientific notation; seeds (at most 20 digits) are kept.
+pub fn compact_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let chars: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        if !chars[i].is_ascii_digit() {
+            out.push(chars[i]);
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < chars.len()
+            && (chars[i].is_ascii_digit()
+                || (chars[i] == '.' && chars.get(i + 1).is_some_and(char::is_ascii_digit)))
+        {
+            i += 1;
+        }
+        let token: String = chars[start..i].iter().collect();
+        let digits = token.chars().filter(char::is_ascii_digit).count();
+        match token.parse::<f64>() {
+            Ok(v) if digits > 20 => out.push_str(&short_sci(v)),
+            _ => out.push_str(&token),
+        }
+    }
+    out
+}
+
+/// `v` as `d.ddddde±N`, trailing zeros of the mantissa dropped.
+fn short_sci(v: f64) -> String {
+    let s = format!("{v:.5e}");
+    match s.split_once('e') {
+        Some((m, e)) if m.contains('.') => {
+            format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+        }
+        _ => s,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -118,7 +118,6 @@ fn output_while_idle_is_bounded_and_retires_the_process() {
         .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
         .expect("VmHWM");
     assert!(hwm_kb < 1_000_000, "peak {hwm_kb} kB");
-    forkbench_ipc::kill_all();
 }
 
 #[test]
@@ -174,11 +173,11 @@ fn an_exit_reports_its_status_and_stderr_even_when_a_child_holds_stdout() {
 #[test]
 fn a_command_that_keeps_timing_out_opens_the_circuit_breaker() {
     let dir = tmp("breaker");
-    let s = scenario("hang", "breaker", 0, 0.5, &dir);
+    let s = scenario("hang", "breaker", 0, 1.0, &dir);
     let t0 = Instant::now();
     run_batch(&spec(s, 8), &dir.join("out"), 1, &|_| {}).expect("finishes");
-    // Three timeouts of 0.5 s, then the other five fail at once.
-    assert!(t0.elapsed() < Duration::from_secs(3), "{:?}", t0.elapsed());
+    // Three timeouts of 1 s, then the other five fail at once (8 s without the breaker).
+    assert!(t0.elapsed() < Duration::from_secs(7), "{:?}", t0.elapsed());
     let recs = read_records(&dir.join("out/trials.jsonl")).expect("records");
     let open = recs
         .iter()

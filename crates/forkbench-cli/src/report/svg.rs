@@ -9,7 +9,8 @@ pub const PALETTE: [&str; 10] = [
 ];
 
 pub fn esc(text: &str) -> String {
-    text.replace('&', "&amp;")
+    forkbench_trial::text::visible(text)
+        .replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")

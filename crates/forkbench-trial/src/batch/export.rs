@@ -4,15 +4,16 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::{BatchError, TrialRecord, io};
+use super::{BatchError, TrialRecord};
+use crate::text::csv_text;
 
 /// One CSV row (column names carry their units).
 #[derive(Debug, Serialize)]
 struct Row<'a> {
-    scenario: &'a str,
-    case: &'a str,
-    planner: &'a str,
-    tracker: &'a str,
+    scenario: String,
+    case: String,
+    planner: String,
+    tracker: String,
     trial: u64,
     seed: u64,
     noise: bool,
@@ -20,7 +21,7 @@ struct Row<'a> {
     pallet_noise_scale: Option<f64>,
     success: bool,
     failure: &'a str,
-    failure_detail: &'a str,
+    failure_detail: String,
     lateral_error_m: Option<f64>,
     heading_error_rad: Option<f64>,
     final_lateral_error_m: Option<f64>,
@@ -37,20 +38,21 @@ struct Row<'a> {
     wall_time_ms: f64,
 }
 
-/// Writes `records` to `path` as CSV (sorted by trial key); a value not measured (the
-/// trial ended before it) is an empty cell.
+/// Writes `records` to `path` as CSV (sorted by trial key), atomically; a value not
+/// measured (the trial ended before it) is an empty cell. Text cells are neutralised
+/// against spreadsheet formulas and control characters ([`csv_text`]).
 pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError> {
     let mut sorted: Vec<&TrialRecord> = records.iter().collect();
     sorted.sort_by_key(|r| r.key());
-    let mut w = csv::Writer::from_path(path).map_err(|e| csv_error(path, e))?;
+    let mut w = csv::Writer::from_writer(Vec::new());
     let finite = |v: f64| v.is_finite().then_some(v);
     for r in sorted {
         let o = &r.outcome;
         w.serialize(Row {
-            scenario: &o.scenario,
-            case: &o.case,
-            planner: &o.planner,
-            tracker: &o.tracker,
+            scenario: csv_text(&o.scenario),
+            case: csv_text(&o.case),
+            planner: csv_text(&o.planner),
+            tracker: csv_text(&o.tracker),
             trial: r.trial,
             seed: o.seed,
             noise: o.noise,
@@ -58,7 +60,7 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
             pallet_noise_scale: r.pallet_noise_scale,
             success: o.success,
             failure: o.failure.map_or("", |f| f.name()),
-            failure_detail: o.failure_detail.as_deref().unwrap_or(""),
+            failure_detail: csv_text(o.failure_detail.as_deref().unwrap_or("")),
             lateral_error_m: o.lateral_error_m,
             heading_error_rad: o.heading_error_rad,
             final_lateral_error_m: finite(o.final_lateral_error_m),
@@ -76,7 +78,10 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
         })
         .map_err(|e| csv_error(path, e))?;
     }
-    w.flush().map_err(io(path))
+    let bytes = w
+        .into_inner()
+        .map_err(|e| BatchError::Invalid(format!("{}: {e}", path.display())))?;
+    super::write_atomic(path, &bytes)
 }
 
 fn csv_error(path: &Path, e: csv::Error) -> BatchError {

@@ -1,5 +1,6 @@
 //! A batch directory's identity: the manifest of what its trials were run with, and the lock that keeps one writer.
 
+use std::collections::HashSet;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -141,6 +142,62 @@ impl Manifest {
             }
         }
         v
+    }
+
+    /// The key of every trial this manifest's batch (this shard of it) runs, in the order
+    /// `BatchSpec::jobs` makes them; none when a scenario's settings lack a name this
+    /// needs (a manifest written by another version).
+    pub fn expected_keys(&self) -> Option<HashSet<super::TrialKey>> {
+        let modes: Vec<Option<bool>> = if self.compare_replanning {
+            vec![Some(false), Some(true)]
+        } else {
+            vec![self.replan]
+        };
+        let [index, count] = self.shard;
+        let mut out = HashSet::new();
+        let mut k: u64 = 0;
+        for s in &self.scenarios {
+            let v = &s.settings;
+            let own = |role: &str| {
+                v.get(role)?
+                    .get("name")?
+                    .as_str()
+                    .map(|n| vec![n.to_owned()])
+            };
+            let or_own = |list: &Vec<String>, role| {
+                (!list.is_empty())
+                    .then(|| list.clone())
+                    .or_else(|| own(role))
+            };
+            let planners = or_own(&self.planners, "planner")?;
+            let trackers = or_own(&self.trackers, "tracker")?;
+            let own_mode = v.get("replan")?.get("enabled")?.as_bool()?;
+            let cases = v.get("cases")?.as_array()?;
+            for case in cases {
+                let case = case.get("name")?.as_str()?;
+                for p in &planners {
+                    for t in &trackers {
+                        for m in &modes {
+                            for trial in 0..self.trials {
+                                if count > 0 && k % count == index {
+                                    let mode = m.unwrap_or(own_mode);
+                                    out.insert((
+                                        s.name.clone(),
+                                        case.to_owned(),
+                                        p.clone(),
+                                        t.clone(),
+                                        mode,
+                                        trial,
+                                    ));
+                                }
+                                k += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Some(out)
     }
 
     /// Trials this manifest's batch (this shard of it) runs.

@@ -2,7 +2,7 @@
 
 use std::collections::{BTreeMap, HashSet};
 use std::fs::File;
-use std::io::{BufRead as _, BufReader};
+use std::io::{BufRead, BufReader, Read as _};
 use std::path::{Path, PathBuf};
 
 use super::{BatchError, DirLock, Manifest, Summary, TrialRecord, io, summarize, write_summary};
@@ -25,15 +25,18 @@ pub(super) fn read_records_torn(path: &Path) -> Result<(Vec<TrialRecord>, bool),
 }
 
 fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), BatchError> {
-    let file = match File::open(path) {
-        Ok(f) => f,
+    let file = match std::fs::metadata(path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((Vec::new(), false)),
         Err(e) => return Err(io(path)(e)),
+        Ok(m) if !m.is_file() => {
+            return Err(BatchError::Invalid(format!(
+                "{}: not a regular file",
+                path.display()
+            )));
+        }
+        Ok(_) => File::open(path).map_err(io(path))?,
     };
-    let lines: Vec<String> = BufReader::new(file)
-        .lines()
-        .collect::<Result<_, _>>()
-        .map_err(io(path))?;
+    let lines = capped_lines(BufReader::new(file), path)?;
     let mut out = Vec::with_capacity(lines.len());
     let last = lines.iter().rposition(|l| !l.trim().is_empty());
     let mut torn = false;
@@ -54,6 +57,36 @@ fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), 
         }
     }
     Ok((out, torn))
+}
+
+/// Longest line of `trials.jsonl` read: a record is a few kilobytes.
+pub const MAX_RECORD_LINE_BYTES: u64 = 16 << 20;
+
+/// The file's lines, each at most [`MAX_RECORD_LINE_BYTES`].
+fn capped_lines(mut r: impl BufRead, path: &Path) -> Result<Vec<String>, BatchError> {
+    let mut lines = Vec::new();
+    loop {
+        let mut buf = Vec::new();
+        let n = (&mut r)
+            .take(MAX_RECORD_LINE_BYTES + 1)
+            .read_until(b'\n', &mut buf)
+            .map_err(io(path))?;
+        if n == 0 {
+            return Ok(lines);
+        }
+        if n as u64 > MAX_RECORD_LINE_BYTES {
+            return Err(BatchError::Record {
+                path: path.display().to_string(),
+                line: lines.len() + 1,
+                message: format!("longer than {MAX_RECORD_LINE_BYTES} bytes; not a trial record"),
+            });
+        }
+        lines.push(
+            String::from_utf8_lossy(&buf)
+                .trim_end_matches('\n')
+                .to_owned(),
+        );
+    }
 }
 
 /// Refuses records that share a trial's key: two writers at once, or a file edited by hand.
@@ -124,9 +157,20 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
     if records.len() as u64 != expected || expected == 0 {
         return Err(BatchError::Invalid(format!(
             "{}: holds {} of the {expected} trials its manifest names (interrupted?); \
-             resume it with the same batch arguments",
+             resume it with the batch's own arguments (its manifest.json says them)",
             dir.display(),
             records.len()
+        )));
+    }
+    // The count alone is not enough: every record must be a trial the manifest names.
+    if let Some(keys) = m.expected_keys()
+        && let Some(stray) = records.iter().find(|r| !keys.contains(&r.key()))
+    {
+        return Err(BatchError::Invalid(format!(
+            "{}: holds a trial its manifest does not name ({}); the file was edited or \
+             mixed with another batch's",
+            path.display(),
+            crate::text::one_line(&format!("{:?}", stray.key()))
         )));
     }
     Ok(records)
@@ -200,6 +244,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
     check_unique(&all, &path)?;
     let mut merged = m0.clone();
     merged.shard = [0, 1];
+    // A merge killed from here on leaves no summary of an older merge beside new records.
+    remove_if_present(&out.join("summary.json"))?;
+    remove_if_present(&out.join("summary.md"))?;
     merged.write(out)?;
     rewrite_records(&path, &all)?;
     let mut summary = summarize(&all);

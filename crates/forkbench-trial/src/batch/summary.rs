@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::{BatchError, TrialRecord};
 use crate::outcome::Failure;
 use crate::stats::{Z95, percentile_sorted, wilson};
+use crate::text::md_cell;
 
 /// Success statistics of one scenario × planner × tracker.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -169,7 +170,7 @@ impl Summary {
     /// The success table as markdown.
     pub fn markdown(&self) -> String {
         let mut s = String::from(
-            "| scenario | planner | tracker | mode | trials | successes | success rate | 95 % CI (Wilson) | failures | lateral mean / p95 (mm) | heading mean / p95 (°) | trial CPU (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+            "| scenario | planner | tracker | mode | trials | successes | success rate | 95 % CI (Wilson) | failures | lateral mean / p95 (mm) | heading mean / p95 (°) | wall time, sum (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         let mm = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.1}", v * 1e3));
         let deg = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.2}", v.to_degrees()));
@@ -185,9 +186,9 @@ impl Summary {
             };
             s.push_str(&format!(
                 "| {} | {} | {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % | {} | {} / {} | {} / {} | {:.2} |\n",
-                r.scenario,
-                r.planner,
-                r.tracker,
+                md_cell(&r.scenario),
+                md_cell(&r.planner),
+                md_cell(&r.tracker),
                 mode_name(r.replan),
                 r.trials,
                 r.successes,
@@ -245,11 +246,11 @@ impl Summary {
             for l in &r.legs {
                 s.push_str(&format!(
                     "| {} | {} | {} | {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % |\n",
-                    r.scenario,
-                    r.planner,
-                    r.tracker,
+                    md_cell(&r.scenario),
+                    md_cell(&r.planner),
+                    md_cell(&r.tracker),
                     mode_name(r.replan),
-                    l.name,
+                    md_cell(&l.name),
                     l.attempted,
                     l.done,
                     100.0 * l.success_rate,

@@ -245,6 +245,15 @@ impl MissionFile {
                 return Err(invalid(file, field, "must be a positive finite number"));
             }
         }
+        if g.inflate_m
+            .is_some_and(|v| v > forkbench_nav::MAX_INFLATION_M)
+        {
+            return Err(invalid(
+                file,
+                "mission.global.inflate_m",
+                &format!("must be at most {} m", forkbench_nav::MAX_INFLATION_M),
+            ));
+        }
         if let Some((field, reason)) = self.tracker.invalid_field() {
             return Err(invalid(file, &format!("mission.tracker.{field}"), reason));
         }

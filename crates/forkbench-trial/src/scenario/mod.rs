@@ -69,7 +69,7 @@ pub(crate) fn parse<T: serde::de::DeserializeOwned>(
     file: &str,
 ) -> Result<T, TrialError> {
     toml::from_str(text).map_err(|e| {
-        let mut message = e.to_string().trim_end().to_owned();
+        let mut message = crate::text::compact_numbers(e.to_string().trim_end());
         if message.chars().count() > MAX_MESSAGE_CHARS {
             message = message.chars().take(MAX_MESSAGE_CHARS).collect::<String>() + " …";
         }

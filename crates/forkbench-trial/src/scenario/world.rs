@@ -138,16 +138,27 @@ impl World {
         let name = path
             .file_stem()
             .map_or("map".to_owned(), |s| s.to_string_lossy().into_owned());
-        Ok(World {
+        let w = World {
             name,
             description: format!("occupancy map {file}"),
             rack,
             ..World::default()
-        })
+        };
+        // A map's origin and resolution can put its cells anywhere: the same bounds.
+        w.check(&file)?;
+        Ok(w)
     }
 
     pub fn parse(text: &str, file: &str) -> Result<Self, TrialError> {
         let w: World = parse(text, file)?;
+        w.check(file)?;
+        Ok(w)
+    }
+
+    /// Every coordinate finite and within ±10 km, lengths positive, and no two pallet
+    /// slots or stations sharing a name (scenarios and missions pick them by name).
+    fn check(&self, file: &str) -> Result<(), TrialError> {
+        let w = self;
         for (kind, list) in [("rack", &w.rack), ("wall", &w.wall)] {
             for (i, r) in list.iter().enumerate() {
                 let f = format!("{kind}[{i}]");
@@ -176,9 +187,19 @@ impl World {
                     heading_deg: s.heading_deg,
                 }
                 .check(file, &format!("{kind}[{i}]"))?;
+                if let Some(j) = list[..i].iter().position(|o| o.name == s.name) {
+                    return Err(invalid(
+                        file,
+                        &format!("{kind}[{i}].name"),
+                        &format!(
+                            "{:?} is also {kind}[{j}]'s name; names pick them, so each once",
+                            s.name
+                        ),
+                    ));
+                }
             }
         }
-        Ok(w)
+        Ok(())
     }
 
     /// Racks and walls for the footprint checker, with a label per obstacle for messages.

@@ -290,6 +290,33 @@ fn approaches(m: &MissionSpec, from: &Pose2, to: &Pose2) -> Vec<Vec<[f64; 2]>> {
 
 /// Plans a leg, trying each approach and then further seeds while no drivable path
 /// comes out.
+/// Most candidate roadmap edges one leg's planning may check over all its attempts and
+/// approaches: a bound on its time that does not depend on the machine (results stay
+/// deterministic), refused before any attempt.
+pub const MAX_LEG_CANDIDATE_EDGES: f64 = 5.0e7;
+
+fn leg_work(map: &NavMap, m: &MissionSpec, (from, to): (&Pose2, &Pose2)) -> Result<(), String> {
+    let g = &m.global;
+    if g.planner != GlobalPlannerKind::Prm {
+        return Ok(());
+    }
+    let (lo, hi) = map.grid.extent();
+    let per =
+        forkbench_nav::candidate_edges(g.nodes, g.connect_m, (hi[0] - lo[0]) * (hi[1] - lo[1]));
+    let tries = f64::from(g.attempts) * approaches(m, from, to).len() as f64;
+    if per * tries > MAX_LEG_CANDIDATE_EDGES {
+        return Err(format!(
+            "planning refused: {} attempts × {} approaches × about {per:.3e} candidate edges \
+             (mission.global nodes {} and connect_m) exceed {MAX_LEG_CANDIDATE_EDGES:.1e}; fewer \
+             nodes, attempts or a shorter connection distance",
+            g.attempts,
+            tries / f64::from(g.attempts),
+            g.nodes
+        ));
+    }
+    Ok(())
+}
+
 fn plan_leg(
     map: &NavMap,
     m: &MissionSpec,
@@ -299,6 +326,9 @@ fn plan_leg(
 ) -> (Result<GlobalPlan, String>, u32, f64) {
     let t0 = Instant::now();
     let g = &m.global;
+    if let Err(why) = leg_work(map, m, (from, to)) {
+        return (Err(why), 0, 0.0);
+    }
     let mut last = Err("no attempt".to_owned());
     for a in 0..g.attempts {
         let seed = seed.wrapping_add(u64::from(a));

@@ -1,0 +1,309 @@
+//! Hostile input, round two: exports that cannot inject (CSV formulas, Markdown, terminal
+//! escapes), special files, records the manifest does not name, duplicate names, maps
+//! beyond the world's bounds, planning settings without a bound, long numbers, secrets in a
+//! planner's environment. Each was accepted, hung or leaked before.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn forkbench(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_forkbench"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!(
+        "forkbench-hostile-in-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("dir");
+    d
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// A pick on the open floor named `name`, with the bspline planner reported as `planner`.
+fn pick(dir: &Path, name: &str, planner: &str) -> PathBuf {
+    let f = dir.join("pick.toml");
+    let body = format!(
+        "name = {name:?}\nstart = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\npallet = {{ x_m = 6.5, y_m = 0.5, heading_deg = 5.0 }}\n[planner]\nkind = \"bspline\"\nname = {planner:?}\n"
+    );
+    std::fs::write(&f, body).expect("write");
+    f
+}
+
+#[test]
+fn csv_and_markdown_cells_cannot_inject() {
+    let dir = tmp("exports");
+    let scn = pick(&dir, "=cmd|' /C calc'!A0", "@SUM(A1) <b>x");
+    let out = dir.join("out");
+    let o = forkbench(&[
+        "batch",
+        scn.to_str().expect("utf8"),
+        "--trials",
+        "2",
+        "--csv",
+        "--record",
+        "none",
+        "--out",
+        out.to_str().expect("utf8"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let csv = std::fs::read_to_string(out.join("trials.csv")).expect("csv");
+    let row = csv.lines().nth(1).expect("a row");
+    assert!(row.starts_with("'=cmd"), "{row}");
+    assert!(row.contains("'@SUM(A1)"), "{row}");
+    let md = std::fs::read_to_string(out.join("summary.md")).expect("md");
+    assert!(md.contains("=cmd\\|' /C calc'!A0"), "{md}");
+    assert!(md.contains("@SUM(A1) &lt;b&gt;x"), "{md}");
+}
+
+#[test]
+fn special_files_are_refused_at_once() {
+    let dir = tmp("special");
+    let t0 = Instant::now();
+    let o = forkbench(&[
+        "regress",
+        "--baseline",
+        "/dev/zero",
+        dir.to_str().expect("utf8"),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        text(&o).contains("not a regular file (a device)"),
+        "{}",
+        text(&o)
+    );
+    // A map whose image is a FIFO or a device, or a file that is no PGM (not quoted).
+    let fifo = dir.join("fifo.pgm");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo")
+            .success()
+    );
+    for (image, says) in [
+        ("fifo.pgm", "not a regular file (a FIFO)"),
+        ("/dev/zero", "not a regular file (a device)"),
+        ("/etc/passwd", "does not start with P5"),
+    ] {
+        let yaml = dir.join("m.yaml");
+        std::fs::write(&yaml, format!("image: {image}\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")).expect("yaml");
+        let o = forkbench(&[
+            "plan",
+            "prm",
+            "--map",
+            yaml.to_str().expect("utf8"),
+            "--start",
+            "1,1,0",
+            "--goal",
+            "2,2,0",
+        ]);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(1), "{t}");
+        assert!(t.contains(says) && !t.contains("root"), "{image}: {t}");
+    }
+    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
+}
+
+#[test]
+fn duplicate_names_and_maps_beyond_the_bounds_are_refused() {
+    let dir = tmp("names");
+    let world = dir.join("w.toml");
+    std::fs::write(&world, "name = \"w\"\n[[station]]\nname = \"dock\"\nx_m = 0.0\ny_m = 0.0\nheading_deg = 0.0\n[[station]]\nname = \"dock\"\nx_m = 5.0\ny_m = 0.0\nheading_deg = 0.0\n").expect("world");
+    let o = forkbench(&[
+        "map",
+        world.to_str().expect("utf8"),
+        "--out",
+        dir.to_str().expect("utf8"),
+    ]);
+    assert!(
+        text(&o).contains("station[1].name") && text(&o).contains("also station[0]"),
+        "{}",
+        text(&o)
+    );
+    // A map placed 1000 km away: its cells become racks beyond ±10 km.
+    let o = forkbench(&[
+        "map",
+        repo_root()
+            .join("worlds/rack-bay.toml")
+            .to_str()
+            .expect("utf8"),
+        "--out",
+        dir.to_str().expect("utf8"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let yaml = dir.join("rack-bay.yaml");
+    let far = std::fs::read_to_string(&yaml)
+        .expect("yaml")
+        .replace("- -5.0", "- 1000000.0");
+    std::fs::write(&yaml, far).expect("write");
+    let scn = dir.join("s.toml");
+    std::fs::write(&scn, format!("name = \"far\"\nworld = {:?}\nstart = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\npallet = {{ x_m = 6.5, y_m = 0.0, heading_deg = 0.0 }}\nplanner = \"bspline\"\n", yaml.display().to_string())).expect("scn");
+    let o = forkbench(&["trial", scn.to_str().expect("utf8")]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("beyond ±10 km"), "{}", text(&o));
+}
+
+#[test]
+fn planning_without_a_bound_is_refused_at_once() {
+    let map = repo_root().join("worlds/warehouse.toml");
+    let map = map.to_str().expect("utf8");
+    let t0 = Instant::now();
+    let o = forkbench(&[
+        "plan",
+        "prm",
+        "--map",
+        map,
+        "--start",
+        "3,3,90",
+        "--goal",
+        "30.75,10.25,0",
+        "--nodes",
+        "100000",
+        "--connect-m",
+        "40",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        text(&o).contains("candidate edges, at most 1.250e7"),
+        "{}",
+        text(&o)
+    );
+    let o = forkbench(&[
+        "map",
+        map,
+        "--inflate-m",
+        "100",
+        "--out",
+        tmp("inflate").to_str().expect("utf8"),
+    ]);
+    assert!(
+        text(&o).contains("--inflate-m 100: must lie within 0..5 m"),
+        "{}",
+        text(&o)
+    );
+    // The shipped mission with 100,000 nodes and 40 m connections: its first leg fails at
+    // once, saying why, and the trial does not pretend the pick follows.
+    let dir = tmp("mission");
+    let src = std::fs::read_to_string(repo_root().join("scenarios/warehouse-mission.toml"))
+        .expect("mission");
+    let big = src
+        .replace("nodes = 500", "nodes = 100000")
+        .replace("connect_m = 10.0", "connect_m = 40.0");
+    let scn = repo_root()
+        .join("crates/forkbench-trial/data/scenarios")
+        .join(format!("probe-{}.toml", std::process::id()));
+    std::fs::write(&scn, big).expect("write");
+    let o = forkbench(&["mission", scn.to_str().expect("utf8")]);
+    let _ = std::fs::remove_file(&scn);
+    let _ = dir;
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(
+        text(&o).contains("planning refused")
+            && text(&o).contains("the trial ends without the pick"),
+        "{}",
+        text(&o)
+    );
+    assert!(t0.elapsed() < Duration::from_secs(20), "{:?}", t0.elapsed());
+}
+
+#[test]
+fn numbers_in_messages_are_compact_and_escapes_are_shown_not_obeyed() {
+    let o = forkbench(&[
+        "plan",
+        "bspline",
+        "--start",
+        "0,0,90",
+        "--goal",
+        "1e300,6.5,105",
+    ]);
+    assert!(text(&o).contains("(1e300, 6.5)"), "{}", text(&o));
+    assert!(text(&o).len() < 400, "{}", text(&o));
+}
+
+#[test]
+fn a_planner_gets_only_the_allowed_environment() {
+    let dir = tmp("env");
+    let script = dir.join("env_planner.py");
+    std::fs::write(&script, "import json, os, sys\nfor line in sys.stdin:\n    m = json.loads(line)\n    if m['type'] == 'hello':\n        print(json.dumps({'type': 'hello', 'protocol': 'forkbench-planner', 'version': 1}), flush=True)\n    else:\n        secret = 'SECRET_PROBE' in os.environ\n        print(json.dumps({'type': 'error', 'id': m['id'], 'message': '\\x1b[2K\\r' + ('secret seen' if secret else 'no secret')}), flush=True)\n").expect("script");
+    for (allow, says) in [
+        ("", "secret seen"),
+        ("pass_env = [\"PATH\"]\n", "no secret"),
+    ] {
+        let scn = dir.join("s.toml");
+        std::fs::write(&scn, format!("name = \"env\"\nstart = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\npallet = {{ x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }}\n[planner]\nkind = \"external\"\ncommand = [\"python3\", \"env_planner.py\"]\n{allow}")).expect("scn");
+        let o = Command::new(env!("CARGO_BIN_EXE_forkbench"))
+            .args(["trial", scn.to_str().expect("utf8"), "--no-noise"])
+            .env("SECRET_PROBE", "1")
+            .output()
+            .expect("runs");
+        let t = text(&o);
+        assert!(t.contains(says), "{allow}: {t}");
+        // The planner's escape is printed as text, not sent to the terminal.
+        assert!(!t.contains('\u{1b}') && t.contains("\\u{1b}[2K"), "{t}");
+    }
+}
+
+#[test]
+fn a_failed_output_skips_none_of_the_others_and_stray_records_are_refused() {
+    let dir = tmp("outputs");
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).expect("dir");
+    // `recordings` is a file: recording the failed trials cannot work.
+    std::fs::write(out.join("recordings"), "in the way").expect("write");
+    let junit = dir.join("batch.xml");
+    let o = forkbench(&[
+        "batch",
+        scn.to_str().expect("utf8"),
+        "--trials",
+        "4",
+        "--out",
+        out.to_str().expect("utf8"),
+        "--csv",
+        "--report",
+        "--junit",
+        junit.to_str().expect("utf8"),
+    ]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(
+        t.contains("| field-test |")
+            && t.contains("the trials are intact")
+            && t.contains("recordings"),
+        "{t}"
+    );
+    for f in [out.join("trials.csv"), out.join("report.html"), junit] {
+        assert!(f.is_file(), "{} was skipped", f.display());
+    }
+    // A record of a trial index the manifest does not name, the count unchanged.
+    let records = out.join("trials.jsonl");
+    let edited = std::fs::read_to_string(&records)
+        .expect("records")
+        .replacen("{\"trial\":0,", "{\"trial\":999,", 1);
+    std::fs::write(&records, edited).expect("write");
+    let o = forkbench(&[
+        "baseline",
+        out.to_str().expect("utf8"),
+        "--out",
+        dir.join("b.json").to_str().expect("utf8"),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o).contains("does not name"), "{}", text(&o));
+}
