@@ -118,6 +118,24 @@ fn special_files_are_refused_at_once() {
         assert_eq!(o.status.code(), Some(1), "{t}");
         assert!(t.contains(says) && !t.contains("root"), "{image}: {t}");
     }
+    // A map YAML that is really another file: the parser's message quotes none of it.
+    let yaml = dir.join("passwd.yaml");
+    std::fs::copy("/etc/passwd", &yaml).expect("copy");
+    let o = forkbench(&[
+        "plan",
+        "prm",
+        "--map",
+        yaml.to_str().expect("utf8"),
+        "--start",
+        "1,1,0",
+        "--goal",
+        "2,2,0",
+    ]);
+    assert!(
+        text(&o).contains("passwd.yaml") && !text(&o).contains("root"),
+        "{}",
+        text(&o)
+    );
     assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
 }
 

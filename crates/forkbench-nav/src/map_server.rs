@@ -92,6 +92,25 @@ pub fn write_map(grid: &OccupancyGrid, dir: &Path, name: &str) -> Result<PathBuf
     Ok(yaml_path)
 }
 
+/// A parser's message with every quoted string replaced by `"…"`: the path may name any
+/// file (a map YAML that is really something else), and its contents stay out of messages.
+fn redact_quoted(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut inside = false;
+    for c in message.chars() {
+        match (c, inside) {
+            ('"', false) => {
+                out.push_str("\"…\"");
+                inside = true;
+            }
+            ('"', true) => inside = false,
+            (c, false) => out.push(c),
+            (_, true) => {}
+        }
+    }
+    out
+}
+
 /// Largest map YAML read.
 pub const MAX_YAML_BYTES: u64 = 1 << 20;
 
@@ -104,7 +123,7 @@ pub fn read_map(path: &Path) -> Result<OccupancyGrid, MapError> {
     let text = forkbench_core::files::read_text(path, MAX_YAML_BYTES)?;
     let meta: MapYaml = serde_norway::from_str(&text).map_err(|e| MapError::Yaml {
         path: p.clone(),
-        message: e.to_string(),
+        message: redact_quoted(&e.to_string()),
     })?;
     check(&meta, &p)?;
     let image = path.parent().unwrap_or(Path::new(".")).join(&meta.image);

@@ -293,7 +293,7 @@ fn approaches(m: &MissionSpec, from: &Pose2, to: &Pose2) -> Vec<Vec<[f64; 2]>> {
 /// Most candidate roadmap edges one leg's planning may check over all its attempts and
 /// approaches: a bound on its time that does not depend on the machine (results stay
 /// deterministic), refused before any attempt.
-pub const MAX_LEG_CANDIDATE_EDGES: f64 = 5.0e7;
+pub const MAX_LEG_CANDIDATE_EDGES: f64 = 1.0e7;
 
 fn leg_work(map: &NavMap, m: &MissionSpec, (from, to): (&Pose2, &Pose2)) -> Result<(), String> {
     let g = &m.global;
