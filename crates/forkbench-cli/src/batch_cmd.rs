@@ -86,7 +86,8 @@ pub struct BatchArgs {
     /// Which trials to record as .rrd and .mcap under OUT/recordings/.
     #[arg(long, value_enum, default_value_t = RecordWhich::Failures)]
     pub record: RecordWhich,
-    /// At most this many recordings (the first in job order).
+    /// At most this many recordings, spread over scenario × case × failure × mode (one
+    /// from each in turn).
     #[arg(long, default_value_t = 20)]
     pub max_recordings: usize,
     /// Discard what OUT holds from a batch with other settings and start over

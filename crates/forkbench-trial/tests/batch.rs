@@ -334,3 +334,28 @@ fn a_corrupt_last_line_is_dropped_before_resuming() {
     assert_eq!(records(&d), full);
     batch::load_results(&d).expect("readable");
 }
+
+/// Recorded failures are spread over scenario × case × failure × mode, not the first ones
+/// in job order (which were all one case of one scenario).
+#[test]
+fn recorded_failures_spread_over_scenarios_failures_and_modes() {
+    let mut s = spec(
+        vec![scenario("field-test.toml"), scenario("rack-pick.toml")],
+        10,
+        7,
+    );
+    s.replan = None;
+    s.compare_replanning = true;
+    let d = tmp("spread");
+    batch::run_batch(&s, &d, 2, &|_| {}).expect("runs");
+    let recs = records(&d);
+    let jobs = batch::trials_to_record(&s, &recs, batch::RecordChoice::Failures, 4);
+    assert_eq!(jobs.len(), 4);
+    let scenarios: std::collections::BTreeSet<&str> =
+        jobs.iter().map(|j| j.scenario.name.as_str()).collect();
+    assert_eq!(scenarios.len(), 2, "both scenarios recorded");
+    let jobs = batch::trials_to_record(&s, &recs, batch::RecordChoice::Failures, 12);
+    let modes: std::collections::BTreeSet<Option<bool>> =
+        jobs.iter().map(|j| j.options.replan).collect();
+    assert_eq!(modes.len(), 2, "both modes recorded");
+}

@@ -1,5 +1,6 @@
 //! Noise sweeps (one batch per pallet-noise scale) and the choice of a batch's trials to record.
 
+use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 
 use super::{BatchSpec, Summary, TrialRecord};
@@ -92,7 +93,7 @@ pub fn trials_to_record<'a>(
     choice: RecordChoice,
     max: usize,
 ) -> Vec<RecordJob<'a>> {
-    let mut sorted: Vec<&TrialRecord> = records
+    let chosen: Vec<&TrialRecord> = records
         .iter()
         .filter(|r| match choice {
             RecordChoice::None => false,
@@ -100,8 +101,7 @@ pub fn trials_to_record<'a>(
             RecordChoice::All => true,
         })
         .collect();
-    sorted.sort_by_key(|r| r.key());
-    sorted
+    spread(chosen, max)
         .into_iter()
         .filter_map(|r| {
             let scenario = spec
@@ -115,6 +115,84 @@ pub fn trials_to_record<'a>(
                 options: r.options(),
             })
         })
-        .take(max)
         .collect()
+}
+
+/// At most `max` of `records`, spread over scenario, then first failed criterion, then
+/// mode, then case: groups are interleaved at each level (one scenario after another, within
+/// one the failures in turn, …) and one trial is taken from each group in turn, so the
+/// recordings show the different ways trials fail, not the first cases of one scenario.
+fn spread(records: Vec<&TrialRecord>, max: usize) -> Vec<&TrialRecord> {
+    type Groups<'r> = BTreeMap<
+        String,
+        BTreeMap<&'static str, BTreeMap<Option<bool>, BTreeMap<String, Vec<&'r TrialRecord>>>>,
+    >;
+    let mut groups: Groups = BTreeMap::new();
+    for r in records {
+        let o = &r.outcome;
+        groups
+            .entry(o.scenario.clone())
+            .or_default()
+            .entry(o.failure.map_or("success", |f| f.name()))
+            .or_default()
+            .entry(r.replan)
+            .or_default()
+            .entry(o.case.clone())
+            .or_default()
+            .push(r);
+    }
+    let ordered: Vec<Vec<&TrialRecord>> = interleave(
+        groups
+            .into_values()
+            .map(|fails| {
+                interleave(
+                    fails
+                        .into_values()
+                        .map(|modes| {
+                            interleave(
+                                modes
+                                    .into_values()
+                                    .map(|cases| cases.into_values().collect())
+                                    .collect(),
+                            )
+                        })
+                        .collect(),
+                )
+            })
+            .collect(),
+    );
+    let mut queues: Vec<VecDeque<&TrialRecord>> = ordered
+        .into_iter()
+        .map(|mut g| {
+            g.sort_by_key(|r| r.key());
+            g.into()
+        })
+        .collect();
+    let mut out = Vec::new();
+    while out.len() < max && queues.iter().any(|q| !q.is_empty()) {
+        for q in &mut queues {
+            if out.len() == max {
+                break;
+            }
+            if let Some(r) = q.pop_front() {
+                out.push(r);
+            }
+        }
+    }
+    out
+}
+
+/// The lists' items taken in turn: the first of each list, then the second of each, …
+fn interleave<T>(lists: Vec<Vec<T>>) -> Vec<T> {
+    let mut iters: Vec<std::vec::IntoIter<T>> = lists.into_iter().map(Vec::into_iter).collect();
+    let mut out = Vec::new();
+    loop {
+        let before = out.len();
+        for it in &mut iters {
+            out.extend(it.next());
+        }
+        if out.len() == before {
+            return out;
+        }
+    }
 }
