@@ -36,7 +36,8 @@ pub fn write_to(dir: &Path, baseline: Option<&Path>, out: &Path) -> anyhow::Resu
 
 fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
     let summary: Summary = batch::load_results(dir)?;
-    let records = batch::read_records(&dir.join("trials.jsonl"))?;
+    let numbered = batch::read_numbered(&dir.join("trials.jsonl"))?;
+    let records: Vec<batch::TrialRecord> = numbered.iter().map(|(_, r)| r.clone()).collect();
     let manifest = Manifest::read(dir)?.context("no manifest.json")?;
     let mut h = format!(
         "<p><b>{} trials, {} successes ({:.1} %)</b></p>",
@@ -80,7 +81,7 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
     h.push_str("<h2>Entry errors (trials whose forks reached the face)</h2>");
     h.push_str(&sections::error_distributions(&manifest, &records));
     h.push_str("<h2>Failed trials</h2>");
-    h.push_str(&sections::failed_trials(dir, &records));
+    h.push_str(&sections::failed_trials(dir, &numbered));
     h.push_str("<h2>Provenance</h2>");
     h.push_str(&sections::provenance(summary.provenance.as_ref()));
     Ok(h)

@@ -247,15 +247,18 @@ pub fn error_distributions(manifest: &Manifest, records: &[TrialRecord]) -> Stri
 }
 
 /// Failed trials: reason, and links to their recordings where the batch wrote them.
-pub fn failed_trials(dir: &Path, records: &[TrialRecord]) -> String {
+pub fn failed_trials(dir: &Path, records: &[(usize, TrialRecord)]) -> String {
+    const MAX_ROWS: usize = 2000;
     let rec_dir = dir.join("recordings");
+    let trials_file = dir.join("trials.jsonl").display().to_string();
     let mut h = String::from(
-        "<table><tr><th>scenario</th><th>case</th><th>planner / tracker</th><th>trial</th><th>failure</th><th>recording</th></tr>",
+        "<p><input id=\"failed-filter\" placeholder=\"filter: scenario, case, mode, failure, seed…\" size=\"60\" oninput=\"const q=this.value.toLowerCase();for(const r of document.querySelectorAll('#failed tr.f'))r.style.display=r.textContent.toLowerCase().includes(q)?'':'none'\"></p><table id=\"failed\"><tr><th>scenario</th><th>case</th><th>planner / tracker</th><th>mode</th><th>trial</th><th>seed</th><th>failure</th><th>recording</th><th>replay</th></tr>",
     );
-    let mut failed: Vec<&TrialRecord> = records.iter().filter(|r| !r.outcome.success).collect();
-    failed.sort_by_key(|r| r.key());
-    let shown = failed.len().min(200);
-    for r in &failed[..shown] {
+    let mut failed: Vec<&(usize, TrialRecord)> =
+        records.iter().filter(|(_, r)| !r.outcome.success).collect();
+    failed.sort_by_key(|(_, r)| r.key());
+    let shown = failed.len().min(MAX_ROWS);
+    for (line, r) in &failed[..shown] {
         let o = &r.outcome;
         let stem = crate::record::recording_stem(o, r.replan == Some(true));
         let links: Vec<String> = ["rrd", "mcap"]
@@ -265,19 +268,22 @@ pub fn failed_trials(dir: &Path, records: &[TrialRecord]) -> String {
             .collect();
         let _ = write!(
             h,
-            "<tr><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td><b>{}</b>: {}</td><td>{}</td></tr>",
+            "<tr class=\"f\"><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td><b>{}</b>: {}</td><td>{}</td><td><code>forkbench replay {} --line {line} --rrd t.rrd</code></td></tr>",
             esc(&o.scenario),
             esc(&o.case),
             esc(&o.planner),
             esc(&o.tracker),
+            batch::mode_name(r.replan == Some(true)),
             r.trial,
+            o.seed,
             o.failure.map_or("?", |f| f.name()),
             esc(o.failure_detail.as_deref().unwrap_or("")),
             if links.is_empty() {
                 "–".to_owned()
             } else {
                 links.join(" ")
-            }
+            },
+            esc(&trials_file)
         );
     }
     let _ = write!(
@@ -285,7 +291,9 @@ pub fn failed_trials(dir: &Path, records: &[TrialRecord]) -> String {
         "</table><p>{} failed trials{}.</p>",
         failed.len(),
         if shown < failed.len() {
-            format!(", the first {shown} listed")
+            format!(
+                ", the first {shown} in key order listed (all are in trials.jsonl and trials.csv)"
+            )
         } else {
             String::new()
         }
