@@ -23,18 +23,14 @@ fn open(id: &str, w: f64, h: f64) -> String {
     )
 }
 
-/// One horizontal bar per row, split into segments (kind, count); a legend of kinds.
+/// One horizontal bar per row, split into segments (kind, count) as shares of the row's
+/// trials (every bar is 100 %, so a 20-trial row reads like a 460-trial one); a legend.
 pub fn stacked_bars(id: &str, rows: &[(String, Vec<(String, u64)>)], kinds: &[String]) -> String {
     let (label_w, bar_w, row_h) = (330.0, 420.0, 22.0);
     let h = 40.0 + row_h * rows.len() as f64 + 22.0 * kinds.len().div_ceil(4) as f64;
-    let mut s = open(id, label_w + bar_w + 80.0, h);
-    let total_max = rows
-        .iter()
-        .map(|(_, segs)| segs.iter().map(|(_, n)| *n).sum::<u64>())
-        .max()
-        .unwrap_or(1)
-        .max(1) as f64;
+    let mut s = open(id, label_w + bar_w + 100.0, h);
     for (i, (label, segs)) in rows.iter().enumerate() {
+        let total = segs.iter().map(|(_, n)| *n).sum::<u64>().max(1) as f64;
         let y = 10.0 + row_h * i as f64;
         let _ = write!(
             s,
@@ -45,19 +41,19 @@ pub fn stacked_bars(id: &str, rows: &[(String, Vec<(String, u64)>)], kinds: &[St
         );
         let mut x = label_w;
         for (kind, n) in segs {
-            let w = bar_w * *n as f64 / total_max;
+            let w = bar_w * *n as f64 / total;
             let c = PALETTE[kinds.iter().position(|k| k == kind).unwrap_or(0) % PALETTE.len()];
             let _ = write!(
                 s,
-                "<rect x=\"{x:.1}\" y=\"{y}\" width=\"{w:.1}\" height=\"16\" fill=\"{c}\"><title>{}: {n}</title></rect>",
-                esc(kind)
+                "<rect x=\"{x:.1}\" y=\"{y}\" width=\"{w:.1}\" height=\"16\" fill=\"{c}\"><title>{}: {n} ({:.1} %)</title></rect>",
+                esc(kind),
+                100.0 * *n as f64 / total
             );
             x += w;
         }
-        let n: u64 = segs.iter().map(|(_, n)| n).sum();
         let _ = write!(
             s,
-            "<text x=\"{:.1}\" y=\"{}\">{n}</text>",
+            "<text x=\"{:.1}\" y=\"{}\">n = {total}</text>",
             x + 4.0,
             y + 13.0
         );
@@ -93,7 +89,7 @@ pub fn heatmap(
     // Wide enough for the title even with few columns.
     let (w, h) = (
         (left + cw * xs.len() as f64 + 20.0).max(left + 7.5 * title.chars().count() as f64),
-        top + ch * ys.len() as f64 + 50.0,
+        top + ch * ys.len() as f64 + 80.0,
     );
     let mut s = open(id, w, h);
     let _ = write!(
@@ -120,12 +116,14 @@ pub fn heatmap(
             );
             let _ = write!(
                 s,
-                "<rect x=\"{x}\" y=\"{y}\" width=\"{}\" height=\"{}\" fill=\"{colour}\"><title>{k}/{n}</title></rect><text x=\"{}\" y=\"{}\" text-anchor=\"middle\" fill=\"white\">{:.0}%</text>",
+                "<rect x=\"{x}\" y=\"{y}\" width=\"{}\" height=\"{}\" fill=\"{colour}\"><title>{k}/{n}</title></rect><text x=\"{}\" y=\"{}\" text-anchor=\"middle\" fill=\"white\">{:.0}%</text><text x=\"{}\" y=\"{}\" text-anchor=\"middle\" fill=\"white\" font-size=\"9\">n={n}</text>",
                 cw - 2.0,
                 ch - 2.0,
                 x + cw / 2.0,
-                y + 19.0,
-                100.0 * r
+                y + 13.0,
+                100.0 * r,
+                x + cw / 2.0,
+                y + 25.0
             );
         }
     }
@@ -148,15 +146,54 @@ pub fn heatmap(
         top + ch * ys.len() as f64 / 2.0,
         esc(y_label)
     );
+    colour_scale(&mut s, left, yb + 50.0);
     s + "</svg>"
+}
+
+/// The heatmap's colour key: 0 % to 100 % success in ten steps.
+fn colour_scale(s: &mut String, left: f64, y: f64) {
+    for i in 0..=10 {
+        let r = f64::from(i) / 10.0;
+        let _ = write!(
+            s,
+            "<rect x=\"{:.1}\" y=\"{y}\" width=\"20\" height=\"10\" fill=\"rgb({},{},90)\"/>",
+            left + 20.0 * f64::from(i),
+            (220.0 * (1.0 - r)) as u8 + 30,
+            (180.0 * r) as u8 + 40
+        );
+    }
+    let _ = write!(
+        s,
+        "<text x=\"{left}\" y=\"{}\" font-size=\"10\">0 %</text><text x=\"{}\" y=\"{}\" font-size=\"10\" text-anchor=\"end\">100 % success</text>",
+        y + 22.0,
+        left + 220.0,
+        y + 22.0
+    );
+}
+
+/// Tick values at round steps (1, 2, 2.5 or 5 × 10ᵏ) within [a, b], about four of them.
+fn round_ticks(a: f64, b: f64) -> Vec<f64> {
+    let span = (b - a).abs().max(1e-12);
+    let raw = span / 4.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 2.5, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let first = (a / step).ceil() as i64;
+    let last = (b / step + 1e-9).floor() as i64;
+    (first..=last).map(|k| k as f64 * step).collect()
 }
 
 /// A tick label with the digits its size needs.
 fn tick(v: f64) -> String {
-    match v.abs() {
-        a if a >= 10.0 || a == 0.0 => format!("{v:.0}"),
-        a if a >= 1.0 => format!("{v:.1}"),
-        _ => format!("{v:.3}"),
+    let t = format!("{v:.3}");
+    let t = t.trim_end_matches('0').trim_end_matches('.');
+    if t == "-0" {
+        "0".to_owned()
+    } else {
+        t.to_owned()
     }
 }
 
@@ -176,22 +213,24 @@ fn axes(
         "<text x=\"{left}\" y=\"18\" font-weight=\"bold\">{}</text><rect x=\"{left}\" y=\"{top}\" width=\"{w}\" height=\"{h}\" fill=\"none\" stroke=\"#444\"/>",
         esc(title)
     );
-    for i in 0..=4 {
-        let f = i as f64 / 4.0;
-        let (x, y) = (left + w * f, top + h * (1.0 - f));
+    for v in round_ticks(y0, y1) {
+        let y = top + h * (1.0 - (v - y0) / (y1 - y0).max(1e-12));
         let _ = write!(
             s,
-            "<line x1=\"{left}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>",
+            "<line x1=\"{left}\" x2=\"{}\" y1=\"{y:.1}\" y2=\"{y:.1}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{:.1}\" text-anchor=\"end\">{}</text>",
             left + w,
             left - 4.0,
             y + 4.0,
-            tick(y0 + (y1 - y0) * f)
+            tick(v)
         );
+    }
+    for v in round_ticks(x0, x1) {
+        let x = left + w * (v - x0) / (x1 - x0).max(1e-12);
         let _ = write!(
             s,
-            "<text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">{}</text>",
+            "<text x=\"{x:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>",
             top + h + 16.0,
-            tick(x0 + (x1 - x0) * f)
+            tick(v)
         );
     }
     let _ = write!(
