@@ -359,3 +359,25 @@ fn recorded_failures_spread_over_scenarios_failures_and_modes() {
         jobs.iter().map(|j| j.options.replan).collect();
     assert_eq!(modes.len(), 2, "both modes recorded");
 }
+
+/// After a resume the provenance keeps the first run's start and lists every run.
+#[test]
+fn provenance_keeps_the_first_run_and_lists_each_resume() {
+    let d = tmp("runs");
+    let s = spec(vec![scenario("field-test.toml")], 6, 3);
+    batch::run_batch(&s, &d, 2, &|_| {}).expect("runs");
+    let path = d.join("trials.jsonl");
+    let kept: Vec<String> = std::fs::read_to_string(&path)
+        .expect("records")
+        .lines()
+        .take(4)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&path, kept.concat()).expect("write");
+    let summary = batch::run_batch(&s, &d, 2, &|_| {}).expect("resumes");
+    let p = summary.provenance.expect("provenance");
+    assert_eq!(p.runs.len(), 2);
+    assert_eq!((p.runs[0].trials_to_run, p.runs[1].trials_to_run), (6, 2));
+    assert_eq!(p.started_at, p.runs[0].started_at);
+    assert!(p.runs.iter().all(|r| r.finished_at.is_some()));
+}

@@ -373,25 +373,33 @@ pub fn provenance(p: Option<&Provenance>) -> String {
             format!("{} / {}", p.started_at, p.finished_at),
         ),
         ("command", p.arguments.join(" ")),
-        (
-            "batch",
-            format!(
-                "seed {}, {} trials per row and case, shard {}/{}, planners {:?}, trackers {:?}, pallet noise {:?}, replan {:?}",
-                m.seed,
-                m.trials,
-                m.shard[0],
-                m.shard[1],
-                m.planners,
-                m.trackers,
-                m.pallet_noise_scale,
-                m.replan
-            ),
-        ),
+        ("batch", batch_in_words(m)),
     ];
     for (k, v) in items {
         let _ = write!(h, "<tr><th>{k}</th><td>{}</td></tr>", esc(&v));
     }
     h.push_str("</table>");
+    if p.runs.len() > 1 {
+        h.push_str("<p>Runs that wrote trials here (the first, then each resume):</p><table><tr><th>run</th><th>started / finished (UTC)</th><th>trials to run</th><th>host, threads</th><th>command</th></tr>");
+        for (i, r) in p.runs.iter().enumerate() {
+            let _ = write!(
+                h,
+                "<tr><td>{}</td><td>{} / {}</td><td>{}</td><td>{}, {}</td><td>{}</td></tr>",
+                if i == 0 {
+                    "first".to_owned()
+                } else {
+                    format!("resume {i}")
+                },
+                esc(&r.started_at),
+                esc(r.finished_at.as_deref().unwrap_or("interrupted")),
+                r.trials_to_run,
+                esc(&r.host),
+                r.jobs,
+                esc(&r.arguments.join(" "))
+            );
+        }
+        h.push_str("</table>");
+    }
     for s in &m.scenarios {
         let text = serde_json::to_string_pretty(&s.settings).unwrap_or_default();
         let _ = write!(
@@ -404,6 +412,37 @@ pub fn provenance(p: Option<&Provenance>) -> String {
         );
     }
     h
+}
+
+/// The batch's arguments in words (not Rust's debug output).
+fn batch_in_words(m: &Manifest) -> String {
+    let list = |v: &[String], none: &str| {
+        if v.is_empty() {
+            none.to_owned()
+        } else {
+            v.join(", ")
+        }
+    };
+    let noise = m
+        .pallet_noise_scale
+        .map_or("as each scenario sets it".to_owned(), |x| {
+            format!("scaled × {x}")
+        });
+    let modes = match (m.compare_replanning, m.replan) {
+        (true, _) => "both (plan once and replan, same seeds)",
+        (false, Some(true)) => "replan always",
+        (false, Some(false)) => "plan once always",
+        (false, None) => "each scenario's own",
+    };
+    format!(
+        "seed {}, {} trials per row and case, shard {} of {}; planners: {}; trackers: {}; pallet-estimate noise {noise}; replanning: {modes}",
+        m.seed,
+        m.trials,
+        m.shard[0] + 1,
+        m.shard[1],
+        list(&m.planners, "each scenario's own"),
+        list(&m.trackers, "each scenario's own"),
+    )
 }
 
 /// Success against the pallet-estimate σ scale, a line per scenario × planner × tracker.

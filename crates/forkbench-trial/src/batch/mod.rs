@@ -31,7 +31,7 @@ pub use gate::{
     paired_trials_needed, regress,
 };
 pub use manifest::{DirLock, Manifest};
-pub use provenance::{Provenance, rfc3339, scenario_differences};
+pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};
 pub use seed::{SEED_SCHEME, trial_seed};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_results, merge, read_numbered, read_records};
@@ -375,7 +375,13 @@ impl BatchSpec {
         let want = Manifest::of(self)?;
         let trials = dir.join("trials.jsonl");
         if self.force_new {
-            for f in ["trials.jsonl", "summary.json", "summary.md", manifest::FILE] {
+            for f in [
+                "trials.jsonl",
+                "summary.json",
+                "summary.md",
+                manifest::FILE,
+                provenance::RUNS_FILE,
+            ] {
                 remove_if_present(&dir.join(f))?;
             }
             let rec = dir.join("recordings");
@@ -443,6 +449,7 @@ pub fn run_batch(
     if torn || !raw_ends_clean {
         rewrite_records(&path, &existing)?;
     }
+    provenance::log_run(dir, jobs, todo.len() as u64, started)?;
     let file = OpenOptions::new()
         .create(true)
         .append(true)
@@ -487,7 +494,8 @@ pub fn run_batch(
         .filter(|r| wanted.contains(&r.key()))
         .collect();
     let mut summary = summarize(&records);
-    summary.provenance = Some(Provenance::collect(Manifest::of(spec)?, jobs, started));
+    let provenance = Provenance::collect(Manifest::of(spec)?, jobs, started);
+    summary.provenance = Some(provenance.with_runs(provenance::finish_runs(dir)));
     write_summary(dir, &summary)?;
     Ok(summary)
 }

@@ -25,6 +25,74 @@ pub struct Provenance {
     /// Seed, trials, shard, planners, trackers, overrides and every scenario resolved in
     /// full (truck, tracker, sensors, tolerances, cases).
     pub manifest: Manifest,
+    /// Every run that wrote trials into the directory, the first one (the original
+    /// command) first, then each resume.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub runs: Vec<RunEntry>,
+}
+
+/// One invocation of a batch on its directory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunEntry {
+    pub started_at: String,
+    /// None when the run was interrupted.
+    pub finished_at: Option<String>,
+    pub arguments: Vec<String>,
+    pub host: String,
+    pub jobs: usize,
+    /// Trials this run had left to do when it started.
+    pub trials_to_run: u64,
+}
+
+/// The run log of a batch directory: one JSON line per invocation.
+pub(super) const RUNS_FILE: &str = "runs.jsonl";
+
+/// Appends this invocation to `dir`'s run log.
+pub(super) fn log_run(
+    dir: &std::path::Path,
+    jobs: usize,
+    trials_to_run: u64,
+    started: SystemTime,
+) -> Result<(), super::BatchError> {
+    use std::io::Write as _;
+    let entry = RunEntry {
+        started_at: rfc3339(started),
+        finished_at: None,
+        arguments: std::env::args().collect(),
+        host: host_name(),
+        jobs,
+        trials_to_run,
+    };
+    let path = dir.join(RUNS_FILE);
+    let line =
+        serde_json::to_string(&entry).map_err(|e| super::BatchError::Invalid(e.to_string()))?;
+    std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .and_then(|mut f| writeln!(f, "{line}"))
+        .map_err(super::io(&path))
+}
+
+/// The run log of `dir` (unreadable lines skipped: it is informative) with this run, the
+/// last, marked finished now and written back; a run without a finish was interrupted.
+pub(super) fn finish_runs(dir: &std::path::Path) -> Vec<RunEntry> {
+    let path = dir.join(RUNS_FILE);
+    let text = forkbench_core::files::read_text(&path, 16 << 20).unwrap_or_default();
+    let mut runs: Vec<RunEntry> = text
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect();
+    if let Some(last) = runs.last_mut() {
+        last.finished_at = Some(rfc3339(SystemTime::now()));
+    }
+    let lines: Vec<String> = runs
+        .iter()
+        .filter_map(|r| serde_json::to_string(r).ok())
+        .collect();
+    // Informative only: a failed rewrite leaves the log as it was.
+    let _ = forkbench_core::files::write_atomic(&path, (lines.join("\n") + "\n").as_bytes());
+    runs
 }
 
 impl Provenance {
@@ -42,7 +110,19 @@ impl Provenance {
             started_at: rfc3339(started),
             finished_at: rfc3339(SystemTime::now()),
             manifest,
+            runs: Vec::new(),
         }
+    }
+
+    /// This provenance over a resumed directory's runs: started and commanded as its
+    /// first run, every run listed.
+    pub fn with_runs(mut self, runs: Vec<RunEntry>) -> Self {
+        if let Some(first) = runs.first() {
+            self.started_at = first.started_at.clone();
+            self.arguments = first.arguments.clone();
+        }
+        self.runs = runs;
+        self
     }
 }
 
