@@ -1026,3 +1026,34 @@ fn replay_reproduces_mission_and_replanning_trials_from_a_batch() {
         );
     }
 }
+
+/// Contradictory truck–pallet geometry is refused at load, naming the field the user set
+/// (before, fork spacing failed at the end of the trial and a short fork named a field the
+/// user never set).
+#[test]
+fn contradictory_fork_geometry_is_refused_at_load() {
+    let base =
+        std::fs::read_to_string(repo_root().join("scenarios/field-test.toml")).expect("read");
+    for (setting, field, says) in [
+        (
+            "fork_spacing_m = 1.5",
+            "truck.fork_spacing_m",
+            "within 0.280..0.790 m",
+        ),
+        (
+            "fork_length_m = 0.5",
+            "truck.fork_length_m",
+            "insertion_depth_m = 1 m (the default)",
+        ),
+    ] {
+        let f = tmp(&format!("geometry-{}.toml", &setting[..8]));
+        std::fs::write(&f, format!("{base}\n[truck]\n{setting}\n")).expect("write");
+        let out = forkbench(&["trial", f.to_str().expect("utf8")]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains(field) && err.contains(says),
+            "{setting}: {err}"
+        );
+    }
+}

@@ -241,3 +241,63 @@ pub(super) fn resolve_cases(
     }
     Ok(cases)
 }
+
+/// The truck's forks against the pallet: each fork inside its pocket, and the required
+/// insertion depth within both the forks and the pallet. Contradictions are refused at
+/// load, naming the field and saying when the other value is a default.
+pub(super) fn check_geometry(
+    f: &ScenarioFile,
+    pallet: &forkbench_core::PalletSpec,
+    file: &str,
+) -> Result<(), TrialError> {
+    let kind = match f.pallet_kind {
+        super::file::PalletKind::Field1200 => "pallet_kind field-1200",
+        super::file::PalletKind::Sim1000 => "pallet_kind sim-1000",
+    };
+    let t = &f.truck;
+    let (half_fork, half_pocket) = (t.fork_width_m / 2.0, pallet.pocket_width_m / 2.0);
+    let o = pallet.pocket_offsets_m()[0].abs();
+    // Each fork's centre at ±spacing/2 must keep the fork inside [o − w/2, o + w/2].
+    let (lo, hi) = (
+        2.0 * (o - half_pocket + half_fork),
+        2.0 * (o + half_pocket - half_fork),
+    );
+    if !(lo..=hi).contains(&t.fork_spacing_m) {
+        return Err(invalid(
+            file,
+            "truck.fork_spacing_m",
+            &format!(
+                "{} m puts the {} m wide forks outside the pallet's pockets ({kind}: pocket centres ±{o:.4} m, {} m wide): the spacing must lie within {lo:.3}..{hi:.3} m",
+                t.fork_spacing_m, t.fork_width_m, pallet.pocket_width_m
+            ),
+        ));
+    }
+    let depth = f.tolerances.insertion_depth_m;
+    let default_depth = super::file::Tolerances::default().insertion_depth_m;
+    let note = if depth == default_depth {
+        " (the default)"
+    } else {
+        ""
+    };
+    if t.fork_length_m < depth {
+        return Err(invalid(
+            file,
+            "truck.fork_length_m",
+            &format!(
+                "{} m forks cannot reach the required insertion depth tolerances.insertion_depth_m = {depth} m{note}; lower that or lengthen the forks",
+                t.fork_length_m
+            ),
+        ));
+    }
+    if pallet.depth_m < depth {
+        return Err(invalid(
+            file,
+            "tolerances.insertion_depth_m",
+            &format!(
+                "{depth} m is deeper than the pallet ({kind}: {} m)",
+                pallet.depth_m
+            ),
+        ));
+    }
+    Ok(())
+}

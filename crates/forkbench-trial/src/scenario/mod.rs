@@ -199,13 +199,7 @@ impl Scenario {
             PalletKind::Field1200 => PalletSpec::field_1200(),
             PalletKind::Sim1000 => PalletSpec::sim_1000(),
         };
-        if f.tolerances.insertion_depth_m > pallet.depth_m.min(f.truck.fork_length_m) {
-            return Err(invalid(
-                file,
-                "tolerances.insertion_depth_m",
-                "deeper than the pallet or the forks allow",
-            ));
-        }
+        checks::check_geometry(&f, &pallet, file)?;
         let cases = resolve_cases(&f, &world, &pallet, file)?;
         let mission = match &f.mission {
             Some(m) => Some(m.resolve(&world, file)?),
