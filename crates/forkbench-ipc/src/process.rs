@@ -158,16 +158,10 @@ impl Process {
         }
     }
 
-    /// Lines it printed while nobody asked: a protocol violation that retires it.
-    pub fn idle_output(&mut self) -> usize {
-        let mut n = 0;
-        loop {
-            match self.lines.try_recv() {
-                Ok(_) => n += 1,
-                Err(TryRecvError::Empty) => return n,
-                Err(TryRecvError::Disconnected) => return n + 1,
-            }
-        }
+    /// Whether it printed while nobody asked (a protocol violation that retires it). One
+    /// look: a child that floods would refill the channel as fast as it is drained.
+    pub fn has_idle_output(&mut self) -> bool {
+        !matches!(self.lines.try_recv(), Err(TryRecvError::Empty))
     }
 
     /// Whether an error message is a timeout (for the circuit breaker).
@@ -336,5 +330,51 @@ pub fn clip(line: &str) -> String {
         t.chars().take(200).collect::<String>() + " …"
     } else {
         t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sh(script: &str) -> Process {
+        let command = vec!["sh".to_owned(), "-c".to_owned(), script.to_owned()];
+        Process::start(Spawn {
+            command: &command,
+            dir: Path::new("."),
+            env: &EnvPolicy::Inherit,
+            what: "child",
+        })
+        .expect("starts")
+    }
+
+    #[test]
+    fn output_while_idle_is_seen_and_bounded() {
+        // Answers, then floods its stdout forever.
+        let mut p = sh("read l; echo answer; yes flood");
+        let a = p
+            .exchange("request", Duration::from_secs(5))
+            .expect("answers");
+        assert_eq!(a.trim(), "answer");
+        std::thread::sleep(Duration::from_millis(200));
+        assert!(p.has_idle_output());
+        // A child that answers and then stays quiet has nothing waiting.
+        let mut q = sh("read l; echo answer; sleep 1000");
+        q.exchange("request", Duration::from_secs(5))
+            .expect("answers");
+        std::thread::sleep(Duration::from_millis(200));
+        assert!(!q.has_idle_output());
+    }
+
+    #[test]
+    fn a_child_that_stops_reading_times_out_and_is_killed() {
+        let mut p = sh("sleep 1000");
+        let big = "x".repeat(1 << 20);
+        let t0 = Instant::now();
+        let e = p
+            .exchange(&big, Duration::from_millis(300))
+            .expect_err("times out");
+        assert!(Process::is_timeout(&e), "{e}");
+        assert!(t0.elapsed() < Duration::from_secs(3));
     }
 }

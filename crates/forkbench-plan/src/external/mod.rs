@@ -122,7 +122,7 @@ impl ExternalPlanner {
         let key = (self.cfg.command.clone(), self.dir.clone(), self.env());
         let taken = POOL.with(|p| p.borrow_mut().remove(&key));
         if let Some((mut p, id)) = taken
-            && p.idle_output() == 0
+            && !p.has_idle_output()
         {
             return Ok((p, id));
         }

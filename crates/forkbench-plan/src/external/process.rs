@@ -56,9 +56,9 @@ impl Process {
         self.0.exchange(line, timeout)
     }
 
-    /// Lines printed while it waited in the pool (each is a protocol violation).
-    pub fn idle_output(&mut self) -> usize {
-        self.0.idle_output()
+    /// Whether it printed while it waited in the pool (a protocol violation).
+    pub fn has_idle_output(&mut self) -> bool {
+        self.0.has_idle_output()
     }
 }
 

@@ -14,6 +14,7 @@ mod compare;
 mod export;
 mod gate;
 mod gate_text;
+mod guard;
 pub mod junit;
 mod manifest;
 mod provenance;
@@ -30,6 +31,7 @@ pub use gate::{
     DEFAULT_ALPHA, GateOptions, GateReport, PairCounts, Pairing, RegressRow, Verdict,
     paired_trials_needed, regress,
 };
+pub use guard::guarded;
 pub use manifest::{DirLock, Manifest};
 pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};
 pub use seed::{SEED_SCHEME, trial_seed};
@@ -43,7 +45,7 @@ pub use sweep::{
 use store::{check_unique, read_records_torn, remove_if_present, rewrite_records};
 use summary::write_summary;
 
-use crate::outcome::{Failure, TrialOutcome};
+use crate::outcome::TrialOutcome;
 use crate::scenario::Scenario;
 use crate::trial::{TrialOptions, run_trial};
 
@@ -282,42 +284,6 @@ impl BatchSpec {
     }
 }
 
-/// Runs `f`, turning a panic into an `error` outcome that carries the message and seed.
-pub fn guarded(
-    s: &Scenario,
-    case: &str,
-    names: (&str, &str),
-    seed: u64,
-    f: impl FnOnce() -> TrialOutcome,
-) -> TrialOutcome {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|panic| {
-        let message = panic
-            .downcast_ref::<&str>()
-            .map(|s| (*s).to_owned())
-            .or_else(|| panic.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "panic with a non-text payload".to_owned());
-        error_outcome(
-            s,
-            case,
-            names,
-            seed,
-            format!("trial panicked (seed {seed}): {message}"),
-        )
-    })
-}
-
-fn error_outcome(
-    s: &Scenario,
-    case: &str,
-    names: (&str, &str),
-    seed: u64,
-    detail: String,
-) -> TrialOutcome {
-    let mut out = TrialOutcome::blank(&s.name, case, names, seed, s.noise.enabled);
-    out.fail(Failure::Error, detail);
-    out
-}
-
 impl BatchSpec {
     /// The batch's own arguments: trials, shard, worker threads and unique names.
     fn check(&self, jobs: usize) -> Result<(), BatchError> {
@@ -488,8 +454,18 @@ pub fn run_batch(
     {
         return Err(io(&path)(e));
     }
+    summarize_dir(spec, dir, jobs, started)
+}
+
+/// The summary of this batch's records in `dir`, with its provenance, written beside them.
+fn summarize_dir(
+    spec: &BatchSpec,
+    dir: &Path,
+    jobs: usize,
+    started: std::time::SystemTime,
+) -> Result<Summary, BatchError> {
     let wanted: HashSet<_> = spec.jobs().iter().map(|j| spec.key(j)).collect();
-    let records: Vec<TrialRecord> = read_records(&path)?
+    let records: Vec<TrialRecord> = read_records(&dir.join("trials.jsonl"))?
         .into_iter()
         .filter(|r| wanted.contains(&r.key()))
         .collect();
