@@ -148,55 +148,41 @@ impl Manifest {
     /// `BatchSpec::jobs` makes them; none when a scenario's settings lack a name this
     /// needs (a manifest written by another version).
     pub fn expected_keys(&self) -> Option<HashSet<super::TrialKey>> {
-        let modes: Vec<Option<bool>> = if self.compare_replanning {
-            vec![Some(false), Some(true)]
-        } else {
-            vec![self.replan]
-        };
-        let [index, count] = self.shard;
-        let mut out = HashSet::new();
-        let mut k: u64 = 0;
+        let mut scenarios = Vec::new();
+        let mut names: Vec<(Vec<String>, bool)> = Vec::new();
         for s in &self.scenarios {
             let v = &s.settings;
-            let own = |role: &str| {
-                v.get(role)?
-                    .get("name")?
-                    .as_str()
-                    .map(|n| vec![n.to_owned()])
-            };
+            let own = |role: &str| Some(vec![v.get(role)?.get("name")?.as_str()?.to_owned()]);
             let or_own = |list: &Vec<String>, role| {
                 (!list.is_empty())
                     .then(|| list.clone())
                     .or_else(|| own(role))
             };
-            let planners = or_own(&self.planners, "planner")?;
-            let trackers = or_own(&self.trackers, "tracker")?;
-            let own_mode = v.get("replan")?.get("enabled")?.as_bool()?;
             let cases = v.get("cases")?.as_array()?;
-            for case in cases {
-                let case = case.get("name")?.as_str()?;
-                for p in &planners {
-                    for t in &trackers {
-                        for m in &modes {
-                            for trial in 0..self.trials {
-                                if count > 0 && k % count == index {
-                                    let mode = m.unwrap_or(own_mode);
-                                    out.insert((
-                                        s.name.clone(),
-                                        case.to_owned(),
-                                        p.clone(),
-                                        t.clone(),
-                                        mode,
-                                        trial,
-                                    ));
-                                }
-                                k += 1;
-                            }
-                        }
-                    }
-                }
-            }
+            let case_names = cases
+                .iter()
+                .map(|c| c.get("name")?.as_str().map(str::to_owned))
+                .collect::<Option<Vec<_>>>()?;
+            scenarios.push(super::order::ScenarioJobs {
+                cases: case_names.len(),
+                planners: or_own(&self.planners, "planner")?,
+                trackers: or_own(&self.trackers, "tracker")?,
+            });
+            names.push((case_names, v.get("replan")?.get("enabled")?.as_bool()?));
         }
+        let modes = super::order::modes(self.compare_replanning, self.replan);
+        let (shard, mut out) = ((self.shard[0], self.shard[1]), HashSet::new());
+        super::order::for_each_job(&scenarios, &modes, self.trials, shard, |j| {
+            let (cases, own_mode) = &names[j.scenario];
+            out.insert((
+                self.scenarios[j.scenario].name.clone(),
+                cases[j.case].clone(),
+                j.planner.to_owned(),
+                j.tracker.to_owned(),
+                j.mode.unwrap_or(*own_mode),
+                j.trial,
+            ));
+        });
         Some(out)
     }
 

@@ -17,6 +17,7 @@ mod gate_text;
 mod guard;
 pub mod junit;
 mod manifest;
+mod order;
 mod provenance;
 mod seed;
 mod shard;
@@ -170,45 +171,43 @@ pub struct Job {
 }
 
 impl BatchSpec {
-    /// Every job of this shard, in a fixed global order.
+    /// Every job of this shard, in a fixed global order ([`order::for_each_job`]).
     pub fn jobs(&self) -> Vec<Job> {
-        let mut out = Vec::new();
-        let mut k: u64 = 0;
-        for (si, s) in self.scenarios.iter().enumerate() {
-            let (planners, trackers) = self.components_of(s);
-            for ci in 0..s.cases.len() {
-                for (p, tr) in planners
-                    .iter()
-                    .flat_map(|p| trackers.iter().map(move |t| (p, t)))
-                {
-                    for replan in self.replan_modes() {
-                        for t in 0..self.trials {
-                            if k % self.shard.1 == self.shard.0 {
-                                out.push(Job {
-                                    scenario: si,
-                                    case: ci,
-                                    planner: p.clone(),
-                                    tracker: tr.clone(),
-                                    replan,
-                                    trial: t,
-                                });
-                            }
-                            k += 1;
-                        }
-                    }
+        let scenarios: Vec<order::ScenarioJobs> = self
+            .scenarios
+            .iter()
+            .map(|s| {
+                let (planners, trackers) = self.components_of(s);
+                order::ScenarioJobs {
+                    cases: s.cases.len(),
+                    planners,
+                    trackers,
                 }
-            }
-        }
+            })
+            .collect();
+        let mut out = Vec::new();
+        order::for_each_job(
+            &scenarios,
+            &self.replan_modes(),
+            self.trials,
+            self.shard,
+            |j| {
+                out.push(Job {
+                    scenario: j.scenario,
+                    case: j.case,
+                    planner: j.planner.to_owned(),
+                    tracker: j.tracker.to_owned(),
+                    replan: j.mode,
+                    trial: j.trial,
+                });
+            },
+        );
         out
     }
 
     /// The replanning modes every case runs with: both, or the batch's override (or none).
     pub fn replan_modes(&self) -> Vec<Option<bool>> {
-        if self.compare_replanning {
-            vec![Some(false), Some(true)]
-        } else {
-            vec![self.replan]
-        }
+        order::modes(self.compare_replanning, self.replan)
     }
 
     /// Every result row this batch makes (scenario / planner / tracker / mode) and its
