@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
-use forkbench_trial::batch::{self, Baseline, CompareOptions, GateOptions, Manifest};
+use forkbench_trial::batch::{self, Baseline, CompareOptions, GateOptions};
 use forkbench_trial::stats::Correction;
 
 /// How rows tested together are corrected.
@@ -84,8 +84,7 @@ fn check_alpha(alpha: f64) -> anyhow::Result<()> {
 
 /// `forkbench baseline`: success counts and every trial's outcome, written atomically.
 pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::Result<()> {
-    let s = batch::load_results(dir)?;
-    let records = batch::read_records(&dir.join("trials.jsonl"))?;
+    let (s, records, _) = batch::load_batch(dir)?;
     let description =
         description.unwrap_or_else(|| format!("success counts from {}", dir.display()));
     let b = Baseline::from_results(&s, &records, description);
@@ -98,12 +97,15 @@ pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::
     ))
 }
 
-/// The gate over a results directory.
-pub fn gate(base: &Baseline, dir: &Path, o: &GateOptions) -> anyhow::Result<batch::GateReport> {
-    let s = batch::load_results(dir)?;
-    let records = batch::read_records(&dir.join("trials.jsonl"))?;
-    let manifest = Manifest::read(dir)?;
-    Ok(batch::regress(base, &s, &records, manifest.as_ref(), o))
+/// The gate over a results directory, and the results' provenance.
+fn gate(
+    base: &Baseline,
+    dir: &Path,
+    o: &GateOptions,
+) -> anyhow::Result<(batch::GateReport, Option<batch::Provenance>)> {
+    let (s, records, manifest) = batch::load_batch(dir)?;
+    let report = batch::regress(base, &s, &records, Some(&manifest), o);
+    Ok((report, s.provenance))
 }
 
 /// Returns whether the gate passed.
@@ -127,7 +129,7 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
         fail_on_new: a.fail_on_new,
         min_detectable_drop: a.min_detectable_drop,
     };
-    let report = gate(&b, &a.results, &o)?;
+    let (report, provenance) = gate(&b, &a.results, &o)?;
     if let batch::Pairing::Unpaired { reason } = &report.pairing {
         eprintln!("warning: compared unpaired: {reason}");
     }
@@ -135,9 +137,8 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
         eprintln!("warning: scenario settings differ from the baseline's batch: {c}");
     }
     if let Some(file) = &a.junit {
-        let s = batch::load_results(&a.results)?;
         let cases = batch::junit::regress_cases(&report, a.fail_on_new);
-        let xml = batch::junit::junit_xml("forkbench regress", &cases, s.provenance.as_ref());
+        let xml = batch::junit::junit_xml("forkbench regress", &cases, provenance.as_ref());
         batch::write_atomic(file, xml.as_bytes())?;
     }
     if a.json {

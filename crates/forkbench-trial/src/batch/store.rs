@@ -127,6 +127,12 @@ pub(super) fn remove_if_present(path: &Path) -> Result<(), BatchError> {
 /// from a `summary.json` that may be stale): refuses a directory without a manifest,
 /// with duplicate records, or with fewer trials than its manifest names.
 pub fn load_results(dir: &Path) -> Result<Summary, BatchError> {
+    load_batch(dir).map(|(summary, _, _)| summary)
+}
+
+/// [`load_results`] with the records it summarised and the manifest they were checked
+/// against, read once.
+pub fn load_batch(dir: &Path) -> Result<(Summary, Vec<TrialRecord>, Manifest), BatchError> {
     let m = Manifest::read(dir)?.ok_or_else(|| {
         BatchError::Invalid(format!(
             "{}: no manifest.json, so not a forkbench batch directory (or one from an older \
@@ -134,9 +140,10 @@ pub fn load_results(dir: &Path) -> Result<Summary, BatchError> {
             dir.display()
         ))
     })?;
-    let mut summary = summarize(&complete_records(dir, &m)?);
+    let records = complete_records(dir, &m)?;
+    let mut summary = summarize(&records);
     summary.provenance = written_provenance(dir);
-    Ok(summary)
+    Ok((summary, records, m))
 }
 
 /// The provenance the batch wrote into its `summary.json`, if any (informative: the
