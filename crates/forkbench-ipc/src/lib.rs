@@ -4,4 +4,4 @@ mod breaker;
 mod process;
 
 pub use breaker::{BREAKER_THRESHOLD, Breaker};
-pub use process::{EnvPolicy, MAX_LINE_BYTES, Process, Spawn, clip, kill_all};
+pub use process::{EnvPolicy, ExchangeError, MAX_LINE_BYTES, Process, Spawn, clip, kill_all};

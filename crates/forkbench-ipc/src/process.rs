@@ -56,6 +56,36 @@ pub struct Spawn<'a> {
     pub what: &'a str,
 }
 
+/// Why an exchange failed: the message (exit status and stderr included), and whether it
+/// was the deadline (what the circuit breaker counts).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ExchangeError {
+    pub timed_out: bool,
+    pub message: String,
+}
+
+impl ExchangeError {
+    /// A failure other than the deadline.
+    pub fn other(message: impl Into<String>) -> Self {
+        Self {
+            timed_out: false,
+            message: message.into(),
+        }
+    }
+}
+
+impl std::fmt::Display for ExchangeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl From<ExchangeError> for String {
+    fn from(e: ExchangeError) -> String {
+        e.message
+    }
+}
+
 /// A running child with its stdin written and its stdout read on threads.
 #[derive(Debug)]
 pub struct Process {
@@ -122,23 +152,27 @@ impl Process {
 
     /// Sends one line and waits for the answer line; `timeout` covers both, so a child
     /// that stopped reading cannot block the send.
-    pub fn exchange(&mut self, line: &str, timeout: Duration) -> Result<String, String> {
+    pub fn exchange(&mut self, line: &str, timeout: Duration) -> Result<String, ExchangeError> {
         let deadline = Instant::now() + timeout;
         let sent = self
             .to_child
             .as_ref()
             .map(|tx| tx.try_send(line.to_owned()));
         if !matches!(sent, Some(Ok(()))) {
-            return Err(self.died("it is not reading its input"));
+            return Err(ExchangeError::other(
+                self.died("it is not reading its input"),
+            ));
         }
         loop {
             let left = deadline.saturating_duration_since(Instant::now());
             match self.lines.recv_timeout(left.min(POLL)) {
                 Ok(Ok(l)) if l.trim().is_empty() => {}
                 Ok(Ok(l)) => return Ok(l),
-                Ok(Err(e)) => return Err(self.died(&e)),
+                Ok(Err(e)) => return Err(ExchangeError::other(self.died(&e))),
                 Err(RecvTimeoutError::Disconnected) => {
-                    return Err(self.died(&format!("the {} closed its output", self.what)));
+                    return Err(ExchangeError::other(
+                        self.died(&format!("the {} closed its output", self.what)),
+                    ));
                 }
                 Err(RecvTimeoutError::Timeout) => {
                     if let Ok(Some(_)) = self.child.try_wait() {
@@ -146,12 +180,14 @@ impl Process {
                         if let Ok(Ok(l)) = self.lines.recv_timeout(Duration::from_millis(50)) {
                             return Ok(l);
                         }
-                        return Err(
-                            self.died(&format!("the {} exited without answering", self.what))
-                        );
+                        let what = format!("the {} exited without answering", self.what);
+                        return Err(ExchangeError::other(self.died(&what)));
                     }
                     if left.is_zero() {
-                        return Err(self.timed_out(timeout));
+                        return Err(ExchangeError {
+                            timed_out: true,
+                            message: self.timed_out(timeout),
+                        });
                     }
                 }
             }
@@ -162,11 +198,6 @@ impl Process {
     /// look: a child that floods would refill the channel as fast as it is drained.
     pub fn has_idle_output(&mut self) -> bool {
         !matches!(self.lines.try_recv(), Err(TryRecvError::Empty))
-    }
-
-    /// Whether an error message is a timeout (for the circuit breaker).
-    pub fn is_timeout(message: &str) -> bool {
-        message.starts_with("no answer within")
     }
 
     fn timed_out(&mut self, timeout: Duration) -> String {
@@ -374,7 +405,7 @@ mod tests {
         let e = p
             .exchange(&big, Duration::from_millis(300))
             .expect_err("times out");
-        assert!(Process::is_timeout(&e), "{e}");
+        assert!(e.timed_out, "{e}");
         assert!(t0.elapsed() < Duration::from_secs(3));
     }
 }

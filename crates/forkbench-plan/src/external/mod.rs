@@ -17,7 +17,7 @@ use serde::Deserialize;
 
 pub use check::{ENDPOINT_TOLERANCE_M, ENDPOINT_TOLERANCE_RAD, MAX_SPACING_M, path_violation};
 pub use process::dir_of;
-use process::{EnvPolicy, Process, clip};
+use process::{EnvPolicy, ExchangeError, Process, clip};
 use protocol::{RequestMsg, ResponseMsg, to_path};
 
 use crate::{Plan, PlanError, PlanParams, PlanRequest, Planner};
@@ -118,7 +118,7 @@ impl ExternalPlanner {
 
     /// This thread's process for the planner, or a new one: one that printed while it
     /// waited in the pool broke the protocol and is retired (its group killed).
-    fn take_process(&self) -> Result<(Process, u64), String> {
+    fn take_process(&self) -> Result<(Process, u64), ExchangeError> {
         let key = (self.cfg.command.clone(), self.dir.clone(), self.env());
         let taken = POOL.with(|p| p.borrow_mut().remove(&key));
         if let Some((mut p, id)) = taken
@@ -137,19 +137,16 @@ impl ExternalPlanner {
         let key = self.breaker_key();
         BREAKER.check(&key)?;
         let r = self.exchange(req);
-        BREAKER.record(
-            &key,
-            r.as_ref()
-                .is_err_and(|e| forkbench_ipc::Process::is_timeout(e)),
-        );
-        r
+        BREAKER.record(&key, r.as_ref().is_err_and(|e| e.timed_out));
+        r.map_err(String::from)
     }
 
     /// One request on a (possibly new) process; the process goes back to the pool only
     /// when the exchange kept to the protocol.
-    fn exchange(&self, req: &PlanRequest) -> Result<ResponseMsg, String> {
+    fn exchange(&self, req: &PlanRequest) -> Result<ResponseMsg, ExchangeError> {
         let (mut proc, id) = self.take_process()?;
-        let line = serde_json::to_string(&RequestMsg::new(id, req)).map_err(|e| e.to_string())?;
+        let line = serde_json::to_string(&RequestMsg::new(id, req))
+            .map_err(|e| ExchangeError::other(e.to_string()))?;
         let answer = proc.exchange(&line, self.timeout())?;
         let msg: ResponseMsg = serde_json::from_str(&answer).map_err(|e| {
             // Python's json writes NaN and Infinity, which JSON has no numbers for.
@@ -161,16 +158,18 @@ impl ExternalPlanner {
             } else {
                 ""
             };
-            format!(
+            ExchangeError::other(format!(
                 "invalid JSON in the answer ({e}{hint}): {:?}",
                 clip(&answer)
-            )
+            ))
         })?;
         let got = match &msg {
             ResponseMsg::Path { id, .. } | ResponseMsg::Error { id, .. } => *id,
         };
         if got != id {
-            return Err(format!("answered request {got}, expected {id}"));
+            return Err(ExchangeError::other(format!(
+                "answered request {got}, expected {id}"
+            )));
         }
         let key = (self.cfg.command.clone(), self.dir.clone(), self.env());
         POOL.with(|p| p.borrow_mut().insert(key, (proc, id + 1)));

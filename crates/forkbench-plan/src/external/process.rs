@@ -4,7 +4,7 @@ use std::path::{Path as FsPath, PathBuf};
 use std::time::Duration;
 
 use forkbench_ipc::Spawn;
-pub use forkbench_ipc::{EnvPolicy, clip};
+pub use forkbench_ipc::{EnvPolicy, ExchangeError, clip};
 
 use super::protocol::{Hello, PROTOCOL, VERSION};
 
@@ -19,40 +19,42 @@ impl Process {
         dir: &FsPath,
         env: &EnvPolicy,
         timeout: Duration,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ExchangeError> {
         let p = forkbench_ipc::Process::start(Spawn {
             command,
             dir,
             env,
             what: "planner",
-        })?;
+        })
+        .map_err(ExchangeError::other)?;
         let mut p = Self(p);
         p.handshake(timeout)?;
         Ok(p)
     }
 
-    fn handshake(&mut self, timeout: Duration) -> Result<(), String> {
-        let hello = serde_json::to_string(&Hello::ours()).map_err(|e| e.to_string())?;
+    fn handshake(&mut self, timeout: Duration) -> Result<(), ExchangeError> {
+        let hello = serde_json::to_string(&Hello::ours())
+            .map_err(|e| ExchangeError::other(e.to_string()))?;
         let line = self.exchange(&hello, timeout)?;
         let theirs: Hello = serde_json::from_str(&line)
-            .map_err(|e| format!("invalid hello {:?}: {e}", clip(&line)))?;
+            .map_err(|e| ExchangeError::other(format!("invalid hello {:?}: {e}", clip(&line))))?;
         if theirs.kind != "hello" || theirs.protocol != PROTOCOL {
-            return Err(format!(
+            return Err(ExchangeError::other(format!(
                 "the first line must be a {PROTOCOL} hello, got {:?}",
                 clip(&line)
-            ));
+            )));
         }
         if theirs.version != VERSION {
-            return Err(format!(
+            return Err(ExchangeError::other(format!(
                 "the planner speaks protocol version {}, forkbench speaks {VERSION}",
                 theirs.version
-            ));
+            )));
         }
         Ok(())
     }
 
     /// Sends one line and waits at most `timeout`, sending included, for the answer line.
-    pub fn exchange(&mut self, line: &str, timeout: Duration) -> Result<String, String> {
+    pub fn exchange(&mut self, line: &str, timeout: Duration) -> Result<String, ExchangeError> {
         self.0.exchange(line, timeout)
     }
 
