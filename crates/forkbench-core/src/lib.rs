@@ -6,6 +6,7 @@ pub mod pallet;
 pub mod path;
 pub mod pose;
 pub mod settings;
+pub mod signal;
 pub mod units;
 pub mod vehicle;
 
@@ -13,4 +14,5 @@ pub use pallet::PalletSpec;
 pub use path::{Path, PathMetrics, PathSample};
 pub use pose::{Pose2, PoseParseError};
 pub use settings::{Settings, SettingsError};
+pub use signal::{Signal, Style};
 pub use vehicle::{ForkliftSpec, SpecError};

@@ -490,3 +490,126 @@ fn a_full_disk_is_reported_by_both_sinks() {
         assert!(e.to_lowercase().contains("no space"), "{e}");
     }
 }
+
+/// Every signal kind, as a component the sinks know nothing about would send it.
+fn send_every_kind(rec: &mut dyn Recorder) {
+    use forkbench_core::signal::{Grid, Scan};
+    use forkbench_core::{Pose2, Signal, Style};
+    let scan = Scan {
+        sensor: Pose2::new(1.0, 2.0, 0.5),
+        angle_min_rad: -0.5,
+        angle_step_rad: 0.01,
+        range_min_m: 0.05,
+        range_max_m: 10.0,
+        ranges_m: (0..101)
+            .map(|i| if i == 7 { f64::NAN } else { 3.0 })
+            .collect(),
+    };
+    let grid = Grid {
+        origin_m: [0.0, 0.0],
+        cell_m: 0.5,
+        cols: 4,
+        rows: 2,
+        cells: vec![0, 100, 100, 0, 0, 100, 0, 0],
+    };
+    let style = Style::rgb(10, 200, 10).width(0.05);
+    let pts = [[0.0, 0.0], [1.0, 1.0], [2.0, 0.5]];
+    for i in 0..3 {
+        let t = 0.1 * f64::from(i);
+        rec.signal(
+            t,
+            "probe/pose",
+            &Signal::Pose(Pose2::new(t, 0.0, 0.0)),
+            style,
+        );
+        rec.signal(t, "probe/value_m", &Signal::Scalar(t * 2.0), style);
+    }
+    rec.signal(0.3, "probe/scan", &Signal::Scan(&scan), style);
+    rec.signal(0.3, "probe/grid", &Signal::Grid(&grid), style);
+    rec.signal(0.3, "probe/path", &Signal::Path(&pts), style);
+    rec.signal(0.3, "probe/points", &Signal::Points(&pts), style);
+    rec.signal(
+        0.3,
+        "probe/segments",
+        &Signal::Segments(&[[pts[0], pts[1]]]),
+        style,
+    );
+    rec.signal(
+        0.3,
+        "probe/boxes",
+        &Signal::Boxes(&[[pts[0], pts[1]]]),
+        style,
+    );
+    rec.signal(0.3, "probe/phase", &Signal::Text("lift started"), style);
+}
+
+/// A new component records itself through `Recorder::signal` alone: each kind lands in
+/// rerun as an entity under `map/` or `signals/`, and in MCAP on the topic its kind maps to.
+#[test]
+fn every_signal_kind_reaches_both_sinks() {
+    let (mut rerun_rec, storage) = RerunRecorder::in_memory().expect("opens");
+    send_every_kind(&mut rerun_rec);
+    rerun_rec.finish().expect("closes");
+    let chunks = chunks_by_entity(storage.take());
+    for kind in [
+        "pose", "scan", "grid", "path", "points", "segments", "boxes",
+    ] {
+        let e = format!("/map/probe/{kind}");
+        assert!(chunks.contains_key(&e), "missing {e}: {:?}", chunks.keys());
+    }
+    assert_eq!(temporal_rows(&chunks)["/map/probe/pose"], 3);
+    assert_eq!(temporal_rows(&chunks)["/signals/probe/value_m"], 3);
+    let log = strings(
+        &chunks,
+        "/events",
+        rerun::TextLog::descriptor_text().component,
+    );
+    assert!(
+        log.iter().any(|l| l == "probe/phase: lift started"),
+        "{log:?}"
+    );
+
+    let path = tmp("signals.mcap");
+    let mut mcap_rec = McapRecorder::create(&path, BTreeMap::new()).expect("opens");
+    send_every_kind(&mut mcap_rec);
+    mcap_rec.finish().expect("finishes");
+    let bytes = std::fs::read(&path).expect("written");
+    let mut topics: BTreeMap<String, (String, Vec<serde_json::Value>)> = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).expect("valid mcap") {
+        let m = m.expect("message");
+        let schema = m.channel.schema.as_ref().expect("schema").name.clone();
+        let v: serde_json::Value = serde_json::from_slice(&m.data).expect("JSON");
+        topics
+            .entry(m.channel.topic.clone())
+            .or_insert((schema, Vec::new()))
+            .1
+            .push(v);
+    }
+    let schema = |t: &str| topics.get(t).map(|(s, _)| s.as_str());
+    assert_eq!(schema("/scan/probe/scan"), Some("foxglove.LaserScan"));
+    assert_eq!(schema("/grid/probe/grid"), Some("foxglove.Grid"));
+    assert_eq!(schema("/pose/probe/pose"), Some("foxglove.PoseInFrame"));
+    assert_eq!(schema("/signals/probe/value_m"), Some("forkbench.Scalar"));
+    let scan = &topics["/scan/probe/scan"].1[0];
+    assert_eq!(scan["ranges"].as_array().map(Vec::len), Some(101));
+    assert!(
+        scan["ranges"][7].is_null() && scan["ranges"][8] == 3.0,
+        "{scan}"
+    );
+    assert_eq!(topics["/grid/probe/grid"].1[0]["data"], "AGRkAABkAAA=");
+    let ids: BTreeSet<String> = topics["/world"]
+        .1
+        .iter()
+        .flat_map(|u| u["entities"].as_array().cloned().unwrap_or_default())
+        .filter_map(|e| e["id"].as_str().map(str::to_owned))
+        .collect();
+    for kind in ["scan", "grid", "path", "points", "segments", "boxes"] {
+        assert!(ids.contains(&format!("probe/{kind}")), "{kind}: {ids:?}");
+    }
+    let log = &topics["/log"].1;
+    assert!(
+        log.iter()
+            .any(|l| l["name"] == "probe/phase" && l["message"] == "lift started"),
+        "{log:?}"
+    );
+}

@@ -219,6 +219,25 @@ impl OccupancyGrid {
     }
 
     /// Lower-left and upper-right corners of the map.
+    /// The grid as a recording signal: free 0, occupied 100, unknown 50.
+    pub fn to_signal(&self) -> forkbench_core::signal::Grid {
+        forkbench_core::signal::Grid {
+            origin_m: self.origin_m,
+            cell_m: self.resolution_m,
+            cols: self.width,
+            rows: self.height,
+            cells: self
+                .cells
+                .iter()
+                .map(|c| match c {
+                    Cell::Free => 0,
+                    Cell::Occupied => 100,
+                    Cell::Unknown => 50,
+                })
+                .collect(),
+        }
+    }
+
     pub fn extent(&self) -> ([f64; 2], [f64; 2]) {
         let o = self.origin_m;
         let r = self.resolution_m;

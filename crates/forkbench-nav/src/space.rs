@@ -140,54 +140,12 @@ pub fn grid_obstacles(grid: &OccupancyGrid) -> Obstacles {
     out
 }
 
-/// A grid's non-free cells as few rectangles (lower-left, upper-right): runs of cells
-/// along rows, merged with identical runs in the rows above.
+/// A grid's non-free cells as few rectangles (lower-left, upper-right).
 pub fn blocked_rects(grid: &OccupancyGrid) -> Vec<[[f64; 2]; 2]> {
-    let r = grid.resolution_m;
-    // Open rectangles keyed by their run: (first cell, last cell) → first row.
-    let mut open: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
-    let mut out = Vec::new();
-    for iy in 0..=grid.height {
-        let runs = if iy < grid.height {
-            row_runs(grid, iy)
-        } else {
-            Vec::new()
-        };
-        let ended: Vec<_> = open.keys().filter(|k| !runs.contains(k)).copied().collect();
-        for (x0, x1) in ended {
-            let y0 = open.remove(&(x0, x1)).unwrap_or(iy);
-            out.push([
-                [
-                    grid.origin_m[0] + x0 as f64 * r,
-                    grid.origin_m[1] + y0 as f64 * r,
-                ],
-                [
-                    grid.origin_m[0] + (x1 + 1) as f64 * r,
-                    grid.origin_m[1] + iy as f64 * r,
-                ],
-            ]);
-        }
-        for k in runs {
-            open.entry(k).or_insert(iy);
-        }
-    }
-    out
-}
-
-/// The runs of non-free cells in row `iy`, as (first, last) column.
-fn row_runs(grid: &OccupancyGrid, iy: usize) -> Vec<(usize, usize)> {
-    let mut runs = Vec::new();
-    let mut start = None;
-    for ix in 0..=grid.width {
-        let blocked = ix < grid.width && grid.get(ix, iy) != Cell::Free;
-        match (blocked, start) {
-            (true, None) => start = Some(ix),
-            (false, Some(s)) => {
-                runs.push((s, ix - 1));
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    runs
+    forkbench_core::signal::merge_cells(
+        (grid.width, grid.height),
+        |ix, iy| grid.get(ix, iy) != Cell::Free,
+        grid.origin_m,
+        grid.resolution_m,
+    )
 }

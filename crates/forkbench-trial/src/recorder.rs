@@ -1,6 +1,6 @@
-//! What a trial reports as it runs, for recording sinks (rerun, MCAP) that live outside this crate.
+//! What a trial reports as it runs, for recording sinks (rerun, MCAP) that live outside this crate: its scene, plans, steps, events and outcome, and open-ended signals.
 
-use forkbench_core::{ForkliftSpec, Path, Pose2};
+use forkbench_core::{ForkliftSpec, Path, Pose2, Signal, Style};
 use forkbench_sim::{Obstacle, PalletSpec};
 
 use crate::outcome::TrialOutcome;
@@ -47,22 +47,6 @@ pub struct StepRecord {
     pub contact_force_n: f64,
 }
 
-/// A mission leg's global plan.
-#[derive(Debug, Clone, Copy)]
-pub struct RouteRecord<'a> {
-    /// Leg index from 0.
-    pub leg: usize,
-    pub name: &'a str,
-    /// PRM's roadmap (the sampling trees leave none).
-    pub roadmap: Option<&'a forkbench_nav::Roadmap>,
-    /// The A* polyline after shortcuts, with the lead-in and lead-out (empty for the
-    /// reverse segment out of a station).
-    pub polyline: &'a [[f64; 2]],
-    /// The smoothed path driven; a `reverse` one is the leg's backing out, sent before
-    /// the forward route.
-    pub path: &'a Path,
-}
-
 /// Severity of a trial event.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Level {
@@ -83,10 +67,10 @@ pub trait Recorder {
         _control_polygon: Option<&[[f64; 2]]>,
     ) {
     }
-    /// A mission's occupancy grid, once before its first leg.
-    fn nav_map(&mut self, _grid: &forkbench_nav::OccupancyGrid) {}
-    /// A mission leg's global plan, when the leg starts driving it.
-    fn route(&mut self, _t_s: f64, _route: &RouteRecord<'_>) {}
+    /// Anything else, at a path: a sensor's scan, a mission's map and routes, a phase.
+    /// Sinks draw each [`Signal`] kind the same way wherever it comes from, so a new
+    /// component records itself without changing this trait.
+    fn signal(&mut self, _t_s: f64, _path: &str, _signal: &Signal<'_>, _style: Style) {}
     fn step(&mut self, _step: &StepRecord) {}
     fn event(&mut self, _t_s: f64, _level: Level, _text: &str) {}
     fn outcome(&mut self, _t_s: f64, _outcome: &TrialOutcome) {}
@@ -114,11 +98,10 @@ impl Recorder for Tee<'_> {
     fn plan(&mut self, t: f64, i: u32, p: &Path, c: Option<&[[f64; 2]]>) {
         self.0.iter_mut().for_each(|r| r.plan(t, i, p, c));
     }
-    fn nav_map(&mut self, g: &forkbench_nav::OccupancyGrid) {
-        self.0.iter_mut().for_each(|r| r.nav_map(g));
-    }
-    fn route(&mut self, t: f64, route: &RouteRecord<'_>) {
-        self.0.iter_mut().for_each(|r| r.route(t, route));
+    fn signal(&mut self, t: f64, path: &str, signal: &Signal<'_>, style: Style) {
+        self.0
+            .iter_mut()
+            .for_each(|r| r.signal(t, path, signal, style));
     }
     fn step(&mut self, s: &StepRecord) {
         self.0.iter_mut().for_each(|r| r.step(s));

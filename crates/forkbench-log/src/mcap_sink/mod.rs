@@ -11,17 +11,18 @@ use serde_json::json;
 
 mod messages;
 mod schemas;
+mod signals;
 mod sink;
 
 use messages::*;
-use sink::{Cmd, Sink};
+use sink::{Cmd, Item, Sink};
 
 use crate::writer::WriterThread;
 use crate::{LogError, pallet_outlines, truck_outlines};
 use forkbench_core::geometry::rect_outline;
 
-/// Steps are handed to the writer thread in batches of this many (0.5 s simulated), so
-/// the threads do not wake each other at every step.
+/// Steps and messages are handed to the writer thread in batches of this many (about
+/// 0.5 s simulated), so the threads do not wake each other at every step.
 const STEP_BATCH: usize = 50;
 
 /// The driven trajectory keeps a point every `TRAJECTORY_POINT_EVERY` steps; it and the
@@ -35,11 +36,6 @@ const TRAJECTORY_RGBA: [f64; 4] = [0.12, 0.63, 0.24, 1.0];
 const LOOKAHEAD_RGBA: [f64; 4] = [0.85, 0.1, 0.75, 1.0];
 const START_RGBA: [f64; 4] = [0.2, 0.2, 0.2, 1.0];
 const GOAL_RGBA: [f64; 4] = [0.1, 0.4, 0.9, 1.0];
-/// A mission's map: blocked cells, the roadmap, a leg's A* polyline.
-const OCCUPIED_RGBA: [f64; 4] = [0.45, 0.45, 0.45, 0.8];
-const ROADMAP_RGBA: [f64; 4] = [0.45, 0.6, 0.9, 0.3];
-const ROUTE_RGBA: [f64; 4] = [1.0, 0.6, 0.15, 1.0];
-const REVERSE_RGBA: [f64; 4] = [0.67, 0.35, 0.9, 1.0];
 
 /// What the trial thread keeps to draw: the trajectory segment being driven and the plan
 /// on screen.
@@ -71,8 +67,10 @@ struct OutcomeMsg {
 pub struct McapRecorder {
     writer: WriterThread<Cmd>,
     /// Steps not yet handed over.
-    steps: Vec<StepRecord>,
+    pending: Vec<Item>,
     draw: DrawState,
+    /// Topics of signals registered so far.
+    signal_topics: std::collections::BTreeSet<String>,
 }
 
 impl std::fmt::Debug for McapRecorder {
@@ -97,36 +95,45 @@ impl McapRecorder {
         )?;
         Ok(Self {
             writer,
-            steps: Vec::with_capacity(STEP_BATCH),
+            pending: Vec::with_capacity(STEP_BATCH),
             draw: DrawState::default(),
+            signal_topics: Default::default(),
         })
     }
 
-    /// Hands `msg` to the writer thread, which serialises it.
-    fn send<M: Serialize + Send + 'static>(&mut self, topic: &'static str, t_s: f64, msg: M) {
-        self.command(Cmd::Json {
-            topic,
+    /// Queues `msg` for the writer thread, which serialises it.
+    fn send<M: Serialize + Send + 'static>(
+        &mut self,
+        topic: impl Into<std::borrow::Cow<'static, str>>,
+        t_s: f64,
+        msg: M,
+    ) {
+        self.pending.push(Item::Json {
+            topic: topic.into(),
             t_s,
             msg: Box::new(move |buf: &mut Vec<u8>| serde_json::to_writer(buf, &msg)),
         });
+        if self.pending.len() >= STEP_BATCH {
+            self.send_pending();
+        }
     }
 
-    fn send_steps(&mut self) {
-        if !self.steps.is_empty() {
-            let steps = std::mem::replace(&mut self.steps, Vec::with_capacity(STEP_BATCH));
-            self.writer.send(Cmd::Steps(steps));
+    fn send_pending(&mut self) {
+        if !self.pending.is_empty() {
+            let items = std::mem::replace(&mut self.pending, Vec::with_capacity(STEP_BATCH));
+            self.writer.send(Cmd::Batch(items));
         }
     }
 
     fn command(&mut self, cmd: Cmd) {
-        // Keep messages in order: steps collected so far go first.
-        self.send_steps();
+        // Keep messages in order: those queued so far go first.
+        self.send_pending();
         self.writer.send(cmd);
     }
 
     /// Finishes the file (summary and index); returns the first write error, if any.
     pub fn finish(&mut self) -> Result<(), LogError> {
-        self.send_steps();
+        self.send_pending();
         self.writer.finish()
     }
 
@@ -144,8 +151,8 @@ impl McapRecorder {
 
     /// Stops writing without finishing the file, as a crash would (tests).
     pub fn abandon(mut self) {
-        // What a crash would lose: steps not yet handed over.
-        self.steps.clear();
+        // What a crash would lose: messages not yet handed over.
+        self.pending.clear();
         self.command(Cmd::Abandon);
         self.writer.abandon();
     }
@@ -318,72 +325,18 @@ impl Recorder for McapRecorder {
         self.send("/world", t_s, scene);
     }
 
-    fn nav_map(&mut self, grid: &forkbench_nav::OccupancyGrid) {
-        let segments = forkbench_nav::blocked_rects(grid)
-            .into_iter()
-            .flat_map(|[lo, hi]| {
-                let c = [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]];
-                (0..4).map(move |i| [c[i], c[(i + 1) % 4]])
-            });
-        let occupied = entity(
-            0.0,
-            "nav/occupied",
-            vec![line_list(segments, OCCUPIED_RGBA, 0.02)],
-        );
-        self.send(
-            "/world",
-            0.0,
-            SceneUpdate {
-                deletions: Vec::new(),
-                entities: vec![occupied],
-            },
-        );
-    }
-
-    fn route(&mut self, t_s: f64, route: &forkbench_trial::recorder::RouteRecord<'_>) {
-        let mut entities = Vec::new();
-        if let Some(map) = route.roadmap {
-            let (nodes, edges) = (&map.nodes, &map.edges);
-            let segments = edges.iter().enumerate().flat_map(|(i, nb)| {
-                nb.iter()
-                    .filter(move |(j, _)| *j > i)
-                    .map(move |(j, _)| [nodes[i], nodes[*j]])
-            });
-            entities.push(entity(
-                t_s,
-                "nav/roadmap",
-                vec![line_list(segments, ROADMAP_RGBA, 0.01)],
-            ));
-        }
-        let path: Vec<[f64; 2]> = route.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect();
-        if route.path.reverse {
-            entities.push(entity(
-                t_s,
-                &format!("nav/route/{}/reverse", route.leg),
-                vec![line_at(&path, 0.02, REVERSE_RGBA, 0.04)],
-            ));
-        } else {
-            entities.push(entity(
-                t_s,
-                &format!("nav/route/{}", route.leg),
-                vec![
-                    line_at(route.polyline, 0.01, ROUTE_RGBA, 0.02),
-                    line_at(&path, 0.02, GOAL_RGBA, 0.04),
-                ],
-            ));
-        }
-        self.send(
-            "/world",
-            t_s,
-            SceneUpdate {
-                deletions: Vec::new(),
-                entities,
-            },
-        );
+    fn signal(
+        &mut self,
+        t_s: f64,
+        path: &str,
+        signal: &forkbench_core::Signal<'_>,
+        style: forkbench_core::Style,
+    ) {
+        self.send_signal(t_s, path, signal, style);
     }
 
     fn step(&mut self, s: &StepRecord) {
-        self.steps.push(*s);
+        self.pending.push(Item::Step(*s));
         self.draw.steps += 1;
         if self.draw.steps % TRAJECTORY_POINT_EVERY == 1 {
             self.draw.segment.push([s.truth.x_m, s.truth.y_m]);
@@ -393,8 +346,8 @@ impl Recorder for McapRecorder {
         if self.draw.steps.is_multiple_of(TRAJECTORY_EVERY) {
             self.send_trajectory(s.t_s);
         }
-        if self.steps.len() >= STEP_BATCH {
-            self.send_steps();
+        if self.pending.len() >= STEP_BATCH {
+            self.send_pending();
         }
     }
 
@@ -420,7 +373,6 @@ impl Recorder for McapRecorder {
             t_s,
             json!({"timestamp": Stamp::at(t_s), "level": level, "message": format!("outcome: {verdict}"), "name": "forkbench", "file": "", "line": 0}),
         );
-        // `send` hands over the steps collected so far first.
         let msg = OutcomeMsg {
             verdict,
             outcome: outcome.clone(),
@@ -429,6 +381,7 @@ impl Recorder for McapRecorder {
         // The outcome is the trial's last message: let the writer thread finish the file
         // (last chunk, summary, index) now, while the other sinks finish theirs;
         // `finish` then only joins it.
+        self.send_pending();
         self.writer.close();
     }
 }

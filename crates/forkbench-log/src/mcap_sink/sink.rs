@@ -21,14 +21,26 @@ pub(super) const PALLET_TURN_RAD: f64 = 1e-4;
 /// A message, serialised by the writer thread into its buffer.
 pub(super) type JsonMsg = Box<dyn FnOnce(&mut Vec<u8>) -> serde_json::Result<()> + Send>;
 
-/// Work for the writer thread.
-pub(super) enum Cmd {
+/// A message for the file, in the order the trial made it.
+pub(super) enum Item {
     Json {
-        topic: &'static str,
+        topic: std::borrow::Cow<'static, str>,
         t_s: f64,
         msg: JsonMsg,
     },
-    Steps(Vec<StepRecord>),
+    Step(StepRecord),
+}
+
+/// Work for the writer thread.
+pub(super) enum Cmd {
+    /// Messages handed over together, so the threads do not wake each other per step.
+    Batch(Vec<Item>),
+    /// A channel first used after the file was opened (a signal's own topic).
+    Channel {
+        topic: String,
+        schema_name: &'static str,
+        schema: &'static str,
+    },
     /// Flush the current chunk and acknowledge.
     Flush(SyncSender<Option<String>>),
     /// Stop without finishing the file, as a crash would.
@@ -38,7 +50,9 @@ pub(super) enum Cmd {
 /// The writer thread's state.
 pub(super) struct Sink {
     pub(super) writer: mcap::Writer<BufWriter<File>>,
-    pub(super) channels: BTreeMap<&'static str, u16>,
+    pub(super) channels: BTreeMap<String, u16>,
+    /// Schema ids by name.
+    pub(super) schemas: BTreeMap<&'static str, u16>,
     pub(super) sequence: u32,
     /// Last transforms sent for the pallet and its estimate.
     pub(super) pallet_sent: Option<Pose2>,
@@ -69,47 +83,76 @@ impl Sink {
             .compression_threads(0)
             .create(BufWriter::new(file))
             .map_err(|e| io(&e))?;
-        let mut schemas = BTreeMap::new();
-        let mut channels = BTreeMap::new();
-        for (topic, name, schema) in CHANNELS {
-            let sid = match schemas.get(name) {
-                Some(id) => *id,
-                None => {
-                    let id = writer
-                        .add_schema(name, "jsonschema", schema.as_bytes())
-                        .map_err(|e| io(&e))?;
-                    schemas.insert(name, id);
-                    id
-                }
-            };
-            let cid = writer
-                .add_channel(sid, topic, "json", &BTreeMap::new())
-                .map_err(|e| io(&e))?;
-            channels.insert(topic, cid);
-        }
         writer
             .write_metadata(&mcap::records::Metadata {
                 name: "forkbench".into(),
                 metadata,
             })
             .map_err(|e| io(&e))?;
-        Ok(Self {
+        let mut me = Self {
             writer,
-            channels,
+            channels: BTreeMap::new(),
+            schemas: BTreeMap::new(),
             sequence: 0,
             pallet_sent: None,
             estimate_sent: None,
             buf: Vec::with_capacity(1024),
             error: None,
-        })
+        };
+        for (topic, name, schema) in CHANNELS {
+            me.add_channel(topic, name, schema)?;
+        }
+        Ok(me)
+    }
+
+    /// Registers `topic` with its schema (once per schema name).
+    fn add_channel(
+        &mut self,
+        topic: &str,
+        schema_name: &'static str,
+        schema: &'static str,
+    ) -> Result<(), String> {
+        let io = |e: &dyn std::error::Error| with_causes(e);
+        let sid = match self.schemas.get(schema_name) {
+            Some(id) => *id,
+            None => {
+                let id = self
+                    .writer
+                    .add_schema(schema_name, "jsonschema", schema.as_bytes())
+                    .map_err(|e| io(&e))?;
+                self.schemas.insert(schema_name, id);
+                id
+            }
+        };
+        let cid = self
+            .writer
+            .add_channel(sid, topic, "json", &BTreeMap::new())
+            .map_err(|e| io(&e))?;
+        self.channels.insert(topic.to_owned(), cid);
+        Ok(())
     }
 
     /// Runs the writer thread's commands, then finishes the file; returns the first error.
     pub(super) fn run(mut self, rx: Receiver<Cmd>) -> Option<String> {
         for cmd in rx {
             match cmd {
-                Cmd::Json { topic, t_s, msg } => self.write_json(topic, t_s, msg),
-                Cmd::Steps(steps) => steps.iter().for_each(|s| self.step(s)),
+                Cmd::Batch(items) => {
+                    for item in items {
+                        match item {
+                            Item::Json { topic, t_s, msg } => self.write_json(&topic, t_s, msg),
+                            Item::Step(s) => self.step(&s),
+                        }
+                    }
+                }
+                Cmd::Channel {
+                    topic,
+                    schema_name,
+                    schema,
+                } => {
+                    if let Err(e) = self.add_channel(&topic, schema_name, schema) {
+                        self.error.get_or_insert(e);
+                    }
+                }
                 Cmd::Flush(ack) => {
                     let r = self.writer.flush().err().map(|e| with_causes(&e));
                     let _ = ack.send(r);

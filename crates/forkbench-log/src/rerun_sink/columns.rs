@@ -225,6 +225,7 @@ impl RerunRecorder {
 
     /// Sends the buffered per-step columns.
     pub(super) fn send_buffered(&mut self) {
+        self.send_signal_columns();
         if self.cols.times.is_empty() {
             return;
         }

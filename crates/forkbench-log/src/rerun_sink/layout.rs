@@ -27,12 +27,6 @@ pub(super) const MEASURED_RGB: [u8; 3] = [240, 70, 70];
 pub(super) const COMMAND_RGB: [u8; 3] = [255, 170, 40];
 pub(super) const ACTUAL_RGB: [u8; 3] = [70, 160, 255];
 pub(super) const LIMIT_RGB: [u8; 3] = [235, 60, 60];
-/// A mission's map: blocked cells, the roadmap, a leg's A* polyline and smoothed path.
-pub(super) const OCCUPIED_RGBA: [u8; 4] = [150, 150, 150, 110];
-pub(super) const ROADMAP_RGBA: [u8; 4] = [120, 160, 230, 25];
-pub(super) const ROUTE_RGB: [u8; 3] = [255, 150, 40];
-pub(super) const SMOOTHED_RGB: [u8; 3] = [40, 110, 240];
-pub(super) const REVERSE_RGB: [u8; 3] = [170, 90, 230];
 
 /// Draw order in the map (higher on top): the driven trajectory over the plans.
 pub(super) const ORDER_GRID: f32 = 0.0;
@@ -101,7 +95,14 @@ fn plot_view(p: &Plot) -> TimeSeriesView {
 /// event log is part of the verdict document rather than a view of its own.
 pub(super) fn blueprint() -> Blueprint {
     let errors = Tabs::new(PLOTS[..2].iter().map(|p| plot_view(p).into()));
-    let drive = Tabs::new(PLOTS[2..].iter().map(|p| plot_view(p).into()));
+    // Scalars any component sends (`Recorder::signal`) share the last tab.
+    let signals = TimeSeriesView::new("other signals").with_origin("signals");
+    let drive = Tabs::new(
+        PLOTS[2..]
+            .iter()
+            .map(|p| plot_view(p).into())
+            .chain([signals.into()]),
+    );
     let right = Vertical::new([
         TextDocumentView::new("verdict")
             .with_origin("verdict")

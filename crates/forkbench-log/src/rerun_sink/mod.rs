@@ -6,9 +6,9 @@
 
 mod columns;
 mod layout;
-mod nav;
 mod recorder;
 mod scene;
+mod signals;
 
 use std::fs::File;
 use std::io::{BufWriter, Write as _};
@@ -79,6 +79,7 @@ pub struct RerunRecorder {
     /// Rack and wall outlines, redrawn unclipped when a mission's map widens the frame.
     obstacle_outlines: Vec<[[f64; 2]; 5]>,
     cols: Columns,
+    signal_cols: signals::SignalColumns,
     error: Option<String>,
     close: Close,
 }
@@ -195,6 +196,7 @@ impl RerunRecorder {
             events: Vec::new(),
             obstacle_outlines: Vec::new(),
             cols: Columns::default(),
+            signal_cols: Default::default(),
             error: None,
             close: Close::Open,
         })

@@ -219,12 +219,14 @@ impl Recorder for RerunRecorder {
         self.note(r);
     }
 
-    fn nav_map(&mut self, grid: &forkbench_nav::OccupancyGrid) {
-        self.draw_nav_map(grid);
-    }
-
-    fn route(&mut self, t_s: f64, route: &forkbench_trial::recorder::RouteRecord<'_>) {
-        self.draw_route(t_s, route);
+    fn signal(
+        &mut self,
+        t_s: f64,
+        path: &str,
+        signal: &forkbench_core::Signal<'_>,
+        style: forkbench_core::Style,
+    ) {
+        self.log_signal(t_s, path, signal, style);
     }
 
     fn step(&mut self, s: &StepRecord) {

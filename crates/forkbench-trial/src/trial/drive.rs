@@ -7,6 +7,7 @@ use forkbench_track::{Command, TrackerInput};
 use super::judge::{in_pallet_frame, insertion_depth};
 use super::setup::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
+use forkbench_core::{Signal, Style};
 
 impl<'a> Trial<'a> {
     /// Drives until the tracker reports the goal reached and the truck stands, or the
@@ -111,6 +112,23 @@ impl<'a> Trial<'a> {
             );
         }
         self.collision |= self.sim.obstacle_contact();
+        let t = self.sim.time_s();
+        let truth = self.sim.fork_root_pose();
+        // What a failed entry is most often traced to: how far off the localisation
+        // was, and how far off the path the tracker let the truck run.
+        let loc_error = (pose.x_m - truth.x_m).hypot(pose.y_m - truth.y_m);
+        rec.signal(
+            t,
+            "localisation/position_error_m",
+            &Signal::Scalar(loc_error),
+            Style::default(),
+        );
+        rec.signal(
+            t,
+            "track/cross_track_m",
+            &Signal::Scalar(cmd.cross_track_m),
+            Style::default(),
+        );
         rec.step(&StepRecord {
             t_s: self.sim.time_s(),
             truth: self.sim.fork_root_pose(),

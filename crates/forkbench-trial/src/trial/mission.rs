@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use forkbench_core::units::wrap_angle;
-use forkbench_core::{Path, Pose2};
+use forkbench_core::{Path, Pose2, Signal, Style};
 use forkbench_nav::smooth::{SmoothParams, smooth};
 use forkbench_nav::{
     Algorithm, GlobalPlan, GlobalQuery, NavMap, PrmParams, RrtParams, plan_global, truck_parts,
@@ -12,8 +12,65 @@ use forkbench_track::{PurePursuit, Tracker};
 
 use super::setup::Trial;
 use crate::outcome::LegOutcome;
-use crate::recorder::{Level, Recorder, RouteRecord};
+use crate::recorder::{Level, Recorder};
 use crate::scenario::mission::{GlobalPlannerKind, MissionSpec, Waypoint};
+
+/// How a mission's navigation layer is drawn: blocked cells, the roadmap, a leg's A*
+/// polyline, its smoothed path and its backing out.
+const OCCUPIED: Style = Style::rgba([150, 150, 150, 110]).width(0.02);
+const ROADMAP: Style = Style::rgba([120, 160, 230, 30]).width(0.012);
+const POLYLINE: Style = Style::rgb(255, 150, 40).width(0.024);
+const SMOOTHED: Style = Style::rgb(40, 110, 240).width(0.06);
+const REVERSE: Style = Style::rgb(170, 90, 230).width(0.06);
+
+fn path_points(p: &Path) -> Vec<[f64; 2]> {
+    p.samples.iter().map(|q| [q.x_m, q.y_m]).collect()
+}
+
+/// A leg's global plan as signals, when the leg starts driving it: the roadmap (PRM's;
+/// the sampling trees leave none) replaces the last leg's, then the A* polyline with its
+/// corners and the smoothed path.
+fn record_route<R: Recorder + ?Sized>(
+    rec: &mut R,
+    t_s: f64,
+    leg: usize,
+    plan: &GlobalPlan,
+    (polyline, path): (&[[f64; 2]], &Path),
+) {
+    if let Some(map) = &plan.roadmap {
+        let (nodes, edges) = (&map.nodes, &map.edges);
+        let segments: Vec<[[f64; 2]; 2]> = edges
+            .iter()
+            .enumerate()
+            .flat_map(|(i, nb)| {
+                nb.iter()
+                    .filter(move |(j, _)| *j > i)
+                    .map(move |(j, _)| [nodes[i], nodes[*j]])
+            })
+            .collect();
+        rec.signal(t_s, "nav/roadmap", &Signal::Segments(&segments), ROADMAP);
+        rec.signal(
+            t_s,
+            "nav/roadmap/nodes",
+            &Signal::Points(nodes),
+            ROADMAP.width(0.08),
+        );
+    }
+    let leg_path = format!("nav/route/{leg}");
+    rec.signal(
+        t_s,
+        &format!("{leg_path}/polyline"),
+        &Signal::Path(polyline),
+        POLYLINE,
+    );
+    rec.signal(
+        t_s,
+        &format!("{leg_path}/corners"),
+        &Signal::Points(polyline),
+        POLYLINE.width(0.12),
+    );
+    rec.signal(t_s, &leg_path, &Signal::Path(&path_points(path)), SMOOTHED);
+}
 
 /// Running totals of one leg's drive.
 #[derive(Debug, Default)]
@@ -34,7 +91,12 @@ impl Trial<'_> {
     ) -> Result<(), String> {
         let map = NavMap::from_world(&self.obstacles, m.global.resolution_m)
             .map_err(|e| format!("rasterising the world: {e}"))?;
-        rec.nav_map(&map.grid);
+        rec.signal(
+            self.sim.time_s(),
+            "nav/occupied",
+            &Signal::Grid(&map.grid.to_signal()),
+            OCCUPIED,
+        );
         let mut from = m.start.clone();
         let targets: Vec<&Waypoint> = m.via.iter().chain(std::iter::once(staging)).collect();
         for (i, to) in targets.into_iter().enumerate() {
@@ -92,16 +154,7 @@ impl Trial<'_> {
             leg.smoothing = "ok".into();
             leg.planned_length_m = s.path.length_m();
             leg.min_clearance_m = leg.min_clearance_m.min(s.min_clearance_m);
-            rec.route(
-                self.sim.time_s(),
-                &RouteRecord {
-                    leg: i,
-                    name: &leg.name,
-                    roadmap: p.roadmap.as_ref(),
-                    polyline: &s.polyline,
-                    path: &s.path,
-                },
-            );
+            record_route(rec, self.sim.time_s(), i, &p, (&s.polyline, &s.path));
             self.drive_path(&s.path, m, &mut stats, rec)?;
             Ok(())
         };
@@ -131,15 +184,12 @@ impl Trial<'_> {
                 )
             })?;
         leg.reverse_length_m = back.length_m();
-        rec.route(
+        let points = path_points(&back);
+        rec.signal(
             self.sim.time_s(),
-            &RouteRecord {
-                leg: i,
-                name: &leg.name,
-                roadmap: None,
-                polyline: &[],
-                path: &back,
-            },
+            &format!("nav/route/{i}/reverse"),
+            &Signal::Path(&points),
+            REVERSE,
         );
         leg.min_clearance_m = clearance;
         self.drive_path(&back, m, stats, rec)
