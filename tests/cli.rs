@@ -332,6 +332,32 @@ fn failed_pick_exits_3_and_names_the_criterion() {
     let out = forkbench(&["trial", bad.to_str().expect("utf8"), "--no-noise"]);
     assert_eq!(out.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&out.stdout).contains("FAILED: contact_force"));
+    // A batch of that biased pick below its JUnit floor: the run worked, the result is a
+    // failure (3), and the outputs are written.
+    let dir = tmp("below-floor");
+    let junit = tmp("below-floor.xml");
+    let out = forkbench(&[
+        "batch",
+        bad.to_str().expect("utf8"),
+        "--trials",
+        "2",
+        "--pallet-noise-scale",
+        "0",
+        "--out",
+        dir.to_str().expect("utf8"),
+        "--junit",
+        junit.to_str().expect("utf8"),
+        "--floor",
+        "0.5",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let xml = std::fs::read_to_string(&junit).expect("junit");
+    assert!(xml.contains("below the floor 50.0 %"), "{xml}");
 }
 
 #[test]
@@ -1056,4 +1082,51 @@ fn contradictory_fork_geometry_is_refused_at_load() {
             "{setting}: {err}"
         );
     }
+}
+
+/// Refactoring must not move results: the first two trials of every row of the README's
+/// main job (same batch seed, so the same trial seeds) end exactly as the committed
+/// baseline recorded them, success and failure criterion alike.
+#[test]
+fn outcomes_at_fixed_seeds_match_the_committed_baseline() {
+    let out_dir = tmp("baseline-replay");
+    let out = forkbench(&[
+        "batch",
+        "--trials",
+        "2",
+        "--out",
+        out_dir.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let base: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(repo_root().join("scenarios/baselines/default.json"))
+            .expect("baseline"),
+    )
+    .expect("JSON");
+    let key = |r: &serde_json::Value| {
+        ["scenario", "case", "planner", "tracker", "replan", "trial"].map(|k| r[k].to_string())
+    };
+    let recorded: std::collections::BTreeMap<_, _> = base["trials"]
+        .as_array()
+        .expect("per-trial results")
+        .iter()
+        .map(|r| (key(r), r))
+        .collect();
+    let text = std::fs::read_to_string(out_dir.join("trials.jsonl")).expect("records");
+    let mut compared = 0;
+    for line in text.lines() {
+        let r: serde_json::Value = serde_json::from_str(line).expect("a record");
+        let want = recorded
+            .get(&key(&r))
+            .unwrap_or_else(|| panic!("not in the baseline: {r}"));
+        for k in ["seed", "success", "failure"] {
+            assert_eq!(r[k], want[k], "{k} of {:?}", key(&r));
+        }
+        compared += 1;
+    }
+    assert!(compared >= 170, "{compared} trials compared");
 }

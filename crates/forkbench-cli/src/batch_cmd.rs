@@ -98,7 +98,7 @@ pub struct BatchArgs {
     /// tracker, failing below --floor.
     #[arg(long)]
     pub junit: Option<PathBuf>,
-    /// Success-rate floor (0–1) for the --junit cases.
+    /// Success-rate floor (0–1) for the --junit cases; a row below it exits 3.
     #[arg(long, requires = "junit")]
     pub floor: Option<f64>,
     /// Also write OUT/trials.csv: one row per trial, flat columns in SI units.
@@ -248,13 +248,15 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     Ok((spec, a))
 }
 
-pub fn run(a: BatchArgs) -> anyhow::Result<()> {
+/// Runs the batch; `Ok(false)` when a row fell below `--floor` (the run worked, the
+/// result is a failure: exit 3).
+pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     let (spec, a) = prepare(a)?;
     if let Some(d) = a.min_detectable_drop {
         check_power(&spec, d)?;
     }
     if let Some(sweep) = &a.sweep {
-        return run_sweep(&spec, &a, sweep);
+        return run_sweep(&spec, &a, sweep).map(|()| true);
     }
     let t0 = std::time::Instant::now();
     let summary = run_one(&spec, &a.out, a.jobs)?;
@@ -290,7 +292,9 @@ pub fn run(a: BatchArgs) -> anyhow::Result<()> {
             failed.join("; ")
         );
     }
-    shown
+    shown?;
+    let below = |f: f64| summary.rows.iter().any(|r| r.success_rate < f);
+    Ok(!a.floor.is_some_and(below))
 }
 
 /// The outputs asked for beside the results (CSV, JUnit, HTML report), each attempted,

@@ -28,7 +28,8 @@ use forkbench_core::{ForkliftSpec, Pose2};
     version,
     about = "Physics test bench for autonomous forklift pallet picking",
     after_help = "Exit status: 0 ok; 1 error or bad input; 2 usage; 3 the run worked and its \
-                  result is a failure (a failed pick or mission, a regression in `regress`)."
+                  result is a failure (a failed pick or mission, a regression in `regress`, a row \
+                  below `batch --floor`)."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -245,7 +246,10 @@ enum Done {
 
 fn run(cli: Cli) -> anyhow::Result<Done> {
     match cli.command {
-        Command::Batch(args) => batch_cmd::run(args).map(|()| Done::Ok),
+        Command::Batch(args) => {
+            let ok = batch_cmd::run(args)?;
+            Ok(if ok { Done::Ok } else { Done::Regressed })
+        }
         Command::Report { dir, baseline, out } => {
             let out = out.unwrap_or_else(|| dir.join("report.html"));
             let page = report::write_to(&dir, baseline.as_deref(), &out)?;

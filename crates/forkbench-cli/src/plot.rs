@@ -96,6 +96,21 @@ where
     let root = root.titled(title, ("sans-serif", 24)).map_err(err)?;
     let (left, right) = root.split_horizontally(700);
     let right_parts = right.split_evenly((2, 1));
+    draw_path_panel(&left, series)?;
+    draw_curvature_panels(&right_parts, series, truck)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// The paths in the plane, equal axis scales, with control polygons and a legend when
+/// there are several.
+fn draw_path_panel<DB: DrawingBackend>(
+    left: &DrawingArea<DB, Shift>,
+    series: &[Series],
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
     let label = |s: &Series| {
         if series.len() > 1 {
             s.label.clone()
@@ -104,27 +119,8 @@ where
         }
     };
 
-    // Path in the plane, equal axis scales.
-    let pts = series.iter().flat_map(|s| {
-        s.path
-            .samples
-            .iter()
-            .map(|p| (p.x_m, p.y_m))
-            .chain(s.control_polygon.iter().flatten().map(|p| (p[0], p[1])))
-    });
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for (x, y) in pts {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 > x1 {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
-    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-    let half = ((x1 - x0).max(y1 - y0) / 2.0 + 0.3).max(0.5);
-    let mut chart = ChartBuilder::on(&left)
+    let (cx, cy, half) = square_bounds(series);
+    let mut chart = ChartBuilder::on(left)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(50)
@@ -174,6 +170,18 @@ where
             .map_err(err)?;
     }
 
+    Ok(())
+}
+
+/// Curvature and equivalent steering against arc length, with the truck's limits.
+fn draw_curvature_panels<DB: DrawingBackend>(
+    right_parts: &[DrawingArea<DB, Shift>],
+    series: &[Series],
+    truck: &ForkliftSpec,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
     // Curvature and steering against arc length, with the truck's limits.
     let s_max = series.iter().map(|s| s.path.length_m()).fold(0.1, f64::max);
     let k_lim = truck.max_curvature_per_m();
@@ -225,7 +233,6 @@ where
             }
         }
     }
-    root.present().map_err(err)?;
     Ok(())
 }
 
@@ -269,37 +276,11 @@ where
         .y_desc("success rate (%)")
         .draw()
         .map_err(err)?;
-    // One series per scenario × tracker of this planner.
-    let mut series: Vec<(String, String)> = points
-        .iter()
-        .flat_map(|(_, s)| {
-            s.rows
-                .iter()
-                .filter(|r| r.planner == planner)
-                .map(|r| (r.scenario.clone(), r.tracker.clone()))
-        })
-        .collect();
-    series.sort();
-    series.dedup();
+    let series = sweep_series(points, planner);
     let several_trackers = series.iter().any(|(_, t)| *t != series[0].1);
     for (i, (sc, tr)) in series.iter().enumerate() {
         let color = COLORS[i % COLORS.len()];
-        let pts: Vec<(f64, f64, f64, f64)> = points
-            .iter()
-            .filter_map(|(v, s)| {
-                s.rows
-                    .iter()
-                    .find(|r| &r.scenario == sc && &r.tracker == tr && r.planner == planner)
-                    .map(|r| {
-                        (
-                            *v,
-                            100.0 * r.success_rate,
-                            100.0 * r.ci95_low,
-                            100.0 * r.ci95_high,
-                        )
-                    })
-            })
-            .collect();
+        let pts = sweep_points(points, (sc, tr), planner);
         chart
             .draw_series(LineSeries::new(
                 pts.iter().map(|p| (p.0, p.1)),
@@ -329,4 +310,71 @@ where
         .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// The (scenario, tracker) pairs of `planner` in a sweep, sorted.
+fn sweep_series(
+    points: &[(f64, forkbench_trial::batch::Summary)],
+    planner: &str,
+) -> Vec<(String, String)> {
+    let mut series: Vec<(String, String)> = points
+        .iter()
+        .flat_map(|(_, s)| {
+            s.rows
+                .iter()
+                .filter(|r| r.planner == planner)
+                .map(|r| (r.scenario.clone(), r.tracker.clone()))
+        })
+        .collect();
+    series.sort();
+    series.dedup();
+    series
+}
+
+/// One series' points: (sweep value, success %, Wilson 95 % low, high).
+fn sweep_points(
+    points: &[(f64, forkbench_trial::batch::Summary)],
+    (sc, tr): (&str, &str),
+    planner: &str,
+) -> Vec<(f64, f64, f64, f64)> {
+    points
+        .iter()
+        .filter_map(|(v, s)| {
+            s.rows
+                .iter()
+                .find(|r| r.scenario == sc && r.tracker == tr && r.planner == planner)
+                .map(|r| {
+                    (
+                        *v,
+                        100.0 * r.success_rate,
+                        100.0 * r.ci95_low,
+                        100.0 * r.ci95_high,
+                    )
+                })
+        })
+        .collect()
+}
+
+/// Centre and half-side of a square around every path sample and control point, with a margin.
+fn square_bounds(series: &[Series]) -> (f64, f64, f64) {
+    let pts = series.iter().flat_map(|s| {
+        s.path
+            .samples
+            .iter()
+            .map(|p| (p.x_m, p.y_m))
+            .chain(s.control_polygon.iter().flatten().map(|p| (p[0], p[1])))
+    });
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in pts {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+    let half = ((x1 - x0).max(y1 - y0) / 2.0 + 0.3).max(0.5);
+    (cx, cy, half)
 }

@@ -191,31 +191,7 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
     let obs = s.bend.obstacles(s.reach_m);
     let fp = s.vehicle.footprint();
     let hits = |p: [f64; 2], h: f64| obs.collides(&fp, &Pose2::new(p[0], p[1], h));
-    let cells: Vec<usize> = g.cells().collect();
-    let stride = (cells.len() / samples.max(1)).max(1);
-    let (mut g_sampled, mut g_passed) = (0, 0);
-    for &cell in cells.iter().step_by(stride) {
-        let Some(path) = g.witness(cell) else {
-            continue;
-        };
-        g_sampled += 1;
-        let clean = path.windows(2).all(|w| {
-            let ((a, ha), (b, hb)) = (w[0], w[1]);
-            let d = (b[0] - a[0]).hypot(b[1] - a[1]);
-            let n = ((d / FINE_STEP_M)
-                .max((hb - ha).abs() / FINE_STEP_RAD)
-                .ceil() as usize)
-                .max(1);
-            (0..=n).all(|i| {
-                let t = i as f64 / n as f64;
-                !hits(
-                    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])],
-                    ha + t * (hb - ha),
-                )
-            })
-        });
-        g_passed += usize::from(clean);
-    }
+    let (g_sampled, g_passed) = sweep_g_passages(g, samples, &hits);
     let (h1, h2) = s.bend.headings();
     let headings: Vec<f64> = if s.mode == Mode::Oblique {
         vec![h1]
@@ -225,22 +201,7 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
             .map(|i| h1 - (h1 - h2) * i as f64 / n as f64)
             .collect()
     };
-    // The legs' cut ends are left out: passages start and end there, in a band one cell
-    // deep, so G there depends on where each grid cuts the window rather than on the bend.
-    let wrong: Vec<usize> = g
-        .through
-        .iter()
-        .enumerate()
-        .filter(|(c, t)| {
-            let p = s.cell_centre(*c);
-            t.is_none()
-                && s.in_window(p)
-                && !s.is_start(p)
-                && !s.is_goal(p)
-                && s.bend.clearance(p) >= s.vehicle.inscribed_m() / 2.0
-        })
-        .map(|(c, _)| c)
-        .collect();
+    let wrong = inscribed_outside_g(g);
     // G's edge, as far as the grid blurs it: one cell of rasterisation, and for the truck
     // one more for the single pose a search state keeps (a vehicle that slides can move
     // onto any pose in a cell; the truck, driving forward only, cannot).
@@ -293,4 +254,58 @@ pub fn validate(g: &GRegion, samples: usize) -> Validation {
         inscribed_wrong_beyond_edge: beyond,
         inscribed_wrong_beyond_edge_confirmed: beyond_confirmed,
     }
+}
+
+/// Sweeps up to `samples` G passages at 1 mm / 0.1° steps: (sampled, collision-free).
+fn sweep_g_passages(
+    g: &GRegion,
+    samples: usize,
+    hits: &dyn Fn([f64; 2], f64) -> bool,
+) -> (usize, usize) {
+    let cells: Vec<usize> = g.cells().collect();
+    let stride = (cells.len() / samples.max(1)).max(1);
+    let (mut g_sampled, mut g_passed) = (0, 0);
+    for &cell in cells.iter().step_by(stride) {
+        let Some(path) = g.witness(cell) else {
+            continue;
+        };
+        g_sampled += 1;
+        let clean = path.windows(2).all(|w| {
+            let ((a, ha), (b, hb)) = (w[0], w[1]);
+            let d = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let n = ((d / FINE_STEP_M)
+                .max((hb - ha).abs() / FINE_STEP_RAD)
+                .ceil() as usize)
+                .max(1);
+            (0..=n).all(|i| {
+                let t = i as f64 / n as f64;
+                !hits(
+                    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])],
+                    ha + t * (hb - ha),
+                )
+            })
+        });
+        g_passed += usize::from(clean);
+    }
+    (g_sampled, g_passed)
+}
+
+/// Cells outside G that inscribed-circle inflation calls free.
+fn inscribed_outside_g(g: &GRegion) -> Vec<usize> {
+    let s = &g.space;
+    // The legs' cut ends are left out: passages start and end there, in a band one cell
+    // deep, so G there depends on where each grid cuts the window rather than on the bend.
+    g.through
+        .iter()
+        .enumerate()
+        .filter(|(c, t)| {
+            let p = s.cell_centre(*c);
+            t.is_none()
+                && s.in_window(p)
+                && !s.is_start(p)
+                && !s.is_goal(p)
+                && s.bend.clearance(p) >= s.vehicle.inscribed_m() / 2.0
+        })
+        .map(|(c, _)| c)
+        .collect()
 }

@@ -1,10 +1,11 @@
 //! Feasibility search per turning mode on a grid of body-centre positions × headings; minimum width by bisection; G regions.
 
-use std::collections::VecDeque;
+use crate::bend::{Bend, MARGIN_M, Vehicle};
 
-use rayon::prelude::*;
+mod bfs;
+mod region;
 
-use crate::bend::{Bend, Junction, MARGIN_M, Vehicle};
+pub use region::{GRegion, min_width_m, passes};
 
 /// How the vehicle changes direction at the bend.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
@@ -88,7 +89,67 @@ pub struct Reached {
     pub goal: Option<u32>,
 }
 
-const ROOT: u32 = u32::MAX;
+pub(crate) const ROOT: u32 = u32::MAX;
+
+/// The search window's corners: both legs out to `reach_m` (and a T's left arm).
+fn window(bend: &Bend, reach_m: f64) -> ([f64; 2], [f64; 2]) {
+    let hw = bend.width_m / 2.0;
+    let corners = [
+        [-hw, -reach_m],
+        [hw, -reach_m],
+        bend.j,
+        bend.i,
+        [
+            bend.d2[0] * reach_m + bend.l2[0] * hw,
+            bend.d2[1] * reach_m + bend.l2[1] * hw,
+        ],
+        [
+            bend.d2[0] * reach_m - bend.l2[0] * hw,
+            bend.d2[1] * reach_m - bend.l2[1] * hw,
+        ],
+    ];
+    // A T's left arm, searched as far as leg 2.
+    let left_arm = [
+        [
+            -bend.d2[0] * reach_m + bend.l2[0] * hw,
+            -bend.d2[1] * reach_m + bend.l2[1] * hw,
+        ],
+        [
+            -bend.d2[0] * reach_m - bend.l2[0] * hw,
+            -bend.d2[1] * reach_m - bend.l2[1] * hw,
+        ],
+    ];
+    let corners = corners
+        .into_iter()
+        .chain(left_arm.into_iter().filter(|_| bend.tee));
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for c in corners {
+        for k in 0..2 {
+            lo[k] = lo[k].min(c[k]);
+            hi[k] = hi[k].max(c[k]);
+        }
+    }
+    (lo, hi)
+}
+
+/// The turning radii a mode searches, and the sweep margin that covers the sagitta of a
+/// step's arc at the widest of them.
+fn turn_radii(mode: Mode, vehicle: &Vehicle, l0: f64, dphi: f64) -> (Vec<f64>, f64) {
+    let turn_radii_m = match mode {
+        Mode::Oblique | Mode::Spin => vec![0.0],
+        Mode::Curve => vec![0.0, vehicle.width_m / 2.0, l0 / 2.0, l0, 2.0 * l0],
+        Mode::CurveFixedRadius => vec![vehicle.width_m / 2.0],
+        Mode::Truck => vec![vehicle.min_radius_m],
+    };
+    // Body points turn about the arc centre at up to radius + |offset of the turning
+    // point| + half the diagonal; between two states they bulge past the chord by the
+    // sagitta r·(1 − cos(Δφ/2)).
+    let widest = turn_radii_m.iter().copied().fold(0.0, f64::max)
+        + vehicle.kinematic_ahead_m.abs()
+        + l0 / 2.0;
+    let margin_m = MARGIN_M.max(1.25 * widest * (1.0 - (dphi / 2.0).cos()));
+    (turn_radii_m, margin_m)
+}
 
 impl Space {
     pub fn new(bend: Bend, vehicle: Vehicle, mode: Mode, res: Resolution) -> Self {
@@ -101,42 +162,7 @@ impl Space {
             0.0
         };
         let reach_m = bend.width_m / 2.0 + l0 + turn_room + 2.0 * res.cell_m;
-        let hw = bend.width_m / 2.0;
-        let corners = [
-            [-hw, -reach_m],
-            [hw, -reach_m],
-            bend.j,
-            bend.i,
-            [
-                bend.d2[0] * reach_m + bend.l2[0] * hw,
-                bend.d2[1] * reach_m + bend.l2[1] * hw,
-            ],
-            [
-                bend.d2[0] * reach_m - bend.l2[0] * hw,
-                bend.d2[1] * reach_m - bend.l2[1] * hw,
-            ],
-        ];
-        // A T's left arm, searched as far as leg 2.
-        let left_arm = [
-            [
-                -bend.d2[0] * reach_m + bend.l2[0] * hw,
-                -bend.d2[1] * reach_m + bend.l2[1] * hw,
-            ],
-            [
-                -bend.d2[0] * reach_m - bend.l2[0] * hw,
-                -bend.d2[1] * reach_m - bend.l2[1] * hw,
-            ],
-        ];
-        let corners = corners
-            .into_iter()
-            .chain(left_arm.into_iter().filter(|_| bend.tee));
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for c in corners {
-            for k in 0..2 {
-                lo[k] = lo[k].min(c[k]);
-                hi[k] = hi[k].max(c[k]);
-            }
-        }
+        let (lo, hi) = window(&bend, reach_m);
         let h = res.cell_m;
         let layers = if mode == Mode::Oblique || bend.angle_rad == 0.0 {
             1
@@ -148,19 +174,7 @@ impl Space {
         } else {
             0.0
         };
-        let turn_radii_m = match mode {
-            Mode::Oblique | Mode::Spin => vec![0.0],
-            Mode::Curve => vec![0.0, vehicle.width_m / 2.0, l0 / 2.0, l0, 2.0 * l0],
-            Mode::CurveFixedRadius => vec![vehicle.width_m / 2.0],
-            Mode::Truck => vec![vehicle.min_radius_m],
-        };
-        // Body points turn about the arc centre at up to radius + |offset of the turning
-        // point| + half the diagonal; between two states they bulge past the chord by the
-        // sagitta r·(1 − cos(Δφ/2)).
-        let widest = turn_radii_m.iter().copied().fold(0.0, f64::max)
-            + vehicle.kinematic_ahead_m.abs()
-            + l0 / 2.0;
-        let margin_m = MARGIN_M.max(1.25 * widest * (1.0 - (dphi / 2.0).cos()));
+        let (turn_radii_m, margin_m) = turn_radii(mode, &vehicle, l0, dphi);
         let mut space = Self {
             turn_radii_m,
             margin_m,
@@ -312,145 +326,6 @@ impl Space {
             .sweep_free_axes(&a.0, &b.0, [a.1[0], a.1[1], b.1[0], b.1[1]], self.margin_m)
     }
 
-    /// Breadth-first search from leg 1 (`forward`) or back from leg 2; stops at the first
-    /// goal when `stop_at_goal`.
-    pub fn search(&self, forward: bool, stop_at_goal: bool) -> Reached {
-        let n = self.cells() * self.layers;
-        let mut parent = vec![0u32; n];
-        let mut pos = vec![[0.0f64; 2]; n];
-        let mut queue = VecDeque::new();
-        // A queued state not yet expanded takes a later arrival nearer its cell's centre.
-        let mut expanded = vec![false; n];
-        let (first, last) = (0, self.layers - 1);
-        let start_layer = if forward { first } else { last };
-        for cell in 0..self.cells() {
-            let p = self.cell_centre(cell);
-            let starts = if forward {
-                self.is_start(p)
-            } else {
-                self.is_goal(p)
-            };
-            if starts
-                && self.in_window(p)
-                && self.free_to(&self.body(p, start_layer), p, start_layer)
-            {
-                let s = start_layer * self.cells() + cell;
-                parent[s] = ROOT;
-                pos[s] = p;
-                queue.push_back(s as u32);
-            }
-        }
-        let h = self.res.cell_m;
-        let sign = if forward { 1.0 } else { -1.0 };
-        let mut goal = None;
-        let mut moves: Vec<([f64; 2], usize)> = Vec::with_capacity(10);
-        while let Some(s) = queue.pop_front() {
-            let s = s as usize;
-            expanded[s] = true;
-            let (layer, p) = (s / self.cells(), pos[s]);
-            let done = if forward {
-                layer == last && self.is_goal(p)
-            } else {
-                layer == first && self.is_start(p)
-            };
-            if done {
-                goal = Some(s as u32);
-                if stop_at_goal {
-                    break;
-                }
-            }
-            let head = self.heading(layer);
-            let here = self.body(p, layer);
-            moves.clear();
-            if self.translates(layer) {
-                for (dx, dy) in [
-                    (1, 0),
-                    (-1, 0),
-                    (0, 1),
-                    (0, -1),
-                    (1, 1),
-                    (1, -1),
-                    (-1, 1),
-                    (-1, -1),
-                ] {
-                    moves.push(([p[0] + dx as f64 * h, p[1] + dy as f64 * h], layer));
-                }
-                // Slides along leg 2 itself: lattice steps alone need a channel about a
-                // cell wider than the body to zigzag along an oblique leg.
-                let d2 = self.bend.d2;
-                for dir in [d2, [-d2[0], -d2[1]]] {
-                    moves.push((self.straight_step(p, dir), layer));
-                }
-            }
-            if self.drives_straight(layer) {
-                let dir = [sign * head.cos(), sign * head.sin()];
-                let q = self.straight_step(p, dir);
-                moves.push((q, layer));
-                if self.mode == Mode::Truck && !stop_at_goal {
-                    // A truck cannot slide back onto a ray whose cells other poses took
-                    // over: for the whole reachable set (G regions) it also drives on
-                    // through cells already reached to the first one that is not (one
-                    // sweep covers the stretch: a translation's hull). Without it the
-                    // truck's G missed strips along the walls up to 4 cells wide; a search
-                    // for one passage (W_min) skips it, at 2.5× the time it moves W_min by
-                    // under a cell.
-                    // (Cells outside the corridor are never reached, so the walk stops
-                    // at a wall; the move's own checks then drop it.)
-                    let mut far = q;
-                    let layer_base = layer * self.cells();
-                    while self
-                        .cell_of(far)
-                        .is_some_and(|c| parent[layer_base + c] != 0)
-                    {
-                        far = self.straight_step(far, dir);
-                    }
-                    if far != q {
-                        moves.push((far, layer));
-                    }
-                }
-            }
-            for &r in &self.turn_radii_m {
-                if forward && layer < last {
-                    let d = self.turn_displacement(layer, r);
-                    moves.push(([p[0] + d[0], p[1] + d[1]], layer + 1));
-                }
-                if !forward && layer > first {
-                    let d = self.turn_displacement(layer - 1, r);
-                    moves.push(([p[0] - d[0], p[1] - d[1]], layer - 1));
-                }
-            }
-            for &(q, ql) in &moves {
-                if !self.in_window(q) {
-                    continue;
-                }
-                let Some(cell) = self.cell_of(q) else {
-                    continue;
-                };
-                let t = ql * self.cells() + cell;
-                let seen = parent[t] != 0;
-                // The pose a state keeps decides what follows, above all for the truck,
-                // which cannot slide: keeping the first arrival made its W_min jump by
-                // several cells under 1e-7 m changes. Preferring the arrival nearest the
-                // cell centre (until the state is expanded) ties the choice to the grid,
-                // not to the order of arrival; each kept move is still checked exactly.
-                let better = seen && !expanded[t] && {
-                    let c = self.cell_centre(cell);
-                    let d = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
-                    d(q) < d(pos[t])
-                };
-                if (seen && !better) || !self.free_to(&here, q, ql) {
-                    continue;
-                }
-                parent[t] = s as u32 + 1;
-                pos[t] = q;
-                if !seen {
-                    queue.push_back(t as u32);
-                }
-            }
-        }
-        Reached { parent, pos, goal }
-    }
-
     /// The chain of (position, heading) from a search root to state `s`.
     pub fn chain(&self, r: &Reached, mut s: usize) -> Vec<([f64; 2], f64)> {
         let mut out = Vec::new();
@@ -465,128 +340,4 @@ impl Space {
         out.reverse();
         out
     }
-}
-
-/// The movable range of one mode at one width.
-#[derive(Debug)]
-pub struct GRegion {
-    pub space: Space,
-    /// Per cell: one state on a passage through it (forward-reached and backward-reached
-    /// in the same heading layer), if any.
-    pub through: Vec<Option<usize>>,
-    pub forward: Reached,
-    pub backward: Reached,
-}
-
-impl GRegion {
-    pub fn compute(bend: Bend, vehicle: Vehicle, mode: Mode, res: Resolution) -> Self {
-        let space = Space::new(bend, vehicle, mode, res);
-        let forward = space.search(true, false);
-        let backward = space.search(false, false);
-        let through = (0..space.cells())
-            .map(|c| {
-                (0..space.layers).map(|l| l * space.cells() + c).find(|&s| {
-                    // Both searches reached the state, each with its own pose in the
-                    // cell; the passage joins them by a slide, which must be free too.
-                    let layer = s / space.cells();
-                    forward.parent[s] != 0
-                        && backward.parent[s] != 0
-                        && space.free_to(&space.body(forward.pos[s], layer), backward.pos[s], layer)
-                })
-            })
-            .collect();
-        Self {
-            space,
-            through,
-            forward,
-            backward,
-        }
-    }
-
-    pub fn cells(&self) -> impl Iterator<Item = usize> + '_ {
-        self.through
-            .iter()
-            .enumerate()
-            .filter_map(|(c, s)| s.map(|_| c))
-    }
-
-    pub fn area_m2(&self) -> f64 {
-        self.cells().count() as f64 * self.space.res.cell_m.powi(2)
-    }
-
-    /// A whole passage through `cell`: from leg 1 to the cell, a step of at most one cell
-    /// inside it, and on to leg 2.
-    pub fn witness(&self, cell: usize) -> Option<Vec<([f64; 2], f64)>> {
-        let s = self.through[cell]?;
-        let mut path = self.space.chain(&self.forward, s);
-        let mut back = self.space.chain(&self.backward, s);
-        back.reverse();
-        path.extend(back);
-        Some(path)
-    }
-}
-
-/// Whether the search finds a passage through a bend of `width_m`. A passage found is
-/// real (every step is an exact sweep); a miss may be the grid's. The truck cannot slide
-/// sideways, so which pose a cell keeps matters most there: it is also searched on a grid
-/// shifted by half a cell diagonally, and passes if either finds a way.
-pub fn passes(
-    vehicle: &Vehicle,
-    mode: Mode,
-    junction: Junction,
-    angle_rad: f64,
-    res: Resolution,
-    width_m: f64,
-) -> bool {
-    let shifts: &[[f64; 2]] = if mode == Mode::Truck {
-        &[[0.0, 0.0], [0.5, 0.5]]
-    } else {
-        &[[0.0, 0.0]]
-    };
-    // The shifted searches are independent: run them on all cores, stop at the first way.
-    shifts.par_iter().any(|s| {
-        let mut space = Space::new(junction.bend(width_m, angle_rad), *vehicle, mode, res);
-        space.shift_grid(*s);
-        space.search(true, true).goal.is_some()
-    })
-}
-
-/// Smallest width (bisection to a quarter cell; the grid itself limits it to about one
-/// cell) at which `mode` passes the bend, or `None`
-/// when even `max_width_m` does not.
-pub fn min_width_m(
-    vehicle: &Vehicle,
-    mode: Mode,
-    junction: Junction,
-    angle_rad: f64,
-    res: Resolution,
-    max_width_m: f64,
-) -> Option<f64> {
-    let passes = |w: f64| passes(vehicle, mode, junction, angle_rad, res, w);
-    let mut lo = vehicle.width_m;
-    let mut hi = vehicle.circumscribed_m() + res.cell_m;
-    while !passes(hi) {
-        lo = hi;
-        hi *= 1.5;
-        if hi > max_width_m {
-            return if passes(max_width_m) {
-                bisect(lo, max_width_m, res.cell_m / 4.0, passes)
-            } else {
-                None
-            };
-        }
-    }
-    bisect(lo, hi, res.cell_m / 4.0, passes)
-}
-
-fn bisect(mut lo: f64, mut hi: f64, tol: f64, passes: impl Fn(f64) -> bool) -> Option<f64> {
-    while hi - lo > tol {
-        let mid = (lo + hi) / 2.0;
-        if passes(mid) {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    Some(hi)
 }

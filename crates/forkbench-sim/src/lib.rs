@@ -1,5 +1,8 @@
 //! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers, fixed racks.
 
+mod bodies;
+use bodies::{insert_obstacles, insert_pallet, insert_truck};
+
 use forkbench_core::{ForkliftSpec, Pose2};
 use rapier2d::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -161,88 +164,15 @@ impl Sim {
         world.gravity = Vector::ZERO;
         world.integration_parameters.dt = cfg.dt_s as Real;
 
-        // Truck: body origin at the front (drive) axle centre, +x forward (fork side).
-        let d = spec.fork_root_ahead_of_front_axle_m;
-        let (s, c) = start.heading_rad.sin_cos();
-        let axle = [start.x_m - c * d, start.y_m - s * d];
-        let truck = world.insert_body(
-            RigidBodyBuilder::dynamic()
-                .translation(v2(axle[0], axle[1]))
-                .rotation(start.heading_rad as Real)
-                .can_sleep(false),
-        );
-        // Chassis (with the mast) ends at the fork root; it carries all the mass, so the
-        // inertia is that of a solid 2.45 × 1.2 m body.
-        let chassis_front = d;
-        let chassis_centre = chassis_front - spec.body_length_m / 2.0;
-        let chassis = world.insert_collider(
-            ColliderBuilder::cuboid(
-                (spec.body_length_m / 2.0) as Real,
-                (spec.body_width_m / 2.0) as Real,
-            )
-            .translation(v2(chassis_centre, 0.0))
-            .mass(spec.mass_kg as Real)
-            .friction(0.5),
-            Some(truck),
-        );
-        let fork = |side: f64| {
-            ColliderBuilder::cuboid(
-                (spec.fork_length_m / 2.0) as Real,
-                (spec.fork_width_m / 2.0) as Real,
-            )
-            .translation(v2(
-                d + spec.fork_length_m / 2.0,
-                side * spec.fork_spacing_m / 2.0,
-            ))
-            .density(0.0)
-            .friction(cfg.fork_friction as Real)
-        };
-        let forks = [
-            world.insert_collider(fork(1.0), Some(truck)),
-            world.insert_collider(fork(-1.0), Some(truck)),
-        ];
+        let (truck, chassis, forks, chassis_centre) = insert_truck(&mut world, spec, start, cfg);
         let truck_mass_kg = spec.mass_kg;
         let truck_inertia =
             spec.mass_kg * (spec.body_length_m.powi(2) + spec.body_width_m.powi(2)) / 12.0;
-
-        // Pallet: stringers run along its heading from the face to the back.
-        let pallet = world.insert_body(
-            RigidBodyBuilder::dynamic()
-                .translation(v2(pallet_pose.x_m, pallet_pose.y_m))
-                .rotation(pallet_pose.heading_rad as Real)
-                .can_sleep(false),
-        );
-        let sw = pallet_spec.stringer_width_m();
-        let mut stringers = Vec::new();
-        for y in pallet_spec.stringer_offsets_m() {
-            stringers.push(
-                world.insert_collider(
-                    ColliderBuilder::cuboid(
-                        (pallet_spec.depth_m / 2.0) as Real,
-                        (sw / 2.0) as Real,
-                    )
-                    .translation(v2(pallet_spec.depth_m / 2.0, y))
-                    .mass((pallet_spec.mass_kg / 3.0) as Real)
-                    .friction(cfg.fork_friction as Real),
-                    Some(pallet),
-                ),
-            );
-        }
+        let (pallet, stringers) = insert_pallet(&mut world, pallet_spec, pallet_pose, cfg);
         let pallet_inertia = pallet_spec.mass_kg
             * (pallet_spec.depth_m.powi(2) + pallet_spec.width_m.powi(2))
             / 12.0;
-
-        let obstacles = obstacles
-            .iter()
-            .map(|o| {
-                world.insert_collider(
-                    ColliderBuilder::cuboid((o.length_m / 2.0) as Real, (o.width_m / 2.0) as Real)
-                        .translation(v2(o.centre.x_m, o.centre.y_m))
-                        .rotation(o.centre.heading_rad as Real),
-                    None,
-                )
-            })
-            .collect();
+        let obstacles = insert_obstacles(&mut world, obstacles);
 
         Ok(Self {
             world,

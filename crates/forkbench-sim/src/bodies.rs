@@ -1,0 +1,102 @@
+//! The rigid bodies and colliders of a trial's world: truck, pallet, racks and walls.
+
+use super::*;
+
+/// The truck's body (origin at the front axle centre, +x toward the forks), its chassis
+/// (carrying all the mass) and its two massless forks; also the chassis centre's offset.
+pub(crate) fn insert_truck(
+    world: &mut PhysicsWorld,
+    spec: &ForkliftSpec,
+    start: &Pose2,
+    cfg: &SimConfig,
+) -> (RigidBodyHandle, ColliderHandle, [ColliderHandle; 2], f64) {
+    // Truck: body origin at the front (drive) axle centre, +x forward (fork side).
+    let d = spec.fork_root_ahead_of_front_axle_m;
+    let (s, c) = start.heading_rad.sin_cos();
+    let axle = [start.x_m - c * d, start.y_m - s * d];
+    let truck = world.insert_body(
+        RigidBodyBuilder::dynamic()
+            .translation(v2(axle[0], axle[1]))
+            .rotation(start.heading_rad as Real)
+            .can_sleep(false),
+    );
+    // Chassis (with the mast) ends at the fork root; it carries all the mass, so the
+    // inertia is that of a solid 2.45 × 1.2 m body.
+    let chassis_front = d;
+    let chassis_centre = chassis_front - spec.body_length_m / 2.0;
+    let chassis = world.insert_collider(
+        ColliderBuilder::cuboid(
+            (spec.body_length_m / 2.0) as Real,
+            (spec.body_width_m / 2.0) as Real,
+        )
+        .translation(v2(chassis_centre, 0.0))
+        .mass(spec.mass_kg as Real)
+        .friction(0.5),
+        Some(truck),
+    );
+    let fork = |side: f64| {
+        ColliderBuilder::cuboid(
+            (spec.fork_length_m / 2.0) as Real,
+            (spec.fork_width_m / 2.0) as Real,
+        )
+        .translation(v2(
+            d + spec.fork_length_m / 2.0,
+            side * spec.fork_spacing_m / 2.0,
+        ))
+        .density(0.0)
+        .friction(cfg.fork_friction as Real)
+    };
+    let forks = [
+        world.insert_collider(fork(1.0), Some(truck)),
+        world.insert_collider(fork(-1.0), Some(truck)),
+    ];
+    (truck, chassis, forks, chassis_centre)
+}
+
+/// The pallet's body and its three stringers, which run along its heading from the face.
+pub(crate) fn insert_pallet(
+    world: &mut PhysicsWorld,
+    pallet_spec: &PalletSpec,
+    pallet_pose: &Pose2,
+    cfg: &SimConfig,
+) -> (RigidBodyHandle, Vec<ColliderHandle>) {
+    // Pallet: stringers run along its heading from the face to the back.
+    let pallet = world.insert_body(
+        RigidBodyBuilder::dynamic()
+            .translation(v2(pallet_pose.x_m, pallet_pose.y_m))
+            .rotation(pallet_pose.heading_rad as Real)
+            .can_sleep(false),
+    );
+    let sw = pallet_spec.stringer_width_m();
+    let mut stringers = Vec::new();
+    for y in pallet_spec.stringer_offsets_m() {
+        stringers.push(
+            world.insert_collider(
+                ColliderBuilder::cuboid((pallet_spec.depth_m / 2.0) as Real, (sw / 2.0) as Real)
+                    .translation(v2(pallet_spec.depth_m / 2.0, y))
+                    .mass((pallet_spec.mass_kg / 3.0) as Real)
+                    .friction(cfg.fork_friction as Real),
+                Some(pallet),
+            ),
+        );
+    }
+    (pallet, stringers)
+}
+
+/// Racks and walls: fixed colliders.
+pub(crate) fn insert_obstacles(
+    world: &mut PhysicsWorld,
+    obstacles: &[Obstacle],
+) -> Vec<ColliderHandle> {
+    obstacles
+        .iter()
+        .map(|o| {
+            world.insert_collider(
+                ColliderBuilder::cuboid((o.length_m / 2.0) as Real, (o.width_m / 2.0) as Real)
+                    .translation(v2(o.centre.x_m, o.centre.y_m))
+                    .rotation(o.centre.heading_rad as Real),
+                None,
+            )
+        })
+        .collect()
+}
