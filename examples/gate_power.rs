@@ -2,7 +2,7 @@
 //! random numbers against unpaired: a steering actuator 16× too slow (field test) and a
 //! tracker that believes the truck 2 cm to the left of where it is (rack pick).
 //!
-//! `cargo run --release -p forkbench-trial --example gate_power` prints, for doubling
+//! `cargo run --release -p forkbench-batch --example gate_power` prints, for doubling
 //! trial counts, the paired p (McNemar, same batch seed before and after) and the unpaired
 //! p (two-proportion z-test, baseline run with another batch seed, as a gate without
 //! per-trial results compares).
@@ -10,12 +10,12 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use forkbench_core::{ForkliftSpec, Path as TrackPath};
-use forkbench_track::{Command, PurePursuit, Tracker, TrackerInput};
-use forkbench_trial::batch::{self, BatchSpec, Summary, TrialRecord};
-use forkbench_trial::stats::{
+use forkbench_batch::stats::{
     drop_p_value, mcnemar_drop_p, paired_power, trials_needed, unpaired_power,
 };
+use forkbench_batch::{self as batch, BatchSpec, Summary, TrialRecord};
+use forkbench_core::{ForkliftSpec, Path as TrackPath};
+use forkbench_track::{Command, PurePursuit, Tracker, TrackerInput};
 use forkbench_trial::{Registry, Scenario};
 
 /// Pure pursuit fed a pose `.1` metres left of the measured one.

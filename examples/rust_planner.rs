@@ -1,17 +1,17 @@
 //! A pick planner written in Rust against forkbench's `Planner` trait, registered by name
 //! and run in a batch beside the built-in planners.
 //!
-//! `cargo run --release -p forkbench-trial --example rust_planner` (results in
+//! `cargo run --release -p forkbench-batch --example rust_planner` (results in
 //! recordings/rust-planner/). A scenario then names it like any other planner:
 //! `[planner] kind = "bezier"` with `handle_fraction = 0.4`.
 
 use std::path::Path;
 use std::sync::Arc;
 
+use forkbench_batch::{BatchSpec, run_batch};
 use forkbench_core::settings::{self, Settings, SettingsError};
 use forkbench_core::{Path as PlanPath, PathSample};
 use forkbench_plan::{Plan, PlanError, PlanParams, PlanRequest, Planner};
-use forkbench_trial::batch::{BatchSpec, run_batch};
 use forkbench_trial::{Registry, Scenario};
 use serde::Deserialize;
 

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context as _, bail};
-use forkbench_trial::batch::{self, BatchSpec, RecordChoice, Summary, TrialRecord};
+use forkbench_batch::{self as batch, BatchSpec, RecordChoice, Summary, TrialRecord};
 use forkbench_trial::{Scenario, defaults};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
-use forkbench_trial::batch::{self, Baseline, CompareOptions, GateOptions};
-use forkbench_trial::stats::Correction;
+use forkbench_batch::stats::Correction;
+use forkbench_batch::{self as batch, Baseline, CompareOptions, GateOptions};
 
 /// How rows tested together are corrected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -240,7 +240,7 @@ where
 pub fn draw_sweep(
     file: &FsPath,
     planner: &str,
-    points: &[(f64, forkbench_trial::batch::Summary)],
+    points: &[(f64, forkbench_batch::Summary)],
 ) -> anyhow::Result<()> {
     to_file(
         file,
@@ -253,7 +253,7 @@ pub fn draw_sweep(
 fn draw_sweep_on<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     planner: &str,
-    points: &[(f64, forkbench_trial::batch::Summary)],
+    points: &[(f64, forkbench_batch::Summary)],
 ) -> anyhow::Result<()>
 where
     DB::ErrorType: 'static,
@@ -314,7 +314,7 @@ where
 
 /// The (scenario, tracker) pairs of `planner` in a sweep, sorted.
 fn sweep_series(
-    points: &[(f64, forkbench_trial::batch::Summary)],
+    points: &[(f64, forkbench_batch::Summary)],
     planner: &str,
 ) -> Vec<(String, String)> {
     let mut series: Vec<(String, String)> = points
@@ -333,7 +333,7 @@ fn sweep_series(
 
 /// One series' points: (sweep value, success %, Wilson 95 % low, high).
 fn sweep_points(
-    points: &[(f64, forkbench_trial::batch::Summary)],
+    points: &[(f64, forkbench_batch::Summary)],
     (sc, tr): (&str, &str),
     planner: &str,
 ) -> Vec<(f64, f64, f64, f64)> {

@@ -1,12 +1,10 @@
 //! One pick trial end to end: scenario and world files, noisy estimate → plan → tracker in rapier2d → judged outcome, with components from a registry.
 
-pub mod batch;
 pub mod components;
 pub mod defaults;
 pub mod outcome;
 pub mod recorder;
 pub mod scenario;
-pub mod stats;
 pub mod text;
 pub mod trial;
 

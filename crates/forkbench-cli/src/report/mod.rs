@@ -6,7 +6,7 @@ mod svg;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
-use forkbench_trial::batch::{self, Baseline, GateOptions, Manifest, Summary};
+use forkbench_batch::{self as batch, Baseline, GateOptions, Manifest, Summary};
 
 const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1300px;color:#222}\
 h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccc}\

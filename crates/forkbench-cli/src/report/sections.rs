@@ -4,8 +4,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use forkbench_trial::batch::{
-    self, GateReport, Manifest, Provenance, Summary, TrialRecord, Verdict,
+use forkbench_batch::{
+    self as batch, GateReport, Manifest, Provenance, Summary, TrialRecord, Verdict,
 };
 use serde_json::Value;
 

@@ -2,7 +2,7 @@
 
 use super::gate::{GateReport, Pairing, RegressRow, Verdict};
 use super::summary::mode_name;
-use crate::text::md_cell;
+use forkbench_trial::text::md_cell;
 
 fn pct(v: f64) -> String {
     format!("{:.1} %", 100.0 * v)

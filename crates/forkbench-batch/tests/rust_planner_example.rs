@@ -7,7 +7,7 @@ mod rust_planner;
 use std::path::Path;
 use std::sync::Arc;
 
-use forkbench_trial::batch::{BatchSpec, run_batch};
+use forkbench_batch::{BatchSpec, run_batch};
 use forkbench_trial::{Scenario, TrialOptions, run_trial};
 
 fn field_test() -> Scenario {

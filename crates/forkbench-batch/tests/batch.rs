@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use forkbench_trial::batch::{self, Baseline, BatchSpec, TrialRecord};
+use forkbench_batch::{self as batch, Baseline, BatchSpec, TrialRecord};
 use forkbench_trial::{Failure, Scenario};
 
 fn scenario(name: &str) -> Scenario {

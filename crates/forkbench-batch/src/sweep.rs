@@ -4,8 +4,8 @@ use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 
 use super::{BatchSpec, Summary, TrialRecord};
-use crate::scenario::{Case, Scenario};
-use crate::trial::TrialOptions;
+use forkbench_trial::scenario::{Case, Scenario};
+use forkbench_trial::trial::TrialOptions;
 
 /// One point of a pallet-noise sweep: the batch to run and where its results go.
 #[derive(Debug, Clone)]

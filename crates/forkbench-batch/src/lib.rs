@@ -1,4 +1,4 @@
-//! Monte-Carlo batches: scenario × case × planner × tracker × trial, in parallel, streamed to JSON lines, summarised, compared.
+//! Monte-Carlo batches of pick trials: scenario × case × planner × tracker × trial in parallel, streamed to JSON lines, sharded, merged, summarised, gated against baselines, exported.
 
 use std::collections::HashSet;
 use std::fs::OpenOptions;
@@ -21,6 +21,7 @@ mod order;
 mod provenance;
 mod seed;
 mod shard;
+pub mod stats;
 mod store;
 mod summary;
 mod sweep;
@@ -46,9 +47,9 @@ pub use sweep::{
 use store::{check_unique, read_records_torn, remove_if_present, rewrite_records};
 use summary::write_summary;
 
-use crate::outcome::TrialOutcome;
-use crate::scenario::Scenario;
-use crate::trial::{TrialOptions, run_trial};
+use forkbench_trial::outcome::TrialOutcome;
+use forkbench_trial::scenario::Scenario;
+use forkbench_trial::trial::{TrialOptions, run_trial};
 
 /// Largest `trials.jsonl` read whole (by `replay`).
 pub const MAX_RECORDS_BYTES: u64 = 1 << 30;
@@ -309,11 +310,11 @@ impl BatchSpec {
         for s in &self.scenarios {
             let (planners, trackers) = self.components_of(s);
             for p in &planners {
-                s.component(crate::Role::Planner, Some(p))
+                s.component(forkbench_trial::Role::Planner, Some(p))
                     .map_err(|e| BatchError::Invalid(e.to_string()))?;
             }
             for t in &trackers {
-                s.component(crate::Role::Tracker, Some(t))
+                s.component(forkbench_trial::Role::Tracker, Some(t))
                     .map_err(|e| BatchError::Invalid(e.to_string()))?;
             }
         }

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use forkbench_trial::batch::{BatchSpec, read_records, run_batch};
+use forkbench_batch::{BatchSpec, read_records, run_batch};
 use forkbench_trial::{Failure, Scenario, TrialOptions, run_trial};
 
 fn tmp(name: &str) -> PathBuf {
@@ -16,7 +16,7 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn script() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/planners/misbehaving.py")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../forkbench-trial/tests/planners/misbehaving.py")
 }
 
 /// A pick straight ahead planned by the misbehaving planner in `mode` (extra arguments

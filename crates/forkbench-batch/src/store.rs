@@ -177,7 +177,7 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
             "{}: holds a trial its manifest does not name ({}); the file was edited or \
              mixed with another batch's",
             path.display(),
-            crate::text::one_line(&format!("{:?}", stray.key()))
+            forkbench_trial::text::one_line(&format!("{:?}", stray.key()))
         )));
     }
     Ok(records)

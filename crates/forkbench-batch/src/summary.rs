@@ -6,9 +6,9 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::{BatchError, TrialRecord};
-use crate::outcome::Failure;
 use crate::stats::{Z95, percentile_sorted, wilson};
-use crate::text::md_cell;
+use forkbench_trial::outcome::Failure;
+use forkbench_trial::text::md_cell;
 
 /// Success statistics of one scenario × planner × tracker.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -54,7 +54,7 @@ pub struct LegSummary {
 }
 
 /// Per-leg counts: (name, attempted, done) by leg index.
-fn count_legs(acc: &mut Vec<(String, u64, u64)>, legs: &[crate::outcome::LegOutcome]) {
+fn count_legs(acc: &mut Vec<(String, u64, u64)>, legs: &[forkbench_trial::outcome::LegOutcome]) {
     for (i, l) in legs.iter().enumerate() {
         if acc.len() <= i {
             acc.push((l.name.clone(), 0, 0));

@@ -5,13 +5,13 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use forkbench_batch::stats::Correction;
+use forkbench_batch::{
+    self as batch, Baseline, BatchSpec, CompareOptions, GateOptions, GateReport, Pairing, Summary,
+    Verdict, junit,
+};
 use forkbench_core::{ForkliftSpec, Path as TrackPath};
 use forkbench_track::{Command, PurePursuit, Tracker, TrackerInput};
-use forkbench_trial::batch::{
-    self, Baseline, BatchSpec, CompareOptions, GateOptions, GateReport, Pairing, Summary, Verdict,
-    junit,
-};
-use forkbench_trial::stats::Correction;
 use forkbench_trial::{Registry, Scenario};
 
 fn scenario_file(name: &str) -> PathBuf {

@@ -1,7 +1,7 @@
 //! A trial that panics becomes that trial's `error` outcome, so a batch goes on.
 
-use crate::outcome::{Failure, TrialOutcome};
-use crate::scenario::Scenario;
+use forkbench_trial::outcome::{Failure, TrialOutcome};
+use forkbench_trial::scenario::Scenario;
 
 /// Runs `f`, turning a panic into an `error` outcome that carries the message and seed.
 pub fn guarded(

@@ -238,7 +238,7 @@ pub fn compare(
 impl CompareReport {
     /// The comparison as Markdown, with every discordant trial and its replay lines.
     pub fn markdown(&self, trials_file: &str) -> String {
-        use crate::text::md_cell;
+        use forkbench_trial::text::md_cell;
         let mut s = format!(
             "{} {} (A) against {} (B), paired trial by trial on shared seeds; McNemar's exact \
              two-sided test per row, {} correction at α = {}.\n\n| scenario | {} | mode | pairs | A | B | A only | B only | p | p adjusted | |\n|---|---|---|---|---|---|---|---|---|---|---|\n",

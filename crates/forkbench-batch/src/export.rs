@@ -5,7 +5,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::{BatchError, TrialRecord};
-use crate::text::csv_text;
+use forkbench_trial::text::csv_text;
 
 /// One CSV row (column names carry their units).
 #[derive(Debug, Serialize)]
