@@ -501,7 +501,7 @@ fn batch_input_errors_are_clear() {
     let cases: [(&[&str], &str); 6] = [
         (&["--shard", "2/2"], "index must be below the count"),
         (&["--shard", "one/2"], "is not a whole number"),
-        (&["--trials", "0"], "--trials must be at least 1"),
+        (&["--trials", "0"], "trials: must be at least 1"),
         (&["--sweep", "nav_noise=1,2"], "unknown knob"),
         (&["--sweep", "pallet_noise=1,x"], "\"x\" is not a number"),
         (

@@ -191,6 +191,7 @@ pub fn compare(
     b: &str,
     o: &CompareOptions,
 ) -> Result<CompareReport, BatchError> {
+    crate::check_alpha(o.alpha)?;
     let planners = kind_of(records, a, b)?;
     let (sa, sb) = (side(records, a, planners), side(records, b, planners));
     let (counts, discordant, paired) = tally(&sa, &sb, (a, b));

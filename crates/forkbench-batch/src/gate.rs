@@ -31,6 +31,21 @@ pub struct GateOptions {
     pub min_detectable_drop: Option<f64>,
 }
 
+impl GateOptions {
+    /// Every option in its range: α in (0, 1), the floor a rate, the detectable drop in
+    /// (0, 1].
+    pub fn validate(&self) -> Result<(), crate::BatchError> {
+        crate::check_alpha(self.alpha)?;
+        crate::check_floor(self.floor)?;
+        match self.min_detectable_drop {
+            Some(d) if !(d > 0.0 && d <= 1.0) => Err(crate::BatchError::Invalid(format!(
+                "min_detectable_drop {d}: must be a drop in success rate in (0, 1]"
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
 impl Default for GateOptions {
     fn default() -> Self {
         Self {

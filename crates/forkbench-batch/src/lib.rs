@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod baseline;
+mod checks;
 mod compare;
 mod export;
 mod gate;
@@ -41,7 +42,8 @@ pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_batch, load_results, merge, read_numbered, read_records};
 pub use summary::{Summary, SummaryRow, mode_name, summarize};
 pub use sweep::{
-    RecordChoice, RecordJob, SweepPoint, sweep_markdown, sweep_points, trials_to_record,
+    RecordChoice, RecordJob, SweepPoint, SweepResult, read_sweep, sweep_markdown, sweep_points,
+    trials_to_record, write_sweep,
 };
 
 use store::{check_unique, read_records_torn, remove_if_present, rewrite_records};
@@ -101,6 +103,27 @@ pub enum BatchError {
 /// Writes an output file atomically (see [`forkbench_core::files::write_atomic`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), BatchError> {
     Ok(forkbench_core::files::write_atomic(path, bytes)?)
+}
+
+/// A success rate given as a floor must lie in [0, 1].
+pub fn check_floor(floor: Option<f64>) -> Result<(), BatchError> {
+    match floor {
+        Some(f) if !(0.0..=1.0).contains(&f) => Err(BatchError::Invalid(format!(
+            "floor {f}: must be a success rate between 0 and 1"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// A significance level must lie strictly between 0 and 1.
+pub fn check_alpha(alpha: f64) -> Result<(), BatchError> {
+    if alpha > 0.0 && alpha < 1.0 {
+        Ok(())
+    } else {
+        Err(BatchError::Invalid(format!(
+            "alpha {alpha}: must lie strictly between 0 and 1"
+        )))
+    }
 }
 
 /// Reads an input file that must be a regular file of at most `max` bytes.
@@ -285,56 +308,6 @@ impl BatchSpec {
 }
 
 impl BatchSpec {
-    /// The batch's own arguments: trials, shard, worker threads and unique names.
-    fn check(&self, jobs: usize) -> Result<(), BatchError> {
-        if self.trials == 0 {
-            return Err(BatchError::Invalid("--trials must be at least 1".into()));
-        }
-        if self.shard.1 == 0 || self.shard.0 >= self.shard.1 {
-            return Err(BatchError::Invalid(format!(
-                "shard {}/{}: the index must be below the shard count",
-                self.shard.0, self.shard.1
-            )));
-        }
-        if jobs > MAX_JOBS {
-            return Err(BatchError::Invalid(format!(
-                "--jobs {jobs}: at most {MAX_JOBS} worker threads"
-            )));
-        }
-        self.check_names()?;
-        self.check_components()
-    }
-
-    /// Every planner and tracker name must resolve in every scenario, before any trial runs.
-    fn check_components(&self) -> Result<(), BatchError> {
-        for s in &self.scenarios {
-            let (planners, trackers) = self.components_of(s);
-            for p in &planners {
-                s.component(forkbench_trial::Role::Planner, Some(p))
-                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
-            }
-            for t in &trackers {
-                s.component(forkbench_trial::Role::Tracker, Some(t))
-                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
-            }
-        }
-        Ok(())
-    }
-
-    /// Scenario names key rows and seeds: two scenarios may not share one.
-    fn check_names(&self) -> Result<(), BatchError> {
-        for (i, a) in self.scenarios.iter().enumerate() {
-            if let Some(b) = self.scenarios[..i].iter().find(|b| b.name == a.name) {
-                return Err(BatchError::Invalid(format!(
-                    "scenario name {:?} is used by both {} and {}: names identify result rows \
-                     and seeds, so each scenario in a batch needs its own",
-                    a.name, b.file, a.file
-                )));
-            }
-        }
-        Ok(())
-    }
-
     /// Makes `dir` hold this batch: a new directory gets the manifest; an existing one
     /// must have been started with the same settings (or is cleared with `force_new`).
     fn prepare_dir(&self, dir: &Path) -> Result<(), BatchError> {

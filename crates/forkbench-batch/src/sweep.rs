@@ -7,6 +7,46 @@ use super::{BatchSpec, Summary, TrialRecord};
 use forkbench_trial::scenario::{Case, Scenario};
 use forkbench_trial::trial::TrialOptions;
 
+/// One point of a finished sweep as `sweep.json` holds it.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct SweepResult {
+    pub pallet_noise: f64,
+    pub summary: Summary,
+}
+
+/// Largest `sweep.json` read.
+const MAX_SWEEP_BYTES: u64 = 256 << 20;
+
+/// Writes a finished sweep: `sweep.md` (the table) and `sweep.json` (every point's
+/// summary), each atomically; returns the table.
+pub fn write_sweep(out: &Path, points: &[(f64, Summary)]) -> Result<String, super::BatchError> {
+    let text = sweep_markdown(points);
+    super::write_atomic(&out.join("sweep.md"), text.as_bytes())?;
+    let results: Vec<SweepResult> = points
+        .iter()
+        .map(|(v, s)| SweepResult {
+            pallet_noise: *v,
+            summary: s.clone(),
+        })
+        .collect();
+    let json = serde_json::to_string_pretty(&results)
+        .map_err(|e| super::BatchError::Invalid(format!("serialising the sweep: {e}")))?;
+    super::write_atomic(&out.join("sweep.json"), (json + "\n").as_bytes())?;
+    Ok(text)
+}
+
+/// Reads the points of the sweep in `dir` (its `sweep.json`).
+pub fn read_sweep(dir: &Path) -> Result<Vec<(f64, Summary)>, super::BatchError> {
+    let path = dir.join("sweep.json");
+    let text = super::read_regular(&path, MAX_SWEEP_BYTES)?;
+    let results: Vec<SweepResult> = serde_json::from_str(&text)
+        .map_err(|e| super::BatchError::Invalid(format!("{}: not a sweep: {e}", path.display())))?;
+    Ok(results
+        .into_iter()
+        .map(|r| (r.pallet_noise, r.summary))
+        .collect())
+}
+
 /// One point of a pallet-noise sweep: the batch to run and where its results go.
 #[derive(Debug, Clone)]
 pub struct SweepPoint {

@@ -113,33 +113,6 @@ pub struct BatchArgs {
     pub min_detectable_drop: Option<f64>,
 }
 
-/// Refuses a batch whose rows are too small for the gate to see `drop` (paired, a change
-/// that only breaks trials: the fewest trials any gate needs).
-fn check_power(spec: &BatchSpec, drop: f64) -> anyhow::Result<()> {
-    if !(drop > 0.0 && drop <= 1.0) {
-        bail!("--min-detectable-drop {drop}: must be a drop in success rate in (0, 1]");
-    }
-    let rows = spec.row_sizes();
-    let need = batch::paired_trials_needed(drop, batch::DEFAULT_ALPHA, rows.len())
-        .context("--min-detectable-drop: no trial count up to a million is enough")?;
-    let short: Vec<String> = rows
-        .iter()
-        .filter(|(_, n)| *n < need)
-        .map(|(name, n)| format!("{name} ({n})"))
-        .collect();
-    if !short.is_empty() {
-        bail!(
-            "--min-detectable-drop {drop}: a paired gate over {} rows (α {} Holm) needs at least \
-             {need} trials per row to see that drop with 80 % power (a change that only breaks \
-             trials; more when it also fixes some), and these rows have fewer: {}. Raise --trials.",
-            rows.len(),
-            batch::DEFAULT_ALPHA,
-            short.join(", ")
-        );
-    }
-    Ok(())
-}
-
 /// `--sweep pallet_noise=0,0.5,1`: the knob and its values.
 fn parse_sweep(text: &str) -> anyhow::Result<Vec<f64>> {
     let (knob, values) = text
@@ -214,19 +187,7 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     };
     let out = batch::shard_dir(&a.out, shard);
     let a = BatchArgs { out, ..a };
-    if a.trials == 0 {
-        bail!("--trials must be at least 1");
-    }
-    if let Some(s) = a.pallet_noise_scale
-        && !(s.is_finite() && s >= 0.0)
-    {
-        bail!("--pallet-noise-scale {s}: must be a finite number ≥ 0");
-    }
-    if let Some(f) = a.floor
-        && !(0.0..=1.0).contains(&f)
-    {
-        bail!("--floor {f}: must be a success rate between 0 and 1");
-    }
+    batch::check_floor(a.floor)?;
     let modes = match (a.replan, a.modes) {
         (true, _) => Modes::Replan,
         (false, Some(m)) => m,
@@ -253,7 +214,7 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
 pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     let (spec, a) = prepare(a)?;
     if let Some(d) = a.min_detectable_drop {
-        check_power(&spec, d)?;
+        spec.check_power(d)?;
     }
     if let Some(sweep) = &a.sweep {
         return run_sweep(&spec, &a, sweep).map(|()| true);
@@ -332,16 +293,7 @@ fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()>
     for p in batch::sweep_points(spec, &a.out, &values) {
         points.push((p.pallet_noise, run_one(&p.spec, &p.dir, a.jobs)?));
     }
-    let text = batch::sweep_markdown(&points);
-    batch::write_atomic(&a.out.join("sweep.md"), text.as_bytes())?;
-    let json: Vec<_> = points
-        .iter()
-        .map(|(v, s)| serde_json::json!({"pallet_noise": v, "summary": s}))
-        .collect();
-    batch::write_atomic(
-        &a.out.join("sweep.json"),
-        (serde_json::to_string_pretty(&json)? + "\n").as_bytes(),
-    )?;
+    let text = batch::write_sweep(&a.out, &points)?;
     let mut planners: Vec<String> = points
         .iter()
         .flat_map(|(_, s)| s.rows.iter().map(|r| r.planner.clone()))
@@ -356,7 +308,14 @@ fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()>
         crate::report::write(&a.out, None)?;
     }
     if a.json {
-        return crate::emit(&format!("{}\n", serde_json::to_string(&json)?));
+        let results: Vec<batch::SweepResult> = points
+            .into_iter()
+            .map(|(pallet_noise, summary)| batch::SweepResult {
+                pallet_noise,
+                summary,
+            })
+            .collect();
+        return crate::emit(&format!("{}\n", serde_json::to_string(&results)?));
     }
     crate::emit(&format!(
         "{text}\nwritten: {}/sweep.md, sweep.json, sweep-<planner>.png\n",
@@ -442,11 +401,7 @@ pub fn replay(
         out.planner,
         out.tracker,
         out.seed,
-        if out.success {
-            "SUCCESS".to_owned()
-        } else {
-            format!("FAILED: {}", out.failure.map_or("?", |f| f.name()))
-        },
+        out.verdict_word(),
         if same {
             "identical to the recorded outcome"
         } else {

@@ -75,13 +75,6 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
-fn check_alpha(alpha: f64) -> anyhow::Result<()> {
-    if !(alpha > 0.0 && alpha < 1.0) {
-        bail!("--alpha {alpha}: must lie strictly between 0 and 1");
-    }
-    Ok(())
-}
-
 /// `forkbench baseline`: success counts and every trial's outcome, written atomically.
 pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::Result<()> {
     let (s, records, _) = batch::load_batch(dir)?;
@@ -110,18 +103,6 @@ fn gate(
 
 /// Returns whether the gate passed.
 pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
-    check_alpha(a.alpha)?;
-    if let Some(f) = a.floor
-        && !(0.0..=1.0).contains(&f)
-    {
-        bail!("--floor {f}: must be a success rate between 0 and 1");
-    }
-    if let Some(d) = a.min_detectable_drop
-        && !(d > 0.0 && d <= 1.0)
-    {
-        bail!("--min-detectable-drop {d}: must be a drop in success rate in (0, 1]");
-    }
-    let b = Baseline::load(&a.baseline)?;
     let o = GateOptions {
         alpha: a.alpha,
         correction: a.correction.into(),
@@ -129,6 +110,8 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
         fail_on_new: a.fail_on_new,
         min_detectable_drop: a.min_detectable_drop,
     };
+    o.validate()?;
+    let b = Baseline::load(&a.baseline)?;
     let (report, provenance) = gate(&b, &a.results, &o)?;
     if let batch::Pairing::Unpaired { reason } = &report.pairing {
         eprintln!("warning: compared unpaired: {reason}");
@@ -151,7 +134,6 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
 
 /// `forkbench compare`: A against B in one batch, pair by pair.
 pub fn compare(a: &CompareArgs) -> anyhow::Result<()> {
-    check_alpha(a.alpha)?;
     let file = a.results.join("trials.jsonl");
     if !file.is_file() {
         bail!(

@@ -1,8 +1,7 @@
-//! A mission's legs as a text table and its overall figures as JSON.
+//! A mission's legs and totals as a text table (the totals themselves are `forkbench_trial::MissionSummary`).
 
-use forkbench_trial::TrialOutcome;
 use forkbench_trial::text::one_line;
-use serde_json::json;
+use forkbench_trial::{MissionSummary, TrialOutcome};
 
 /// One line per leg, then the totals; empty for a pick trial.
 pub fn legs_text(out: &TrialOutcome) -> String {
@@ -38,53 +37,17 @@ pub fn legs_text(out: &TrialOutcome) -> String {
             one_line(l.failure_detail.as_deref().unwrap_or(&l.smoothing)),
         );
     }
-    let o = overall_json(out);
-    let next = if o["legs_done"] == o["legs"] {
+    let Some(o) = MissionSummary::of(out) else {
+        return s;
+    };
+    let next = if o.legs_done == o.legs {
         "the pick follows"
     } else {
         "a leg failed, so the trial ends without the pick"
     };
     s += &format!(
         "legs: {} of {} done, {:.1} m driven in {:.1} s; {next}\n\n",
-        o["legs_done"],
-        o["legs"],
-        o["driven_m"].as_f64().unwrap_or(f64::NAN),
-        o["legs_time_s"].as_f64().unwrap_or(f64::NAN)
+        o.legs_done, o.legs, o.driven_m, o.legs_time_s
     );
     s
-}
-
-/// Totals over the legs and the mission's verdict.
-pub fn overall_json(out: &TrialOutcome) -> serde_json::Value {
-    let done = out.legs.iter().filter(|l| l.success).count();
-    let driven: f64 = out
-        .legs
-        .iter()
-        .map(|l| {
-            l.reverse_length_m
-                + if l.planned_length_m.is_finite() {
-                    l.planned_length_m
-                } else {
-                    0.0
-                }
-        })
-        .sum();
-    let min_clearance = out
-        .legs
-        .iter()
-        .map(|l| l.min_clearance_m)
-        .filter(|v| v.is_finite())
-        .fold(f64::INFINITY, f64::min);
-    json!({
-        "legs": out.legs.len(),
-        "legs_done": done,
-        "driven_m": driven,
-        "legs_time_s": out.legs.iter().map(|l| l.time_s).sum::<f64>(),
-        "planning_time_s": out.legs.iter().map(|l| l.planning_time_s).sum::<f64>(),
-        "min_clearance_m": min_clearance.is_finite().then_some(min_clearance),
-        "collisions": out.legs.iter().map(|l| l.collisions).sum::<u32>(),
-        "cross_track_max_m": out.legs.iter().map(|l| l.cross_track_max_m).filter(|v| v.is_finite()).fold(0.0, f64::max),
-        "pick_success": out.success,
-        "success": out.success && done == out.legs.len(),
-    })
 }

@@ -87,9 +87,9 @@ pub struct PlanCli {
 impl PlanCli {
     /// A global planner's arguments, when `planner` is one.
     pub fn route(&self) -> anyhow::Result<Option<crate::route_cmd::RouteArgs>> {
-        if !crate::route_cmd::GLOBAL_PLANNERS.contains(&self.planner.as_str()) {
+        let Some(planner) = forkbench_nav::GlobalPlannerKind::from_name(&self.planner) else {
             return Ok(None);
-        }
+        };
         let map = self.map.clone().ok_or_else(|| {
             anyhow::anyhow!(
                 "plan {}: --map WORLD.toml|MAP.yaml is required",
@@ -97,7 +97,7 @@ impl PlanCli {
             )
         })?;
         Ok(Some(crate::route_cmd::RouteArgs {
-            planner: self.planner.clone(),
+            planner,
             map,
             start: self.start,
             goal: self.goal,
@@ -110,10 +110,7 @@ impl PlanCli {
             smooth: self.smooth,
             lead_m: self.lead_m,
             approach_m: self.approach_m,
-            margin_m: self.margin_m.unwrap_or(match self.collision {
-                forkbench_nav::CollisionModel::Inflate => 0.0,
-                forkbench_nav::CollisionModel::Footprint => 0.15,
-            }),
+            margin_m: self.margin_m.unwrap_or(self.collision.default_margin_m()),
             truck: crate::load_truck(self.truck.as_ref())?,
             json: self.json,
             plot: self.plot.clone(),

@@ -104,22 +104,11 @@ pub fn metadata(
     case: &str,
     run: &forkbench_trial::Resolved,
 ) -> BTreeMap<String, String> {
-    BTreeMap::from([
-        ("scenario".to_owned(), scenario.to_owned()),
-        ("case".to_owned(), case.to_owned()),
-        ("planner".to_owned(), run.planner.name.clone()),
-        ("tracker".to_owned(), run.tracker.name.clone()),
-        ("seed".to_owned(), run.seed.to_string()),
-        (
-            "forkbench_version".to_owned(),
-            env!("CARGO_PKG_VERSION").to_owned(),
-        ),
-        ("rerun_version".to_owned(), "0.36.3".to_owned()),
-        (
-            "time".to_owned(),
-            "log time = simulation time in ns".to_owned(),
-        ),
-    ])
+    forkbench_log::mcap_metadata(
+        [scenario, case, &run.planner.name, &run.tracker.name],
+        run.seed,
+        env!("CARGO_PKG_VERSION"),
+    )
 }
 
 /// The file stem of a trial's recordings: `<scenario>-<case>-<planner>-<tracker>-seed<seed>`,

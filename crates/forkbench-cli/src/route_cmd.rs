@@ -6,18 +6,15 @@ use anyhow::Context as _;
 use forkbench_core::ForkliftSpec;
 use forkbench_core::Pose2;
 use forkbench_nav::{
-    Algorithm, CollisionModel, GlobalPlan, GlobalQuery, NavMap, OccupancyGrid, PrmParams,
-    RrtParams, plan_global, read_map,
+    CollisionModel, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap, OccupancyGrid, plan_global,
+    read_map,
 };
 use serde_json::json;
-
-/// The global planners `plan` knows besides the pick planners.
-pub const GLOBAL_PLANNERS: [&str; 3] = ["prm", "rrt", "rrt-connect"];
 
 /// What a global plan needs beyond start and goal.
 #[derive(Debug, Clone)]
 pub struct RouteArgs {
-    pub planner: String,
+    pub planner: GlobalPlannerKind,
     pub map: PathBuf,
     pub start: Pose2,
     pub goal: Pose2,
@@ -64,19 +61,9 @@ pub fn load_map(map: &Path, resolution_m: f64) -> anyhow::Result<NavMap> {
 
 impl RouteArgs {
     fn query(&self) -> GlobalQuery {
-        let rrt = RrtParams {
-            seed: self.seed,
-            ..RrtParams::default()
-        };
-        let algorithm = match self.planner.as_str() {
-            "prm" => Algorithm::Prm(PrmParams {
-                nodes: self.nodes,
-                connect_m: self.connect_m,
-                seed: self.seed,
-            }),
-            "rrt" => Algorithm::Rrt(rrt),
-            _ => Algorithm::RrtConnect(rrt),
-        };
+        let algorithm = self
+            .planner
+            .algorithm(self.nodes, self.connect_m, self.seed);
         GlobalQuery {
             start: self.start,
             goal: self.goal,
@@ -98,7 +85,7 @@ pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
     let map = load_map(&a.map, a.resolution_m)?;
     let q = a.query();
     let plan = plan_global(&map, &q)
-        .with_context(|| format!("plan {} on {}", a.planner, a.map.display()))?;
+        .with_context(|| format!("plan {} on {}", a.planner.name(), a.map.display()))?;
     if let Some(file) = &a.plot {
         plot(a, &map, &q, &plan, file)?;
     }
@@ -116,11 +103,11 @@ fn plot(
     let title = match &route.points {
         Some(_) => format!(
             "{} on {}: {:.1} m",
-            a.planner,
+            a.planner.name(),
             a.map.display(),
             route.length_m
         ),
-        None => format!("{} on {}: no path", a.planner, a.map.display()),
+        None => format!("{} on {}: no path", a.planner.name(), a.map.display()),
     };
     let band = match q.collision {
         CollisionModel::Inflate => q.inflate_m,
@@ -190,7 +177,7 @@ fn report(a: &RouteArgs, grid: &OccupancyGrid, q: &GlobalQuery, plan: &GlobalPla
     let total = t.total_s() + plan.smoothing_s;
     if a.json {
         let out = json!({
-            "planner": a.planner,
+            "planner": a.planner.name(),
             "map": a.map.display().to_string(),
             "grid": {"width": grid.width, "height": grid.height, "resolution_m": grid.resolution_m, "origin_m": grid.origin_m},
             "collision": q.collision,
@@ -218,7 +205,7 @@ fn report(a: &RouteArgs, grid: &OccupancyGrid, q: &GlobalQuery, plan: &GlobalPla
     };
     let head = format!(
         "{} on {} ({} × {} cells at {} m, {model}), seed {}\n",
-        a.planner,
+        a.planner.name(),
         a.map.display(),
         grid.width,
         grid.height,

@@ -74,10 +74,11 @@ fn pick_case<'a>(
 /// The outcome as one JSON object; a mission's also carries its `overall` figures.
 fn json_report(out: &TrialOutcome) -> anyhow::Result<String> {
     let mut v = serde_json::to_value(out).context("serialising the outcome")?;
-    if !out.legs.is_empty()
+    if let Some(summary) = forkbench_trial::MissionSummary::of(out)
         && let Some(map) = v.as_object_mut()
     {
-        map.insert("overall".into(), crate::mission_report::overall_json(out));
+        let summary = serde_json::to_value(summary).context("serialising the mission")?;
+        map.insert("overall".into(), summary);
     }
     Ok(format!("{v}\n"))
 }
@@ -95,11 +96,7 @@ fn text_report(out: &TrialOutcome) -> String {
     let opt = |v: Option<f64>, scale: f64, unit: &str| {
         v.map_or("never entered".to_owned(), |v| num(v * scale, 4, unit))
     };
-    let verdict = match (&out.failure, out.success) {
-        (_, true) => "SUCCESS".to_owned(),
-        (Some(f), false) => format!("FAILED: {}", f.name()),
-        (None, false) => "FAILED".to_owned(),
-    };
+    let verdict = out.verdict_word();
     let noise = if out.noise { "" } else { " / no noise" };
     let mut lines = vec![
         format!(

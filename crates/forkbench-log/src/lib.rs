@@ -12,6 +12,32 @@ use forkbench_core::{PalletSpec, Pose2};
 pub use mcap_sink::McapRecorder;
 pub use rerun_sink::{RerunRecorder, RerunTarget};
 
+/// The rerun SDK this crate is built against (pinned with `=` in the workspace; a test
+/// checks this against Cargo.lock), for the recordings' metadata.
+pub const RERUN_VERSION: &str = "0.36.3";
+
+/// The metadata record of a trial's MCAP file: what ran, the versions, and what log time
+/// means.
+pub fn mcap_metadata(
+    [scenario, case, planner, tracker]: [&str; 4],
+    seed: u64,
+    forkbench_version: &str,
+) -> std::collections::BTreeMap<String, String> {
+    [
+        ("scenario", scenario),
+        ("case", case),
+        ("planner", planner),
+        ("tracker", tracker),
+        ("seed", &seed.to_string()),
+        ("forkbench_version", forkbench_version),
+        ("rerun_version", RERUN_VERSION),
+        ("time", "log time = simulation time in ns"),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_owned(), v.to_owned()))
+    .collect()
+}
+
 /// A recording sink that could not be opened or written.
 #[derive(Debug, thiserror::Error)]
 pub enum LogError {
@@ -82,22 +108,4 @@ pub(crate) fn pallet_outlines(pallet: &PalletSpec, face: &Pose2) -> Vec<[[f64; 2
         .iter()
         .map(|c| rect_outline(c, pallet.depth_m, pallet.stringer_width_m()))
         .collect()
-}
-
-/// The trial's verdict in one line: success with the entry errors, or the failed
-/// criterion with its value and limit.
-pub(crate) fn verdict(o: &forkbench_trial::TrialOutcome) -> String {
-    match (o.success, o.failure) {
-        (true, _) => format!(
-            "SUCCESS: entry {:.3} m off the pocket centre line, {:.2}° off the pallet axis; forks {:.2} m deep",
-            o.lateral_error_m.unwrap_or(f64::NAN),
-            o.heading_error_rad.unwrap_or(f64::NAN).to_degrees(),
-            o.insertion_depth_m
-        ),
-        (false, Some(f)) => match o.failure_detail.as_deref() {
-            Some(d) => format!("FAILED: {}: {d}", f.name()),
-            None => format!("FAILED: {}", f.name()),
-        },
-        (false, None) => "FAILED".to_owned(),
-    }
 }

@@ -613,3 +613,18 @@ fn every_signal_kind_reaches_both_sinks() {
         "{log:?}"
     );
 }
+
+/// The version the metadata names is the rerun SDK actually locked.
+#[test]
+fn rerun_version_matches_the_lock_file() {
+    let lock = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../Cargo.lock"))
+        .expect("Cargo.lock");
+    let want = format!(
+        "name = \"rerun\"\nversion = \"{}\"",
+        forkbench_log::RERUN_VERSION
+    );
+    assert!(lock.contains(&want), "Cargo.lock has no {want}");
+    let meta = forkbench_log::mcap_metadata(["s", "c", "p", "t"], 7, "9.9.9");
+    assert_eq!(meta["rerun_version"], forkbench_log::RERUN_VERSION);
+    assert_eq!(meta["seed"], "7");
+}

@@ -42,6 +42,50 @@ impl NavMap {
     }
 }
 
+/// The global planners by name: the one mapping from a name (scenario files, `plan
+/// --planner`) to an [`Algorithm`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GlobalPlannerKind {
+    Prm,
+    Rrt,
+    RrtConnect,
+}
+
+impl GlobalPlannerKind {
+    pub const ALL: [Self; 3] = [Self::Prm, Self::Rrt, Self::RrtConnect];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Prm => "prm",
+            Self::Rrt => "rrt",
+            Self::RrtConnect => "rrt-connect",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// The algorithm with its parameters: PRM's node count and connection distance, the
+    /// RRTs' defaults, and the seed for either.
+    pub fn algorithm(self, nodes: usize, connect_m: Option<f64>, seed: u64) -> Algorithm {
+        let rrt = RrtParams {
+            seed,
+            ..RrtParams::default()
+        };
+        match self {
+            Self::Prm => Algorithm::Prm(PrmParams {
+                nodes,
+                connect_m,
+                seed,
+            }),
+            Self::Rrt => Algorithm::Rrt(rrt),
+            Self::RrtConnect => Algorithm::RrtConnect(rrt),
+        }
+    }
+}
+
 /// Which sampling planner.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Algorithm {

@@ -10,7 +10,7 @@ pub mod rrt;
 pub mod smooth;
 pub mod space;
 
-pub use global::{Algorithm, GlobalPlan, GlobalQuery, NavMap, plan_global};
+pub use global::{Algorithm, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap, plan_global};
 pub use grid::{Cell, GridError, OccupancyGrid};
 pub use inflate::{MAX_INFLATION_M, luo_inflation_m};
 pub use map_server::{MapError, read_map, write_map};

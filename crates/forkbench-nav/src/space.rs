@@ -59,6 +59,17 @@ pub enum CollisionModel {
     Footprint,
 }
 
+impl CollisionModel {
+    /// The clearance a plan keeps by default: none for the inflated grid (inflation is the
+    /// clearance), 0.15 m around the swept footprint.
+    pub fn default_margin_m(self) -> f64 {
+        match self {
+            Self::Inflate => 0.0,
+            Self::Footprint => 0.15,
+        }
+    }
+}
+
 impl std::str::FromStr for CollisionModel {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {

@@ -2,6 +2,7 @@
 
 pub mod components;
 pub mod defaults;
+pub mod mission_summary;
 pub mod outcome;
 pub mod recorder;
 pub mod scenario;
@@ -9,6 +10,7 @@ pub mod text;
 pub mod trial;
 
 pub use components::{ComponentSpec, Registry, Role};
+pub use mission_summary::MissionSummary;
 pub use outcome::{Failure, TrialOutcome};
 pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord, Tee};
 pub use scenario::{Case, PoseDeg, Scenario, Tolerances, World};

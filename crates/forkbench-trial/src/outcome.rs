@@ -129,6 +129,30 @@ pub struct LegOutcome {
 }
 
 impl TrialOutcome {
+    /// `SUCCESS`, or `FAILED: <criterion>`: the one short form of the verdict.
+    pub fn verdict_word(&self) -> String {
+        match (self.success, self.failure) {
+            (true, _) => "SUCCESS".to_owned(),
+            (false, Some(f)) => format!("FAILED: {}", f.name()),
+            (false, None) => "FAILED".to_owned(),
+        }
+    }
+
+    /// The verdict in one line: success with the entry errors, or the failed criterion
+    /// with its value and limit (the recordings' last log line).
+    pub fn verdict_line(&self) -> String {
+        match (self.success, self.failure, self.failure_detail.as_deref()) {
+            (true, ..) => format!(
+                "SUCCESS: entry {:.3} m off the pocket centre line, {:.2}° off the pallet axis; forks {:.2} m deep",
+                self.lateral_error_m.unwrap_or(f64::NAN),
+                self.heading_error_rad.unwrap_or(f64::NAN).to_degrees(),
+                self.insertion_depth_m
+            ),
+            (false, Some(_), Some(d)) => format!("{}: {d}", self.verdict_word()),
+            _ => self.verdict_word(),
+        }
+    }
+
     /// A not-yet-judged outcome: nothing measured (NaN where a value would be), no failure.
     pub fn blank(
         scenario: &str,

@@ -88,19 +88,7 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
 }
 
 fn sweep_body(dir: &Path) -> anyhow::Result<String> {
-    let path = dir.join("sweep.json");
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let raw: Vec<serde_json::Value> =
-        serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
-    let points: Vec<(f64, Summary)> = raw
-        .into_iter()
-        .map(|v| {
-            let x = v["pallet_noise"].as_f64().unwrap_or(f64::NAN);
-            serde_json::from_value(v["summary"].clone()).map(|s| (x, s))
-        })
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("{}: not a sweep", path.display()))?;
+    let points = batch::read_sweep(dir)?;
     let mut h = String::from("<h2>Success vs pallet-estimate noise</h2>");
     h.push_str(&sections::sweep(&points));
     for (v, s) in &points {

@@ -366,7 +366,7 @@ impl Recorder for McapRecorder {
 
     fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
         self.send_trajectory(t_s);
-        let verdict = crate::verdict(outcome);
+        let verdict = outcome.verdict_line();
         let level = if outcome.success { 2 } else { 4 };
         self.send(
             "/log",

@@ -276,7 +276,7 @@ impl Recorder for RerunRecorder {
         } else {
             rerun::TextLogLevel::ERROR
         };
-        let line = format!("outcome: {}", crate::verdict(outcome));
+        let line = format!("outcome: {}", outcome.verdict_line());
         let r = self
             .rec
             .log("events", &rerun::TextLog::new(line).with_level(level));

@@ -10,13 +10,7 @@ use super::{PoseDeg, invalid};
 use crate::TrialError;
 
 /// The global planner of a mission (Luo's PRM + A* by default).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum GlobalPlannerKind {
-    Prm,
-    Rrt,
-    RrtConnect,
-}
+pub use forkbench_nav::GlobalPlannerKind;
 
 /// `[mission.global]`: how legs are planned.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -51,7 +45,7 @@ impl Default for GlobalFile {
             connect_m: Some(10.0),
             collision: CollisionModel::Footprint,
             inflate_m: None,
-            margin_m: 0.15,
+            margin_m: CollisionModel::Footprint.default_margin_m(),
             lead_m: 2.5,
             approach_m: 1.8,
             resolution_m: 0.05,

@@ -5,9 +5,7 @@ use std::time::Instant;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Path, Pose2, Signal, Style};
 use forkbench_nav::smooth::{SmoothParams, smooth};
-use forkbench_nav::{
-    Algorithm, GlobalPlan, GlobalQuery, NavMap, PrmParams, RrtParams, plan_global, truck_parts,
-};
+use forkbench_nav::{GlobalPlan, GlobalQuery, NavMap, plan_global, truck_parts};
 use forkbench_track::{PurePursuit, Tracker};
 
 use super::setup::Trial;
@@ -382,19 +380,7 @@ fn plan_leg(
     let mut last = Err("no attempt".to_owned());
     for a in 0..g.attempts {
         let seed = seed.wrapping_add(u64::from(a));
-        let rrt = RrtParams {
-            seed,
-            ..RrtParams::default()
-        };
-        let algorithm = match g.planner {
-            GlobalPlannerKind::Prm => Algorithm::Prm(PrmParams {
-                nodes: g.nodes,
-                connect_m: g.connect_m,
-                seed,
-            }),
-            GlobalPlannerKind::Rrt => Algorithm::Rrt(rrt),
-            GlobalPlannerKind::RrtConnect => Algorithm::RrtConnect(rrt),
-        };
+        let algorithm = g.planner.algorithm(g.nodes, g.connect_m, seed);
         for (k, approach) in approaches(m, from, to).into_iter().enumerate() {
             let q = GlobalQuery {
                 start: *from,

@@ -1,0 +1,94 @@
+//! What a batch is checked for before any trial runs: its own arguments, unique scenario names, resolvable components, and the gate's power.
+
+use crate::{BatchError, BatchSpec, DEFAULT_ALPHA, MAX_JOBS, paired_trials_needed};
+
+impl BatchSpec {
+    /// The batch's own arguments: trials, shard, worker threads and unique names.
+    pub(crate) fn check(&self, jobs: usize) -> Result<(), BatchError> {
+        if self.trials == 0 {
+            return Err(BatchError::Invalid("trials: must be at least 1".into()));
+        }
+        if let Some(v) = self.pallet_noise_scale
+            && !(v.is_finite() && v >= 0.0)
+        {
+            return Err(BatchError::Invalid(format!(
+                "pallet_noise_scale {v}: must be a finite number ≥ 0"
+            )));
+        }
+        if self.shard.1 == 0 || self.shard.0 >= self.shard.1 {
+            return Err(BatchError::Invalid(format!(
+                "shard {}/{}: the index must be below the shard count",
+                self.shard.0, self.shard.1
+            )));
+        }
+        if jobs > MAX_JOBS {
+            return Err(BatchError::Invalid(format!(
+                "jobs {jobs}: at most {MAX_JOBS} worker threads"
+            )));
+        }
+        self.check_names()?;
+        self.check_components()
+    }
+
+    /// Refuses a batch too small for the paired gate to see a success-rate drop of `drop`
+    /// with 80 % power in every row (at the default α, Holm over the rows).
+    pub fn check_power(&self, drop: f64) -> Result<(), BatchError> {
+        if !(drop > 0.0 && drop <= 1.0) {
+            return Err(BatchError::Invalid(format!(
+                "min_detectable_drop {drop}: must be a drop in success rate in (0, 1]"
+            )));
+        }
+        let rows = self.row_sizes();
+        let need = paired_trials_needed(drop, DEFAULT_ALPHA, rows.len()).ok_or_else(|| {
+            BatchError::Invalid(format!(
+                "min_detectable_drop {drop}: no trial count up to a million is enough"
+            ))
+        })?;
+        let short: Vec<String> = rows
+            .iter()
+            .filter(|(_, n)| *n < need)
+            .map(|(name, n)| format!("{name} ({n})"))
+            .collect();
+        if short.is_empty() {
+            return Ok(());
+        }
+        Err(BatchError::Invalid(format!(
+            "min_detectable_drop {drop}: a paired gate over {} rows (α {DEFAULT_ALPHA} Holm) \
+             needs at least {need} trials per row to see that drop with 80 % power (a change \
+             that only breaks trials; more when it also fixes some), and these rows have fewer: \
+             {}. Raise the trial count.",
+            rows.len(),
+            short.join(", ")
+        )))
+    }
+
+    /// Every planner and tracker name must resolve in every scenario, before any trial runs.
+    fn check_components(&self) -> Result<(), BatchError> {
+        for s in &self.scenarios {
+            let (planners, trackers) = self.components_of(s);
+            for p in &planners {
+                s.component(forkbench_trial::Role::Planner, Some(p))
+                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
+            }
+            for t in &trackers {
+                s.component(forkbench_trial::Role::Tracker, Some(t))
+                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Scenario names key rows and seeds: two scenarios may not share one.
+    fn check_names(&self) -> Result<(), BatchError> {
+        for (i, a) in self.scenarios.iter().enumerate() {
+            if let Some(b) = self.scenarios[..i].iter().find(|b| b.name == a.name) {
+                return Err(BatchError::Invalid(format!(
+                    "scenario name {:?} is used by both {} and {}: names identify result rows \
+                     and seeds, so each scenario in a batch needs its own",
+                    a.name, b.file, a.file
+                )));
+            }
+        }
+        Ok(())
+    }
+}
