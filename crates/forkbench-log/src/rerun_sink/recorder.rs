@@ -136,7 +136,7 @@ impl RerunRecorder {
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
         self.pallet0 = s.pallet_pose;
-        self.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg];
+        self.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg()];
         let name = format!(
             "{} / {} / {} / {} / seed {}",
             s.scenario, s.case, s.planner, s.tracker, s.seed

@@ -2,6 +2,7 @@
 
 mod checks;
 mod file;
+mod limits;
 pub mod mission;
 mod world;
 
@@ -17,6 +18,7 @@ use crate::components::{ComponentSpec, Registry, Role};
 
 pub use checks::{pallet_footprint, truck_footprint};
 pub use file::{NoiseFile, PalletKind, PalletPlacement, ReplanFile, Tolerances};
+pub use limits::{Limits, Replan};
 pub use world::{MAX_WORLD_EXTENT_M, PalletSlot, PoseDeg, RectFile, World};
 
 use checks::{check_values, resolve_cases};
@@ -99,8 +101,8 @@ pub struct Scenario {
     pub truck: ForkliftSpec,
     pub sim: SimConfig,
     pub noise: NoiseFile,
-    pub replan: ReplanFile,
-    pub tolerances: Tolerances,
+    pub replan: Replan,
+    pub tolerances: Limits,
     /// Fixed pallet-estimate error in the pallet frame.
     pub estimate_bias: Pose2,
     /// σ of the per-trial jitter of the true pallet pose (pallet frame; heading in rad).
@@ -220,8 +222,8 @@ impl Scenario {
             truck: f.truck,
             sim: f.sim,
             noise: f.noise,
-            replan: f.replan,
-            tolerances: f.tolerances,
+            replan: f.replan.into(),
+            tolerances: f.tolerances.into(),
             estimate_bias: f.estimate_bias.map_or(zero, PoseDeg::to_pose),
             pallet_jitter: f.pallet_jitter.map_or(zero, PoseDeg::to_pose),
             world,

@@ -186,9 +186,7 @@ impl<'a> Trial<'a> {
         let moved = new_est.distance_to(&self.pallet_est);
         let turned = wrap_angle(new_est.heading_rad - self.pallet_est.heading_rad).abs();
         let limits = &self.scn.replan;
-        if moved <= limits.position_threshold_m
-            && turned <= limits.heading_threshold_deg.to_radians()
-        {
+        if moved <= limits.position_threshold_m && turned <= limits.heading_threshold_rad {
             return;
         }
         let t = self.sim.time_s();

@@ -91,7 +91,7 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
         ));
     }
     if out.pallet_displacement_m > tol.pallet_displacement_m
-        || out.pallet_rotation_rad.abs() > tol.pallet_rotation_deg.to_radians()
+        || out.pallet_rotation_rad.abs() > tol.pallet_rotation_rad
     {
         return Some((
             Failure::PalletDisplaced,
@@ -100,7 +100,7 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
                 out.pallet_displacement_m,
                 out.pallet_rotation_rad.to_degrees(),
                 tol.pallet_displacement_m,
-                tol.pallet_rotation_deg
+                tol.pallet_rotation_deg()
             ),
         ));
     }
@@ -113,16 +113,13 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
             ),
         ));
     }
-    if let Some(e) = out
-        .heading_error_rad
-        .filter(|e| e.abs() > tol.heading_deg.to_radians())
-    {
+    if let Some(e) = out.heading_error_rad.filter(|e| e.abs() > tol.heading_rad) {
         return Some((
             Failure::HeadingError,
             format!(
                 "{:.2}° off the pallet axis at entry (limit {}°)",
                 e.to_degrees(),
-                tol.heading_deg
+                tol.heading_deg()
             ),
         ));
     }
