@@ -60,7 +60,7 @@ impl PalletSpec {
             .map(|y| face.to_world(&Pose2::new(self.depth_m / 2.0, y, 0.0)))
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), crate::SettingsError> {
         for (f, v) in [
             ("depth_m", self.depth_m),
             ("width_m", self.width_m),
@@ -68,13 +68,19 @@ impl PalletSpec {
             ("mass_kg", self.mass_kg),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("`{f}` = {v}: must be a positive finite number"));
+                return Err(crate::SettingsError::field(
+                    f,
+                    format!("must be a positive finite number (got {v})"),
+                ));
             }
         }
         if self.stringer_width_m() <= 0.01 {
-            return Err(format!(
-                "`pocket_width_m` = {}: two pockets leave no room for stringers in a {} m wide pallet",
-                self.pocket_width_m, self.width_m
+            return Err(crate::SettingsError::field(
+                "pocket_width_m",
+                format!(
+                    "two pockets of {} m leave no room for stringers in a {} m wide pallet",
+                    self.pocket_width_m, self.width_m
+                ),
             ));
         }
         Ok(())

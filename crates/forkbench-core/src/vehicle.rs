@@ -51,13 +51,12 @@ impl Default for ForkliftSpec {
     }
 }
 
-/// A forklift spec value that cannot describe a real truck.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("forklift spec field `{field}` = {value}: {reason}")]
-pub struct SpecError {
-    pub field: &'static str,
-    pub value: f64,
-    pub reason: &'static str,
+/// A forklift spec value that cannot describe a real truck: the settings convention.
+pub type SpecError = crate::SettingsError;
+
+/// `field` refused: `reason`, with the value given.
+fn refused(field: &str, value: f64, reason: &str) -> SpecError {
+    SpecError::field(field, format!("{reason} (got {value})"))
 }
 
 impl ForkliftSpec {
@@ -108,33 +107,29 @@ impl ForkliftSpec {
         ];
         for (field, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SpecError {
-                    field,
-                    value,
-                    reason: "must be a positive finite number",
-                });
+                return Err(refused(field, value, "must be a positive finite number"));
             }
         }
         if !(self.max_steer_rad > 0.0 && self.max_steer_rad < std::f64::consts::FRAC_PI_2) {
-            return Err(SpecError {
-                field: "max_steer_rad",
-                value: self.max_steer_rad,
-                reason: "must lie strictly between 0 and π/2",
-            });
+            return Err(refused(
+                "max_steer_rad",
+                self.max_steer_rad,
+                "must lie strictly between 0 and π/2",
+            ));
         }
         if !self.fork_root_ahead_of_front_axle_m.is_finite() {
-            return Err(SpecError {
-                field: "fork_root_ahead_of_front_axle_m",
-                value: self.fork_root_ahead_of_front_axle_m,
-                reason: "must be finite",
-            });
+            return Err(refused(
+                "fork_root_ahead_of_front_axle_m",
+                self.fork_root_ahead_of_front_axle_m,
+                "must be finite",
+            ));
         }
         if self.fork_spacing_m + self.fork_width_m > self.body_width_m * 1.5 {
-            return Err(SpecError {
-                field: "fork_spacing_m",
-                value: self.fork_spacing_m,
-                reason: "forks spread far wider than the truck",
-            });
+            return Err(refused(
+                "fork_spacing_m",
+                self.fork_spacing_m,
+                "forks spread far wider than the truck",
+            ));
         }
         Ok(())
     }
@@ -167,14 +162,17 @@ mod tests {
             ..ForkliftSpec::default()
         };
         let err = spec.validate().expect_err("negative wheelbase");
-        assert_eq!(err.field, "wheelbase_m");
+        assert_eq!(err.field.as_deref(), Some("wheelbase_m"));
         let spec = ForkliftSpec {
             max_steer_rad: 2.0,
             ..ForkliftSpec::default()
         };
         assert_eq!(
-            spec.validate().expect_err("too much steer").field,
-            "max_steer_rad"
+            spec.validate()
+                .expect_err("too much steer")
+                .field
+                .as_deref(),
+            Some("max_steer_rad")
         );
     }
 }

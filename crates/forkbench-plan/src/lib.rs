@@ -125,6 +125,9 @@ pub const MIN_SAMPLE_SPACING_M: f64 = 1e-4;
 pub enum PlanError {
     #[error("invalid {what}: {reason}")]
     InvalidInput { what: &'static str, reason: String },
+    /// The planner's own settings are out of range.
+    #[error("planner setting {0}")]
+    Settings(#[from] forkbench_core::SettingsError),
     #[error("goal is {distance_m:.3} m from the start; a pick path needs at least {min_m} m")]
     GoalTooClose { distance_m: f64, min_m: f64 },
     #[error(

@@ -44,7 +44,7 @@ impl BsplinePlanner {
             }
             e
         })?;
-        cfg.validate().map_err(|e| settings_error(&e))?;
+        cfg.validate()?;
         Ok(Self {
             cfg,
             relax_handles_near_goal: relax,
@@ -77,7 +77,7 @@ impl SpiralPlanner {
     /// From a scenario's `[planner]` table: [`SpiralConfig`]'s fields.
     pub fn from_settings(s: &Settings) -> Result<Self, SettingsError> {
         let cfg: SpiralConfig = settings::parse(s)?;
-        cfg.validate().map_err(|e| settings_error(&e))?;
+        cfg.validate()?;
         Ok(Self { cfg })
     }
 }
@@ -89,19 +89,5 @@ impl Planner for SpiralPlanner {
 
     fn plan(&mut self, req: &PlanRequest) -> Result<Plan, PlanError> {
         spiral::plan(req, &self.cfg).map(spiral::SpiralPlan::into_plan)
-    }
-}
-
-/// A config check's error as a settings error: `InvalidInput`'s `what` is `kind.field`.
-fn settings_error(e: &PlanError) -> SettingsError {
-    match e {
-        PlanError::InvalidInput { what, reason } => SettingsError::field(
-            what.split_once('.').map_or(*what, |(_, f)| f),
-            reason.clone(),
-        ),
-        other => SettingsError {
-            field: None,
-            reason: other.to_string(),
-        },
     }
 }

@@ -3,6 +3,7 @@
 use std::collections::VecDeque;
 
 use forkbench_core::Pose2;
+use forkbench_core::SettingsError;
 use forkbench_core::units::wrap_angle;
 use rand::{Rng, RngExt as _};
 use rand_distr::StandardNormal;
@@ -82,9 +83,12 @@ impl Default for Nav350Config {
 }
 
 impl Nav350Config {
-    pub fn invalid_field(&self) -> Option<(&'static str, &'static str)> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
-            return Some(("rate_hz", "must be a positive finite number"));
+            return Err(SettingsError::field(
+                "rate_hz",
+                "must be a positive finite number",
+            ));
         }
         for (f, v) in [
             ("position_sigma_m", self.position_sigma_m),
@@ -92,10 +96,10 @@ impl Nav350Config {
             ("latency_s", self.latency_s),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Some((f, "must be a finite number ≥ 0"));
+                return Err(SettingsError::field(f, "must be a finite number ≥ 0"));
             }
         }
-        None
+        Ok(())
     }
 }
 
@@ -186,13 +190,13 @@ impl Default for PalletEstimateConfig {
 }
 
 impl PalletEstimateConfig {
-    pub fn invalid_field(&self) -> Option<(&'static str, &'static str)> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         for (f, v) in [
             ("reference_range_m", self.reference_range_m),
             ("near_range_m", self.near_range_m),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Some((f, "must be a positive finite number"));
+                return Err(SettingsError::field(f, "must be a positive finite number"));
             }
         }
         for (f, v) in [
@@ -208,20 +212,26 @@ impl PalletEstimateConfig {
             ("scale", self.scale),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Some((f, "must be a finite number ≥ 0"));
+                return Err(SettingsError::field(f, "must be a finite number ≥ 0"));
             }
         }
         if self.near_range_m > self.reference_range_m {
-            return Some(("near_range_m", "must not exceed reference_range_m"));
+            return Err(SettingsError::field(
+                "near_range_m",
+                "must not exceed reference_range_m",
+            ));
         }
         if self
             .reestimate_at_m
             .iter()
             .any(|r| !(r.is_finite() && *r > 0.0))
         {
-            return Some(("reestimate_at_m", "ranges must be positive finite numbers"));
+            return Err(SettingsError::field(
+                "reestimate_at_m",
+                "ranges must be positive finite numbers",
+            ));
         }
-        None
+        Ok(())
     }
 
     /// σ multiplier at a range: near fraction up to near range, linear to 1 at the

@@ -47,16 +47,12 @@ impl Default for SimConfig {
 /// Why a world could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
-    #[error("sim setting `{field}` = {value}: {reason}")]
-    Config {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error("sim setting {0}")]
+    Config(forkbench_core::SettingsError),
     #[error("pallet spec: {0}")]
-    Pallet(String),
+    Pallet(forkbench_core::SettingsError),
     #[error("truck spec: {0}")]
-    Truck(#[from] forkbench_core::SpecError),
+    Truck(forkbench_core::SettingsError),
 }
 
 /// The simulated truck, pallet and obstacles.
@@ -102,9 +98,14 @@ fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[1] - a[1] * b[0]
 }
 
+/// `field` refused: `reason`, with the value given.
+fn setting(field: &str, value: f64, reason: &str) -> forkbench_core::SettingsError {
+    forkbench_core::SettingsError::field(field, format!("{reason} (got {value})"))
+}
+
 impl SimConfig {
     /// Checks every setting; scenario loading calls it so bad values fail at load.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub fn validate(&self) -> Result<(), forkbench_core::SettingsError> {
         let fields = [
             ("dt_s", self.dt_s),
             ("tyre_friction", self.tyre_friction),
@@ -114,33 +115,29 @@ impl SimConfig {
         ];
         for (field, value) in fields {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SimError::Config {
-                    field,
-                    value,
-                    reason: "must be a positive finite number",
-                });
+                return Err(setting(field, value, "must be a positive finite number"));
             }
         }
         if self.dt_s > 0.02 {
-            return Err(SimError::Config {
-                field: "dt_s",
-                value: self.dt_s,
-                reason: "must be ≤ 0.02 s (50 Hz) for stable tyre impulses",
-            });
+            return Err(setting(
+                "dt_s",
+                self.dt_s,
+                "must be ≤ 0.02 s (50 Hz) for stable tyre impulses",
+            ));
         }
         if self.dt_s < 1e-3 {
-            return Err(SimError::Config {
-                field: "dt_s",
-                value: self.dt_s,
-                reason: "must be ≥ 0.001 s: a finer step only multiplies the work",
-            });
+            return Err(setting(
+                "dt_s",
+                self.dt_s,
+                "must be ≥ 0.001 s: a finer step only multiplies the work",
+            ));
         }
         if !(self.fork_friction.is_finite() && self.fork_friction >= 0.0) {
-            return Err(SimError::Config {
-                field: "fork_friction",
-                value: self.fork_friction,
-                reason: "must be a finite number ≥ 0",
-            });
+            return Err(setting(
+                "fork_friction",
+                self.fork_friction,
+                "must be a finite number ≥ 0",
+            ));
         }
         Ok(())
     }
@@ -157,9 +154,9 @@ impl Sim {
         obstacles: &[Obstacle],
         cfg: &SimConfig,
     ) -> Result<Self, SimError> {
-        spec.validate()?;
+        spec.validate().map_err(SimError::Truck)?;
         pallet_spec.validate().map_err(SimError::Pallet)?;
-        cfg.validate()?;
+        cfg.validate().map_err(SimError::Config)?;
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::ZERO;
         world.integration_parameters.dt = cfg.dt_s as Real;

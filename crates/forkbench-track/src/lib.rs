@@ -16,9 +16,7 @@ impl PurePursuit {
     /// From a scenario's `[tracker]` table: [`TrackerConfig`]'s fields.
     pub fn from_settings(s: &Settings) -> Result<Self, SettingsError> {
         let cfg: TrackerConfig = settings::parse(s)?;
-        if let Some((f, why)) = cfg.invalid_field() {
-            return Err(SettingsError::field(f, why));
-        }
+        cfg.validate()?;
         Ok(Self::with_config(cfg))
     }
 }

@@ -1,7 +1,7 @@
 //! Pure pursuit on the fork-root reference point, with fixed or speed-scaled look-ahead and a slow final approach.
 
 use forkbench_core::units::wrap_angle;
-use forkbench_core::{ForkliftSpec, Path, Pose2};
+use forkbench_core::{ForkliftSpec, Path, Pose2, SettingsError};
 use serde::{Deserialize, Serialize};
 
 use crate::{Tracker, TrackerInput};
@@ -40,7 +40,7 @@ impl Default for TrackerConfig {
 
 impl TrackerConfig {
     /// The first field that holds an impossible value, with the reason.
-    pub fn invalid_field(&self) -> Option<(&'static str, &'static str)> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         let positive = [
             ("lookahead_m", self.lookahead_m),
             ("min_lookahead_m", self.min_lookahead_m),
@@ -50,18 +50,24 @@ impl TrackerConfig {
         ];
         for (f, v) in positive {
             if !(v.is_finite() && v > 0.0) {
-                return Some((f, "must be a positive finite number"));
+                return Err(SettingsError::field(f, "must be a positive finite number"));
             }
         }
         if !(self.approach_distance_m.is_finite() && self.approach_distance_m >= 0.0) {
-            return Some(("approach_distance_m", "must be a finite number ≥ 0"));
+            return Err(SettingsError::field(
+                "approach_distance_m",
+                "must be a finite number ≥ 0",
+            ));
         }
         if let Some(k) = self.lookahead_gain_s
             && !(k.is_finite() && k > 0.0)
         {
-            return Some(("lookahead_gain_s", "must be a positive finite number"));
+            return Err(SettingsError::field(
+                "lookahead_gain_s",
+                "must be a positive finite number",
+            ));
         }
-        None
+        Ok(())
     }
 }
 

@@ -45,7 +45,7 @@ impl Default for RegulatedConfig {
 
 impl RegulatedConfig {
     /// The first field that holds an impossible value, with the reason.
-    pub fn invalid_field(&self) -> Option<(&'static str, &'static str)> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         let fields = [
             ("lookahead_time_s", self.lookahead_time_s),
             ("min_lookahead_m", self.min_lookahead_m),
@@ -58,12 +58,15 @@ impl RegulatedConfig {
             ("decel_mps2", self.decel_mps2),
         ];
         if let Some((f, _)) = fields.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
-            return Some((f, "must be a positive finite number"));
+            return Err(SettingsError::field(f, "must be a positive finite number"));
         }
         if self.max_lookahead_m < self.min_lookahead_m {
-            return Some(("max_lookahead_m", "must be ≥ min_lookahead_m"));
+            return Err(SettingsError::field(
+                "max_lookahead_m",
+                "must be ≥ min_lookahead_m",
+            ));
         }
-        None
+        Ok(())
     }
 }
 
@@ -85,9 +88,7 @@ impl RegulatedPurePursuit {
     /// From a scenario's `[tracker]` table.
     pub fn from_settings(s: &Settings) -> Result<Self, SettingsError> {
         let cfg: RegulatedConfig = settings::parse(s)?;
-        if let Some((f, why)) = cfg.invalid_field() {
-            return Err(SettingsError::field(f, why));
-        }
+        cfg.validate()?;
         Ok(Self::new(cfg))
     }
 

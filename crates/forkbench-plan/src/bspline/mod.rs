@@ -1,6 +1,6 @@
 //! Cubic uniform B-spline pick planner (Lü et al. 2019): six control points, min-max curvature over (L1, L2).
 
-use forkbench_core::{Path, PathSample, Pose2};
+use forkbench_core::{Path, PathSample, Pose2, SettingsError};
 use serde::{Deserialize, Serialize};
 
 use crate::numeric::max_abs_on_interval;
@@ -254,31 +254,23 @@ pub fn max_abs_curvature_for(start: &Pose2, goal: &Pose2, l1_m: f64, l2_m: f64) 
 }
 
 impl BsplineConfig {
-    pub(crate) fn validate(&self) -> Result<(), PlanError> {
-        let bad = |what, reason: &str| {
-            Err(PlanError::InvalidInput {
-                what,
-                reason: reason.into(),
-            })
-        };
+    pub(crate) fn validate(&self) -> Result<(), SettingsError> {
+        let bad = |field, reason: &str| Err(SettingsError::field(field, reason));
         if !(self.min_handle_m.is_finite() && self.min_handle_m > 0.0) {
-            return bad("bspline.min_handle_m", "must be a positive finite length");
+            return bad("min_handle_m", "must be a positive finite length");
         }
         if let Some(max) = self.max_handle_m
             && !(max.is_finite() && max >= self.min_handle_m)
         {
-            return bad("bspline.max_handle_m", "must be finite and ≥ min_handle_m");
+            return bad("max_handle_m", "must be finite and ≥ min_handle_m");
         }
         if self.grid_points < 3 {
-            return bad("bspline.grid_points", "must be at least 3");
+            return bad("grid_points", "must be at least 3");
         }
         if !(self.sample_spacing_m.is_finite()
             && self.sample_spacing_m >= crate::MIN_SAMPLE_SPACING_M)
         {
-            return bad(
-                "bspline.sample_spacing_m",
-                "must be a positive finite length",
-            );
+            return bad("sample_spacing_m", "must be a positive finite length");
         }
         Ok(())
     }

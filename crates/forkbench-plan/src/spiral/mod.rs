@@ -88,23 +88,23 @@ impl SpiralPlan {
 }
 
 impl SpiralConfig {
-    pub(crate) fn validate(&self) -> Result<(), PlanError> {
+    pub(crate) fn validate(&self) -> Result<(), forkbench_core::SettingsError> {
         if self.length_grid_points < 3 {
-            return Err(PlanError::InvalidInput {
-                what: "spiral.length_grid_points",
-                reason: "must be at least 3".into(),
-            });
+            return Err(forkbench_core::SettingsError::field(
+                "length_grid_points",
+                "must be at least 3",
+            ));
         }
         if !(self.sample_spacing_m.is_finite()
             && self.sample_spacing_m >= crate::MIN_SAMPLE_SPACING_M)
         {
-            return Err(PlanError::InvalidInput {
-                what: "spiral.sample_spacing_m",
-                reason: format!(
+            return Err(forkbench_core::SettingsError::field(
+                "sample_spacing_m",
+                format!(
                     "must be a finite length of at least {} m",
                     crate::MIN_SAMPLE_SPACING_M
                 ),
-            });
+            ));
         }
         Ok(())
     }

@@ -4,7 +4,7 @@ use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
 use forkbench_geom::{Footprint, Obstacles};
 
 use super::file::{CaseFile, PalletPlacement, ScenarioFile};
-use super::{Case, MAX_CASES, MAX_TIMEOUT_S, World, invalid};
+use super::{Case, MAX_CASES, MAX_TIMEOUT_S, World, invalid, invalid_setting};
 use crate::TrialError;
 
 /// The truck body's footprint referenced to the fork root: the chassis ends there (forks
@@ -91,8 +91,8 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
             "must be a positive time of at most 600 s",
         ));
     }
-    if let Err(forkbench_sim::SimError::Config { field, reason, .. }) = f.sim.validate() {
-        return Err(invalid(file, &format!("sim.{field}"), reason));
+    if let Err(e) = f.sim.validate() {
+        return Err(invalid_setting(file, "sim", &e));
     }
     for (name, v) in [
         ("position_threshold_m", f.replan.position_threshold_m),
@@ -130,16 +130,12 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
 pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
     f.truck
         .validate()
-        .map_err(|e| invalid(file, &format!("truck.{}", e.field), e.reason))?;
-    if let Some((field, reason)) = f.noise.nav350.invalid_field() {
-        return Err(invalid(file, &format!("noise.nav350.{field}"), reason));
+        .map_err(|e| invalid_setting(file, "truck", &e))?;
+    if let Err(e) = f.noise.nav350.validate() {
+        return Err(invalid_setting(file, "noise.nav350", &e));
     }
-    if let Some((field, reason)) = f.noise.pallet_estimate.invalid_field() {
-        return Err(invalid(
-            file,
-            &format!("noise.pallet_estimate.{field}"),
-            reason,
-        ));
+    if let Err(e) = f.noise.pallet_estimate.validate() {
+        return Err(invalid_setting(file, "noise.pallet_estimate", &e));
     }
     check_settings(f, file)?;
     if let Some(b) = &f.estimate_bias {

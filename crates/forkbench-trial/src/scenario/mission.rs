@@ -248,8 +248,8 @@ impl MissionFile {
                 &format!("must be at most {} m", forkbench_nav::MAX_INFLATION_M),
             ));
         }
-        if let Some((field, reason)) = self.tracker.invalid_field() {
-            return Err(invalid(file, &format!("mission.tracker.{field}"), reason));
+        if let Err(e) = self.tracker.validate() {
+            return Err(super::invalid_setting(file, "mission.tracker", &e));
         }
         Ok(())
     }

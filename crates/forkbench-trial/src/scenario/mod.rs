@@ -35,6 +35,19 @@ pub(crate) fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
     }
 }
 
+/// A component's settings error under the scenario table it came from (`prefix`).
+pub(crate) fn invalid_setting(
+    file: &str,
+    prefix: &str,
+    e: &forkbench_core::SettingsError,
+) -> TrialError {
+    let field = match &e.field {
+        Some(f) => format!("{prefix}.{f}"),
+        None => prefix.to_owned(),
+    };
+    invalid(file, &field, &e.reason)
+}
+
 /// Longest simulated trial a scenario may ask for: bounds the steps one trial takes.
 pub const MAX_TIMEOUT_S: f64 = 600.0;
 

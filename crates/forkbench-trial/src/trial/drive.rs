@@ -4,6 +4,7 @@ use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 use forkbench_track::{Command, TrackerInput};
 
+use super::error::StageError;
 use super::judge::{in_pallet_frame, insertion_depth};
 use super::setup::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
@@ -12,7 +13,7 @@ use forkbench_core::{Signal, Style};
 impl<'a> Trial<'a> {
     /// Drives until the tracker reports the goal reached and the truck stands, or the
     /// scenario's time limit. Err: the state went non-finite.
-    pub(super) fn drive<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), String> {
+    pub(super) fn drive<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), StageError> {
         // Re-estimate ranges still ahead of the truck, nearest last.
         let start_range = self.first_fix.distance_to(&self.pallet_est);
         let mut reestimates: Vec<f64> = self
@@ -68,7 +69,7 @@ impl<'a> Trial<'a> {
 
     /// The NAV350 fix at this instant (if one is due) and the predicted pose; Err when the
     /// state went non-finite.
-    pub(super) fn sense(&mut self) -> Result<(Option<Pose2>, Pose2), String> {
+    pub(super) fn sense(&mut self) -> Result<(Option<Pose2>, Pose2), StageError> {
         let truth = self.sim.fork_root_pose();
         let fix = self
             .localizer
@@ -78,10 +79,9 @@ impl<'a> Trial<'a> {
         }
         let pose = self.predictor.pose().unwrap_or(self.first_fix);
         if !(pose.is_finite() && truth.is_finite()) {
-            return Err(format!(
-                "non-finite state at t = {:.3} s",
-                self.sim.time_s()
-            ));
+            return Err(StageError::NonFinite {
+                t_s: self.sim.time_s(),
+            });
         }
         Ok((fix, pose))
     }

@@ -8,6 +8,7 @@ use forkbench_nav::smooth::{SmoothParams, smooth};
 use forkbench_nav::{GlobalPlan, GlobalQuery, NavMap, plan_global, truck_parts};
 use forkbench_track::{PurePursuit, Tracker};
 
+use super::error::{LegError, StageError};
 use super::setup::Trial;
 use crate::outcome::LegOutcome;
 use crate::recorder::{Level, Recorder};
@@ -86,9 +87,8 @@ impl Trial<'_> {
         m: &MissionSpec,
         staging: &Waypoint,
         rec: &mut R,
-    ) -> Result<(), String> {
-        let map = NavMap::from_world(&self.obstacles, m.global.resolution_m)
-            .map_err(|e| format!("rasterising the world: {e}"))?;
+    ) -> Result<(), StageError> {
+        let map = NavMap::from_world(&self.obstacles, m.global.resolution_m)?;
         rec.signal(
             self.sim.time_s(),
             "nav/occupied",
@@ -108,12 +108,11 @@ impl Trial<'_> {
             );
             self.out.legs.push(leg);
             if !ok {
-                return Err(format!(
-                    "leg {} {}: {}",
-                    i + 1,
-                    self.out.legs[i].name,
-                    why.unwrap_or_default()
-                ));
+                return Err(StageError::Leg {
+                    number: i + 1,
+                    name: self.out.legs[i].name.clone(),
+                    detail: why.unwrap_or_default(),
+                });
             }
             from = to.clone();
         }
@@ -132,7 +131,7 @@ impl Trial<'_> {
         let t0 = self.sim.time_s();
         let mut leg = blank_leg(format!("{} → {}", from.name, to.name));
         let mut stats = DriveStats::default();
-        let mut run = || -> Result<(), String> {
+        let mut run = || -> Result<(), LegError> {
             if i > 0 {
                 self.back_out(map, m, (i, from, to), (&mut leg, &mut stats), rec)?;
             }
@@ -148,7 +147,7 @@ impl Trial<'_> {
             leg.planning_attempts = attempts;
             leg.route_length_m = plan.as_ref().map_or(f64::NAN, |p| p.route.length_m);
             let p = plan?;
-            let s = accepted(&p, m).ok_or_else(|| leg_plan_failure(&p))?;
+            let s = accepted(&p, m).ok_or_else(|| LegError::Smoothing(leg_plan_failure(&p)))?;
             leg.smoothing = "ok".into();
             leg.planned_length_m = s.path.length_m();
             leg.min_clearance_m = leg.min_clearance_m.min(s.min_clearance_m);
@@ -172,14 +171,14 @@ impl Trial<'_> {
         (i, from, to): (usize, &Waypoint, &Waypoint),
         (leg, stats): (&mut LegOutcome, &mut DriveStats),
         rec: &mut R,
-    ) -> Result<(), String> {
+    ) -> Result<(), LegError> {
         let here = self.sense()?.1;
         let (back, clearance) =
             plan_backout(map, m, &here, &to.pose, &self.scn.truck).ok_or_else(|| {
-                format!(
-                    "no clear way to back {:.1} m out of {}",
-                    m.backout_m, from.name
-                )
+                LegError::NoBackout {
+                    backout_m: m.backout_m,
+                    from: from.name.clone(),
+                }
             })?;
         leg.reverse_length_m = back.length_m();
         let points = path_points(&back);
@@ -201,7 +200,7 @@ impl Trial<'_> {
         m: &MissionSpec,
         stats: &mut DriveStats,
         rec: &mut R,
-    ) -> Result<(), String> {
+    ) -> Result<(), LegError> {
         let truck = &self.scn.truck;
         let mut tracker = PurePursuit::with_config(m.tracker.clone());
         tracker.reset(path, truck);
@@ -219,16 +218,15 @@ impl Trial<'_> {
             if self.sim.obstacle_contact() {
                 stats.collisions += 1;
                 let p = self.sim.fork_root_pose();
-                return Err(format!(
-                    "the truck struck a rack or wall at ({:.2}, {:.2}) m",
-                    p.x_m, p.y_m
-                ));
+                return Err(LegError::Struck {
+                    x_m: p.x_m,
+                    y_m: p.y_m,
+                });
             }
         }
-        Err(format!(
-            "not stopped at the end of the path within {} s",
-            m.leg_timeout_s
-        ))
+        Err(LegError::NotStopped {
+            timeout_s: m.leg_timeout_s,
+        })
     }
 }
 
@@ -272,7 +270,7 @@ fn blank_leg(name: String) -> LegOutcome {
     }
 }
 
-fn finish_leg(leg: &mut LegOutcome, result: Result<(), String>, s: &DriveStats, time_s: f64) {
+fn finish_leg(leg: &mut LegOutcome, result: Result<(), LegError>, s: &DriveStats, time_s: f64) {
     leg.collisions = s.collisions;
     if s.steps > 0 {
         leg.cross_track_mean_m = s.cross_track_sum_m / s.steps as f64;
@@ -285,6 +283,7 @@ fn finish_leg(leg: &mut LegOutcome, result: Result<(), String>, s: &DriveStats, 
     match result {
         Ok(()) => leg.success = true,
         Err(why) => {
+            let why = why.to_string();
             if leg.smoothing.is_empty() {
                 leg.smoothing = why.clone();
             }
@@ -343,7 +342,7 @@ fn approaches(m: &MissionSpec, from: &Pose2, to: &Pose2) -> Vec<Vec<[f64; 2]>> {
 /// deterministic), refused before any attempt.
 pub const MAX_LEG_CANDIDATE_EDGES: f64 = 1.0e7;
 
-fn leg_work(map: &NavMap, m: &MissionSpec, (from, to): (&Pose2, &Pose2)) -> Result<(), String> {
+fn leg_work(map: &NavMap, m: &MissionSpec, (from, to): (&Pose2, &Pose2)) -> Result<(), LegError> {
     let g = &m.global;
     if g.planner != GlobalPlannerKind::Prm {
         return Ok(());
@@ -351,16 +350,15 @@ fn leg_work(map: &NavMap, m: &MissionSpec, (from, to): (&Pose2, &Pose2)) -> Resu
     let (lo, hi) = map.grid.extent();
     let per =
         forkbench_nav::candidate_edges(g.nodes, g.connect_m, (hi[0] - lo[0]) * (hi[1] - lo[1]));
-    let tries = f64::from(g.attempts) * approaches(m, from, to).len() as f64;
-    if per * tries > MAX_LEG_CANDIDATE_EDGES {
-        return Err(format!(
-            "planning refused: {} attempts × {} approaches × about {per:.3e} candidate edges \
-             (mission.global nodes {} and connect_m) exceed {MAX_LEG_CANDIDATE_EDGES:.1e}; fewer \
-             nodes, attempts or a shorter connection distance",
-            g.attempts,
-            tries / f64::from(g.attempts),
-            g.nodes
-        ));
+    let n_approaches = approaches(m, from, to).len();
+    if per * f64::from(g.attempts) * n_approaches as f64 > MAX_LEG_CANDIDATE_EDGES {
+        return Err(LegError::TooMuchWork {
+            attempts: g.attempts,
+            approaches: n_approaches,
+            per_attempt: per,
+            nodes: g.nodes,
+            limit: MAX_LEG_CANDIDATE_EDGES,
+        });
     }
     Ok(())
 }
@@ -371,13 +369,13 @@ fn plan_leg(
     (from, to): (&Pose2, &Pose2),
     truck: &forkbench_core::ForkliftSpec,
     seed: u64,
-) -> (Result<GlobalPlan, String>, u32, f64) {
+) -> (Result<GlobalPlan, LegError>, u32, f64) {
     let t0 = Instant::now();
     let g = &m.global;
     if let Err(why) = leg_work(map, m, (from, to)) {
         return (Err(why), 0, 0.0);
     }
-    let mut last = Err("no attempt".to_owned());
+    let mut last = Err(LegError::NoAttempt);
     for a in 0..g.attempts {
         let seed = seed.wrapping_add(u64::from(a));
         let algorithm = g.planner.algorithm(g.nodes, g.connect_m, seed);
@@ -394,7 +392,7 @@ fn plan_leg(
                 margin_m: g.margin_m,
                 truck: truck.clone(),
             };
-            let plan = plan_global(map, &q).map_err(|e| e.to_string());
+            let plan = plan_global(map, &q).map_err(LegError::from);
             if plan.as_ref().is_ok_and(|p| accepted(p, m).is_some()) {
                 return (plan, a + 1, t0.elapsed().as_secs_f64());
             }

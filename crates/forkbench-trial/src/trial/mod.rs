@@ -1,6 +1,7 @@
 //! One pick trial as named stages: setup, plan, drive (with replans), judge.
 
 mod drive;
+mod error;
 mod judge;
 mod mission;
 mod plan;
@@ -154,7 +155,7 @@ fn run_stages<R: Recorder + ?Sized>(
         };
         if let Err(why) = trial.run_legs(m, &staging, rec) {
             trial.out.sim_time_s = trial.sim.time_s();
-            trial.out.fail(Failure::LegFailed, why);
+            trial.out.fail(Failure::LegFailed, why.to_string());
             return trial.out;
         }
         let pallet = trial.sim.pallet_pose();
@@ -169,6 +170,7 @@ fn run_stages<R: Recorder + ?Sized>(
     };
     trial.tracker.reset(&path, &scn.truck);
     if let Err(why) = trial.drive(rec) {
+        let why = why.to_string();
         rec.event(trial.sim.time_s(), Level::Error, &why);
         trial.out.fail(Failure::Error, why);
         return trial.out;

@@ -3,6 +3,7 @@
 use forkbench_core::{Path, Pose2};
 use forkbench_plan::{Plan, PlanRequest};
 
+use super::error::StageError;
 use super::setup::Trial;
 use super::{APPROACH_GAP_M, goal_for};
 use crate::outcome::Failure;
@@ -23,14 +24,14 @@ impl Trial<'_> {
         pose: Pose2,
         curvature: f64,
         est: &Pose2,
-    ) -> Result<Plan, String> {
+    ) -> Result<Plan, StageError> {
         let truck = &self.scn.truck;
         let mut req = PlanRequest::new(pose, goal_for(est, truck, -APPROACH_GAP_M));
         req.truck = truck.clone();
         req.start_curvature_per_m = curvature;
         req.obstacles = self.obstacles.clone();
         req.seed = self.run.seed;
-        let mut plan = self.planner.plan(&req).map_err(|e| e.to_string())?;
+        let mut plan = self.planner.plan(&req)?;
         plan.path
             .extend_straight(APPROACH_GAP_M + self.insertion_m, 0.01);
         Ok(plan)
@@ -38,7 +39,7 @@ impl Trial<'_> {
 
     /// Why the truck body swept along `path` would hit a rack or wall (the footprint
     /// checker the corridor analysis uses), if it would and paths are validated.
-    pub(super) fn clash(&self, path: &Path) -> Option<String> {
+    pub(super) fn clash(&self, path: &Path) -> Option<StageError> {
         if !self.scn.validate_paths {
             return None;
         }
@@ -46,11 +47,9 @@ impl Trial<'_> {
         let body = truck_footprint(&self.scn.truck);
         obstacles
             .first_hit_along(&body, path, PATH_CHECK_STEP_M)
-            .map(|h| {
-                format!(
-                    "the planned path runs the truck body into {} at s = {:.2} m",
-                    labels[h.obstacle], h.s_m
-                )
+            .map(|h| StageError::Clash {
+                obstacle: labels[h.obstacle].clone(),
+                s_m: h.s_m,
             })
     }
 
@@ -63,11 +62,12 @@ impl Trial<'_> {
         let t = self.sim.time_s();
         let plan = self.plan_from(self.first_fix, 0.0, &est).map_err(|e| {
             rec.event(t, Level::Error, &format!("planning failed: {e}"));
-            (Failure::PlanFailed, e)
+            (Failure::PlanFailed, e.to_string())
         })?;
         rec.plan(t, 0, &plan.path, plan.control_polygon_m.as_deref());
         self.out.path_length_m = plan.path.length_m();
         if let Some(why) = self.clash(&plan.path) {
+            let why = why.to_string();
             rec.event(t, Level::Error, &why);
             return Err((Failure::PlanFailed, why));
         }

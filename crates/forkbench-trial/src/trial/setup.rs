@@ -8,6 +8,7 @@ use forkbench_track::{PosePredictor, Tracker};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+use super::error::StageError;
 use super::judge::jitter;
 use super::{Resolved, target_insertion_m};
 use crate::outcome::{Failure, TrialOutcome};
@@ -61,7 +62,7 @@ fn build_world(
     scn: &Scenario,
     case: &Case,
     seed: u64,
-) -> Result<(Sim, Pose2, Pose2, Vec<forkbench_sim::Obstacle>), String> {
+) -> Result<(Sim, Pose2, Pose2, Vec<forkbench_sim::Obstacle>), StageError> {
     let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(seed, 3));
     let obstacles = scn.world.obstacles();
     let start = scn.mission.as_ref().map_or(case.start, |m| m.start.pose);
@@ -72,8 +73,7 @@ fn build_world(
         &true_pallet,
         &obstacles,
         &scn.sim,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok((sim, start, true_pallet, obstacles))
 }
 
@@ -106,7 +106,7 @@ impl<'a> Trial<'a> {
         let (sim, start, true_pallet, obstacles) = match build_world(scn, case, run.seed) {
             Ok(w) => w,
             Err(e) => {
-                fail(&mut out, e);
+                fail(&mut out, e.to_string());
                 return Err(Box::new(out));
             }
         };
