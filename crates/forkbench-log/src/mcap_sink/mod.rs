@@ -69,8 +69,9 @@ pub struct McapRecorder {
     /// Steps not yet handed over.
     pending: Vec<Item>,
     draw: DrawState,
-    /// Topics of signals registered so far.
+    /// Topics of signals registered so far, and the scalar signals' by path.
     signal_topics: std::collections::BTreeSet<String>,
+    scalar_topics: Vec<(String, std::sync::Arc<str>)>,
 }
 
 impl std::fmt::Debug for McapRecorder {
@@ -98,6 +99,7 @@ impl McapRecorder {
             pending: Vec::with_capacity(STEP_BATCH),
             draw: DrawState::default(),
             signal_topics: Default::default(),
+            scalar_topics: Vec::new(),
         })
     }
 
@@ -108,11 +110,15 @@ impl McapRecorder {
         t_s: f64,
         msg: M,
     ) {
-        self.pending.push(Item::Json {
+        self.queue(Item::Json {
             topic: topic.into(),
             t_s,
             msg: Box::new(move |buf: &mut Vec<u8>| serde_json::to_writer(buf, &msg)),
         });
+    }
+
+    fn queue(&mut self, item: Item) {
+        self.pending.push(item);
         if self.pending.len() >= STEP_BATCH {
             self.send_pending();
         }

@@ -9,7 +9,8 @@ use serde_json::json;
 use super::McapRecorder;
 use super::messages::*;
 use super::schemas::{GRID_SCHEMA, LASER_SCAN_SCHEMA, POSE_IN_FRAME_SCHEMA, SCALAR_SCHEMA};
-use super::sink::Cmd;
+use super::sink::{Cmd, Item};
+use std::sync::Arc;
 
 /// What a style leaves unset.
 const DEFAULT_RGBA: [u8; 4] = [200, 200, 200, 255];
@@ -24,13 +25,6 @@ fn rgba(style: &Style) -> [f64; 4] {
 
 fn width(style: &Style) -> f64 {
     style.width_m.unwrap_or(DEFAULT_WIDTH_M)
-}
-
-/// `forkbench.Scalar`: one value of a signal's series.
-#[derive(Serialize)]
-struct ScalarMsg {
-    t_s: f64,
-    value: f64,
 }
 
 /// `foxglove.LaserScan` in the world frame; `null` ranges are beams without a return.
@@ -79,10 +73,7 @@ impl McapRecorder {
     pub(super) fn send_signal(&mut self, t_s: f64, path: &str, signal: &Signal<'_>, style: Style) {
         let (c, w) = (rgba(&style), width(&style));
         let lines = match signal {
-            Signal::Scalar(v) => {
-                let topic = self.topic("/signals/", path, "forkbench.Scalar", SCALAR_SCHEMA);
-                return self.send(topic, t_s, ScalarMsg { t_s, value: *v });
-            }
+            Signal::Scalar(v) => return self.send_scalar(t_s, path, *v),
             Signal::Text(text) => return self.send_text(t_s, path, text),
             Signal::Scan(scan) => {
                 self.send_scan(t_s, path, scan);
@@ -113,6 +104,21 @@ impl McapRecorder {
             Signal::Boxes(b) => boxes(b, c, w),
         };
         self.send_entity(t_s, entity(t_s, path, lines));
+    }
+
+    /// Queues a scalar; its topic is registered and named once per path.
+    fn send_scalar(&mut self, t_s: f64, path: &str, value: f64) {
+        let topic = match self.scalar_topics.iter().find(|(p, _)| p == path) {
+            Some((_, t)) => t.clone(),
+            None => {
+                let t: Arc<str> = self
+                    .topic("/signals/", path, "forkbench.Scalar", SCALAR_SCHEMA)
+                    .into();
+                self.scalar_topics.push((path.to_owned(), t.clone()));
+                t
+            }
+        };
+        self.queue(Item::Scalar { topic, t_s, value });
     }
 
     fn send_entity(&mut self, t_s: f64, e: SceneEntity) {

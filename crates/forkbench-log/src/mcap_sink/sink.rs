@@ -29,6 +29,20 @@ pub(super) enum Item {
         msg: JsonMsg,
     },
     Step(StepRecord),
+    /// A scalar signal's value (`forkbench.Scalar`): per step, so no closure and no
+    /// topic string of its own.
+    Scalar {
+        topic: std::sync::Arc<str>,
+        t_s: f64,
+        value: f64,
+    },
+}
+
+/// `forkbench.Scalar`: one value of a signal's series.
+#[derive(Serialize)]
+pub(super) struct ScalarMsg {
+    pub(super) t_s: f64,
+    pub(super) value: f64,
 }
 
 /// Work for the writer thread.
@@ -141,6 +155,9 @@ impl Sink {
                         match item {
                             Item::Json { topic, t_s, msg } => self.write_json(&topic, t_s, msg),
                             Item::Step(s) => self.step(&s),
+                            Item::Scalar { topic, t_s, value } => {
+                                self.write(&topic, t_s, &ScalarMsg { t_s, value })
+                            }
                         }
                     }
                 }
