@@ -557,7 +557,7 @@ fn trial_records_rrd_and_mcap_and_refuses_to_overwrite() {
     assert_eq!(&std::fs::read(&mcap).expect("mcap")[..8], b"\x89MCAP0\r\n");
     let again = forkbench(&["trial", scn, "--no-noise", "--mcap", m]);
     assert_eq!(again.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&again.stderr).contains("exists (use --force"));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("exists (overwriting it needs force"));
     assert!(
         forkbench(&["trial", scn, "--no-noise", "--mcap", m, "--force"])
             .status

@@ -115,7 +115,7 @@ fn scheduler_variables_that_are_missing_or_disagree_are_errors() {
         String::from_utf8_lossy(&out.stderr).into_owned()
     };
     assert!(run(&["--shard", "auto"], &[]).contains("no scheduler shard in the environment"));
-    assert!(run(&["--shard", "auto"], &[("JOB_COMPLETION_INDEX", "1")]).contains("--shard-count"));
+    assert!(run(&["--shard", "auto"], &[("JOB_COMPLETION_INDEX", "1")]).contains("shard_count"));
     let both = [
         ("JOB_COMPLETION_INDEX", "1"),
         ("SLURM_ARRAY_TASK_ID", "2"),

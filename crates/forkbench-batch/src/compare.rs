@@ -112,7 +112,7 @@ fn kind_of(records: &[(usize, TrialRecord)], a: &str, b: &str) -> Result<bool, B
         .map(|(_, r)| r.outcome.tracker.as_str())
         .collect();
     if a == b {
-        return Err(BatchError::Invalid(format!("--a and --b are both {a:?}")));
+        return Err(BatchError::Invalid(format!("A and B are both {a:?}")));
     }
     if planners.contains(a) && planners.contains(b) {
         Ok(true)

@@ -335,7 +335,7 @@ impl BatchSpec {
                 if !diff.is_empty() {
                     return Err(BatchError::Invalid(format!(
                         "{}: holds trials of a different batch ({} differences, directory → \
-                         this run: {}); use --force-new to discard them, or another --out",
+                         this run: {}); set force_new to discard them, or choose another output directory",
                         dir.display(),
                         diff.len(),
                         diff.iter().take(8).cloned().collect::<Vec<_>>().join("; ")
@@ -346,7 +346,7 @@ impl BatchSpec {
             None if std::fs::metadata(&trials).is_ok_and(|m| m.len() > 0) => {
                 Err(BatchError::Invalid(format!(
                     "{}: has trials.jsonl but no manifest.json (written by an older forkbench?), \
-                     so its settings are unknown; use --force-new to start over",
+                     so its settings are unknown; set force_new to start over",
                     dir.display()
                 )))
             }
@@ -367,7 +367,7 @@ pub fn run_batch(
     let started = std::time::SystemTime::now();
     if dir.exists() && !dir.is_dir() {
         return Err(BatchError::Invalid(format!(
-            "{}: exists and is not a directory (--out names a directory)",
+            "{}: exists and is not a directory (the output is a directory)",
             dir.display()
         )));
     }

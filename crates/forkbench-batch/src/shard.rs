@@ -16,13 +16,13 @@ pub enum ShardArg {
 
 /// Parses `I/N` or `auto`.
 pub fn parse_shard(text: &str, count: Option<u64>) -> Result<ShardArg, BatchError> {
-    let bad = |why: &str| BatchError::Invalid(format!("--shard {text:?}: {why}"));
+    let bad = |why: &str| BatchError::Invalid(format!("shard {text:?}: {why}"));
     if text.trim() == "auto" {
         return Ok(ShardArg::Auto { count });
     }
     if count.is_some() {
         return Err(bad(
-            "--shard-count goes with --shard auto; I/N names the count itself",
+            "shard_count goes with shard auto; I/N names the count itself",
         ));
     }
     let (i, n) = text
@@ -44,13 +44,13 @@ fn var(env: &dyn Fn(&str) -> Option<String>, name: &str) -> Result<Option<u64>, 
     env(name)
         .map(|v| {
             v.trim().parse::<u64>().map_err(|_| {
-                BatchError::Invalid(format!("--shard auto: {name}={v:?} is not a whole number"))
+                BatchError::Invalid(format!("shard auto: {name}={v:?} is not a whole number"))
             })
         })
         .transpose()
 }
 
-/// A Slurm array task's shard. With the count given (`--shard-count N`), the task ID is
+/// A Slurm array task's shard. With the count given (`shard_count N`), the task ID is
 /// the shard index, so one index can be resubmitted alone (`sbatch --array=2`) and keep its
 /// place; without it, (ID − MIN) / STEP of SLURM_ARRAY_TASK_COUNT.
 fn slurm(
@@ -65,7 +65,7 @@ fn slurm(
         let top = max.unwrap_or(id).max(id);
         if top >= n {
             return Err(BatchError::Invalid(format!(
-                "--shard auto: the array reaches task {top} but --shard-count is {n}; number \
+                "shard auto: the array reaches task {top} but shard_count is {n}; number \
                  the tasks 0…{} (--array=0-{})",
                 n - 1,
                 n - 1
@@ -77,18 +77,18 @@ fn slurm(
     let step = var(env, "SLURM_ARRAY_TASK_STEP")?.unwrap_or(1).max(1);
     let count = var(env, "SLURM_ARRAY_TASK_COUNT")?.ok_or_else(|| {
         BatchError::Invalid(
-            "--shard auto: SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not".into(),
+            "shard auto: SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not".into(),
         )
     })?;
     if id < min || (id - min) % step != 0 {
         return Err(BatchError::Invalid(format!(
-            "--shard auto: array task {id} is not on the range {min}, {min}+{step}, …"
+            "shard auto: array task {id} is not on the range {min}, {min}+{step}, …"
         )));
     }
     let i = (id - min) / step;
     if i >= count || max.is_some_and(|m| (m - min) / step + 1 != count) {
         return Err(BatchError::Invalid(format!(
-            "--shard auto: array task {id} (min {min}, step {step}, max {max:?}) does not fit \
+            "shard auto: array task {id} (min {min}, step {step}, max {max:?}) does not fit \
              SLURM_ARRAY_TASK_COUNT={count}; submit a contiguous range such as --array=0-{}",
             count.saturating_sub(1)
         )));
@@ -110,14 +110,14 @@ pub fn resolve_shard(
     let from_k8s = match (k8s, count) {
         (Some(_), None) => {
             return Err(BatchError::Invalid(
-                "--shard auto: JOB_COMPLETION_INDEX is set; give the Job's completions as \
-                 --shard-count N (Kubernetes does not export it)"
+                "shard auto: JOB_COMPLETION_INDEX is set; give the Job's completions as \
+                 shard_count N (Kubernetes does not export it)"
                     .into(),
             ));
         }
         (Some(i), Some(n)) if i >= n => {
             return Err(BatchError::Invalid(format!(
-                "--shard auto: JOB_COMPLETION_INDEX={i} is not below --shard-count {n}"
+                "shard auto: JOB_COMPLETION_INDEX={i} is not below shard_count {n}"
             )));
         }
         (Some(i), Some(n)) => Some((i, n)),
@@ -125,13 +125,13 @@ pub fn resolve_shard(
     };
     match (from_slurm, from_k8s) {
         (Some(s), Some(k)) if s != k => Err(BatchError::Invalid(format!(
-            "--shard auto: Slurm says shard {}/{} but JOB_COMPLETION_INDEX says {}/{}",
+            "shard auto: Slurm says shard {}/{} but JOB_COMPLETION_INDEX says {}/{}",
             s.0, s.1, k.0, k.1
         ))),
         (Some(s), _) => Ok(s),
         (None, Some(k)) => Ok(k),
         (None, None) => Err(BatchError::Invalid(
-            "--shard auto: no scheduler shard in the environment (SLURM_ARRAY_TASK_ID for a \
+            "shard auto: no scheduler shard in the environment (SLURM_ARRAY_TASK_ID for a \
              Slurm job array, JOB_COMPLETION_INDEX for a Kubernetes Indexed Job)"
                 .into(),
         )),
@@ -235,7 +235,7 @@ mod tests {
             auto(None, &k)
                 .expect_err("no count")
                 .to_string()
-                .contains("--shard-count")
+                .contains("shard_count")
         );
         assert!(auto(Some(3), &k).is_err(), "index beyond the count");
         // A resubmitted single index keeps its place when the count is given.

@@ -196,7 +196,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
         .map(|d| {
             if out_real.is_some() && std::fs::canonicalize(d).ok() == out_real {
                 return Err(BatchError::Invalid(format!(
-                    "{}: is both an input and --out; merge into a new directory",
+                    "{}: is both an input and the output; merge into a new directory",
                     d.display()
                 )));
             }

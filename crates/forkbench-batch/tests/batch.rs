@@ -170,7 +170,7 @@ fn resume_refuses_other_settings_and_force_new_starts_over() {
     quiet.pallet_noise_scale = Some(0.0);
     let e = err(batch::run_batch(&quiet, &d, 2, &|_| {}));
     assert!(
-        e.contains("pallet_noise_scale: null → 0.0") && e.contains("--force-new"),
+        e.contains("pallet_noise_scale: null → 0.0") && e.contains("force_new"),
         "{e}"
     );
     let mut seed = base.clone();
@@ -227,7 +227,7 @@ fn merge_checks_manifests_and_shard_coverage() {
     assert!(e.contains("shards 1 of 2 are missing"), "{e}");
     assert!(err(batch::merge(&[], &out)).contains("at least one input"));
     let e = err(batch::merge(&[a0.clone(), a1.clone()], &a1));
-    assert!(e.contains("both an input and --out"), "{e}");
+    assert!(e.contains("both an input and the output"), "{e}");
     // An unfinished shard is refused too.
     let text = std::fs::read_to_string(a1.join("trials.jsonl")).expect("written");
     let first = text.lines().next().expect("a line");

@@ -41,7 +41,7 @@ pub fn mcap_metadata(
 /// A recording sink that could not be opened or written.
 #[derive(Debug, thiserror::Error)]
 pub enum LogError {
-    #[error("{path}: exists (use --force to overwrite)")]
+    #[error("{path}: exists (overwriting it needs force)")]
     Exists { path: String },
     #[error("{path}: {message}")]
     Io { path: String, message: String },

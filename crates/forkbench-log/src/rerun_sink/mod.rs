@@ -274,7 +274,7 @@ fn connect(
 ) -> Result<rerun::RecordingStream, LogError> {
     let sock: std::net::SocketAddr = addr
         .parse()
-        .map_err(|e| LogError::Rerun(format!("--connect {addr:?}: expected host:port ({e})")))?;
+        .map_err(|e| LogError::Rerun(format!("connect {addr:?}: expected host:port ({e})")))?;
     std::net::TcpStream::connect_timeout(&sock, std::time::Duration::from_secs(2))
         .map_err(|e| LogError::Rerun(format!("no rerun viewer reachable at {addr}: {e}")))?;
     builder
