@@ -1,5 +1,7 @@
 //! Sensor models: NAV350 laser localisation and the pallet-pose estimate, drawing only from a passed-in RNG.
 
+pub mod scan;
+
 use std::collections::VecDeque;
 
 use forkbench_core::Pose2;

@@ -1,6 +1,7 @@
 //! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers, fixed racks.
 
 mod bodies;
+mod view;
 use bodies::{insert_obstacles, insert_pallet, insert_truck};
 
 use forkbench_core::{ForkliftSpec, Pose2};
@@ -90,7 +91,7 @@ impl std::fmt::Debug for Sim {
     }
 }
 
-fn v2(x: f64, y: f64) -> Vector {
+pub(crate) fn v2(x: f64, y: f64) -> Vector {
     Vector::new(x as Real, y as Real)
 }
 
@@ -170,6 +171,9 @@ impl Sim {
             * (pallet_spec.depth_m.powi(2) + pallet_spec.width_m.powi(2))
             / 12.0;
         let obstacles = insert_obstacles(&mut world, obstacles);
+        // Scene queries (the sensors' ray casts) read the broad phase, which a step fills:
+        // fill it now, so the world can be seen before the first step.
+        world.detect_collisions(&(), &());
 
         Ok(Self {
             world,
