@@ -1,5 +1,6 @@
 //! Sensor models: NAV350 laser localisation and the pallet-pose estimate, drawing only from a passed-in RNG.
 
+pub mod detect;
 pub mod scan;
 
 use std::collections::VecDeque;

@@ -1,0 +1,426 @@
+//! A pallet pocket detector for 2-D scans at fork-pocket height, the way published laser detectors work: segment the scan, keep the segments a stringer face could make, find stringers spaced as the pallet's are, fit the face line.
+
+use forkbench_core::signal::Scan;
+use forkbench_core::{PalletSpec, Pose2};
+use serde::{Deserialize, Serialize};
+
+/// The detector's tolerances (SI).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DetectorConfig {
+    /// Neighbouring returns further apart than this plus the beam spacing at their range
+    /// start a new segment.
+    pub break_m: f64,
+    /// A run of returns bends into separate straight pieces (a stringer's face and its
+    /// side seen through a pocket) where a point lies this far off their chord.
+    pub split_m: f64,
+    /// Fewest returns on a stringer face (a sliver of a half-hidden one is not enough).
+    pub min_points: usize,
+    /// A stringer face's segment may be this much narrower or wider than the stringer.
+    pub width_tolerance_m: f64,
+    /// Stringer centres may sit this far from the pallet's spacing.
+    pub spacing_tolerance_m: f64,
+    /// A stringer's centre may lie this far off the face line through the others.
+    pub line_tolerance_m: f64,
+}
+
+impl Default for DetectorConfig {
+    fn default() -> Self {
+        Self {
+            break_m: 0.06,
+            split_m: 0.05,
+            min_points: 3,
+            width_tolerance_m: 0.08,
+            spacing_tolerance_m: 0.08,
+            line_tolerance_m: 0.08,
+        }
+    }
+}
+
+/// A pallet found in a scan.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Detection {
+    /// Face centre, heading into the pallet (the direction the forks travel).
+    pub face: Pose2,
+    /// Stringer faces the fit used (2 when one is hidden).
+    pub stringers: usize,
+    /// Returns on those faces, and their RMS distance from the fitted face line.
+    pub points: usize,
+    pub rms_m: f64,
+}
+
+/// Points further than this (or 2.5 RMS) off the first face line are left out of the
+/// second fit.
+const REFIT_M: f64 = 0.02;
+
+/// One run of neighbouring returns.
+#[derive(Debug, Clone)]
+struct Segment {
+    points: Vec<[f64; 2]>,
+    centre: [f64; 2],
+    width_m: f64,
+}
+
+impl Segment {
+    fn of(points: Vec<[f64; 2]>) -> Self {
+        let n = points.len() as f64;
+        let centre = [
+            points.iter().map(|p| p[0]).sum::<f64>() / n,
+            points.iter().map(|p| p[1]).sum::<f64>() / n,
+        ];
+        let (a, b) = (points[0], points[points.len() - 1]);
+        let width_m = (b[0] - a[0]).hypot(b[1] - a[1]);
+        Self {
+            points,
+            centre,
+            width_m,
+        }
+    }
+}
+
+/// The scan's returns split where neighbouring beams jump in range or return nothing.
+fn segments(scan: &Scan, break_m: f64) -> Vec<Segment> {
+    let mut out = Vec::new();
+    let mut run: Vec<[f64; 2]> = Vec::new();
+    let mut last_r = f64::NAN;
+    let s = &scan.sensor;
+    for (i, &r) in scan.ranges_m.iter().enumerate() {
+        let joins = r.is_finite()
+            && last_r.is_finite()
+            && (r - last_r).abs() <= break_m + 2.0 * r * scan.angle_step_rad;
+        if !joins && !run.is_empty() {
+            out.push(Segment::of(std::mem::take(&mut run)));
+        }
+        if r.is_finite() {
+            let a = s.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
+            run.push([s.x_m + r * a.cos(), s.y_m + r * a.sin()]);
+        }
+        last_r = r;
+    }
+    if !run.is_empty() {
+        out.push(Segment::of(run));
+    }
+    out
+}
+
+/// `points` split into straight pieces (Douglas–Peucker): at the point farthest from
+/// the chord while it lies more than `tol_m` off; a corner point ends one piece and
+/// starts the next.
+fn straight_pieces(points: &[[f64; 2]], tol_m: f64) -> Vec<Vec<[f64; 2]>> {
+    let n = points.len();
+    if n < 3 {
+        return vec![points.to_vec()];
+    }
+    let (a, b) = (points[0], points[n - 1]);
+    let len = dist(a, b).max(1e-12);
+    let off =
+        |p: &[f64; 2]| ((p[0] - a[0]) * (b[1] - a[1]) - (p[1] - a[1]) * (b[0] - a[0])).abs() / len;
+    let (k, worst) = points[1..n - 1]
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (i + 1, off(p)))
+        .fold((0, 0.0), |m, c| if c.1 > m.1 { c } else { m });
+    if worst <= tol_m {
+        return vec![points.to_vec()];
+    }
+    let mut out = straight_pieces(&points[..=k], tol_m);
+    out.extend(straight_pieces(&points[k..], tol_m));
+    out
+}
+
+/// Total-least-squares line through `points`: (centroid, unit direction, RMS residual).
+fn fit_line(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2], f64) {
+    let n = points.len() as f64;
+    let c = [
+        points.iter().map(|p| p[0]).sum::<f64>() / n,
+        points.iter().map(|p| p[1]).sum::<f64>() / n,
+    ];
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in points {
+        let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let d = [theta.cos(), theta.sin()];
+    let rms = (points
+        .iter()
+        .map(|p| ((p[0] - c[0]) * -d[1] + (p[1] - c[1]) * d[0]).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    (c, d, rms)
+}
+
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// A set of stringer segments taken as one pallet face: which slots (0 left of the
+/// sensor's view … 2) they fill is decided by their spacing.
+struct Candidate<'a> {
+    segs: Vec<&'a Segment>,
+    /// Face centre offset along the face line from the first segment's centre.
+    centre_from_first_m: f64,
+}
+
+/// Finds the pallet; with a `prior` (the last estimate) the candidate nearest it wins,
+/// else the nearest to the sensor. `None`: no stringers spaced like this pallet's.
+pub fn detect(
+    cfg: &DetectorConfig,
+    scan: &Scan,
+    pallet: &PalletSpec,
+    prior: Option<&Pose2>,
+) -> Option<Detection> {
+    let sw = pallet.stringer_width_m();
+    let spacing = pallet.stringer_offsets_m()[2];
+    let segs: Vec<Segment> = segments(scan, cfg.break_m)
+        .into_iter()
+        .flat_map(|s| straight_pieces(&s.points, cfg.split_m))
+        .map(Segment::of)
+        .filter(|s| {
+            s.points.len() >= cfg.min_points && (s.width_m - sw).abs() <= cfg.width_tolerance_m
+        })
+        .collect();
+    let mut candidates = Vec::new();
+    for (i, a) in segs.iter().enumerate() {
+        for (j, b) in segs.iter().enumerate().skip(i + 1) {
+            let d = dist(a.centre, b.centre);
+            if (d - 2.0 * spacing).abs() <= cfg.spacing_tolerance_m {
+                // The outer pair; the centre stringer, when visible, sits between them.
+                let mid = [
+                    (a.centre[0] + b.centre[0]) / 2.0,
+                    (a.centre[1] + b.centre[1]) / 2.0,
+                ];
+                let mut set = vec![a, b];
+                if let Some(c) = segs[i + 1..j]
+                    .iter()
+                    .find(|c| dist(c.centre, mid) <= cfg.line_tolerance_m)
+                {
+                    set.push(c);
+                }
+                candidates.push(Candidate {
+                    segs: set,
+                    centre_from_first_m: d / 2.0,
+                });
+            } else if (d - spacing).abs() <= cfg.spacing_tolerance_m {
+                // Two neighbours, the third hidden: which two they are is ambiguous, so
+                // both readings are candidates for the prior to decide.
+                // (left, centre): the centre is the second; (centre, right): the first.
+                for centre_from_first_m in [d, 0.0] {
+                    candidates.push(Candidate {
+                        segs: vec![a, b],
+                        centre_from_first_m,
+                    });
+                }
+            }
+        }
+    }
+    let found: Vec<Detection> = candidates
+        .iter()
+        .filter_map(|c| face_of(c, scan, pallet))
+        .collect();
+    // Three stringers beat two; then the prior, else nearness to the sensor.
+    let s = scan.sensor;
+    let score = |d: &Detection| {
+        let near = match prior {
+            Some(p) => d.face.distance_to(p),
+            None => d.face.distance_to(&s),
+        };
+        (3 - d.stringers.min(3)) as f64 * 1e6 + near
+    };
+    found
+        .into_iter()
+        .min_by(|a, b| score(a).total_cmp(&score(b)))
+}
+
+/// The face pose of a candidate: the line through its segments' points, centred.
+fn face_of(c: &Candidate<'_>, scan: &Scan, pallet: &PalletSpec) -> Option<Detection> {
+    let all: Vec<[f64; 2]> = c
+        .segs
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .collect();
+    // Refit without the points far off the line (a corner of a stringer's side, a mixed
+    // return): they would tilt the face. Each round tightens as the fit improves.
+    let mut points = all;
+    for _ in 0..3 {
+        let (c0, d0, rms0) = fit_line(&points);
+        let keep = REFIT_M.max(2.5 * rms0);
+        points.retain(|p| ((p[0] - c0[0]) * -d0[1] + (p[1] - c0[1]) * d0[0]).abs() <= keep);
+        if points.len() < 3 {
+            return None;
+        }
+    }
+    let (_, d, rms) = fit_line(&points);
+    // Orient the line from the first segment towards the second.
+    let (p0, p1) = (c.segs[0].centre, c.segs[1].centre);
+    let along = if (p1[0] - p0[0]) * d[0] + (p1[1] - p0[1]) * d[1] >= 0.0 {
+        d
+    } else {
+        [-d[0], -d[1]]
+    };
+    let centre = [
+        p0[0] + c.centre_from_first_m * along[0],
+        p0[1] + c.centre_from_first_m * along[1],
+    ];
+    // Into the pallet: the face normal pointing away from the sensor.
+    let mut n = [-along[1], along[0]];
+    let s = scan.sensor;
+    if (centre[0] - s.x_m) * n[0] + (centre[1] - s.y_m) * n[1] < 0.0 {
+        n = [-n[0], -n[1]];
+    }
+    // A face wider than the pallet is not this pallet.
+    let width = dist(c.segs[0].centre, c.segs[1].centre);
+    (width <= pallet.width_m + 0.1).then_some(Detection {
+        face: Pose2::new(centre[0], centre[1], n[1].atan2(n[0])),
+        stringers: c.segs.len(),
+        points: points.len(),
+        rms_m: rms,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scan::{Errors, RayHit, ScannerConfig, Seen, Surface, WorldView, scan};
+
+    /// Boxes (centre pose, length along its heading, width) as a world.
+    struct Boxes(Vec<(Pose2, f64, f64)>);
+
+    impl WorldView for Boxes {
+        fn cast_ray(&self, _: [f64; 2], _: [f64; 2], _: f64) -> Option<RayHit> {
+            None
+        }
+
+        fn surfaces_near(&self, _: [f64; 2], _: f64, out: &mut Vec<Surface>) {
+            for (c, l, w) in &self.0 {
+                let k = forkbench_core::geometry::rect_corners(c, *l, *w);
+                let (s, co) = c.heading_rad.sin_cos();
+                let normals = [[-s, co], [-co, -s], [s, -co], [co, s]];
+                for i in 0..4 {
+                    out.push(Surface {
+                        a: k[i],
+                        b: k[(i + 1) % 4],
+                        normal: normals[i],
+                        seen: Seen::Fixed,
+                    });
+                }
+            }
+        }
+    }
+
+    fn pallet_boxes(p: &PalletSpec, face: &Pose2) -> Vec<(Pose2, f64, f64)> {
+        p.stringer_centres(face)
+            .iter()
+            .map(|c| (*c, p.depth_m, p.stringer_width_m()))
+            .collect()
+    }
+
+    fn ideal(world: &Boxes) -> Scan {
+        let cfg = ScannerConfig::tim561();
+        scan::<rand::rngs::ThreadRng>(&cfg, world, Pose2::new(0.0, 0.0, 0.0), Errors::Ideal)
+    }
+
+    fn assert_close(got: &Pose2, want: &Pose2, tol_m: f64, tol_rad: f64) {
+        let dh = forkbench_core::units::wrap_angle(got.heading_rad - want.heading_rad);
+        assert!(
+            got.distance_to(want) < tol_m && dh.abs() < tol_rad,
+            "got {got:?}, want {want:?}"
+        );
+    }
+
+    #[test]
+    fn a_noise_free_scan_gives_the_face_pose() {
+        let p = PalletSpec::field_1200();
+        for truth in [
+            Pose2::new(4.0, 0.3, 10f64.to_radians()),
+            Pose2::new(6.5, 1.5, -15f64.to_radians()),
+            Pose2::new(2.0, -0.4, 0.0),
+        ] {
+            let world = Boxes(pallet_boxes(&p, &truth));
+            let d = detect(&DetectorConfig::default(), &ideal(&world), &p, None).expect("found");
+            assert_eq!(d.stringers, 3);
+            // Exact up to the beam spacing: each stringer's edges are known to within
+            // one step at its range, so its centre to half of one.
+            let half_step = 0.5 * truth.x_m.hypot(truth.y_m) * 0.33f64.to_radians();
+            assert_close(&d.face, &truth, half_step + 0.002, 0.5f64.to_radians());
+            assert!(d.rms_m < 0.005, "{d:?}");
+        }
+    }
+
+    #[test]
+    fn a_hidden_stringer_leaves_two_and_the_prior_decides() {
+        let p = PalletSpec::field_1200();
+        let truth = Pose2::new(4.0, 0.0, 0.0);
+        let mut boxes = pallet_boxes(&p, &truth);
+        // An upright in front of the right-hand stringer (negative y).
+        let y = p.stringer_offsets_m()[0];
+        boxes.push((Pose2::new(3.0, y, 0.0), 0.1, 0.3));
+        let world = Boxes(boxes);
+        let prior = Pose2::new(4.1, 0.1, 0.05);
+        let d =
+            detect(&DetectorConfig::default(), &ideal(&world), &p, Some(&prior)).expect("found");
+        assert_eq!(d.stringers, 2);
+        assert_close(&d.face, &truth, 0.01, 0.5f64.to_radians());
+    }
+
+    #[test]
+    fn no_pallet_is_not_found() {
+        let p = PalletSpec::field_1200();
+        // A wall and a lone box the width of a stringer.
+        let world = Boxes(vec![
+            (Pose2::new(6.0, 0.0, 0.0), 0.2, 8.0),
+            (Pose2::new(3.0, 1.0, 0.0), 0.5, p.stringer_width_m()),
+        ]);
+        assert_eq!(
+            detect(&DetectorConfig::default(), &ideal(&world), &p, None),
+            None
+        );
+    }
+
+    /// With the TiM561's errors (20 mm noise, a per-scan bias within ±60 mm, mixed
+    /// returns at the stringers' edges), the pallet is still found at 4 m and the face
+    /// heading stays within a few degrees.
+    #[test]
+    fn a_modelled_tim561_scan_still_finds_the_pallet() {
+        use rand::SeedableRng;
+        let p = PalletSpec::field_1200();
+        let truth = Pose2::new(4.0, 0.3, 10f64.to_radians());
+        let world = Boxes(pallet_boxes(&p, &truth));
+        let cfg = ScannerConfig::tim561();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut heading_errors = Vec::new();
+        let mut lateral = Vec::new();
+        for _ in 0..50 {
+            let bias_m = cfg.draw_bias(&mut rng);
+            let e = Errors::Modelled {
+                bias_m,
+                rng: &mut rng,
+            };
+            let sc = scan(&cfg, &world, Pose2::new(0.0, 0.0, 0.0), e);
+            if let Some(d) = detect(&DetectorConfig::default(), &sc, &p, None) {
+                let local = truth.to_local(&d.face);
+                heading_errors.push(local.heading_rad.abs().to_degrees());
+                lateral.push(local.y_m.abs());
+            }
+        }
+        assert!(
+            heading_errors.len() >= 45,
+            "found in {} of 50",
+            heading_errors.len()
+        );
+        heading_errors.sort_by(f64::total_cmp);
+        lateral.sort_by(f64::total_cmp);
+        let (h, l) = (
+            heading_errors[heading_errors.len() / 2],
+            lateral[lateral.len() / 2],
+        );
+        eprintln!("median |heading error| {h:.2}°, |lateral| {l:.3} m");
+        assert!(
+            h < 3.0 && l < 0.03,
+            "median |heading| {h}°, |lateral| {l} m"
+        );
+    }
+}
