@@ -1130,3 +1130,49 @@ fn outcomes_at_fixed_seeds_match_the_committed_baseline() {
     }
     assert!(compared >= 170, "{compared} trials compared");
 }
+
+/// `scan`: one TiM561 scan from the field test's start, as JSON; with ideal rays the
+/// detector's estimate lies within half a beam step of the truth; an unknown sensor is
+/// refused naming the known ones.
+#[test]
+fn scan_reports_beams_truth_and_estimate() {
+    let scn = repo_root().join("scenarios/field-test.toml");
+    let scn = scn.to_str().expect("utf8");
+    let v = stdout_json(&forkbench(&["scan", scn, "--no-noise", "--json"]));
+    let beams = v["beams"].as_array().expect("beams");
+    assert_eq!(beams.len(), 819);
+    assert!(beams.iter().any(|b| b["range_m"].is_null()));
+    assert!(
+        beams
+            .iter()
+            .any(|b| b["range_m"].as_f64().is_some_and(|r| r > 8.0))
+    );
+    assert_eq!(v["sensor"], "tim561");
+    let (t, e) = (&v["truth"], &v["estimate"]);
+    let d = (e["x_m"].as_f64().expect("x") - t["x_m"].as_f64().expect("x"))
+        .hypot(e["y_m"].as_f64().expect("y") - t["y_m"].as_f64().expect("y"));
+    // Half a 0.33° step at the pallet's 8.4 m.
+    assert!(
+        d < 0.5 * 8.4 * 0.33f64.to_radians(),
+        "{d} m off: {e} vs {t}"
+    );
+    let png = tmp("scan.png");
+    let out = forkbench(&[
+        "scan",
+        scn,
+        "--at",
+        "2.719,11.018,102.8",
+        "--plot",
+        png.to_str().expect("utf8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("3 stringers"));
+    assert!(std::fs::metadata(&png).expect("plot").len() > 10_000);
+    let out = forkbench(&["scan", scn, "--sensor", "kinect"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("known: tim561"));
+}

@@ -13,6 +13,7 @@ mod record;
 mod report;
 mod reproduce_cmd;
 mod route_cmd;
+mod scan_cmd;
 mod trial_cmd;
 
 use std::path::PathBuf;
@@ -193,6 +194,9 @@ enum Command {
     Corridor(corridor_cmd::CorridorCli),
     /// A world rasterised to an occupancy grid, written as a ROS map_server map (YAML + PGM).
     Map(map_cmd::MapArgs),
+    /// One scan of a scenario's world from the truck, with the pallet detector's estimate
+    /// beside the truth.
+    Scan(scan_cmd::ScanArgs),
     /// Reproduce a paper's table side by side with this project's results.
     Reproduce {
         what: ReproduceArg,
@@ -291,6 +295,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         } => reproduce(&what, table.as_deref(), json, plot.as_deref()).map(|()| Done::Ok),
         Command::Corridor(args) => corridor_cmd::run(&args.resolve()?).map(|()| Done::Ok),
         Command::Map(args) => map_cmd::run(&args).map(|()| Done::Ok),
+        Command::Scan(args) => scan_cmd::run(&args).map(|()| Done::Ok),
     }
 }
 

@@ -50,7 +50,7 @@ pub fn run(
 }
 
 /// The case to run: the one named, or the only one.
-fn pick_case<'a>(
+pub(crate) fn pick_case<'a>(
     scn: &'a Scenario,
     file: &Path,
     case: Option<&str>,

@@ -47,7 +47,7 @@ impl Signal<'_> {
 }
 
 /// A planar scan: beams at equal angular steps from the sensor's pose in the map.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Scan {
     /// The sensor's pose in the map when it scanned.
     pub sensor: Pose2,

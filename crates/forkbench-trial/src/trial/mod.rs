@@ -3,6 +3,7 @@
 mod drive;
 mod error;
 mod judge;
+mod look;
 mod mission;
 mod plan;
 mod setup;
@@ -17,6 +18,7 @@ use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
+pub use look::{SCANNERS, ScanReport, scan_once, scanner};
 pub use setup::Trial;
 
 /// Per-run choices on top of the scenario file.

@@ -57,15 +57,18 @@ impl std::fmt::Debug for Trial<'_> {
 }
 
 /// The physics world of a trial: the truck at its start (a mission's first place, else the
-/// case's start), the pallet where it really stands (jittered on its own random stream).
-fn build_world(
+/// case's start, or `start_at`), the pallet where it really stands (jittered on its own
+/// random stream).
+pub(super) fn build_world(
     scn: &Scenario,
     case: &Case,
     seed: u64,
+    start_at: Option<Pose2>,
 ) -> Result<(Sim, Pose2, Pose2, Vec<forkbench_sim::Obstacle>), StageError> {
     let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(seed, 3));
     let obstacles = scn.world.obstacles();
-    let start = scn.mission.as_ref().map_or(case.start, |m| m.start.pose);
+    let start =
+        start_at.unwrap_or_else(|| scn.mission.as_ref().map_or(case.start, |m| m.start.pose));
     let sim = Sim::new(
         &scn.truck,
         &start,
@@ -103,7 +106,7 @@ impl<'a> Trial<'a> {
                 return Err(Box::new(out));
             }
         };
-        let (sim, start, true_pallet, obstacles) = match build_world(scn, case, run.seed) {
+        let (sim, start, true_pallet, obstacles) = match build_world(scn, case, run.seed, None) {
             Ok(w) => w,
             Err(e) => {
                 fail(&mut out, e.to_string());

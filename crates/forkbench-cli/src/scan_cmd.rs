@@ -1,0 +1,224 @@
+//! `forkbench scan`: one scan of a scenario's world from the truck, the detector's estimate beside the truth, as text, JSON or a plot.
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+use forkbench_core::Pose2;
+use forkbench_trial::trial::{SCANNERS, ScanReport, scan_once, scanner};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use serde_json::json;
+
+#[derive(Debug, clap::Args)]
+pub struct ScanArgs {
+    /// Scenario file.
+    scenario: PathBuf,
+    /// Case by name (required when the scenario has several).
+    #[arg(long)]
+    case: Option<String>,
+    /// Fork-root pose to scan from, `x,y,heading_deg` (default: the case's start).
+    #[arg(long, value_parser = crate::parse_pose, allow_hyphen_values = true)]
+    at: Option<Pose2>,
+    /// Scanner model.
+    #[arg(long, default_value = "tim561")]
+    sensor: String,
+    /// Seed of the pallet's jitter and the scanner's noise and bias.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Ideal rays: no noise, no bias, no beam divergence.
+    #[arg(long)]
+    no_noise: bool,
+    #[arg(long)]
+    json: bool,
+    /// Draw the scan, the pallet and the estimate to FILE (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+pub fn run(a: &ScanArgs) -> anyhow::Result<()> {
+    let cfg = scanner(&a.sensor).with_context(|| {
+        format!(
+            "--sensor {:?}: unknown (known: {})",
+            a.sensor,
+            SCANNERS.join(", ")
+        )
+    })?;
+    let scn = forkbench_trial::Scenario::load(&a.scenario)?;
+    let case = crate::trial_cmd::pick_case(&scn, &a.scenario, a.case.as_deref())?;
+    let report = scan_once(&scn, case, (&a.sensor, &cfg), a.at, a.seed, a.no_noise)?;
+    if let Some(file) = &a.plot {
+        draw(file, &report, &scn.pallet)?;
+    }
+    if a.json {
+        return crate::emit(&format!("{}\n", to_json(&report)));
+    }
+    crate::emit(&text(&report))
+}
+
+fn pose_json(p: &Pose2) -> serde_json::Value {
+    json!({"x_m": p.x_m, "y_m": p.y_m, "heading_rad": p.heading_rad})
+}
+
+fn to_json(r: &ScanReport) -> serde_json::Value {
+    let s = &r.scan;
+    let beams: Vec<_> = s
+        .ranges_m
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let range = v.is_finite().then_some(*v);
+            json!({"angle_rad": s.angle_min_rad + i as f64 * s.angle_step_rad, "range_m": range})
+        })
+        .collect();
+    let detection = r
+        .estimate
+        .map(|d| json!({"stringers": d.stringers, "points": d.points, "rms_m": d.rms_m}));
+    json!({
+        "sensor": r.sensor,
+        "sensor_pose": pose_json(&s.sensor),
+        "fork_root": pose_json(&r.fork_root),
+        "beams": beams,
+        "truth": pose_json(&r.truth),
+        "estimate": r.estimate.map(|d| pose_json(&d.face)),
+        "detection": detection,
+    })
+}
+
+fn text(r: &ScanReport) -> String {
+    let s = &r.scan;
+    let returns = s.ranges_m.iter().filter(|v| v.is_finite()).count();
+    let deg = |p: &Pose2| {
+        format!(
+            "({:.3}, {:.3}) m, {:.2}°",
+            p.x_m,
+            p.y_m,
+            p.heading_rad.to_degrees()
+        )
+    };
+    let mut out = format!(
+        "{} from {}: {} beams, {} returns\npallet face (truth) {}\n",
+        r.sensor,
+        deg(&s.sensor),
+        s.ranges_m.len(),
+        returns,
+        deg(&r.truth)
+    );
+    match &r.estimate {
+        Some(d) => {
+            let e = r.truth.to_local(&d.face);
+            out += &format!(
+                "estimate            {}  ({} stringers, {} points, RMS {:.1} mm)\n\
+                 error in the pallet frame: along {:+.3} m, lateral {:+.3} m, heading {:+.2}°\n",
+                deg(&d.face),
+                d.stringers,
+                d.points,
+                1e3 * d.rms_m,
+                e.x_m,
+                e.y_m,
+                forkbench_core::units::wrap_angle(e.heading_rad).to_degrees()
+            );
+        }
+        None => out += "estimate            not found (no stringers spaced like this pallet's)\n",
+    }
+    out
+}
+
+fn draw(
+    file: &std::path::Path,
+    r: &ScanReport,
+    pallet: &forkbench_core::PalletSpec,
+) -> anyhow::Result<()> {
+    crate::plot::to_file(
+        file,
+        (1000, 800),
+        |a| draw_on(a, r, pallet),
+        |a| draw_on(a, r, pallet),
+    )
+}
+
+fn draw_on<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    r: &ScanReport,
+    pallet: &forkbench_core::PalletSpec,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    use crate::plot::err;
+    root.fill(&WHITE).map_err(err)?;
+    let pts = r.scan.points();
+    let s = r.scan.sensor;
+    // Frame the sensor and the pallet, equal scales.
+    let xs = [s.x_m, r.truth.x_m];
+    let ys = [s.y_m, r.truth.y_m];
+    let (cx, cy) = ((xs[0] + xs[1]) / 2.0, (ys[0] + ys[1]) / 2.0);
+    let half = ((xs[0] - xs[1]).abs().max((ys[0] - ys[1]).abs()) / 2.0 + 2.0).max(3.0);
+    let title = match &r.estimate {
+        Some(d) => {
+            let e = r.truth.to_local(&d.face);
+            format!(
+                "{} scan: estimate off by {:+.3} m lateral, {:+.2}° (truth orange, estimate red)",
+                r.sensor,
+                e.y_m,
+                e.heading_rad.to_degrees()
+            )
+        }
+        None => format!("{} scan: pallet not found (truth orange)", r.sensor),
+    };
+    let mut chart = ChartBuilder::on(&root)
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .caption(title, ("sans-serif", 18))
+        .build_cartesian_2d(
+            (cx - half)..(cx + half),
+            (cy - half * 0.8)..(cy + half * 0.8),
+        )
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .draw()
+        .map_err(err)?;
+    let outline = |face: &Pose2| -> Vec<Vec<(f64, f64)>> {
+        pallet
+            .stringer_centres(face)
+            .iter()
+            .map(|c| {
+                forkbench_core::geometry::rect_outline(c, pallet.depth_m, pallet.stringer_width_m())
+                    .iter()
+                    .map(|p| (p[0], p[1]))
+                    .collect()
+            })
+            .collect()
+    };
+    let orange = RGBColor(205, 140, 50);
+    for o in outline(&r.truth) {
+        chart
+            .draw_series(LineSeries::new(o, orange.stroke_width(2)))
+            .map_err(err)?;
+    }
+    if let Some(d) = &r.estimate {
+        for o in outline(&d.face) {
+            chart
+                .draw_series(LineSeries::new(o, RED.stroke_width(1)))
+                .map_err(err)?;
+        }
+    }
+    chart
+        .draw_series(
+            pts.iter()
+                .map(|p| Circle::new((p[0], p[1]), 2, BLUE.filled())),
+        )
+        .map_err(err)?;
+    let (sn, cs) = s.heading_rad.sin_cos();
+    chart
+        .draw_series(LineSeries::new(
+            [(s.x_m, s.y_m), (s.x_m + 0.6 * cs, s.y_m + 0.6 * sn)],
+            BLACK.stroke_width(3),
+        ))
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}

@@ -1,0 +1,74 @@
+//! One scan of a scenario's world from the truck (its start or a given fork-root pose), with the detector's estimate beside the truth: what `forkbench scan` shows.
+
+use forkbench_core::Pose2;
+use forkbench_core::signal::Scan;
+use forkbench_sensors::detect::{Detection, DetectorConfig, detect};
+use forkbench_sensors::scan::{Errors, ScannerConfig, scan};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+use super::error::StageError;
+use super::setup::build_world;
+use crate::scenario::{Case, Scenario};
+
+/// The scanners `scan` knows by name.
+pub const SCANNERS: [&str; 1] = ["tim561"];
+
+/// A scanner by name, with its settings.
+pub fn scanner(name: &str) -> Option<ScannerConfig> {
+    match name {
+        "tim561" => Some(ScannerConfig::tim561()),
+        _ => None,
+    }
+}
+
+/// One scan and what the detector made of it.
+#[derive(Debug, Clone, Serialize)]
+pub struct ScanReport {
+    pub sensor: String,
+    /// The fork-root pose the truck scanned from.
+    pub fork_root: Pose2,
+    pub scan: Scan,
+    /// The pallet's true face pose (jittered as the trial with this seed places it).
+    pub truth: Pose2,
+    pub estimate: Option<Detection>,
+}
+
+/// Scans from `at` (a fork-root pose; the case's start when `None`) with the named
+/// scanner, seeded by `seed`; `ideal` takes exact rays (no noise, bias or spot).
+pub fn scan_once(
+    scn: &Scenario,
+    case: &Case,
+    (sensor, cfg): (&str, &ScannerConfig),
+    at: Option<Pose2>,
+    seed: u64,
+    ideal: bool,
+) -> Result<ScanReport, StageError> {
+    let (sim, root, truth, _) = build_world(scn, case, seed, at)?;
+    let pose = cfg.sensor_pose(&root);
+    // Its own stream, so a scan does not shift the trial's other draws.
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5CA7_5CA7_5CA7_5CA7);
+    let s = if ideal {
+        scan::<ChaCha8Rng>(cfg, &sim, pose, Errors::Ideal)
+    } else {
+        let bias_m = cfg.draw_bias(&mut rng);
+        scan(
+            cfg,
+            &sim,
+            pose,
+            Errors::Modelled {
+                bias_m,
+                rng: &mut rng,
+            },
+        )
+    };
+    let estimate = detect(&DetectorConfig::default(), &s, &scn.pallet, None);
+    Ok(ScanReport {
+        sensor: sensor.to_owned(),
+        fork_root: root,
+        scan: s,
+        truth,
+        estimate,
+    })
+}
