@@ -153,18 +153,7 @@ where
     let ys = [s.y_m, r.truth.y_m];
     let (cx, cy) = ((xs[0] + xs[1]) / 2.0, (ys[0] + ys[1]) / 2.0);
     let half = ((xs[0] - xs[1]).abs().max((ys[0] - ys[1]).abs()) / 2.0 + 2.0).max(3.0);
-    let title = match &r.estimate {
-        Some(d) => {
-            let e = r.truth.to_local(&d.face);
-            format!(
-                "{} scan: estimate off by {:+.3} m lateral, {:+.2}° (truth orange, estimate red)",
-                r.sensor,
-                e.y_m,
-                e.heading_rad.to_degrees()
-            )
-        }
-        None => format!("{} scan: pallet not found (truth orange)", r.sensor),
-    };
+    let title = plot_title(r);
     let mut chart = ChartBuilder::on(&root)
         .margin(15)
         .x_label_area_size(40)
@@ -221,4 +210,20 @@ where
         .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// The plot's title: the estimate's error, or that the pallet was not found.
+fn plot_title(r: &ScanReport) -> String {
+    match &r.estimate {
+        Some(d) => {
+            let e = r.truth.to_local(&d.face);
+            format!(
+                "{} scan: estimate off by {:+.3} m lateral, {:+.2}° (truth orange, estimate red)",
+                r.sensor,
+                e.y_m,
+                e.heading_rad.to_degrees()
+            )
+        }
+        None => format!("{} scan: pallet not found (truth orange)", r.sensor),
+    }
 }

@@ -1,6 +1,7 @@
 //! A pallet pocket detector for 2-D scans at fork-pocket height, the way published laser detectors work: segment the scan, keep the segments a stringer face could make, find stringers spaced as the pallet's are, fit the face line.
 
 use forkbench_core::signal::Scan;
+use forkbench_core::units::wrap_angle;
 use forkbench_core::{PalletSpec, Pose2};
 use serde::{Deserialize, Serialize};
 
@@ -14,12 +15,17 @@ pub struct DetectorConfig {
     /// A run of returns bends into separate straight pieces (a stringer's face and its
     /// side seen through a pocket) where a point lies this far off their chord.
     pub split_m: f64,
-    /// Fewest returns on a stringer face (a sliver of a half-hidden one is not enough).
-    pub min_points: usize,
+    /// Fewest returns on a stringer face, as a share of the beams a whole face gets at
+    /// its range (a sliver of a half-hidden one is not enough), and never below 2.
+    pub min_coverage: f64,
     /// A stringer face's segment may be this much narrower or wider than the stringer.
     pub width_tolerance_m: f64,
     /// Stringer centres may sit this far from the pallet's spacing.
     pub spacing_tolerance_m: f64,
+    /// With a prior, faces further than this or turned more than `roi_rad` from it are
+    /// not this pallet.
+    pub roi_m: f64,
+    pub roi_rad: f64,
     /// A stringer's centre may lie this far off the face line through the others.
     pub line_tolerance_m: f64,
 }
@@ -29,9 +35,11 @@ impl Default for DetectorConfig {
         Self {
             break_m: 0.06,
             split_m: 0.05,
-            min_points: 3,
+            min_coverage: 0.6,
             width_tolerance_m: 0.08,
             spacing_tolerance_m: 0.08,
+            roi_m: 1.0,
+            roi_rad: 0.5,
             line_tolerance_m: 0.08,
         }
     }
@@ -179,9 +187,7 @@ pub fn detect(
         .into_iter()
         .flat_map(|s| straight_pieces(&s.points, cfg.split_m))
         .map(Segment::of)
-        .filter(|s| {
-            s.points.len() >= cfg.min_points && (s.width_m - sw).abs() <= cfg.width_tolerance_m
-        })
+        .filter(|s| looks_like_a_stringer(cfg, s, scan, sw))
         .collect();
     let mut candidates = Vec::new();
     for (i, a) in segs.iter().enumerate() {
@@ -221,18 +227,36 @@ pub fn detect(
         .iter()
         .filter_map(|c| face_of(c, scan, pallet))
         .collect();
-    // Three stringers beat two; then the prior, else nearness to the sensor.
+    // With a prior (where the pallet should be): only faces within the region of
+    // interest, the nearest to it winning and a hidden stringer costing a little.
+    // Without one: three stringers beat two, then nearness to the sensor.
     let s = scan.sensor;
-    let score = |d: &Detection| {
-        let near = match prior {
-            Some(p) => d.face.distance_to(p),
-            None => d.face.distance_to(&s),
-        };
-        (3 - d.stringers.min(3)) as f64 * 1e6 + near
+    let found = found.into_iter().filter(|d| {
+        prior.is_none_or(|p| {
+            d.face.distance_to(p) <= cfg.roi_m
+                && wrap_angle(d.face.heading_rad - p.heading_rad).abs() <= cfg.roi_rad
+        })
+    });
+    let score = |d: &Detection| match prior {
+        Some(p) => {
+            d.face.distance_to(p)
+                + 0.5 * wrap_angle(d.face.heading_rad - p.heading_rad).abs()
+                + 0.25 * (3 - d.stringers.min(3)) as f64
+        }
+        None => (3 - d.stringers.min(3)) as f64 * 1e6 + d.face.distance_to(&s),
     };
-    found
-        .into_iter()
-        .min_by(|a, b| score(a).total_cmp(&score(b)))
+    found.min_by(|a, b| score(a).total_cmp(&score(b)))
+}
+
+/// Whether a straight piece could be a stringer's face: as wide as one (the returns span
+/// about one beam spacing less than the face) and covered by enough of the beams that
+/// fall on a face at that range.
+fn looks_like_a_stringer(cfg: &DetectorConfig, s: &Segment, scan: &Scan, sw: f64) -> bool {
+    let r = dist(s.centre, [scan.sensor.x_m, scan.sensor.y_m]);
+    let spacing = r * scan.angle_step_rad;
+    let beams_on_face = sw / spacing.max(1e-6);
+    let enough = (s.points.len() as f64) >= (cfg.min_coverage * beams_on_face).max(2.0);
+    enough && (s.width_m + spacing - sw).abs() <= cfg.width_tolerance_m
 }
 
 /// The face pose of a candidate: the line through its segments' points, centred.

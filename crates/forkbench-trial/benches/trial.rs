@@ -26,6 +26,29 @@ fn bench(c: &mut Criterion) {
             });
         }
     }
+    // The same pick with the pallet estimated from a TiM561 scan and the pocket detector
+    // (first estimate and two re-estimates) and with the Gaussian model.
+    for (label, sensing) in [
+        ("gaussian", ""),
+        ("tim561", "[sensors.pallet]\nkind = \"tim561\"\n"),
+    ] {
+        let text = format!(
+            "name = \"near\"\nplanner = \"bspline\"\npallet_kind = \"field-1200\"\n\
+             start = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\n\
+             pallet = {{ x_m = 5.0, y_m = 0.4, heading_deg = 5.0 }}\n[replan]\nenabled = true\n{sensing}"
+        );
+        let scn = Scenario::parse(&text, "near.toml", |_: &Path| {
+            Ok(forkbench_trial::World::default())
+        })
+        .expect("parses");
+        let opts = TrialOptions {
+            seed: Some(7),
+            ..TrialOptions::default()
+        };
+        g.bench_function(format!("near_5m/replan/{label}"), |b| {
+            b.iter(|| run_trial(&scn, &scn.cases[0], &opts))
+        });
+    }
     g.finish();
 }
 

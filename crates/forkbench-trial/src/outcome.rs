@@ -29,6 +29,8 @@ pub enum Failure {
     ForkOutsidePocket,
     /// The trial itself broke (panic or non-finite state).
     Error,
+    /// The pallet sensing never found the pallet, so there was nothing to plan to.
+    PalletNotFound,
 }
 
 impl Failure {
@@ -45,6 +47,7 @@ impl Failure {
             Failure::InsertionDepth => "insertion_depth",
             Failure::ForkOutsidePocket => "fork_outside_pocket",
             Failure::Error => "error",
+            Failure::PalletNotFound => "pallet_not_found",
         }
     }
 }
@@ -82,6 +85,18 @@ pub struct TrialOutcome {
     pub replans: u32,
     /// New estimates whose replan the planner refused (the old plan was kept).
     pub replans_failed: u32,
+    /// Pallet estimates taken, and how many of them found no pallet (a scanner's
+    /// detector; the Gaussian model always finds it).
+    #[serde(default)]
+    pub estimates: u32,
+    #[serde(default)]
+    pub estimates_missed: u32,
+    /// The error of the estimate the truck last aimed at, against the true face then,
+    /// in the pallet frame (lateral, heading): the usual root of an entry failure.
+    #[serde(default)]
+    pub estimate_lateral_error_m: Option<f64>,
+    #[serde(default)]
+    pub estimate_heading_error_rad: Option<f64>,
     pub path_length_m: f64,
     pub sim_time_s: f64,
     pub wall_time_ms: f64,
@@ -182,6 +197,10 @@ impl TrialOutcome {
             pallet_rotation_rad: 0.0,
             replans: 0,
             replans_failed: 0,
+            estimates: 0,
+            estimates_missed: 0,
+            estimate_lateral_error_m: None,
+            estimate_heading_error_rad: None,
             path_length_m: 0.0,
             sim_time_s: 0.0,
             wall_time_ms: 0.0,

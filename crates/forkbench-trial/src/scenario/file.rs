@@ -149,6 +149,8 @@ pub(super) struct ScenarioFile {
     pub(super) case: Vec<CaseFile>,
     /// A warehouse mission that ends where the pick starts.
     pub(super) mission: Option<super::mission::MissionFile>,
+    /// Sensors beyond the defaults (`[sensors.pallet]`).
+    pub(super) sensors: Option<super::sensors::SensorsFile>,
 }
 
 fn default_true() -> bool {

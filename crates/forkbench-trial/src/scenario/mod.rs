@@ -4,6 +4,7 @@ mod checks;
 mod file;
 mod limits;
 pub mod mission;
+pub mod sensors;
 mod world;
 
 use std::path::{Path as FsPath, PathBuf};
@@ -116,6 +117,10 @@ pub struct Scenario {
     pub noise: NoiseFile,
     pub replan: Replan,
     pub tolerances: Limits,
+    /// How the pallet is estimated; the Gaussian default is left out of manifests, so
+    /// scenarios without `[sensors]` keep their settings hash.
+    #[serde(skip_serializing_if = "sensors::PalletSensing::is_gaussian")]
+    pub pallet_sensing: sensors::PalletSensing,
     /// Fixed pallet-estimate error in the pallet frame.
     pub estimate_bias: Pose2,
     /// σ of the per-trial jitter of the true pallet pose (pallet frame; heading in rad).
@@ -221,6 +226,7 @@ impl Scenario {
             None => None,
         };
         let zero = Pose2::new(0.0, 0.0, 0.0);
+        let pallet_sensing = sensors::resolve(f.sensors.as_ref(), &f.truck, file)?;
         Ok(Scenario {
             file: file.to_owned(),
             name: f.name,
@@ -237,6 +243,7 @@ impl Scenario {
             noise: f.noise,
             replan: f.replan.into(),
             tolerances: f.tolerances.into(),
+            pallet_sensing,
             estimate_bias: f.estimate_bias.map_or(zero, PoseDeg::to_pose),
             pallet_jitter: f.pallet_jitter.map_or(zero, PoseDeg::to_pose),
             world,

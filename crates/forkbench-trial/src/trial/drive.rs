@@ -190,7 +190,14 @@ impl<'a> Trial<'a> {
     fn reestimate<R: Recorder + ?Sized>(&mut self, pose: &Pose2, rec: &mut R) {
         let range = pose.distance_to(&self.pallet_est);
         let truth = self.sim.pallet_pose();
-        let new_est = self.estimate(&truth, range);
+        let Some(new_est) = self.estimate_recorded(&truth, range, pose, rec) else {
+            rec.event(
+                self.sim.time_s(),
+                Level::Warn,
+                &format!("no pallet found at {range:.2} m; keeping the last estimate"),
+            );
+            return;
+        };
         let moved = new_est.distance_to(&self.pallet_est);
         let turned = wrap_angle(new_est.heading_rad - self.pallet_est.heading_rad).abs();
         let limits = &self.scn.replan;
@@ -222,7 +229,7 @@ impl<'a> Trial<'a> {
                     ),
                 );
                 self.tracker.reset(&p.path, &self.scn.truck);
-                self.pallet_est = new_est;
+                self.adopt_estimate(new_est, &truth);
                 self.out.replans += 1;
             }
             Err(e) => {

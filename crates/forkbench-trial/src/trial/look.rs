@@ -63,7 +63,13 @@ pub fn scan_once(
             },
         )
     };
-    let estimate = detect(&DetectorConfig::default(), &s, &scn.pallet, None);
+    // Where the pallet should stand is where the detector looks (as in a trial).
+    let estimate = detect(
+        &DetectorConfig::default(),
+        &s,
+        &scn.pallet,
+        Some(&case.pallet),
+    );
     Ok(ScanReport {
         sensor: sensor.to_owned(),
         fork_root: root,

@@ -6,6 +6,7 @@ mod judge;
 mod look;
 mod mission;
 mod plan;
+mod sense;
 mod setup;
 
 use std::time::Instant;
@@ -161,7 +162,13 @@ fn run_stages<R: Recorder + ?Sized>(
             return trial.out;
         }
         let pallet = trial.sim.pallet_pose();
-        trial.first_fix_and_estimate(&pallet);
+        trial.first_fix_and_estimate(&pallet, rec);
+    }
+    if trial.out.estimates_missed == trial.out.estimates && trial.out.estimates > 0 {
+        let why = "the pallet sensing found no pallet from the start pose".to_owned();
+        rec.event(trial.sim.time_s(), Level::Error, &why);
+        trial.out.fail(Failure::PalletNotFound, why);
+        return trial.out;
     }
     let path = match trial.first_plan(rec) {
         Ok(p) => p,

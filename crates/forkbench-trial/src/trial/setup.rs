@@ -17,7 +17,7 @@ use crate::scenario::{Case, Scenario};
 
 /// Independent random streams per sensor, so changing one sensor's settings does not
 /// change the other's draws.
-fn stream(seed: u64, salt: u64) -> ChaCha8Rng {
+pub(super) fn stream(seed: u64, salt: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed ^ salt.wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
 
@@ -44,6 +44,11 @@ pub struct Trial<'a> {
     pub(super) footprints: (forkbench_geom::Obstacles, Vec<String>),
     /// Pallet pose before the truck moved: displacement is measured from it.
     pub(super) pallet0: Pose2,
+    /// Where the pallet should stand (the case's placement, before any jitter): the
+    /// region a detector looks in before its first estimate.
+    pub(super) pallet_nominal: Pose2,
+    /// A scanner's range bias for the whole trial (its systematic error).
+    pub(super) scan_bias_m: f64,
     pub(super) collision: bool,
     pub(super) timed_out: bool,
 }
@@ -78,6 +83,17 @@ pub(super) fn build_world(
         &scn.sim,
     )?;
     Ok((sim, start, true_pallet, obstacles))
+}
+
+/// A scanner's systematic range error for one trial, on a stream of its own (none for the
+/// Gaussian model or with noise off, which draw nothing).
+fn scan_bias(scn: &Scenario, run: &Resolved) -> f64 {
+    match &scn.pallet_sensing {
+        crate::scenario::sensors::PalletSensing::Scanner { scanner, .. } if run.noise => {
+            scanner.draw_bias(&mut stream(run.seed, 4))
+        }
+        _ => 0.0,
+    }
 }
 
 impl<'a> Trial<'a> {
@@ -145,18 +161,24 @@ impl<'a> Trial<'a> {
             obstacles,
             footprints: scn.world.footprint_obstacles(),
             pallet0,
+            pallet_nominal: case.pallet,
+            scan_bias_m: scan_bias(scn, run),
             collision: false,
             timed_out: true,
         };
         if scn.mission.is_none() {
-            trial.first_fix_and_estimate(&true_pallet);
+            trial.first_fix_and_estimate(&true_pallet, rec);
         }
         Ok(trial)
     }
 
     /// The fix the pick plans from (the odometry-predicted pose when no fix is due) and
     /// the first pallet estimate.
-    pub(super) fn first_fix_and_estimate(&mut self, true_pallet: &Pose2) {
+    pub(super) fn first_fix_and_estimate<R: Recorder + ?Sized>(
+        &mut self,
+        true_pallet: &Pose2,
+        rec: &mut R,
+    ) {
         let truth = self.sim.fork_root_pose();
         let fix = self
             .localizer
@@ -164,17 +186,9 @@ impl<'a> Trial<'a> {
         self.first_fix = fix.or(self.predictor.pose()).unwrap_or(self.first_fix);
         self.predictor.fix(self.first_fix);
         let range = self.first_fix.distance_to(true_pallet);
-        self.pallet_est = self.estimate(true_pallet, range);
-    }
-
-    /// A pallet estimate seen from `range_m`: the scenario's fixed bias, then the
-    /// estimator's noise (none with noise off, which draws nothing).
-    pub(super) fn estimate(&mut self, truth: &Pose2, range_m: f64) -> Pose2 {
-        let biased = truth.to_world(&self.scn.estimate_bias);
-        if self.run.noise {
-            self.estimator.estimate(&biased, range_m, &mut self.est_rng)
-        } else {
-            biased
+        let believed = self.first_fix;
+        if let Some(est) = self.estimate_recorded(true_pallet, range, &believed, rec) {
+            self.adopt_estimate(est, true_pallet);
         }
     }
 }

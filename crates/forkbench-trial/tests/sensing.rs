@@ -1,0 +1,85 @@
+//! Pallet sensing that looks at the world: a TiM561 scan and the pocket detector drive the pick; a pallet out of its sight is never found; bad sensor settings are refused at load.
+
+use std::path::Path;
+
+use forkbench_trial::{Failure, Scenario, TrialOptions, World, run_trial};
+
+fn scenario(extra: &str, pallet: &str) -> Result<Scenario, forkbench_trial::TrialError> {
+    let text = format!(
+        "name = \"s\"\nplanner = \"bspline\"\npallet_kind = \"field-1200\"\n\
+         start = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\npallet = {pallet}\n{extra}"
+    );
+    Scenario::parse(&text, "s.toml", |_: &Path| Ok(World::default()))
+}
+
+const NEAR: &str = "{ x_m = 5.0, y_m = 0.4, heading_deg = 5.0 }";
+
+#[test]
+fn a_tim561_scan_guides_the_pick() {
+    let scn = scenario("[sensors.pallet]\nkind = \"tim561\"\n", NEAR).expect("loads");
+    for (no_noise, seed) in [(true, 1), (false, 1), (false, 2)] {
+        let opts = TrialOptions {
+            no_noise,
+            seed: Some(seed),
+            ..TrialOptions::default()
+        };
+        let out = run_trial(&scn, &scn.cases[0], &opts);
+        assert!(
+            out.success,
+            "{no_noise} {seed}: {:?} {:?}",
+            out.failure, out.failure_detail
+        );
+        assert!(out.estimates >= 1 && out.estimates_missed == 0, "{out:?}");
+        let lateral = out.estimate_lateral_error_m.expect("an estimate");
+        // Ideal rays: within half a beam step at 5 m; with the sensor's errors, centimetres.
+        let tol = if no_noise { 0.015 } else { 0.06 };
+        assert!(
+            lateral.abs() < tol,
+            "{no_noise} {seed}: estimate {lateral} m off"
+        );
+    }
+}
+
+#[test]
+fn a_pallet_beyond_the_scanners_range_is_never_found() {
+    let far = "{ x_m = 14.0, y_m = 0.0, heading_deg = 0.0 }";
+    let scn = scenario("[sensors.pallet]\nkind = \"tim561\"\n", far).expect("loads");
+    let out = run_trial(&scn, &scn.cases[0], &TrialOptions::default());
+    assert_eq!(out.failure, Some(Failure::PalletNotFound), "{out:?}");
+    assert_eq!((out.estimates, out.estimates_missed), (1, 1));
+    // The Gaussian model, by construction, always "sees" it.
+    let gaussian = scenario("", far).expect("loads");
+    let out = run_trial(&gaussian, &gaussian.cases[0], &TrialOptions::default());
+    assert_ne!(out.failure, Some(Failure::PalletNotFound));
+    assert_eq!(out.estimates_missed, 0);
+}
+
+#[test]
+fn bad_sensor_settings_are_refused_naming_the_field() {
+    let cases = [
+        (
+            "[sensors.pallet]\nkind = \"lidar\"\n",
+            "sensors.pallet.kind",
+        ),
+        (
+            "[sensors.pallet]\nkind = \"tim561\"\n[sensors.pallet.scanner]\nrange_sigma_m = -0.02\n",
+            "sensors.pallet.scanner.range_sigma_m",
+        ),
+        (
+            "[sensors.pallet]\nkind = \"tim561\"\n[sensors.pallet.scanner]\nfov_rad = 7.0\n",
+            "sensors.pallet.scanner.fov_rad",
+        ),
+        (
+            "[sensors.pallet]\nkind = \"tim561\"\n[sensors.pallet.scanner]\nmount = { x_m = -1.0, y_m = 0.0, heading_rad = 0.0 }\n",
+            "inside the truck's body",
+        ),
+        (
+            "[sensors.pallet]\nkind = \"tim561\"\nrange = 3\n",
+            "unknown field",
+        ),
+    ];
+    for (extra, want) in cases {
+        let e = scenario(extra, NEAR).expect_err(extra).to_string();
+        assert!(e.contains(want), "{extra}: {e}");
+    }
+}
