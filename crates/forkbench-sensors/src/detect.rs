@@ -441,7 +441,10 @@ mod tests {
             heading_errors[heading_errors.len() / 2],
             lateral[lateral.len() / 2],
         );
-        eprintln!("median |heading error| {h:.2}°, |lateral| {l:.3} m");
+        eprintln!(
+            "found in {} of 50; median |heading error| {h:.2}°, |lateral| {l:.3} m",
+            lateral.len()
+        );
         assert!(
             h < 3.0 && l < 0.03,
             "median |heading| {h}°, |lateral| {l} m"
