@@ -18,6 +18,7 @@ mod gate_text;
 mod guard;
 pub mod junit;
 mod manifest;
+mod modes;
 mod order;
 mod provenance;
 mod seed;
@@ -36,6 +37,7 @@ pub use gate::{
 };
 pub use guard::guarded;
 pub use manifest::{DirLock, Manifest};
+pub use modes::ReplanModes;
 pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};
 pub use seed::{SEED_SCHEME, trial_seed};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};

@@ -27,12 +27,22 @@ impl From<RecordWhich> for RecordChoice {
     }
 }
 
-/// Which replanning modes a batch runs.
+/// Which replanning modes a batch runs (`forkbench_batch::ReplanModes`, as a flag).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Modes {
     Scenario,
     Replan,
     Both,
+}
+
+impl From<Modes> for batch::ReplanModes {
+    fn from(m: Modes) -> Self {
+        match m {
+            Modes::Scenario => Self::Scenario,
+            Modes::Replan => Self::Replan,
+            Modes::Both => Self::Both,
+        }
+    }
 }
 
 /// `forkbench batch`.
@@ -188,12 +198,9 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     let out = batch::shard_dir(&a.out, shard);
     let a = BatchArgs { out, ..a };
     batch::check_floor(a.floor)?;
-    let modes = match (a.replan, a.modes) {
-        (true, _) => Modes::Replan,
-        (false, Some(m)) => m,
-        (false, None) if a.scenarios.is_empty() => Modes::Both,
-        (false, None) => Modes::Scenario,
-    };
+    let modes =
+        batch::ReplanModes::choose(a.replan, a.modes.map(Into::into), a.scenarios.is_empty());
+    let (replan, compare_replanning) = modes.spec_fields();
     let spec = BatchSpec {
         scenarios,
         planners: a.planners.clone(),
@@ -202,8 +209,8 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         seed: a.seed,
         shard,
         pallet_noise_scale: a.pallet_noise_scale,
-        replan: (modes == Modes::Replan).then_some(true),
-        compare_replanning: modes == Modes::Both,
+        replan,
+        compare_replanning,
         force_new: a.force_new,
     };
     Ok((spec, a))
