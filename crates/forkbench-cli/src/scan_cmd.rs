@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Context as _;
 use forkbench_core::Pose2;
-use forkbench_trial::trial::{SCANNERS, ScanReport, scan_once, scanner};
+use forkbench_sensors::scan::{SCANNER_PRESETS, ScannerConfig};
+use forkbench_trial::trial::{ScanReport, scan_once};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::json;
@@ -36,11 +37,11 @@ pub struct ScanArgs {
 }
 
 pub fn run(a: &ScanArgs) -> anyhow::Result<()> {
-    let cfg = scanner(&a.sensor).with_context(|| {
+    let cfg = ScannerConfig::preset(&a.sensor).with_context(|| {
         format!(
             "--sensor {:?}: unknown (known: {})",
             a.sensor,
-            SCANNERS.join(", ")
+            SCANNER_PRESETS.join(", ")
         )
     })?;
     let scn = forkbench_trial::Scenario::load(&a.scenario)?;

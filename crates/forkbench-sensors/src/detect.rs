@@ -320,17 +320,7 @@ mod tests {
 
         fn surfaces_near(&self, _: [f64; 2], _: f64, out: &mut Vec<Surface>) {
             for (c, l, w) in &self.0 {
-                let k = forkbench_core::geometry::rect_corners(c, *l, *w);
-                let (s, co) = c.heading_rad.sin_cos();
-                let normals = [[-s, co], [-co, -s], [s, -co], [co, s]];
-                for i in 0..4 {
-                    out.push(Surface {
-                        a: k[i],
-                        b: k[(i + 1) % 4],
-                        normal: normals[i],
-                        seen: Seen::Fixed,
-                    });
-                }
+                out.extend(Surface::rect(c, *l, *w, Seen::Fixed));
             }
         }
     }

@@ -39,6 +39,23 @@ pub struct Surface {
     pub seen: Seen,
 }
 
+impl Surface {
+    /// The four sides of a `length_m` × `width_m` rectangle centred on `centre` (length
+    /// along its heading), each facing outward.
+    pub fn rect(centre: &Pose2, length_m: f64, width_m: f64, seen: Seen) -> [Surface; 4] {
+        let k = forkbench_core::geometry::rect_corners(centre, length_m, width_m);
+        let (s, c) = centre.heading_rad.sin_cos();
+        // Corners run counter-clockwise from front left: top, left, bottom, right sides.
+        let normals = [[-s, c], [-c, -s], [s, -c], [c, s]];
+        std::array::from_fn(|i| Surface {
+            a: k[i],
+            b: k[(i + 1) % 4],
+            normal: normals[i],
+            seen,
+        })
+    }
+}
+
 /// A read-only view of the world that sensors cast rays into. The truck's own body and
 /// forks are not in it: its sensors are mounted between the forks.
 pub trait WorldView {
@@ -84,7 +101,18 @@ const SPOT_RAYS: usize = 3;
 /// Sub-ray ranges further apart than this are a depth edge inside the spot.
 const EDGE_M: f64 = 0.05;
 
+/// The scanner models known by name.
+pub const SCANNER_PRESETS: [&str; 1] = ["tim561"];
+
 impl ScannerConfig {
+    /// A scanner model by name ([`SCANNER_PRESETS`]), with its settings.
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "tim561" => Some(Self::tim561()),
+            _ => None,
+        }
+    }
+
     /// SICK TiM561 (see the module's sources), mounted at the fork root facing forward.
     pub fn tim561() -> Self {
         Self {

@@ -1,9 +1,21 @@
 //! The simulator as the world sensors see: ray casts through rapier's query pipeline against every collider but the truck's own.
 
+use forkbench_core::Pose2;
 use forkbench_sensors::scan::{RayHit, Seen, Surface, WorldView};
 use rapier2d::prelude::*;
 
 use crate::{Sim, v2};
+
+impl Sim {
+    /// What a collider is to a sensor: a pallet's stringer or a fixed obstacle.
+    fn seen(&self, handle: ColliderHandle) -> Seen {
+        if self.stringers.contains(&handle) {
+            Seen::Pallet(0)
+        } else {
+            Seen::Fixed
+        }
+    }
+}
 
 impl WorldView for Sim {
     fn cast_ray(&self, origin: [f64; 2], dir: [f64; 2], max_m: f64) -> Option<RayHit> {
@@ -13,14 +25,10 @@ impl WorldView for Sim {
         let (handle, hit) =
             self.world
                 .cast_ray_and_get_normal(&ray, max_m as Real, true, filter)?;
-        let seen = match self.stringers.contains(&handle) {
-            true => Seen::Pallet(0),
-            false => Seen::Fixed,
-        };
         Some(RayHit {
             range_m: f64::from(hit.time_of_impact),
             normal: [f64::from(hit.normal.x), f64::from(hit.normal.y)],
-            seen,
+            seen: self.seen(handle),
         })
     }
 
@@ -42,27 +50,8 @@ impl WorldView for Sim {
             if (tx - centre[0]).hypot(ty - centre[1]) > radius_m + hx.hypot(hy) {
                 continue;
             }
-            let (s, co) = f64::from(pose.rotation.angle()).sin_cos();
-            let world = |x: f64, y: f64| [tx + co * x - s * y, ty + s * x + co * y];
-            let corners = [
-                world(hx, hy),
-                world(-hx, hy),
-                world(-hx, -hy),
-                world(hx, -hy),
-            ];
-            let normals = [[-s, co], [-co, -s], [s, -co], [co, s]];
-            let seen = match self.stringers.contains(&handle) {
-                true => Seen::Pallet(0),
-                false => Seen::Fixed,
-            };
-            for k in 0..4 {
-                out.push(Surface {
-                    a: corners[k],
-                    b: corners[(k + 1) % 4],
-                    normal: normals[k],
-                    seen,
-                });
-            }
+            let at = Pose2::new(tx, ty, f64::from(pose.rotation.angle()));
+            out.extend(Surface::rect(&at, 2.0 * hx, 2.0 * hy, self.seen(handle)));
         }
     }
 }

@@ -16,8 +16,34 @@ const POSE_ARROW_M: f64 = 0.4;
 /// Per-step signals buffered until the next columns go out: poses and scalars by path.
 #[derive(Default)]
 pub(super) struct SignalColumns {
-    poses: Vec<(String, Style, Vec<f64>, Vec<Pose2>)>,
-    scalars: Vec<(String, Vec<f64>, Vec<f64>)>,
+    poses: Vec<Series<Pose2>>,
+    scalars: Vec<Series<f64>>,
+}
+
+/// One path's buffered values and their times.
+struct Series<T> {
+    path: String,
+    style: Style,
+    times: Vec<f64>,
+    values: Vec<T>,
+}
+
+/// Appends (`t_s`, `value`) to `path`'s series, starting it with `style` if new.
+fn push<T>(buf: &mut Vec<Series<T>>, path: &str, style: Style, t_s: f64, value: T) {
+    let i = match buf.iter().position(|s| s.path == path) {
+        Some(i) => i,
+        None => {
+            buf.push(Series {
+                path: path.to_owned(),
+                style,
+                times: Vec::new(),
+                values: Vec::new(),
+            });
+            buf.len() - 1
+        }
+    };
+    buf[i].times.push(t_s);
+    buf[i].values.push(value);
 }
 
 fn colour(style: &Style) -> rerun::Color {
@@ -33,8 +59,8 @@ impl RerunRecorder {
     pub(super) fn log_signal(&mut self, t_s: f64, path: &str, signal: &Signal<'_>, style: Style) {
         let map = format!("map/{path}");
         match signal {
-            Signal::Pose(p) => self.buffer_pose(t_s, path, *p, style),
-            Signal::Scalar(v) => self.buffer_scalar(t_s, path, *v),
+            Signal::Pose(p) => push(&mut self.signal_cols.poses, path, style, t_s, *p),
+            Signal::Scalar(v) => push(&mut self.signal_cols.scalars, path, style, t_s, *v),
             Signal::Text(text) => self.log_text(t_s, path, text),
             Signal::Path(points) => self.log_at(t_s, &map, &lines([strip(points)], &style)),
             Signal::Segments(segs) => {
@@ -79,36 +105,16 @@ impl RerunRecorder {
         self.draw_racks(&frame);
     }
 
-    fn buffer_pose(&mut self, t_s: f64, path: &str, pose: Pose2, style: Style) {
-        let buf = &mut self.signal_cols.poses;
-        let i = match buf.iter().position(|(p, ..)| p == path) {
-            Some(i) => i,
-            None => {
-                buf.push((path.to_owned(), style, Vec::new(), Vec::new()));
-                buf.len() - 1
-            }
-        };
-        buf[i].2.push(t_s);
-        buf[i].3.push(pose);
-    }
-
-    fn buffer_scalar(&mut self, t_s: f64, path: &str, value: f64) {
-        let buf = &mut self.signal_cols.scalars;
-        let i = match buf.iter().position(|(p, ..)| p == path) {
-            Some(i) => i,
-            None => {
-                buf.push((path.to_owned(), Vec::new(), Vec::new()));
-                buf.len() - 1
-            }
-        };
-        buf[i].1.push(t_s);
-        buf[i].2.push(value);
-    }
-
     /// Sends the buffered poses (arrows) and scalars as columns.
     pub(super) fn send_signal_columns(&mut self) {
         let cols = std::mem::take(&mut self.signal_cols);
-        for (path, style, times, poses) in cols.poses {
+        for Series {
+            path,
+            style,
+            times,
+            values: poses,
+        } in cols.poses
+        {
             let (origins, vectors): (Vec<[f32; 2]>, Vec<[f32; 2]>) = poses
                 .iter()
                 .map(|p| {
@@ -129,7 +135,13 @@ impl RerunRecorder {
             self.set_once(&entity, &first);
             self.send_cols(&entity, &times, data);
         }
-        for (path, times, values) in cols.scalars {
+        for Series {
+            path,
+            times,
+            values,
+            ..
+        } in cols.scalars
+        {
             let data = rerun::Scalars::new(values).columns_of_unit_batches();
             self.send_cols(&format!("signals/{path}"), &times, data);
         }

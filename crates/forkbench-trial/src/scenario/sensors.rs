@@ -25,9 +25,6 @@ struct PalletSensorFile {
     detector: Option<DetectorConfig>,
 }
 
-/// The pallet sensing kinds a scenario can name.
-pub const PALLET_SENSING_KINDS: [&str; 2] = ["gaussian", "tim561"];
-
 /// How a trial estimates the pallet.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -59,16 +56,16 @@ pub(super) fn resolve(
     let Some(p) = f.and_then(|s| s.pallet.as_ref()) else {
         return Ok(PalletSensing::Gaussian);
     };
-    let scanner = match p.kind.as_str() {
-        "gaussian" => return Ok(PalletSensing::Gaussian),
-        "tim561" => p.scanner.clone().unwrap_or_else(ScannerConfig::tim561),
-        other => {
+    let scanner = match (p.kind.as_str(), ScannerConfig::preset(&p.kind)) {
+        ("gaussian", _) => return Ok(PalletSensing::Gaussian),
+        (_, Some(preset)) => p.scanner.clone().unwrap_or(preset),
+        (other, None) => {
             return Err(invalid(
                 file,
                 "sensors.pallet.kind",
                 &format!(
-                    "{other:?} is not a pallet sensing kind (known: {})",
-                    PALLET_SENSING_KINDS.join(", ")
+                    "{other:?} is not a pallet sensing kind (known: gaussian, {})",
+                    forkbench_sensors::scan::SCANNER_PRESETS.join(", ")
                 ),
             ));
         }

@@ -190,7 +190,7 @@ impl<'a> Trial<'a> {
     fn reestimate<R: Recorder + ?Sized>(&mut self, pose: &Pose2, rec: &mut R) {
         let range = pose.distance_to(&self.pallet_est);
         let truth = self.sim.pallet_pose();
-        let Some(new_est) = self.estimate_recorded(&truth, range, pose, rec) else {
+        let Some(new_est) = self.estimate(&truth, range, pose, rec) else {
             rec.event(
                 self.sim.time_s(),
                 Level::Warn,

@@ -12,17 +12,6 @@ use super::error::StageError;
 use super::setup::build_world;
 use crate::scenario::{Case, Scenario};
 
-/// The scanners `scan` knows by name.
-pub const SCANNERS: [&str; 1] = ["tim561"];
-
-/// A scanner by name, with its settings.
-pub fn scanner(name: &str) -> Option<ScannerConfig> {
-    match name {
-        "tim561" => Some(ScannerConfig::tim561()),
-        _ => None,
-    }
-}
-
 /// One scan and what the detector made of it.
 #[derive(Debug, Clone, Serialize)]
 pub struct ScanReport {

@@ -19,7 +19,7 @@ use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
-pub use look::{SCANNERS, ScanReport, scan_once, scanner};
+pub use look::{ScanReport, scan_once};
 pub use setup::Trial;
 
 /// Per-run choices on top of the scenario file.

@@ -18,39 +18,20 @@ impl Trial<'_> {
     /// A pallet estimate when the fork root is `range_m` from the face: the scenario's
     /// fixed bias on top of the sensing's own error. `believed` is the fork-root pose
     /// the truck thinks it has: a scanner's detection, made in the sensor's frame, is
-    /// placed in the map with it. `None`: the detector found no pallet.
-    pub(super) fn estimate(
-        &mut self,
-        truth: &Pose2,
-        range_m: f64,
-        believed: &Pose2,
-    ) -> Option<Pose2> {
-        self.out.estimates += 1;
-        let est = match &self.scn.pallet_sensing {
-            PalletSensing::Gaussian => Some(self.gaussian_estimate(truth, range_m)),
-            PalletSensing::Scanner { .. } => {
-                self.scanned_estimate(believed, &mut crate::NoRecorder)
-            }
-        };
-        if est.is_none() {
-            self.out.estimates_missed += 1;
-        }
-        est
-    }
-
-    /// [`Trial::estimate`] that also records a scanner's scan and detection.
-    pub(super) fn estimate_recorded<R: Recorder + ?Sized>(
+    /// placed in the map with it, and its scan and detection are recorded. `None`: the
+    /// detector found no pallet.
+    pub(super) fn estimate<R: Recorder + ?Sized>(
         &mut self,
         truth: &Pose2,
         range_m: f64,
         believed: &Pose2,
         rec: &mut R,
     ) -> Option<Pose2> {
-        if self.scn.pallet_sensing.is_gaussian() {
-            return self.estimate(truth, range_m, believed);
-        }
         self.out.estimates += 1;
-        let est = self.scanned_estimate(believed, rec);
+        let est = match &self.scn.pallet_sensing {
+            PalletSensing::Gaussian => Some(self.gaussian_estimate(truth, range_m)),
+            PalletSensing::Scanner { .. } => self.scanned_estimate(believed, rec),
+        };
         if est.is_none() {
             self.out.estimates_missed += 1;
         }

@@ -187,7 +187,7 @@ impl<'a> Trial<'a> {
         self.predictor.fix(self.first_fix);
         let range = self.first_fix.distance_to(true_pallet);
         let believed = self.first_fix;
-        if let Some(est) = self.estimate_recorded(true_pallet, range, &believed, rec) {
+        if let Some(est) = self.estimate(true_pallet, range, &believed, rec) {
             self.adopt_estimate(est, true_pallet);
         }
     }
