@@ -1,6 +1,8 @@
-//! Sensor models: NAV350 laser localisation and the pallet-pose estimate, drawing only from a passed-in RNG.
+//! Sensor models: NAV350 laser localisation, the pallet-pose estimate, world-seeing scanners and pallet detectors, drawing only from a passed-in RNG.
 
 pub mod detect;
+pub mod detector;
+pub mod external;
 pub mod scan;
 
 use std::collections::VecDeque;

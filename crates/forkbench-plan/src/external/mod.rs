@@ -4,21 +4,19 @@ mod check;
 mod process;
 pub mod protocol;
 
-use std::cell::RefCell;
-use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::LazyLock;
 use std::time::Duration;
 
-use forkbench_ipc::Breaker;
+use forkbench_ipc::{Breaker, EnvPolicy, ExchangeError, PoolKey, Process, Spawn, clip};
 
 use forkbench_core::settings::{self, Settings, SettingsError};
 use serde::Deserialize;
 
 pub use check::{ENDPOINT_TOLERANCE_M, ENDPOINT_TOLERANCE_RAD, MAX_SPACING_M, path_violation};
+pub use forkbench_ipc::release_pooled;
 pub use process::dir_of;
-use process::{EnvPolicy, ExchangeError, Process, clip};
-use protocol::{RequestMsg, ResponseMsg, to_path};
+use protocol::{PROTOCOL, RequestMsg, ResponseMsg, VERSION, to_path};
 
 use crate::{Plan, PlanError, PlanParams, PlanRequest, Planner};
 
@@ -43,20 +41,6 @@ pub struct ExternalConfig {
 
 fn default_timeout() -> f64 {
     10.0
-}
-
-/// A planner process per worker thread, started on first use and restarted after it
-/// misbehaves. Keyed by command, directory and environment.
-type Pool = HashMap<(Vec<String>, PathBuf, EnvPolicy), (Process, u64)>;
-
-thread_local! {
-    static POOL: RefCell<Pool> = RefCell::new(HashMap::new());
-}
-
-/// Ends this thread's pooled planner processes (each process group killed): called on
-/// every worker when a batch ends, so no planner outlives the batch.
-pub fn release_pooled() {
-    POOL.with(|p| p.borrow_mut().clear());
 }
 
 /// Consecutive timeouts per command, across worker threads.
@@ -116,20 +100,28 @@ impl ExternalPlanner {
         format!("{:?} in {}", self.cfg.command, self.dir.display())
     }
 
-    /// This thread's process for the planner, or a new one: one that printed while it
-    /// waited in the pool broke the protocol and is retired (its group killed).
+    fn pool_key(&self) -> PoolKey {
+        (
+            PROTOCOL,
+            self.cfg.command.clone(),
+            self.dir.clone(),
+            self.env(),
+        )
+    }
+
+    /// This thread's pooled process for the planner, or a new one that answered the hello.
     fn take_process(&self) -> Result<(Process, u64), ExchangeError> {
-        let key = (self.cfg.command.clone(), self.dir.clone(), self.env());
-        let taken = POOL.with(|p| p.borrow_mut().remove(&key));
-        if let Some((mut p, id)) = taken
-            && !p.has_idle_output()
-        {
-            return Ok((p, id));
+        if let Some(p) = forkbench_ipc::take_pooled(&self.pool_key()) {
+            return Ok(p);
         }
-        Ok((
-            Process::start(&self.cfg.command, &self.dir, &self.env(), self.timeout())?,
-            0,
-        ))
+        let spawn = Spawn {
+            command: &self.cfg.command,
+            dir: &self.dir,
+            env: &self.env(),
+            what: "planner",
+        };
+        let p = forkbench_ipc::start_with_hello(spawn, PROTOCOL, VERSION.into(), self.timeout())?;
+        Ok((p, 0))
     }
 
     /// One request, counted by the circuit breaker.
@@ -171,8 +163,7 @@ impl ExternalPlanner {
                 "answered request {got}, expected {id}"
             )));
         }
-        let key = (self.cfg.command.clone(), self.dir.clone(), self.env());
-        POOL.with(|p| p.borrow_mut().insert(key, (proc, id + 1)));
+        forkbench_ipc::put_back(self.pool_key(), proc, id + 1);
         Ok(msg)
     }
 }

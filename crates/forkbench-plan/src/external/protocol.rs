@@ -9,31 +9,8 @@ use crate::PlanRequest;
 /// Name of the protocol in both hello messages.
 pub const PROTOCOL: &str = "forkbench-planner";
 
-/// The protocol version this forkbench speaks.
+/// The protocol version this forkbench speaks (the hello each way: `forkbench_ipc::start_with_hello`).
 pub const VERSION: u32 = 1;
-
-/// First line each way.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Hello {
-    #[serde(rename = "type")]
-    pub kind: String,
-    pub protocol: String,
-    pub version: u32,
-    /// The planner's own name for itself (informational).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub name: Option<String>,
-}
-
-impl Hello {
-    pub fn ours() -> Self {
-        Self {
-            kind: "hello".into(),
-            protocol: PROTOCOL.into(),
-            version: VERSION,
-            name: Some("forkbench".into()),
-        }
-    }
-}
 
 /// An obstacle as sent: its rectangle and, for convenience, its corners.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

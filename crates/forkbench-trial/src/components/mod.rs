@@ -1,4 +1,4 @@
-//! The component registry: planners and trackers by name, built from their scenario settings tables.
+//! The component registry: planners, trackers and pallet detectors by name, built from their scenario settings tables.
 
 mod spec;
 
@@ -9,6 +9,8 @@ use std::sync::{Arc, OnceLock};
 use forkbench_core::settings::{Settings, SettingsError};
 use forkbench_plan::external::ExternalPlanner;
 use forkbench_plan::{BsplinePlanner, Planner, SpiralPlanner};
+use forkbench_sensors::detector::{PalletDetector, Pockets};
+use forkbench_sensors::external::ExternalDetector;
 use forkbench_sensors::{Localizer, Nav350, Nav350Config, PalletEstimateConfig, PalletEstimator};
 use forkbench_track::{PurePursuit, RegulatedPurePursuit, Tracker};
 
@@ -29,6 +31,8 @@ type Ctor<T> = Arc<dyn Fn(&Settings, &ComponentContext) -> Result<T, SettingsErr
 pub type PlannerCtor = Ctor<Box<dyn Planner>>;
 /// Builds a tracker from its settings table.
 pub type TrackerCtor = Ctor<Box<dyn Tracker>>;
+/// Builds a pallet detector from its settings table.
+pub type DetectorCtor = Ctor<Box<dyn PalletDetector>>;
 /// Builds the localisation sensor from the scenario's NAV350 settings (noise on or off).
 pub type LocalizerCtor = Arc<dyn Fn(&Nav350Config, bool) -> Box<dyn Localizer> + Send + Sync>;
 /// Builds the pallet-pose estimator from the scenario's estimate settings.
@@ -40,6 +44,7 @@ pub type EstimatorCtor =
 pub struct Registry {
     planners: BTreeMap<String, PlannerCtor>,
     trackers: BTreeMap<String, TrackerCtor>,
+    detectors: BTreeMap<String, DetectorCtor>,
     localizer: LocalizerCtor,
     estimator: EstimatorCtor,
 }
@@ -49,6 +54,7 @@ impl std::fmt::Debug for Registry {
         f.debug_struct("Registry")
             .field("planners", &self.planners.keys().collect::<Vec<_>>())
             .field("trackers", &self.trackers.keys().collect::<Vec<_>>())
+            .field("detectors", &self.detectors.keys().collect::<Vec<_>>())
             .finish_non_exhaustive()
     }
 }
@@ -82,14 +88,28 @@ impl Registry {
         Arc::clone(BUILTIN.get_or_init(|| Arc::new(Self::builtin())))
     }
 
-    /// No planners or trackers; the NAV350 and the range-scaled pallet estimate.
+    /// No planners or trackers; the NAV350, the range-scaled pallet estimate, and the
+    /// pallet detectors (the pocket detector and `external`).
     pub fn sensors_only() -> Self {
         Self {
             planners: BTreeMap::new(),
             trackers: BTreeMap::new(),
+            detectors: BTreeMap::new(),
             localizer: Arc::new(|cfg, noise| Box::new(Nav350::new(cfg.clone(), noise))),
             estimator: Arc::new(|cfg| Box::new(cfg.clone())),
         }
+        .with_detector("pockets", |s, _| {
+            Ok(Box::new(Pockets {
+                cfg: forkbench_core::settings::parse(s)?,
+            }))
+        })
+        .with_detector("external", |s, cx| {
+            Ok(Box::new(ExternalDetector::from_settings(
+                s,
+                cx.dir.clone(),
+                &cx.name,
+            )?))
+        })
     }
 
     /// Adds (or replaces) a planner kind.
@@ -118,6 +138,19 @@ impl Registry {
         self
     }
 
+    /// Adds (or replaces) a pallet detector kind.
+    pub fn with_detector(
+        mut self,
+        kind: &str,
+        ctor: impl Fn(&Settings, &ComponentContext) -> Result<Box<dyn PalletDetector>, SettingsError>
+        + Send
+        + Sync
+        + 'static,
+    ) -> Self {
+        self.detectors.insert(kind.to_owned(), Arc::new(ctor));
+        self
+    }
+
     /// Replaces the localisation sensor model.
     pub fn with_localizer(mut self, ctor: LocalizerCtor) -> Self {
         self.localizer = ctor;
@@ -135,6 +168,7 @@ impl Registry {
         match role {
             Role::Planner => self.planners.keys().map(String::as_str).collect(),
             Role::Tracker => self.trackers.keys().map(String::as_str).collect(),
+            Role::Detector => self.detectors.keys().map(String::as_str).collect(),
         }
     }
 
@@ -164,11 +198,20 @@ impl Registry {
         ctor(&spec.settings, &spec.context())
     }
 
+    pub fn detector(&self, spec: &ComponentSpec) -> Result<Box<dyn PalletDetector>, SettingsError> {
+        let ctor = self
+            .detectors
+            .get(&spec.kind)
+            .ok_or_else(|| self.unknown(Role::Detector, &spec.kind))?;
+        ctor(&spec.settings, &spec.context())
+    }
+
     /// Checks a spec by building it once (external planners start no process for this).
     pub fn check(&self, spec: &ComponentSpec) -> Result<(), SettingsError> {
         match spec.role {
             Role::Planner => self.planner(spec).map(drop),
             Role::Tracker => self.tracker(spec).map(drop),
+            Role::Detector => self.detector(spec).map(drop),
         }
     }
 

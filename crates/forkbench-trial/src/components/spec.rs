@@ -13,6 +13,7 @@ use super::ComponentContext;
 pub enum Role {
     Planner,
     Tracker,
+    Detector,
 }
 
 impl std::fmt::Display for Role {
@@ -20,6 +21,7 @@ impl std::fmt::Display for Role {
         f.write_str(match self {
             Role::Planner => "planner",
             Role::Tracker => "tracker",
+            Role::Detector => "detector",
         })
     }
 }

@@ -106,6 +106,14 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
             ));
         }
     }
+    let ranges = f.replan.reestimate_at_m.as_deref().unwrap_or_default();
+    if ranges.len() > 64 || ranges.iter().any(|r| !(r.is_finite() && *r > 0.0)) {
+        return Err(invalid(
+            file,
+            "replan.reestimate_at_m",
+            "must list at most 64 positive finite ranges",
+        ));
+    }
     let t = &f.tolerances;
     for (name, v) in [
         ("lateral_m", t.lateral_m),

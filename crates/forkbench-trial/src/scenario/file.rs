@@ -85,6 +85,10 @@ pub struct ReplanFile {
     pub enabled: bool,
     pub position_threshold_m: f64,
     pub heading_threshold_deg: f64,
+    /// Ranges (fork root to the estimated face) at which a new estimate is taken; absent:
+    /// `[noise.pallet_estimate] reestimate_at_m`, where it used to live.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reestimate_at_m: Option<Vec<f64>>,
 }
 
 impl Default for ReplanFile {
@@ -93,6 +97,7 @@ impl Default for ReplanFile {
             enabled: false,
             position_threshold_m: 0.02,
             heading_threshold_deg: 1.0,
+            reestimate_at_m: None,
         }
     }
 }

@@ -85,6 +85,9 @@ pub struct Replan {
     pub position_threshold_m: f64,
     pub heading_threshold_rad: f64,
     written_heading_deg: f64,
+    /// Ranges at which a new estimate is taken (the trial's schedule, not the sensor's);
+    /// `None`: the pallet-estimate settings' own list.
+    pub reestimate_at_m: Option<Vec<f64>>,
 }
 
 impl Default for Replan {
@@ -100,6 +103,7 @@ impl From<ReplanFile> for Replan {
             position_threshold_m: r.position_threshold_m,
             heading_threshold_rad: r.heading_threshold_deg.to_radians(),
             written_heading_deg: r.heading_threshold_deg,
+            reestimate_at_m: r.reestimate_at_m,
         }
     }
 }
@@ -110,6 +114,7 @@ impl From<Replan> for ReplanFile {
             enabled: r.enabled,
             position_threshold_m: r.position_threshold_m,
             heading_threshold_deg: deg_of(r.heading_threshold_rad, r.written_heading_deg),
+            reestimate_at_m: r.reestimate_at_m,
         }
     }
 }

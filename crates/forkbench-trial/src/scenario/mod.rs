@@ -188,10 +188,17 @@ impl Scenario {
                     .map_err(|e| component_error(&self.file, text, role, v.span(), &e))?,
                 None => ComponentSpec::of_kind(role, "pure_pursuit"),
             };
-            match role {
-                Role::Planner => self.planner = spec,
-                Role::Tracker => self.tracker = spec,
+            if role == Role::Planner {
+                self.planner = spec;
+            } else {
+                self.tracker = spec;
             }
+        }
+        if let sensors::PalletSensing::Scanner { detector, .. } = &mut self.pallet_sensing {
+            detector.dir = dir;
+            registry
+                .check(detector)
+                .map_err(|e| invalid_setting(&self.file, "sensors.pallet.detector", &e))?;
         }
         self.registry = registry;
         Ok(self)

@@ -1,12 +1,14 @@
-//! `[sensors.pallet]`: how a trial estimates the pallet: the range-scaled Gaussian around the truth (`gaussian`, the default, set in `[noise.pallet_estimate]`), or a scanner the world answers (`tim561`) with the pocket detector.
+//! `[sensors.pallet]`: how a trial estimates the pallet: the range-scaled Gaussian around the truth (`gaussian`, set in `[noise.pallet_estimate]`), or scanners the world answers (`tim561`, `kinect2`, or both fused: `tim561+kinect2`) and a detector from the registry.
+
+use std::collections::BTreeMap;
 
 use forkbench_core::ForkliftSpec;
-use forkbench_sensors::detect::DetectorConfig;
-use forkbench_sensors::scan::ScannerConfig;
+use forkbench_sensors::scan::{SCANNER_PRESETS, ScannerConfig};
 use serde::{Deserialize, Serialize};
 
 use super::{invalid, invalid_setting};
 use crate::TrialError;
+use crate::components::{ComponentSpec, Role};
 
 /// `[sensors]` as written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -15,14 +17,24 @@ pub(super) struct SensorsFile {
     pallet: Option<PalletSensorFile>,
 }
 
-/// `[sensors.pallet]` as written: a kind, and for a scanner its settings and the
-/// detector's (each defaulting to the kind's own).
+/// `[sensors.pallet]` as written: a kind (one scanner model or several joined by `+`),
+/// settings for a single scanner (`scanner`) or by model name (`scanners.<model>`), and
+/// the detector (`kind` from the registry, default `pockets`, and its settings).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PalletSensorFile {
     kind: String,
     scanner: Option<ScannerConfig>,
-    detector: Option<DetectorConfig>,
+    #[serde(default)]
+    scanners: BTreeMap<String, ScannerConfig>,
+    detector: Option<toml::Table>,
+}
+
+/// One scanner on the truck: its model's name and settings.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NamedScanner {
+    pub name: String,
+    pub scanner: ScannerConfig,
 }
 
 /// How a trial estimates the pallet.
@@ -32,11 +44,11 @@ pub enum PalletSensing {
     /// A pose drawn around the true face (`[noise.pallet_estimate]`).
     #[default]
     Gaussian,
-    /// A scan of the world from the truck, and the pocket detector on it.
+    /// Scans of the world from the truck, shortest-reaching scanner first (a depth
+    /// camera before the laser), and a detector on them.
     Scanner {
-        name: String,
-        scanner: ScannerConfig,
-        detector: DetectorConfig,
+        sensors: Vec<NamedScanner>,
+        detector: ComponentSpec,
     },
 }
 
@@ -46,8 +58,9 @@ impl PalletSensing {
     }
 }
 
-/// The sensing a scenario's `[sensors]` names, checked: a known kind, settings in range,
-/// the scanner mounted outside the truck's body.
+/// The sensing a scenario's `[sensors]` names, checked: known models, settings in range,
+/// each scanner mounted outside the truck's body. The detector's settings are checked
+/// against the registry with the other components.
 pub(super) fn resolve(
     f: Option<&SensorsFile>,
     truck: &ForkliftSpec,
@@ -56,32 +69,89 @@ pub(super) fn resolve(
     let Some(p) = f.and_then(|s| s.pallet.as_ref()) else {
         return Ok(PalletSensing::Gaussian);
     };
-    let scanner = match (p.kind.as_str(), ScannerConfig::preset(&p.kind)) {
-        ("gaussian", _) => return Ok(PalletSensing::Gaussian),
-        (_, Some(preset)) => p.scanner.clone().unwrap_or(preset),
-        (other, None) => {
+    if p.kind == "gaussian" {
+        return Ok(PalletSensing::Gaussian);
+    }
+    let names: Vec<&str> = p.kind.split('+').map(str::trim).collect();
+    if names.len() > 1 && p.scanner.is_some() {
+        return Err(invalid(
+            file,
+            "sensors.pallet.scanner",
+            "names one scanner's settings, but the kind has several: use \
+             [sensors.pallet.scanners.<model>]",
+        ));
+    }
+    if let Some(k) = p.scanners.keys().find(|k| !names.contains(&k.as_str())) {
+        return Err(invalid(
+            file,
+            &format!("sensors.pallet.scanners.{k}"),
+            &format!("{k:?} is not one of this kind's scanners ({})", p.kind),
+        ));
+    }
+    let mut sensors = Vec::new();
+    for name in names {
+        let Some(preset) = ScannerConfig::preset(name) else {
             return Err(invalid(
                 file,
                 "sensors.pallet.kind",
                 &format!(
-                    "{other:?} is not a pallet sensing kind (known: gaussian, {})",
-                    forkbench_sensors::scan::SCANNER_PRESETS.join(", ")
+                    "{name:?} is not a pallet sensing kind (known: gaussian, {}, or scanners \
+                     joined by '+')",
+                    SCANNER_PRESETS.join(", ")
                 ),
             ));
+        };
+        if sensors.iter().any(|s: &NamedScanner| s.name == name) {
+            return Err(invalid(
+                file,
+                "sensors.pallet.kind",
+                &format!("{name:?} is named twice"),
+            ));
         }
-    };
+        let scanner = p
+            .scanners
+            .get(name)
+            .or(p.scanner.as_ref())
+            .cloned()
+            .unwrap_or(preset);
+        let table = if p.scanners.contains_key(name) {
+            format!("sensors.pallet.scanners.{name}")
+        } else {
+            "sensors.pallet.scanner".to_owned()
+        };
+        check_scanner(&scanner, truck, file, &table)?;
+        sensors.push(NamedScanner {
+            name: name.to_owned(),
+            scanner,
+        });
+    }
+    sensors.sort_by(|a, b| a.scanner.range_max_m.total_cmp(&b.scanner.range_max_m));
+    let table = toml::Value::Table(p.detector.clone().unwrap_or_default());
+    let detector = ComponentSpec::from_value(Role::Detector, &table, Some("pockets"), ".".into())
+        .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))?;
+    Ok(PalletSensing::Scanner { sensors, detector })
+}
+
+/// A scanner's settings in range, and its mount outside the truck's body.
+fn check_scanner(
+    scanner: &ScannerConfig,
+    truck: &ForkliftSpec,
+    file: &str,
+    table: &str,
+) -> Result<(), TrialError> {
     scanner
         .validate()
-        .map_err(|e| invalid_setting(file, "sensors.pallet.scanner", &e))?;
+        .map_err(|e| invalid_setting(file, table, &e))?;
     // The fork-root frame: the body lies behind the root (x < 0), within its half width.
     let m = &scanner.mount;
     if m.x_m < 0.0 && m.x_m > -truck.body_length_m && m.y_m.abs() < truck.body_width_m / 2.0 {
         return Err(invalid(
             file,
-            "sensors.pallet.scanner.mount",
+            &format!("{table}.mount"),
             &format!(
-                "({}, {}) m lies inside the truck's body (fork-root frame: the body spans x from \
-                 -{} to 0 m, y within ±{} m); mount it at the fork root or ahead of it",
+                "({}, {}) m lies inside the truck's body (fork-root frame: the body \
+                 spans x from -{} to 0 m, y within ±{} m); mount it at the fork root or ahead \
+                 of it",
                 m.x_m,
                 m.y_m,
                 truck.body_length_m,
@@ -89,9 +159,5 @@ pub(super) fn resolve(
             ),
         ));
     }
-    Ok(PalletSensing::Scanner {
-        name: p.kind.clone(),
-        scanner,
-        detector: p.detector.clone().unwrap_or_default(),
-    })
+    Ok(())
 }

@@ -19,9 +19,9 @@ impl<'a> Trial<'a> {
     pub(super) fn drive<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), StageError> {
         // Re-estimate ranges still ahead of the truck, nearest last.
         let start_range = self.first_fix.distance_to(&self.pallet_est);
-        let mut reestimates: Vec<f64> = self
-            .estimator
-            .reestimate_at_m()
+        let schedule = self.scn.replan.reestimate_at_m.clone();
+        let mut reestimates: Vec<f64> = schedule
+            .unwrap_or_else(|| self.estimator.reestimate_at_m())
             .into_iter()
             .filter(|r| *r < start_range)
             .collect();
@@ -35,7 +35,7 @@ impl<'a> Trial<'a> {
                     .is_some_and(|r| pose.distance_to(&self.pallet_est) <= *r)
             {
                 reestimates.remove(0);
-                self.reestimate(&pose, rec);
+                self.reestimate(&pose, rec)?;
             }
             let cmd = self.tracker.command(&self.tracker_input(pose));
             if cmd.done && self.sim.speed_mps().abs() < 0.01 {
@@ -187,22 +187,26 @@ impl<'a> Trial<'a> {
 
     /// A new pallet estimate at a re-estimate range; replans when it moved past the
     /// thresholds. A refused replan keeps the old plan: the truck cannot turn onto the new goal.
-    fn reestimate<R: Recorder + ?Sized>(&mut self, pose: &Pose2, rec: &mut R) {
+    fn reestimate<R: Recorder + ?Sized>(
+        &mut self,
+        pose: &Pose2,
+        rec: &mut R,
+    ) -> Result<(), StageError> {
         let range = pose.distance_to(&self.pallet_est);
         let truth = self.sim.pallet_pose();
-        let Some(new_est) = self.estimate(&truth, range, pose, rec) else {
+        let Some(new_est) = self.estimate(&truth, range, pose, rec)? else {
             rec.event(
                 self.sim.time_s(),
                 Level::Warn,
                 &format!("no pallet found at {range:.2} m; keeping the last estimate"),
             );
-            return;
+            return Ok(());
         };
         let moved = new_est.distance_to(&self.pallet_est);
         let turned = wrap_angle(new_est.heading_rad - self.pallet_est.heading_rad).abs();
         let limits = &self.scn.replan;
         if moved <= limits.position_threshold_m && turned <= limits.heading_threshold_rad {
-            return;
+            return Ok(());
         }
         let t = self.sim.time_s();
         let k0 = self.sim.steer_rad().tan() / self.scn.truck.wheelbase_m;
@@ -241,5 +245,6 @@ impl<'a> Trial<'a> {
                 self.out.replans_failed += 1;
             }
         }
+        Ok(())
     }
 }

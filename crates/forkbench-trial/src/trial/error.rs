@@ -17,6 +17,10 @@ pub enum StageError {
     Clash { obstacle: String, s_m: f64 },
     #[error("rasterising the world: {0}")]
     Rasterise(#[from] GridError),
+    /// The pallet detector could not answer (an external one hung, crashed or broke the
+    /// protocol).
+    #[error(transparent)]
+    Detector(#[from] forkbench_sensors::detector::DetectorError),
     /// A mission leg failed; `detail` is the leg's recorded failure.
     #[error("leg {number} {name}: {detail}")]
     Leg {

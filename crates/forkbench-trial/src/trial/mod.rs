@@ -70,6 +70,15 @@ impl Scenario {
         let own = match role {
             Role::Planner => &self.planner,
             Role::Tracker => &self.tracker,
+            Role::Detector => {
+                return Err(TrialError::Invalid {
+                    file: self.file.clone(),
+                    field: "sensors.pallet.detector".into(),
+                    reason: "a run does not choose the detector; the scenario's \
+                             [sensors.pallet.detector] does"
+                        .into(),
+                });
+            }
         };
         let Some(name) = name.filter(|n| *n != own.name) else {
             return Ok(own.clone());
@@ -162,7 +171,12 @@ fn run_stages<R: Recorder + ?Sized>(
             return trial.out;
         }
         let pallet = trial.sim.pallet_pose();
-        trial.first_fix_and_estimate(&pallet, rec);
+        if let Err(e) = trial.first_fix_and_estimate(&pallet, rec) {
+            let why = e.to_string();
+            rec.event(trial.sim.time_s(), Level::Error, &why);
+            trial.out.fail(Failure::Error, why);
+            return trial.out;
+        }
     }
     if trial.out.estimates_missed == trial.out.estimates && trial.out.estimates > 0 {
         let why = "the pallet sensing found no pallet from the start pose".to_owned();

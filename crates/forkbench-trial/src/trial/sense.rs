@@ -1,41 +1,52 @@
-//! Pallet estimates as the scenario's sensing makes them: the Gaussian model around the truth, or a scan of the world from the truck and the pocket detector on it, placed in the map with the truck's believed pose.
+//! Pallet estimates as the scenario's sensing makes them: the Gaussian model around the truth, or scans of the world from the truck and a detector on them, placed in the map with the truck's believed pose.
 
+use forkbench_core::signal::Scan;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, Signal, Style};
-use forkbench_sensors::detect::detect;
+use forkbench_sensors::detector::{DetectRequest, SensorScan};
 use forkbench_sensors::scan::{Errors, scan};
 use rand_chacha::ChaCha8Rng;
 
+use super::error::StageError;
 use super::setup::Trial;
 use crate::recorder::Recorder;
-use crate::scenario::sensors::PalletSensing;
+use crate::scenario::sensors::{NamedScanner, PalletSensing};
 
-/// How a scan and its detection are drawn in recordings.
-const SCAN_STYLE: Style = Style::rgba([90, 200, 255, 255]).width(0.04);
+/// How scans (a colour per sensor, in the order sensors are listed) and a detection are
+/// drawn in recordings.
+const SCAN_STYLES: [Style; 3] = [
+    Style::rgba([90, 200, 255, 255]).width(0.04),
+    Style::rgba([255, 170, 40, 255]).width(0.04),
+    Style::rgba([170, 110, 255, 255]).width(0.04),
+];
 const DETECTION_STYLE: Style = Style::rgb(255, 60, 60).width(0.03);
+
+/// A scanner is asked only when the pallet may lie within its reach (scans cost time,
+/// and a camera cannot see 8 m): the prior's face within its range plus this margin.
+const REACH_MARGIN_M: f64 = 0.5;
 
 impl Trial<'_> {
     /// A pallet estimate when the fork root is `range_m` from the face: the scenario's
     /// fixed bias on top of the sensing's own error. `believed` is the fork-root pose
-    /// the truck thinks it has: a scanner's detection, made in the sensor's frame, is
-    /// placed in the map with it, and its scan and detection are recorded. `None`: the
-    /// detector found no pallet.
+    /// the truck thinks it has: scans are placed in the map with it, so a detection is
+    /// where the truck believes the pallet is; scans and detection are recorded.
+    /// `Ok(None)`: no pallet found. Err: the detector could not answer.
     pub(super) fn estimate<R: Recorder + ?Sized>(
         &mut self,
         truth: &Pose2,
         range_m: f64,
         believed: &Pose2,
         rec: &mut R,
-    ) -> Option<Pose2> {
+    ) -> Result<Option<Pose2>, StageError> {
         self.out.estimates += 1;
         let est = match &self.scn.pallet_sensing {
             PalletSensing::Gaussian => Some(self.gaussian_estimate(truth, range_m)),
-            PalletSensing::Scanner { .. } => self.scanned_estimate(believed, rec),
+            PalletSensing::Scanner { .. } => self.scanned_estimate(believed, rec)?,
         };
         if est.is_none() {
             self.out.estimates_missed += 1;
         }
-        est
+        Ok(est)
     }
 
     fn gaussian_estimate(&mut self, truth: &Pose2, range_m: f64) -> Pose2 {
@@ -47,36 +58,30 @@ impl Trial<'_> {
         }
     }
 
+    /// One scan from `sensor` (its true pose), placed at `placed` (its believed pose).
+    fn scan_from(&mut self, k: usize, s: &NamedScanner, sensor: Pose2, placed: Pose2) -> Scan {
+        let mut out = if self.run.noise {
+            let bias_m = self.scan_bias_m[k];
+            let errors = Errors::Modelled {
+                bias_m,
+                rng: &mut self.est_rng,
+            };
+            scan(&s.scanner, &self.sim, sensor, errors)
+        } else {
+            scan::<ChaCha8Rng>(&s.scanner, &self.sim, sensor, Errors::Ideal)
+        };
+        out.sensor = placed;
+        out
+    }
+
     fn scanned_estimate<R: Recorder + ?Sized>(
         &mut self,
         believed: &Pose2,
         rec: &mut R,
-    ) -> Option<Pose2> {
-        let PalletSensing::Scanner {
-            name,
-            scanner,
-            detector,
-        } = &self.scn.pallet_sensing
-        else {
-            return None;
+    ) -> Result<Option<Pose2>, StageError> {
+        let PalletSensing::Scanner { sensors, .. } = &self.scn.pallet_sensing else {
+            return Ok(None);
         };
-        let sensor = scanner.sensor_pose(&self.sim.fork_root_pose());
-        let s = if self.run.noise {
-            let bias_m = self.scan_bias_m;
-            scan(
-                scanner,
-                &self.sim,
-                sensor,
-                Errors::Modelled {
-                    bias_m,
-                    rng: &mut self.est_rng,
-                },
-            )
-        } else {
-            scan::<ChaCha8Rng>(scanner, &self.sim, sensor, Errors::Ideal)
-        };
-        let t = self.sim.time_s();
-        rec.signal(t, &format!("sensors/{name}"), &Signal::Scan(&s), SCAN_STYLE);
         // Where to look: the last estimate, or before the first, where the pallet should
         // stand (a warehouse system knows the slot, not the placement error).
         let prior = if self.out.estimates > 1 {
@@ -84,17 +89,42 @@ impl Trial<'_> {
         } else {
             self.pallet_nominal
         };
-        let found = detect(detector, &s, &self.scn.pallet, Some(&prior))?;
+        let root = self.sim.fork_root_pose();
+        let t = self.sim.time_s();
+        let mut scans = Vec::with_capacity(sensors.len());
+        for (k, s) in sensors.iter().enumerate() {
+            let placed = s.scanner.sensor_pose(believed);
+            if placed.distance_to(&prior) > s.scanner.range_max_m + REACH_MARGIN_M {
+                continue;
+            }
+            let sc = self.scan_from(k, s, s.scanner.sensor_pose(&root), placed);
+            let style = SCAN_STYLES[k % SCAN_STYLES.len()];
+            rec.signal(t, &format!("sensors/{}", s.name), &Signal::Scan(&sc), style);
+            scans.push((s.name.as_str(), sc));
+        }
+        let views: Vec<SensorScan<'_>> = scans
+            .iter()
+            .map(|(sensor, scan)| SensorScan { sensor, scan })
+            .collect();
+        let req = DetectRequest {
+            scans: &views,
+            pallet: &self.scn.pallet,
+            prior: Some(prior),
+        };
+        let Some(detector) = self.detector.as_mut() else {
+            return Ok(None);
+        };
+        let Some(found) = detector.detect(&req)? else {
+            return Ok(None);
+        };
+        let face = found.detection.face;
         rec.signal(
             t,
             "sensors/pallet_detection",
-            &Signal::Pose(found.face),
+            &Signal::Pose(face),
             DETECTION_STYLE,
         );
-        // Seen from the sensor, placed from where the truck believes the sensor is.
-        let local = sensor.to_local(&found.face);
-        let est = scanner.sensor_pose(believed).to_world(&local);
-        Some(est.to_world(&self.scn.estimate_bias))
+        Ok(Some(face.to_world(&self.scn.estimate_bias)))
     }
 
     /// Makes `est` the estimate the truck aims at, and records its error against the

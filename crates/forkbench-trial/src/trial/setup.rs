@@ -1,6 +1,6 @@
 //! Setup stage: the simulated world, sensors with their own random streams, the components, the first fix and estimate.
 
-use forkbench_core::Pose2;
+use forkbench_core::{Pose2, SettingsError};
 use forkbench_plan::Planner;
 use forkbench_sensors::{Localizer, PalletEstimator};
 use forkbench_sim::Sim;
@@ -13,6 +13,7 @@ use super::judge::jitter;
 use super::{Resolved, target_insertion_m};
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, Recorder, SceneInfo};
+use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Case, Scenario};
 
 /// Independent random streams per sensor, so changing one sensor's settings does not
@@ -47,8 +48,10 @@ pub struct Trial<'a> {
     /// Where the pallet should stand (the case's placement, before any jitter): the
     /// region a detector looks in before its first estimate.
     pub(super) pallet_nominal: Pose2,
-    /// A scanner's range bias for the whole trial (its systematic error).
-    pub(super) scan_bias_m: f64,
+    /// Each scanner's range bias for the whole trial (its systematic error).
+    pub(super) scan_bias_m: Vec<f64>,
+    /// The pallet detector, when the sensing scans.
+    pub(super) detector: Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
     pub(super) collision: bool,
     pub(super) timed_out: bool,
 }
@@ -85,15 +88,37 @@ pub(super) fn build_world(
     Ok((sim, start, true_pallet, obstacles))
 }
 
-/// A scanner's systematic range error for one trial, on a stream of its own (none for the
-/// Gaussian model or with noise off, which draw nothing).
-fn scan_bias(scn: &Scenario, run: &Resolved) -> f64 {
+/// Each scanner's systematic range error for one trial, on a stream of their own (none
+/// for the Gaussian model or with noise off, which draw nothing).
+fn scan_bias(scn: &Scenario, run: &Resolved) -> Vec<f64> {
     match &scn.pallet_sensing {
-        crate::scenario::sensors::PalletSensing::Scanner { scanner, .. } if run.noise => {
-            scanner.draw_bias(&mut stream(run.seed, 4))
+        PalletSensing::Scanner { sensors, .. } if run.noise => {
+            let mut rng = stream(run.seed, 4);
+            sensors
+                .iter()
+                .map(|s| s.scanner.draw_bias(&mut rng))
+                .collect()
         }
-        _ => 0.0,
+        PalletSensing::Scanner { sensors, .. } => vec![0.0; sensors.len()],
+        PalletSensing::Gaussian => Vec::new(),
     }
+}
+
+/// The scenario's planner, tracker and (when it scans) pallet detector, from its registry.
+type Built = (
+    Box<dyn Planner>,
+    Box<dyn Tracker>,
+    Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
+);
+
+fn build_components(scn: &Scenario, run: &Resolved) -> Result<Built, SettingsError> {
+    let planner = scn.registry.planner(&run.planner)?;
+    let tracker = scn.registry.tracker(&run.tracker)?;
+    let detector = match &scn.pallet_sensing {
+        PalletSensing::Scanner { detector, .. } => Some(scn.registry.detector(detector)?),
+        PalletSensing::Gaussian => None,
+    };
+    Ok((planner, tracker, detector))
 }
 
 impl<'a> Trial<'a> {
@@ -111,11 +136,7 @@ impl<'a> Trial<'a> {
             rec.event(0.0, Level::Error, &why);
             out.fail(Failure::Error, why);
         };
-        let components = scn
-            .registry
-            .planner(&run.planner)
-            .and_then(|p| Ok((p, scn.registry.tracker(&run.tracker)?)));
-        let (planner, tracker) = match components {
+        let (planner, tracker, detector) = match build_components(scn, run) {
             Ok(c) => c,
             Err(e) => {
                 fail(&mut out, format!("building the components: {e}"));
@@ -163,11 +184,17 @@ impl<'a> Trial<'a> {
             pallet0,
             pallet_nominal: case.pallet,
             scan_bias_m: scan_bias(scn, run),
+            detector,
             collision: false,
             timed_out: true,
         };
-        if scn.mission.is_none() {
-            trial.first_fix_and_estimate(&true_pallet, rec);
+        if scn.mission.is_none()
+            && let Err(e) = trial.first_fix_and_estimate(&true_pallet, rec)
+        {
+            let why = e.to_string();
+            rec.event(0.0, Level::Error, &why);
+            trial.out.fail(Failure::Error, why);
+            return Err(Box::new(trial.out));
         }
         Ok(trial)
     }
@@ -178,7 +205,7 @@ impl<'a> Trial<'a> {
         &mut self,
         true_pallet: &Pose2,
         rec: &mut R,
-    ) {
+    ) -> Result<(), StageError> {
         let truth = self.sim.fork_root_pose();
         let fix = self
             .localizer
@@ -187,8 +214,9 @@ impl<'a> Trial<'a> {
         self.predictor.fix(self.first_fix);
         let range = self.first_fix.distance_to(true_pallet);
         let believed = self.first_fix;
-        if let Some(est) = self.estimate(true_pallet, range, &believed, rec) {
+        if let Some(est) = self.estimate(true_pallet, range, &believed, rec)? {
             self.adopt_estimate(est, true_pallet);
         }
+        Ok(())
     }
 }

@@ -1,0 +1,74 @@
+//! The pallet detector as an extension point: the scans of one or more sensors in, the pallet's face pose or "not found" out; the built-in pocket detector fuses sensors near-first.
+
+use forkbench_core::signal::Scan;
+use forkbench_core::{PalletSpec, Pose2};
+use serde::Serialize;
+
+use crate::detect::{Detection, DetectorConfig, detect};
+
+/// One sensor's scan, as the truck knows it: `scan.sensor` is the sensor's pose from the
+/// truck's own localisation, so a detection is in the map as the truck believes it.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct SensorScan<'a> {
+    /// The sensor model's name (`tim561`, `kinect2`).
+    pub sensor: &'a str,
+    pub scan: &'a Scan,
+}
+
+/// What a detector is asked: the scans (nearest-reaching sensor first), the pallet's
+/// dimensions, and where the pallet should be (the last estimate, or before the first
+/// the slot's nominal placement).
+#[derive(Debug, Clone, Copy)]
+pub struct DetectRequest<'a> {
+    pub scans: &'a [SensorScan<'a>],
+    pub pallet: &'a PalletSpec,
+    pub prior: Option<Pose2>,
+}
+
+/// A pallet found: the detection and which sensor's scan (an index into the request).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Found {
+    pub detection: Detection,
+    pub sensor: usize,
+}
+
+/// Why a detector could not answer (an external process that hung, crashed or broke the
+/// protocol): that trial's error, never the batch's.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("detector {detector}: {reason}")]
+pub struct DetectorError {
+    pub detector: String,
+    pub reason: String,
+}
+
+/// Finds the pallet in scans.
+pub trait PalletDetector: Send {
+    fn name(&self) -> &str;
+
+    /// The pallet's face pose, or `None` when no scan shows it.
+    fn detect(&mut self, req: &DetectRequest<'_>) -> Result<Option<Found>, DetectorError>;
+}
+
+/// The built-in pocket detector ([`detect`]) on each scan in turn: the first sensor that
+/// finds the pallet wins. The trial orders the nearest-reaching sensor first, so a depth
+/// camera decides where it sees the pallet and the laser beyond (laser far, camera near,
+/// as Lü et al. fuse them).
+#[derive(Debug, Clone, Default)]
+pub struct Pockets {
+    pub cfg: DetectorConfig,
+}
+
+impl PalletDetector for Pockets {
+    fn name(&self) -> &str {
+        "pockets"
+    }
+
+    fn detect(&mut self, req: &DetectRequest<'_>) -> Result<Option<Found>, DetectorError> {
+        Ok(req.scans.iter().enumerate().find_map(|(i, s)| {
+            detect(&self.cfg, s.scan, req.pallet, req.prior.as_ref()).map(|detection| Found {
+                detection,
+                sensor: i,
+            })
+        }))
+    }
+}

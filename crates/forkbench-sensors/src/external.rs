@@ -1,0 +1,291 @@
+//! Detectors in any language: a child process speaking JSON lines (docs/external-detector.md), with the robustness of external planners: a deadline per request, crashes and bad answers fail only that trial.
+
+use std::path::PathBuf;
+use std::sync::LazyLock;
+use std::time::Duration;
+
+use forkbench_core::settings::{self, Settings, SettingsError};
+use forkbench_core::{PalletSpec, Pose2};
+use forkbench_ipc::{Breaker, EnvPolicy, ExchangeError, PoolKey, Process, Spawn, clip};
+use serde::{Deserialize, Serialize};
+
+use crate::detect::Detection;
+use crate::detector::{DetectRequest, DetectorError, Found, PalletDetector, SensorScan};
+
+/// Name of the protocol in both hello messages.
+pub const PROTOCOL: &str = "forkbench-detector";
+/// The protocol version this forkbench speaks.
+pub const VERSION: u64 = 1;
+/// Longest answer time a scenario may allow a detector.
+pub const MAX_TIMEOUT_S: f64 = 600.0;
+
+/// Settings of `[sensors.pallet.detector] kind = "external"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExternalDetectorConfig {
+    /// Program and arguments, run in the directory of the file that names them.
+    pub command: Vec<String>,
+    /// Longest wait for the hello and for each answer; past it the process group is
+    /// killed and the trial ends in an error.
+    #[serde(default = "default_timeout")]
+    pub timeout_s: f64,
+    /// Environment variables passed: all of forkbench's when absent, only these when given.
+    #[serde(default)]
+    pub pass_env: Option<Vec<String>>,
+}
+
+fn default_timeout() -> f64 {
+    10.0
+}
+
+/// Consecutive timeouts per command, across worker threads.
+static BREAKER: LazyLock<Breaker> = LazyLock::new(Breaker::default);
+
+/// The pallet as sent: its dimensions and the stringers derived from them.
+#[derive(Debug, Clone, Serialize)]
+struct PalletMsg {
+    depth_m: f64,
+    width_m: f64,
+    pocket_width_m: f64,
+    stringer_width_m: f64,
+    stringer_offsets_m: [f64; 3],
+}
+
+/// One scan as sent: the sensor's believed pose in the map, the beams in its frame
+/// (`null` where a beam returned nothing).
+#[derive(Debug, Clone, Serialize)]
+struct ScanMsg<'a> {
+    sensor: &'a str,
+    pose: Pose2,
+    angle_min_rad: f64,
+    angle_step_rad: f64,
+    range_min_m: f64,
+    range_max_m: f64,
+    ranges_m: Vec<Option<f64>>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+struct RequestMsg<'a> {
+    #[serde(rename = "type")]
+    kind: &'static str,
+    id: u64,
+    pallet: PalletMsg,
+    prior: Option<Pose2>,
+    scans: Vec<ScanMsg<'a>>,
+}
+
+/// An answer: the face found, none, or the detector's own error.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum ResponseMsg {
+    Pallet {
+        id: u64,
+        face: Pose2,
+        /// Index of the scan it used (default 0).
+        #[serde(default)]
+        sensor: usize,
+        /// RMS distance of the returns from the fitted face, if it has one.
+        #[serde(default)]
+        rms_m: Option<f64>,
+    },
+    None {
+        id: u64,
+    },
+    Error {
+        id: u64,
+        message: String,
+    },
+}
+
+impl ResponseMsg {
+    fn id(&self) -> u64 {
+        match self {
+            Self::Pallet { id, .. } | Self::None { id } | Self::Error { id, .. } => *id,
+        }
+    }
+}
+
+fn pallet_msg(p: &PalletSpec) -> PalletMsg {
+    PalletMsg {
+        depth_m: p.depth_m,
+        width_m: p.width_m,
+        pocket_width_m: p.pocket_width_m,
+        stringer_width_m: p.stringer_width_m(),
+        stringer_offsets_m: p.stringer_offsets_m(),
+    }
+}
+
+fn scan_msg<'a>(s: &SensorScan<'a>) -> ScanMsg<'a> {
+    ScanMsg {
+        sensor: s.sensor,
+        pose: s.scan.sensor,
+        angle_min_rad: s.scan.angle_min_rad,
+        angle_step_rad: s.scan.angle_step_rad,
+        range_min_m: s.scan.range_min_m,
+        range_max_m: s.scan.range_max_m,
+        ranges_m: s
+            .scan
+            .ranges_m
+            .iter()
+            .map(|r| r.is_finite().then_some(*r))
+            .collect(),
+    }
+}
+
+/// An external detector, as configured; its process lives in this thread's pool.
+#[derive(Debug, Clone)]
+pub struct ExternalDetector {
+    cfg: ExternalDetectorConfig,
+    dir: PathBuf,
+    name: String,
+}
+
+impl ExternalDetector {
+    /// From a detector table; `dir` is where the command runs, `name` what errors say.
+    pub fn from_settings(s: &Settings, dir: PathBuf, name: &str) -> Result<Self, SettingsError> {
+        let cfg: ExternalDetectorConfig = settings::parse(s)?;
+        if cfg.command.is_empty() || cfg.command[0].trim().is_empty() {
+            return Err(SettingsError::field(
+                "command",
+                "must name a program: [\"python3\", \"detector.py\"]",
+            ));
+        }
+        if !(cfg.timeout_s.is_finite() && cfg.timeout_s > 0.0 && cfg.timeout_s <= MAX_TIMEOUT_S) {
+            return Err(SettingsError::field(
+                "timeout_s",
+                format!("must lie in (0, {MAX_TIMEOUT_S}] s"),
+            ));
+        }
+        Ok(Self {
+            cfg,
+            dir,
+            name: name.to_owned(),
+        })
+    }
+
+    fn timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.cfg.timeout_s)
+    }
+
+    fn env(&self) -> EnvPolicy {
+        self.cfg
+            .pass_env
+            .clone()
+            .map_or(EnvPolicy::Inherit, EnvPolicy::Only)
+    }
+
+    fn pool_key(&self) -> PoolKey {
+        (
+            PROTOCOL,
+            self.cfg.command.clone(),
+            self.dir.clone(),
+            self.env(),
+        )
+    }
+
+    fn take_process(&self) -> Result<(Process, u64), ExchangeError> {
+        if let Some(p) = forkbench_ipc::take_pooled(&self.pool_key()) {
+            return Ok(p);
+        }
+        let spawn = Spawn {
+            command: &self.cfg.command,
+            dir: &self.dir,
+            env: &self.env(),
+            what: "detector",
+        };
+        let p = forkbench_ipc::start_with_hello(spawn, PROTOCOL, VERSION, self.timeout())?;
+        Ok((p, 0))
+    }
+
+    /// One request on a (possibly new) process, counted by the circuit breaker; the
+    /// process goes back to the pool only when the exchange kept to the protocol.
+    fn request(&self, req: &DetectRequest<'_>) -> Result<ResponseMsg, String> {
+        let key = format!("{:?} in {}", self.cfg.command, self.dir.display());
+        BREAKER.check(&key)?;
+        let r = self.exchange(req);
+        BREAKER.record(&key, r.as_ref().is_err_and(|e| e.timed_out));
+        r.map_err(String::from)
+    }
+
+    fn exchange(&self, req: &DetectRequest<'_>) -> Result<ResponseMsg, ExchangeError> {
+        let (mut proc, id) = self.take_process()?;
+        let msg = RequestMsg {
+            kind: "detect",
+            id,
+            pallet: pallet_msg(req.pallet),
+            prior: req.prior,
+            scans: req.scans.iter().map(scan_msg).collect(),
+        };
+        let line = serde_json::to_string(&msg).map_err(|e| ExchangeError::other(e.to_string()))?;
+        let answer = proc.exchange(&line, self.timeout())?;
+        let msg: ResponseMsg = serde_json::from_str(&answer).map_err(|e| {
+            ExchangeError::other(format!("invalid answer ({e}): {:?}", clip(&answer)))
+        })?;
+        if msg.id() != id {
+            return Err(ExchangeError::other(format!(
+                "answered request {}, expected {id}",
+                msg.id()
+            )));
+        }
+        forkbench_ipc::put_back(self.pool_key(), proc, id + 1);
+        Ok(msg)
+    }
+}
+
+/// Why an answered face cannot be a detection: not finite, or out of every sensor's reach.
+fn implausible(face: &Pose2, sensor: usize, req: &DetectRequest<'_>) -> Option<String> {
+    if !face.is_finite() {
+        return Some(format!("the face pose is not finite: {face:?}"));
+    }
+    let Some(s) = req.scans.get(sensor) else {
+        return Some(format!(
+            "sensor {sensor} does not exist ({} scans were sent)",
+            req.scans.len()
+        ));
+    };
+    let reach = s.scan.range_max_m + req.pallet.width_m;
+    (face.distance_to(&s.scan.sensor) > reach).then(|| {
+        format!(
+            "the face ({:.2}, {:.2}) m lies beyond the sensor's reach ({reach:.1} m)",
+            face.x_m, face.y_m
+        )
+    })
+}
+
+impl PalletDetector for ExternalDetector {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn detect(&mut self, req: &DetectRequest<'_>) -> Result<Option<Found>, DetectorError> {
+        let fail = |reason: String| DetectorError {
+            detector: self.name.clone(),
+            reason,
+        };
+        match self.request(req).map_err(fail)? {
+            ResponseMsg::None { .. } => Ok(None),
+            ResponseMsg::Error { message, .. } => {
+                Err(fail(format!("it reported: {}", clip(&message))))
+            }
+            ResponseMsg::Pallet {
+                face,
+                sensor,
+                rms_m,
+                ..
+            } => {
+                if let Some(why) = implausible(&face, sensor, req) {
+                    return Err(fail(why));
+                }
+                Ok(Some(Found {
+                    detection: Detection {
+                        face,
+                        stringers: 0,
+                        points: 0,
+                        rms_m: rms_m.unwrap_or(f64::NAN),
+                    },
+                    sensor,
+                }))
+            }
+        }
+    }
+}
