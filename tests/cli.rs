@@ -389,6 +389,8 @@ fn batch_writes_results_and_regress_gates_them() {
         "4",
         "--pallet-noise-scale",
         "0",
+        "--pallet-sensing",
+        "gaussian",
         "--out",
         dir,
         "--csv",
@@ -996,10 +998,13 @@ fn error_messages_are_polished() {
     let out = forkbench(&["replay", lines.to_str().expect("utf8"), "--line", "0"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("numbered from 1"));
-    let behind = text.replace(
-        "pallet = { x_m = 1.832533, y_m = 14.917769",
-        "pallet = { x_m = 0.505353, y_m = 1.0",
-    );
+    // The Gaussian model "sees" a pallet behind the truck, so the planner is what refuses.
+    let behind = text
+        .replace(
+            "pallet = { x_m = 1.832533, y_m = 14.917769",
+            "pallet = { x_m = 0.505353, y_m = 1.0",
+        )
+        .replace("kind = \"tim561+kinect2\"", "kind = \"gaussian\"");
     let f = tmp("pallet-behind.toml");
     std::fs::write(&f, behind).expect("write");
     let out = forkbench(&["trial", f.to_str().expect("utf8"), "--no-noise"]);

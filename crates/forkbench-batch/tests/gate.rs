@@ -18,8 +18,11 @@ fn scenario_file(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios")).join(name)
 }
 
+/// A scenario with the Gaussian pallet model: the power figures below were measured on it.
 fn scenario(name: &str) -> Scenario {
-    Scenario::load(&scenario_file(name)).expect("loads")
+    Scenario::load(&scenario_file(name))
+        .and_then(|s| s.with_pallet_sensing("gaussian"))
+        .expect("loads")
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -87,7 +90,9 @@ fn offset_scenario(name: &str) -> Scenario {
     let registry = Registry::builtin().with_tracker("pure_pursuit", |s, _| {
         Ok(Box::new(Offset(PurePursuit::from_settings(s)?)))
     });
-    Scenario::load_with(&scenario_file(name), Arc::new(registry)).expect("loads")
+    Scenario::load_with(&scenario_file(name), Arc::new(registry))
+        .and_then(|s| s.with_pallet_sensing("gaussian"))
+        .expect("loads")
 }
 
 #[test]

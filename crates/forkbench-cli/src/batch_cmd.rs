@@ -53,6 +53,11 @@ pub struct BatchArgs {
     /// Trials per scenario × case × planner × tracker.
     #[arg(long, default_value_t = 20)]
     pub trials: u64,
+    /// Estimate the pallet with this sensing in every scenario, at its default settings:
+    /// gaussian (the range-scaled Gaussian around the truth), tim561, kinect2 or
+    /// tim561+kinect2 (default: each scenario's own [sensors.pallet]).
+    #[arg(long, value_name = "KIND")]
+    pub pallet_sensing: Option<String>,
     /// Batch seed; each trial's seed derives from it and the trial's identity.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -186,6 +191,13 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
             .iter()
             .map(|p| Scenario::load(p))
             .collect::<Result<_, _>>()?
+    };
+    let scenarios = match &a.pallet_sensing {
+        Some(kind) => scenarios
+            .into_iter()
+            .map(|s| s.with_pallet_sensing(kind))
+            .collect::<Result<_, _>>()?,
+        None => scenarios,
     };
     let shard = match a.shard.as_deref() {
         Some(text) => {

@@ -1,5 +1,6 @@
 //! `forkbench`: the command-line front end (parse, call the libraries, print).
 
+mod accuracy_cmd;
 mod batch_cmd;
 mod corridor_cmd;
 mod gate_cmd;
@@ -44,6 +45,8 @@ enum ReproduceArg {
     Spiral,
     Corridor,
     Prm,
+    /// The pallet detector's accuracy over range, angle and lateral offset.
+    Detector,
 }
 
 /// Recording targets of one trial.
@@ -208,6 +211,9 @@ enum Command {
         /// Draw all paths, curvature and steering to FILE (.svg or .png).
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// `reproduce detector`: scans per placement.
+        #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(2..=10_000))]
+        draws: u32,
     },
 }
 
@@ -292,7 +298,8 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             table,
             json,
             plot,
-        } => reproduce(&what, table.as_deref(), json, plot.as_deref()).map(|()| Done::Ok),
+            draws,
+        } => reproduce(&what, table.as_deref(), (json, draws), plot.as_deref()).map(|()| Done::Ok),
         Command::Corridor(args) => corridor_cmd::run(&args.resolve()?).map(|()| Done::Ok),
         Command::Map(args) => map_cmd::run(&args).map(|()| Done::Ok),
         Command::Scan(args) => scan_cmd::run(&args).map(|()| Done::Ok),
@@ -303,7 +310,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
 fn reproduce(
     what: &ReproduceArg,
     table: Option<&std::path::Path>,
-    json: bool,
+    (json, draws): (bool, u32),
     plot: Option<&std::path::Path>,
 ) -> anyhow::Result<()> {
     match what {
@@ -322,6 +329,8 @@ fn reproduce(
             }
             route_cmd::reproduce(100, json, plot)
         }
+        // --table: a scenario whose pallet and sensing are studied.
+        ReproduceArg::Detector => accuracy_cmd::run(table, draws, json, plot),
     }
 }
 

@@ -20,7 +20,7 @@ pub struct ScanArgs {
     /// Fork-root pose to scan from, `x,y,heading_deg` (default: the case's start).
     #[arg(long, value_parser = crate::parse_pose, allow_hyphen_values = true)]
     at: Option<Pose2>,
-    /// Scanner model.
+    /// Scanner model (the scenario's own settings for it when it has that scanner).
     #[arg(long, default_value = "tim561")]
     sensor: String,
     /// Seed of the pallet's jitter and the scanner's noise and bias.
@@ -37,14 +37,20 @@ pub struct ScanArgs {
 }
 
 pub fn run(a: &ScanArgs) -> anyhow::Result<()> {
-    let cfg = ScannerConfig::preset(&a.sensor).with_context(|| {
-        format!(
-            "--sensor {:?}: unknown (known: {})",
-            a.sensor,
-            SCANNER_PRESETS.join(", ")
-        )
-    })?;
     let scn = forkbench_trial::Scenario::load(&a.scenario)?;
+    // The scenario's own scanner of that model (with its settings), else the model's.
+    let cfg = scn
+        .pallet_sensing
+        .scanner(&a.sensor)
+        .cloned()
+        .or_else(|| ScannerConfig::preset(&a.sensor))
+        .with_context(|| {
+            format!(
+                "--sensor {:?}: unknown (known: {})",
+                a.sensor,
+                SCANNER_PRESETS.join(", ")
+            )
+        })?;
     let case = crate::trial_cmd::pick_case(&scn, &a.scenario, a.case.as_deref())?;
     let report = scan_once(&scn, case, (&a.sensor, &cfg), a.at, a.seed, a.no_noise)?;
     if let Some(file) = &a.plot {

@@ -11,6 +11,7 @@ fn field_test() -> Scenario {
         env!("CARGO_MANIFEST_DIR"),
         "/../../scenarios/field-test.toml"
     )))
+    .and_then(|s| s.with_pallet_sensing("gaussian"))
     .expect("loads")
 }
 

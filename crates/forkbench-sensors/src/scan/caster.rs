@@ -170,5 +170,16 @@ pub(super) fn spot_return(cfg: &ScannerConfig, caster: &Caster, a: f64) -> Optio
     if n < 2 || hi - lo <= EDGE_M {
         return centre;
     }
+    if cfg.echo_separation_m > 0.0 && hi - lo > cfg.echo_separation_m {
+        // Two echoes told apart: the one from the larger share of the spot (the nearer on
+        // a tie, which arrives first).
+        let near = subs.iter().filter(|r| **r - lo <= EDGE_M).count();
+        let far: Vec<f64> = subs.iter().copied().filter(|r| *r - lo > EDGE_M).collect();
+        return if 2 * near >= n || far.is_empty() {
+            Some((lo, 0.0))
+        } else {
+            Some((far.iter().sum::<f64>() / far.len() as f64, 0.0))
+        };
+    }
     Some((subs.iter().sum::<f64>() / n as f64, 0.0))
 }

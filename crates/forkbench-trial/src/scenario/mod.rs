@@ -259,6 +259,14 @@ impl Scenario {
         })
     }
 
+    /// The same scenario estimating the pallet with `kind` (`gaussian`, `tim561`,
+    /// `kinect2`, `tim561+kinect2`) at its default settings and the pocket detector: how
+    /// a run compares sensing models on the same seeds.
+    pub fn with_pallet_sensing(mut self, kind: &str) -> Result<Self, TrialError> {
+        self.pallet_sensing = sensors::of_kind(kind, &self.truck, &self.file)?;
+        Ok(self)
+    }
+
     pub fn case(&self, name: &str) -> Result<&Case, TrialError> {
         self.cases
             .iter()

@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 
 use forkbench_core::ForkliftSpec;
+use forkbench_sensors::detect::DetectorConfig;
 use forkbench_sensors::scan::{SCANNER_PRESETS, ScannerConfig};
 use serde::{Deserialize, Serialize};
 
@@ -55,6 +56,26 @@ pub enum PalletSensing {
 impl PalletSensing {
     pub fn is_gaussian(&self) -> bool {
         matches!(self, PalletSensing::Gaussian)
+    }
+
+    /// The settings of this sensing's scanner of model `name`, if it has one.
+    pub fn scanner(&self, name: &str) -> Option<&ScannerConfig> {
+        match self {
+            PalletSensing::Scanner { sensors, .. } => {
+                sensors.iter().find(|s| s.name == name).map(|s| &s.scanner)
+            }
+            PalletSensing::Gaussian => None,
+        }
+    }
+
+    /// The pocket detector's settings, when this sensing uses it (else its defaults).
+    pub fn pocket_settings(&self) -> DetectorConfig {
+        match self {
+            PalletSensing::Scanner { detector, .. } if detector.kind == "pockets" => {
+                forkbench_core::settings::parse(&detector.settings).unwrap_or_default()
+            }
+            _ => DetectorConfig::default(),
+        }
     }
 }
 
@@ -130,6 +151,23 @@ pub(super) fn resolve(
     let detector = ComponentSpec::from_value(Role::Detector, &table, Some("pockets"), ".".into())
         .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))?;
     Ok(PalletSensing::Scanner { sensors, detector })
+}
+
+/// The sensing a kind names with every setting at its default (`--pallet-sensing`).
+pub(super) fn of_kind(
+    kind: &str,
+    truck: &ForkliftSpec,
+    file: &str,
+) -> Result<PalletSensing, TrialError> {
+    let f = SensorsFile {
+        pallet: Some(PalletSensorFile {
+            kind: kind.to_owned(),
+            scanner: None,
+            scanners: BTreeMap::new(),
+            detector: None,
+        }),
+    };
+    resolve(Some(&f), truck, file)
 }
 
 /// A scanner's settings in range, and its mount outside the truck's body.

@@ -2,7 +2,7 @@
 
 use forkbench_core::Pose2;
 use forkbench_core::signal::Scan;
-use forkbench_sensors::detect::{Detection, DetectorConfig, detect};
+use forkbench_sensors::detect::{Detection, detect};
 use forkbench_sensors::scan::{Errors, ScannerConfig, scan};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -54,7 +54,7 @@ pub fn scan_once(
     };
     // Where the pallet should stand is where the detector looks (as in a trial).
     let estimate = detect(
-        &DetectorConfig::default(),
+        &scn.pallet_sensing.pocket_settings(),
         &s,
         &scn.pallet,
         Some(&case.pallet),

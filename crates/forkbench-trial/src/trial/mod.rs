@@ -1,5 +1,6 @@
 //! One pick trial as named stages: setup, plan, drive (with replans), judge.
 
+pub mod accuracy;
 mod drive;
 mod error;
 mod judge;
