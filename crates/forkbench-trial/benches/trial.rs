@@ -26,11 +26,16 @@ fn bench(c: &mut Criterion) {
             });
         }
     }
-    // The same pick with the pallet estimated from a TiM561 scan and the pocket detector
-    // (first estimate and two re-estimates) and with the Gaussian model.
+    // The same pick with the pallet estimated from a TiM561 scan (and with the Kinect v2
+    // row fused) and the pocket detector (first estimate and two re-estimates), and with
+    // the Gaussian model.
     for (label, sensing) in [
         ("gaussian", ""),
         ("tim561", "[sensors.pallet]\nkind = \"tim561\"\n"),
+        (
+            "tim561_kinect2",
+            "[sensors.pallet]\nkind = \"tim561+kinect2\"\n",
+        ),
     ] {
         let text = format!(
             "name = \"near\"\nplanner = \"bspline\"\npallet_kind = \"field-1200\"\n\

@@ -122,8 +122,13 @@ impl ScannerConfig {
 
     /// The random range error's σ at range `r_m` and incidence `theta_rad` (0 = head-on).
     pub fn range_sigma_at(&self, r_m: f64, theta_rad: f64) -> f64 {
-        let edge = (std::f64::consts::FRAC_PI_2 - theta_rad).max(1e-3);
-        let incidence = self.incidence_sigma * r_m.powf(1.5) * (theta_rad / edge).powi(2);
+        // A laser's σ is one constant: skip the power per beam.
+        let incidence = if self.incidence_sigma == 0.0 {
+            0.0
+        } else {
+            let edge = (std::f64::consts::FRAC_PI_2 - theta_rad).max(1e-3);
+            self.incidence_sigma * r_m * r_m.sqrt() * (theta_rad / edge).powi(2)
+        };
         (self.range_sigma_m
             + self.range_sigma_per_m * r_m
             + self.range_sigma_per_m2 * r_m * r_m
