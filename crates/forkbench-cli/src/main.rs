@@ -3,6 +3,7 @@
 mod accuracy_cmd;
 mod batch_cmd;
 mod corridor_cmd;
+mod coverage_cmd;
 mod gate_cmd;
 mod map_cmd;
 mod map_plot;
@@ -200,6 +201,9 @@ enum Command {
     /// One scan of a scenario's world from the truck, with the pallet detector's estimate
     /// beside the truth.
     Scan(scan_cmd::ScanArgs),
+    /// Reflector coverage of a world: reflectors in sight and the NAV350 fix's predicted
+    /// 1σ at every free cell.
+    Coverage(coverage_cmd::CoverageArgs),
     /// Reproduce a paper's table side by side with this project's results.
     Reproduce {
         what: ReproduceArg,
@@ -303,6 +307,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Corridor(args) => corridor_cmd::run(&args.resolve()?).map(|()| Done::Ok),
         Command::Map(args) => map_cmd::run(&args).map(|()| Done::Ok),
         Command::Scan(args) => scan_cmd::run(&args).map(|()| Done::Ok),
+        Command::Coverage(args) => coverage_cmd::run(&args).map(|()| Done::Ok),
     }
 }
 

@@ -3,6 +3,7 @@
 pub mod detect;
 pub mod detector;
 pub mod external;
+pub mod reflectors;
 pub mod scan;
 
 use std::collections::VecDeque;

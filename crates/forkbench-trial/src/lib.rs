@@ -1,6 +1,7 @@
 //! One pick trial end to end: scenario and world files, noisy estimate → plan → tracker in rapier2d → judged outcome, with components from a registry.
 
 pub mod components;
+pub mod coverage;
 pub mod defaults;
 pub mod mission_summary;
 pub mod outcome;

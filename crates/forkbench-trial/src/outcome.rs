@@ -100,6 +100,14 @@ pub struct TrialOutcome {
     pub path_length_m: f64,
     pub sim_time_s: f64,
     pub wall_time_ms: f64,
+    /// Every other criterion the trial broke, after the first, each with its value and
+    /// limit (`criterion: detail`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub also_failed: Vec<String>,
+    /// What most likely made the trial fail (the estimate's error, a saturated steer),
+    /// when the bench can tell.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub likely_cause: Option<String>,
     /// A mission's legs before the pick, in order (empty for a pick trial).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub legs: Vec<LegOutcome>,
@@ -163,7 +171,16 @@ impl TrialOutcome {
                 self.heading_error_rad.unwrap_or(f64::NAN).to_degrees(),
                 self.insertion_depth_m
             ),
-            (false, Some(_), Some(d)) => format!("{}: {d}", self.verdict_word()),
+            (false, Some(_), Some(d)) => {
+                let mut line = format!("{}: {d}", self.verdict_word());
+                if let Some(c) = &self.likely_cause {
+                    line += &format!("; likely cause: {c}");
+                }
+                if !self.also_failed.is_empty() {
+                    line += &format!("; also {}", self.also_failed.join("; "));
+                }
+                line
+            }
             _ => self.verdict_word(),
         }
     }
@@ -205,6 +222,8 @@ impl TrialOutcome {
             sim_time_s: 0.0,
             wall_time_ms: 0.0,
             legs: Vec::new(),
+            also_failed: Vec::new(),
+            likely_cause: None,
         }
     }
 }

@@ -116,3 +116,38 @@ fn the_accuracy_study_sees_the_camera_near_and_the_lasers_bias_far() {
         far.along.sigma
     );
 }
+
+#[test]
+fn a_failed_trial_names_every_broken_criterion_and_the_likely_cause() {
+    // The estimate 0.3 m to the side of the pallet: the truck aims beside the pockets.
+    let scn = scenario(
+        "estimate_bias = { x_m = 0.0, y_m = 0.3, heading_deg = 0.0 }\n",
+        "{ x_m = 5.0, y_m = 0.0, heading_deg = 0.0 }",
+    )
+    .expect("loads");
+    let opts = TrialOptions {
+        no_noise: true,
+        ..TrialOptions::default()
+    };
+    let out = run_trial(&scn, &scn.cases[0], &opts);
+    assert!(!out.success, "{out:?}");
+    let first = out.failure.expect("a failure").name();
+    assert!(!out.also_failed.is_empty(), "{out:?}");
+    assert!(
+        out.also_failed
+            .iter()
+            .all(|a| !a.starts_with(&format!("{first}:"))),
+        "{:?}",
+        out.also_failed
+    );
+    let cause = out.likely_cause.clone().expect("a likely cause");
+    assert!(
+        cause.contains("-0.300 m") || cause.contains("0.300 m"),
+        "{cause}"
+    );
+    let line = out.verdict_line();
+    assert!(
+        line.contains("likely cause") && line.contains("; also "),
+        "{line}"
+    );
+}

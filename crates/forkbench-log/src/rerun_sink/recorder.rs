@@ -90,7 +90,20 @@ impl RerunRecorder {
                 o.failure.map_or("unknown", |f| f.name())
             )
         };
-        let detail = o.failure_detail.as_deref().unwrap_or("");
+        // The first failed criterion, the likely cause, then every other one broken.
+        let mut detail = o.failure_detail.clone().unwrap_or_default();
+        if let Some(c) = &o.likely_cause {
+            detail += &format!("\n\n**Likely cause:** {c}");
+        }
+        for other in &o.also_failed {
+            detail += &format!("\n\n❌ also {other}");
+        }
+        if o.estimates_missed > 0 {
+            detail += &format!(
+                "\n\n{} of {} pallet estimates found no pallet (scans under map/sensors)",
+                o.estimates_missed, o.estimates
+            );
+        }
         let [lat_limit, head_limit] = self.limits;
         let num = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map_or("—".to_owned(), f);
         format!(

@@ -102,6 +102,9 @@ pub struct World {
     /// fork root should reach.
     #[serde(default)]
     pub station: Vec<PalletSlot>,
+    /// NAV350 reflectors (points in the scanner's plane).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reflector: Vec<forkbench_sensors::reflectors::Reflector>,
 }
 
 impl World {
@@ -199,7 +202,54 @@ impl World {
                 }
             }
         }
+        self.check_reflectors(file)
+    }
+
+    /// Reflectors: finite and within the world's extent, each name once, none inside a
+    /// rack or wall (mount them on a face, a few centimetres proud of it).
+    fn check_reflectors(&self, file: &str) -> Result<(), TrialError> {
+        let obstacles = self.obstacles();
+        for (i, r) in self.reflector.iter().enumerate() {
+            let f = format!("reflector[{i}]");
+            PoseDeg {
+                x_m: r.x_m,
+                y_m: r.y_m,
+                heading_deg: 0.0,
+            }
+            .check(file, &f)?;
+            if let Some(j) = self.reflector[..i].iter().position(|o| o.name == r.name) {
+                return Err(invalid(
+                    file,
+                    &format!("{f}.name"),
+                    &format!("{:?} is also reflector[{j}]'s name", r.name),
+                ));
+            }
+            let at = Pose2::new(r.x_m, r.y_m, 0.0);
+            if let Some(o) = obstacles.iter().find(|o| {
+                let l = o.centre.to_local(&at);
+                l.x_m.abs() < o.length_m / 2.0 && l.y_m.abs() < o.width_m / 2.0
+            }) {
+                return Err(invalid(
+                    file,
+                    &f,
+                    &format!(
+                        "({}, {}) m lies inside the obstacle at ({}, {}) m; a reflector hangs on \
+                         a face, outside it",
+                        r.x_m, r.y_m, o.centre.x_m, o.centre.y_m
+                    ),
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// Every rack's and wall's sides, as the surfaces a scanner's light can meet.
+    pub fn fixed_surfaces(&self) -> Vec<forkbench_sensors::scan::Surface> {
+        use forkbench_sensors::scan::{Seen, Surface};
+        self.obstacles()
+            .iter()
+            .flat_map(|o| Surface::rect(&o.centre, o.length_m, o.width_m, Seen::Fixed))
+            .collect()
     }
 
     /// Racks and walls for the footprint checker, with a label per obstacle for messages.

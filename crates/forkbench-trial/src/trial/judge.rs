@@ -6,6 +6,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::setup::Trial;
 use crate::outcome::{Failure, TrialOutcome};
+use crate::text::compact_numbers;
 
 /// The pallet pose moved by a draw of N(0, σ) per axis in its own frame, truncated at 3σ.
 pub(super) fn jitter(pallet: &Pose2, sigma: &Pose2, rng: &mut ChaCha8Rng) -> Pose2 {
@@ -62,27 +63,58 @@ impl Trial<'_> {
             // Lateral position of the fork's middle in the pallet frame, against its pocket.
             .map(|(mid, py)| (pallet_now.to_local(mid).y_m - py).abs())
             .fold(0.0, f64::max);
-        let verdict = verdict(&self, worst_pocket_miss);
-        match verdict {
-            Some((f, why)) => self.out.fail(f, why),
+        let mut broken = violations(&self, worst_pocket_miss).into_iter();
+        match broken.next() {
+            Some((f, why)) => {
+                self.out.also_failed = broken
+                    .map(|(f, why)| format!("{}: {}", f.name(), compact_numbers(&why)))
+                    .collect();
+                self.out.likely_cause = likely_cause(&self);
+                self.out.fail(f, why);
+            }
             None => self.out.success = true,
         }
         self.out
     }
 }
 
-/// The first failed criterion, in check order, with its value and limit.
-fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
+/// What most likely made a trial fail, in the order a reviewer would look: the pallet
+/// estimate the truck last aimed at (off by more than half the entry limits), then the
+/// steering held at its limit. `None` when neither stands out.
+fn likely_cause(t: &Trial<'_>) -> Option<String> {
+    let (out, tol, truck) = (&t.out, &t.scn.tolerances, &t.scn.truck);
+    let lateral = out.estimate_lateral_error_m.unwrap_or(0.0);
+    let heading = out.estimate_heading_error_rad.unwrap_or(0.0);
+    if lateral.abs() > tol.lateral_m / 2.0 || heading.abs() > tol.heading_rad / 2.0 {
+        return Some(format!(
+            "the pallet estimate the truck last aimed at was {lateral:.3} m and {:.2}° off the \
+             true pallet",
+            heading.to_degrees()
+        ));
+    }
+    (out.max_steer_rad >= 0.98 * truck.max_steer_rad).then(|| {
+        format!(
+            "the steering reached its limit ({:.1}°): the path asked for more curvature than \
+             the truck has",
+            truck.max_steer_rad.to_degrees()
+        )
+    })
+}
+
+/// Every failed criterion, in check order (the first is the verdict), each with its value
+/// and limit.
+fn violations(t: &Trial<'_>, worst_pocket_miss: f64) -> Vec<(Failure, String)> {
+    let mut v = Vec::new();
     let (out, tol, truck) = (&t.out, &t.scn.tolerances, &t.scn.truck);
     let clearance = (t.scn.pallet.pocket_width_m - truck.fork_width_m) / 2.0;
     if t.collision {
-        return Some((
+        v.push((
             Failure::Collision,
             "truck touched a rack or wall".to_owned(),
         ));
     }
     if out.max_contact_force_n > tol.contact_force_n {
-        return Some((
+        v.push((
             Failure::ContactForce,
             format!(
                 "fork–pallet contact {:.0} N > {:.0} N before full depth",
@@ -93,7 +125,7 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
     if out.pallet_displacement_m > tol.pallet_displacement_m
         || out.pallet_rotation_rad.abs() > tol.pallet_rotation_rad
     {
-        return Some((
+        v.push((
             Failure::PalletDisplaced,
             format!(
                 "pallet moved {:.3} m and turned {:.2}° (limits {} m, {}°)",
@@ -105,7 +137,7 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
         ));
     }
     if let Some(e) = out.lateral_error_m.filter(|e| e.abs() > tol.lateral_m) {
-        return Some((
+        v.push((
             Failure::LateralError,
             format!(
                 "{e:.3} m off the pocket centre line at entry (limit {} m)",
@@ -114,7 +146,7 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
         ));
     }
     if let Some(e) = out.heading_error_rad.filter(|e| e.abs() > tol.heading_rad) {
-        return Some((
+        v.push((
             Failure::HeadingError,
             format!(
                 "{:.2}° off the pallet axis at entry (limit {}°)",
@@ -124,13 +156,13 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
         ));
     }
     if t.timed_out {
-        return Some((
+        v.push((
             Failure::Timeout,
             format!("not stopped at the goal after {} s", t.scn.timeout_s),
         ));
     }
     if out.insertion_depth_m < tol.insertion_depth_m {
-        return Some((
+        v.push((
             Failure::InsertionDepth,
             format!(
                 "forks {:.3} m deep (required {} m)",
@@ -138,14 +170,15 @@ fn verdict(t: &Trial<'_>, worst_pocket_miss: f64) -> Option<(Failure, String)> {
             ),
         ));
     }
-    (worst_pocket_miss > clearance).then(|| {
-        (
+    if worst_pocket_miss > clearance {
+        v.push((
             Failure::ForkOutsidePocket,
             format!(
                 "a fork is {worst_pocket_miss:.3} m from its pocket centre (clearance {clearance:.4} m)"
             ),
-        )
-    })
+        ));
+    }
+    v
 }
 
 #[cfg(test)]

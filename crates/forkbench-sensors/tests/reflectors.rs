@@ -1,0 +1,186 @@
+//! NAV350 reflector positioning: line of sight against an independent segment-versus-rectangle clip, the least-squares fix exact without noise and as spread as predicted with it, no fix from two reflectors, ambiguous associations dropped.
+
+use forkbench_core::Pose2;
+use forkbench_sensors::reflectors::{
+    Observation, Reflector, ReflectorNavConfig, associate, measure, predicted_sigma_m, solve,
+    visible,
+};
+use forkbench_sensors::scan::{Seen, Surface};
+use rand::{RngExt as _, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn refl(name: &str, x: f64, y: f64) -> Reflector {
+    Reflector {
+        name: name.into(),
+        x_m: x,
+        y_m: y,
+    }
+}
+
+/// Liang–Barsky: whether the segment a→b enters the rectangle (centre, length along the
+/// heading, width), clipped in the rectangle's own frame.
+fn clips(a: [f64; 2], b: [f64; 2], c: &Pose2, length: f64, width: f64) -> bool {
+    let la = c.to_local(&Pose2::new(a[0], a[1], 0.0));
+    let lb = c.to_local(&Pose2::new(b[0], b[1], 0.0));
+    let d = [lb.x_m - la.x_m, lb.y_m - la.y_m];
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-d[0], la.x_m + length / 2.0),
+        (d[0], length / 2.0 - la.x_m),
+        (-d[1], la.y_m + width / 2.0),
+        (d[1], width / 2.0 - la.y_m),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return false;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    t0 <= t1
+}
+
+type Rect = (Pose2, f64, f64);
+
+fn random_rects(rng: &mut ChaCha8Rng) -> Vec<Rect> {
+    (0..4)
+        .map(|_| {
+            let c = Pose2::new(
+                rng.random_range(2.0..18.0),
+                rng.random_range(2.0..18.0),
+                rng.random_range(-1.5..1.5),
+            );
+            (c, rng.random_range(0.2..4.0), rng.random_range(0.1..1.0))
+        })
+        .collect()
+}
+
+#[test]
+fn line_of_sight_matches_an_independent_clip() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let cfg = ReflectorNavConfig::default();
+    let (mut blocked, mut clear) = (0, 0);
+    for _ in 0..300 {
+        let rects = random_rects(&mut rng);
+        let fixed: Vec<Surface> = rects
+            .iter()
+            .flat_map(|(c, l, w)| Surface::rect(c, *l, *w, Seen::Fixed))
+            .collect();
+        let at = [rng.random_range(0.0..20.0), rng.random_range(0.0..20.0)];
+        let r = refl(
+            "r",
+            rng.random_range(0.0..20.0),
+            rng.random_range(0.0..20.0),
+        );
+        // Both ends outside every rectangle: line of sight is about what lies between.
+        let inside = |p: [f64; 2]| rects.iter().any(|(c, l, w)| clips(p, p, c, *l, *w));
+        if inside(at) || inside([r.x_m, r.y_m]) || (r.x_m - at[0]).hypot(r.y_m - at[1]) < 0.5 {
+            continue;
+        }
+        let want = !rects
+            .iter()
+            .any(|(c, l, w)| clips(at, [r.x_m, r.y_m], c, *l, *w));
+        let got = !visible(at, std::slice::from_ref(&r), &fixed, &cfg).is_empty();
+        assert_eq!(got, want, "from {at:?} to {r:?} past {rects:?}");
+        if want {
+            clear += 1;
+        } else {
+            blocked += 1;
+        }
+    }
+    assert!(
+        blocked > 30 && clear > 30,
+        "{blocked} blocked, {clear} clear"
+    );
+    // Pallets never block: they lie below the scanner's plane.
+    let pallet = Surface::rect(&Pose2::new(5.0, 0.0, 0.0), 1.2, 1.2, Seen::Pallet(0));
+    assert_eq!(
+        visible([0.0, 0.0], &[refl("a", 10.0, 0.0)], &pallet, &cfg),
+        vec![0]
+    );
+}
+
+fn ring(n: usize, radius: f64) -> Vec<Reflector> {
+    (0..n)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / n as f64 + 0.3;
+            refl(&format!("r{k}"), radius * a.cos(), radius * a.sin())
+        })
+        .collect()
+}
+
+fn exact_observations(truth: &Pose2, map: &[Reflector]) -> Vec<Observation> {
+    map.iter()
+        .map(|r| {
+            let (dx, dy) = (r.x_m - truth.x_m, r.y_m - truth.y_m);
+            Observation {
+                range_m: dx.hypot(dy),
+                bearing_rad: forkbench_core::units::wrap_angle(dy.atan2(dx) - truth.heading_rad),
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn the_fix_is_exact_without_noise_and_as_spread_as_predicted_with_it() {
+    let cfg = ReflectorNavConfig::default();
+    let map = ring(5, 10.0);
+    let truth = Pose2::new(1.3, -0.7, 0.4);
+    let exact = exact_observations(&truth, &map);
+    let predicted = Pose2::new(1.35, -0.66, 0.405);
+    let pairs = associate(&exact, &predicted, &map, &cfg);
+    assert_eq!(pairs.len(), 5);
+    let fix = solve(&exact, &pairs, &map, &predicted, &cfg).expect("fix");
+    assert!(
+        fix.pose.distance_to(&truth) < 1e-9
+            && (fix.pose.heading_rad - truth.heading_rad).abs() < 1e-12,
+        "{fix:?}"
+    );
+    assert!(fix.mean_deviation_m < 1e-9 && fix.used.len() == 5);
+    // With noise: the radial RMS error over many fixes is the predicted σ.
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let seen: Vec<usize> = (0..map.len()).collect();
+    let n = 3000;
+    let ss: f64 = (0..n)
+        .map(|_| {
+            let obs = measure(&truth, &map, &seen, &cfg, &mut rng);
+            let pairs = associate(&obs, &truth, &map, &cfg);
+            let f = solve(&obs, &pairs, &map, &truth, &cfg).expect("fix");
+            f.pose.distance_to(&truth).powi(2)
+        })
+        .sum();
+    let rms = (ss / n as f64).sqrt();
+    let pts: Vec<[f64; 2]> = map.iter().map(|r| [r.x_m, r.y_m]).collect();
+    let sigma = predicted_sigma_m([truth.x_m, truth.y_m], &pts, &cfg).expect("σ");
+    assert!(
+        (rms / sigma - 1.0).abs() < 0.06,
+        "rms {rms} vs predicted {sigma}"
+    );
+    // The calibration: four reflectors around at 10 m give ±4 mm per axis as 2σ.
+    let four: Vec<[f64; 2]> = ring(4, 10.0).iter().map(|r| [r.x_m, r.y_m]).collect();
+    let per_axis = predicted_sigma_m([0.0, 0.0], &four, &cfg).expect("σ") / 2f64.sqrt();
+    assert!((per_axis - 0.002).abs() < 1e-4, "{per_axis}");
+}
+
+#[test]
+fn two_reflectors_give_no_fix_and_ambiguity_is_dropped() {
+    let cfg = ReflectorNavConfig::default();
+    let map = ring(2, 8.0);
+    let truth = Pose2::new(0.0, 0.0, 0.0);
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let obs = measure(&truth, &map, &[0, 1], &cfg, &mut rng);
+    let pairs = associate(&obs, &truth, &map, &cfg);
+    assert_eq!(pairs.len(), 2);
+    assert!(solve(&obs, &pairs, &map, &truth, &cfg).is_none());
+    assert!(predicted_sigma_m([0.0, 0.0], &[[8.0, 0.0], [0.0, 8.0]], &cfg).is_none());
+    // Two map reflectors 0.3 m apart, both within the gate: neither is used.
+    let close = vec![refl("a", 5.0, 0.0), refl("b", 5.0, 0.3)];
+    let obs = measure(&truth, &close, &[0], &cfg, &mut rng);
+    assert!(associate(&obs, &truth, &close, &cfg).is_empty());
+}

@@ -1,0 +1,77 @@
+//! Reflector coverage: the warehouse's layout gives most free cells a fix with millimetre σ, removing an aisle's reflectors leaves it without one, and bad reflectors are refused at load naming the field.
+
+use forkbench_sensors::reflectors::ReflectorNavConfig;
+use forkbench_trial::World;
+use forkbench_trial::coverage::coverage;
+use forkbench_trial::defaults::embedded_world;
+
+#[test]
+fn the_warehouse_layout_covers_its_aisles_and_losing_one_aisles_reflectors_shows() {
+    let cfg = ReflectorNavConfig::default();
+    let full = embedded_world("warehouse.toml").expect("world");
+    let cov = coverage(&full, 0.5, &cfg).expect("coverage");
+    let with_fix = cov.cells.iter().filter(|c| c.sigma_m.is_some()).count();
+    assert!(
+        with_fix * 10 > cov.cells.len() * 9,
+        "{with_fix} of {}",
+        cov.cells.len()
+    );
+    // The aisle between rows 1 and 2 (y 5.75–11.75 m, x 10–35 m) is covered everywhere.
+    let aisle = |c: &&forkbench_trial::coverage::CoverageCell| {
+        (10.0..35.0).contains(&c.x_m) && (6.5..11.0).contains(&c.y_m)
+    };
+    assert!(
+        cov.cells
+            .iter()
+            .filter(aisle)
+            .all(|c| c.sigma_m.is_some_and(|s| s < 0.005))
+    );
+    // Without the reflectors that face that aisle and its ends, its middle has no fix.
+    let mut degraded = full.clone();
+    degraded.reflector.retain(|r| {
+        !(r.name.starts_with("row1-north")
+            || r.name.starts_with("row2-south")
+            || r.name.starts_with("east-8.75")
+            || r.name.starts_with("shelf-frame0"))
+    });
+    let cov = coverage(&degraded, 0.5, &cfg).expect("coverage");
+    let middle = |c: &&forkbench_trial::coverage::CoverageCell| {
+        (14.0..31.0).contains(&c.x_m) && (7.5..10.0).contains(&c.y_m)
+    };
+    let lost = cov
+        .cells
+        .iter()
+        .filter(middle)
+        .filter(|c| c.sigma_m.is_none())
+        .count();
+    let all = cov.cells.iter().filter(middle).count();
+    assert!(
+        lost * 2 > all,
+        "{lost} of {all} middle cells lost their fix"
+    );
+}
+
+#[test]
+fn bad_reflectors_are_refused_naming_the_field() {
+    let base = "name = \"w\"\n[[wall]]\nx_m = 0.0\ny_m = 0.0\nlength_m = 4.0\nwidth_m = 0.2\n";
+    for (extra, field) in [
+        (
+            "[[reflector]]\nname = \"a\"\nx_m = 0.5\ny_m = 0.0\n",
+            "reflector[0]",
+        ),
+        (
+            "[[reflector]]\nname = \"a\"\nx_m = 0.5\ny_m = 1.0\n[[reflector]]\nname = \"a\"\nx_m = 1.5\ny_m = 1.0\n",
+            "reflector[1].name",
+        ),
+        (
+            "[[reflector]]\nname = \"a\"\nx_m = nan\ny_m = 1.0\n",
+            "reflector[0].x_m",
+        ),
+        ("[[reflector]]\nname = \"a\"\nx_m = 1.0\n", "reflector"),
+    ] {
+        let e = World::parse(&format!("{base}{extra}"), "w.toml")
+            .expect_err(extra)
+            .to_string();
+        assert!(e.contains(field) && e.contains("w.toml"), "{extra}: {e}");
+    }
+}
