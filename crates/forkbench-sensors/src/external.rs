@@ -2,11 +2,10 @@
 
 use std::path::PathBuf;
 use std::sync::LazyLock;
-use std::time::Duration;
 
 use forkbench_core::settings::{self, Settings, SettingsError};
 use forkbench_core::{PalletSpec, Pose2};
-use forkbench_ipc::{Breaker, EnvPolicy, ExchangeError, PoolKey, Process, Spawn, clip};
+use forkbench_ipc::{Breaker, ExchangeError, Process, Spawn, clip};
 use serde::{Deserialize, Serialize};
 
 use crate::detect::Detection;
@@ -16,27 +15,8 @@ use crate::detector::{DetectRequest, DetectorError, Found, PalletDetector, Senso
 pub const PROTOCOL: &str = "forkbench-detector";
 /// The protocol version this forkbench speaks.
 pub const VERSION: u64 = 1;
-/// Longest answer time a scenario may allow a detector.
-pub const MAX_TIMEOUT_S: f64 = 600.0;
-
-/// Settings of `[sensors.pallet.detector] kind = "external"`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ExternalDetectorConfig {
-    /// Program and arguments, run in the directory of the file that names them.
-    pub command: Vec<String>,
-    /// Longest wait for the hello and for each answer; past it the process group is
-    /// killed and the trial ends in an error.
-    #[serde(default = "default_timeout")]
-    pub timeout_s: f64,
-    /// Environment variables passed: all of forkbench's when absent, only these when given.
-    #[serde(default)]
-    pub pass_env: Option<Vec<String>>,
-}
-
-fn default_timeout() -> f64 {
-    10.0
-}
+/// Settings of `[sensors.pallet.detector] kind = "external"`: the shared command settings.
+pub type ExternalDetectorConfig = forkbench_ipc::CommandConfig;
 
 /// Consecutive timeouts per command, across worker threads.
 static BREAKER: LazyLock<Breaker> = LazyLock::new(Breaker::default);
@@ -144,17 +124,8 @@ impl ExternalDetector {
     /// From a detector table; `dir` is where the command runs, `name` what errors say.
     pub fn from_settings(s: &Settings, dir: PathBuf, name: &str) -> Result<Self, SettingsError> {
         let cfg: ExternalDetectorConfig = settings::parse(s)?;
-        if cfg.command.is_empty() || cfg.command[0].trim().is_empty() {
-            return Err(SettingsError::field(
-                "command",
-                "must name a program: [\"python3\", \"detector.py\"]",
-            ));
-        }
-        if !(cfg.timeout_s.is_finite() && cfg.timeout_s > 0.0 && cfg.timeout_s <= MAX_TIMEOUT_S) {
-            return Err(SettingsError::field(
-                "timeout_s",
-                format!("must lie in (0, {MAX_TIMEOUT_S}] s"),
-            ));
+        if let Some((field, why)) = cfg.problem("[\"python3\", \"detector.py\"]") {
+            return Err(SettingsError::field(field, why));
         }
         Ok(Self {
             cfg,
@@ -163,44 +134,24 @@ impl ExternalDetector {
         })
     }
 
-    fn timeout(&self) -> Duration {
-        Duration::from_secs_f64(self.cfg.timeout_s)
-    }
-
-    fn env(&self) -> EnvPolicy {
-        self.cfg
-            .pass_env
-            .clone()
-            .map_or(EnvPolicy::Inherit, EnvPolicy::Only)
-    }
-
-    fn pool_key(&self) -> PoolKey {
-        (
-            PROTOCOL,
-            self.cfg.command.clone(),
-            self.dir.clone(),
-            self.env(),
-        )
-    }
-
     fn take_process(&self) -> Result<(Process, u64), ExchangeError> {
-        if let Some(p) = forkbench_ipc::take_pooled(&self.pool_key()) {
+        if let Some(p) = forkbench_ipc::take_pooled(&self.cfg.pool_key(PROTOCOL, &self.dir)) {
             return Ok(p);
         }
         let spawn = Spawn {
             command: &self.cfg.command,
             dir: &self.dir,
-            env: &self.env(),
+            env: &self.cfg.env(),
             what: "detector",
         };
-        let p = forkbench_ipc::start_with_hello(spawn, PROTOCOL, VERSION, self.timeout())?;
+        let p = forkbench_ipc::start_with_hello(spawn, PROTOCOL, VERSION, self.cfg.timeout())?;
         Ok((p, 0))
     }
 
     /// One request on a (possibly new) process, counted by the circuit breaker; the
     /// process goes back to the pool only when the exchange kept to the protocol.
     fn request(&self, req: &DetectRequest<'_>) -> Result<ResponseMsg, String> {
-        let key = format!("{:?} in {}", self.cfg.command, self.dir.display());
+        let key = self.cfg.breaker_key(&self.dir);
         BREAKER.check(&key)?;
         let r = self.exchange(req);
         BREAKER.record(&key, r.as_ref().is_err_and(|e| e.timed_out));
@@ -217,7 +168,7 @@ impl ExternalDetector {
             scans: req.scans.iter().map(scan_msg).collect(),
         };
         let line = serde_json::to_string(&msg).map_err(|e| ExchangeError::other(e.to_string()))?;
-        let answer = proc.exchange(&line, self.timeout())?;
+        let answer = proc.exchange(&line, self.cfg.timeout())?;
         let msg: ResponseMsg = serde_json::from_str(&answer).map_err(|e| {
             ExchangeError::other(format!("invalid answer ({e}): {:?}", clip(&answer)))
         })?;
@@ -227,7 +178,7 @@ impl ExternalDetector {
                 msg.id()
             )));
         }
-        forkbench_ipc::put_back(self.pool_key(), proc, id + 1);
+        forkbench_ipc::put_back(self.cfg.pool_key(PROTOCOL, &self.dir), proc, id + 1);
         Ok(msg)
     }
 }
