@@ -1,9 +1,10 @@
-//! One TiM561 scan (819 beams, spot and noise modelled, and ideal rays) in the warehouse world, the truck at a rack-aisle pick (issue target: ≤ 150 µs).
+//! One TiM561 scan (819 beams, spot and noise modelled, and ideal rays) in the warehouse world, the truck at a rack-aisle pick (issue target: ≤ 150 µs); one NAV350 reflector fix there (visibility, association, least squares; target ≤ 50 µs).
 
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use forkbench_core::Pose2;
+use forkbench_sensors::reflectors::{ReflectorNavConfig, associate, measure, solve, visible};
 use forkbench_sensors::scan::{Errors, ScannerConfig, scan};
 use forkbench_sim::{PalletSpec, Sim, SimConfig};
 use forkbench_trial::World;
@@ -43,6 +44,20 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("tim561/warehouse/ideal", |b| {
         b.iter(|| scan::<rand_chacha::ChaCha8Rng>(&cfg, &sim, sensor, Errors::Ideal))
+    });
+    // A NAV350 fix from the same spot: which of the 36 reflectors are in sight past the
+    // racks and walls, their measurement, association from a pose 5 cm off, the solve.
+    let fixed = world.fixed_surfaces();
+    let ncfg = ReflectorNavConfig::default();
+    let predicted = Pose2::new(root.x_m + 0.05, root.y_m - 0.03, 0.01);
+    g.bench_function("nav350_fix/warehouse", |b| {
+        b.iter(|| {
+            let at = [root.x_m, root.y_m];
+            let seen = visible(at, &world.reflector, &fixed, &ncfg);
+            let obs = measure(&root, &world.reflector, &seen, &ncfg, &mut rng);
+            let pairs = associate(&obs, &predicted, &world.reflector, &ncfg);
+            solve(&obs, &pairs, &world.reflector, &predicted, &ncfg).expect("a fix in the aisle")
+        })
     });
     g.finish();
 }
