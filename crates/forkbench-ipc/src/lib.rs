@@ -1,12 +1,14 @@
 //! Child processes speaking newline-delimited text (external planners and detectors): each in its own process group, one deadline over writing a request and reading the answer, bounded output, the group killed when done, exit status and stderr in every failure, and a circuit breaker for commands that keep timing out.
 
 mod breaker;
+mod call;
 mod command;
 mod hello;
 mod pool;
 mod process;
 
 pub use breaker::{BREAKER_THRESHOLD, Breaker};
+pub use call::Callee;
 pub use command::{CommandConfig, MAX_TIMEOUT_S};
 pub use hello::start_with_hello;
 pub use pool::{PoolKey, put_back, release_pooled, take_pooled};

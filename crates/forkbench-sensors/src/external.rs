@@ -5,7 +5,7 @@ use std::sync::LazyLock;
 
 use forkbench_core::settings::{self, Settings, SettingsError};
 use forkbench_core::{PalletSpec, Pose2};
-use forkbench_ipc::{Breaker, ExchangeError, Process, Spawn, clip};
+use forkbench_ipc::{Breaker, Callee, ExchangeError, clip};
 use serde::{Deserialize, Serialize};
 
 use crate::detect::Detection;
@@ -134,52 +134,33 @@ impl ExternalDetector {
         })
     }
 
-    fn take_process(&self) -> Result<(Process, u64), ExchangeError> {
-        if let Some(p) = forkbench_ipc::take_pooled(&self.cfg.pool_key(PROTOCOL, &self.dir)) {
-            return Ok(p);
-        }
-        let spawn = Spawn {
-            command: &self.cfg.command,
-            dir: &self.dir,
-            env: &self.cfg.env(),
-            what: "detector",
-        };
-        let p = forkbench_ipc::start_with_hello(spawn, PROTOCOL, VERSION, self.cfg.timeout())?;
-        Ok((p, 0))
-    }
-
-    /// One request on a (possibly new) process, counted by the circuit breaker; the
-    /// process goes back to the pool only when the exchange kept to the protocol.
+    /// One request on this thread's pooled detector (a new one when none waits), counted
+    /// by the circuit breaker.
     fn request(&self, req: &DetectRequest<'_>) -> Result<ResponseMsg, String> {
-        let key = self.cfg.breaker_key(&self.dir);
-        BREAKER.check(&key)?;
-        let r = self.exchange(req);
-        BREAKER.record(&key, r.as_ref().is_err_and(|e| e.timed_out));
-        r.map_err(String::from)
-    }
-
-    fn exchange(&self, req: &DetectRequest<'_>) -> Result<ResponseMsg, ExchangeError> {
-        let (mut proc, id) = self.take_process()?;
-        let msg = RequestMsg {
-            kind: "detect",
-            id,
-            pallet: pallet_msg(req.pallet),
-            prior: req.prior,
-            scans: req.scans.iter().map(scan_msg).collect(),
+        let callee = Callee {
+            dir: &self.dir,
+            protocol: PROTOCOL,
+            version: VERSION,
+            what: "detector",
+            breaker: &BREAKER,
         };
-        let line = serde_json::to_string(&msg).map_err(|e| ExchangeError::other(e.to_string()))?;
-        let answer = proc.exchange(&line, self.cfg.timeout())?;
-        let msg: ResponseMsg = serde_json::from_str(&answer).map_err(|e| {
-            ExchangeError::other(format!("invalid answer ({e}): {:?}", clip(&answer)))
-        })?;
-        if msg.id() != id {
-            return Err(ExchangeError::other(format!(
-                "answered request {}, expected {id}",
-                msg.id()
-            )));
-        }
-        forkbench_ipc::put_back(self.cfg.pool_key(PROTOCOL, &self.dir), proc, id + 1);
-        Ok(msg)
+        let request = |id| {
+            let msg = RequestMsg {
+                kind: "detect",
+                id,
+                pallet: pallet_msg(req.pallet),
+                prior: req.prior,
+                scans: req.scans.iter().map(scan_msg).collect(),
+            };
+            serde_json::to_string(&msg).map_err(|e| ExchangeError::other(e.to_string()))
+        };
+        let read = |answer: &str| {
+            let msg: ResponseMsg = serde_json::from_str(answer).map_err(|e| {
+                ExchangeError::other(format!("invalid answer ({e}): {:?}", clip(answer)))
+            })?;
+            Ok((msg.id(), msg))
+        };
+        self.cfg.call(callee, request, read)
     }
 }
 

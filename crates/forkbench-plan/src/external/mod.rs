@@ -7,7 +7,7 @@ pub mod protocol;
 use std::path::PathBuf;
 use std::sync::LazyLock;
 
-use forkbench_ipc::{Breaker, ExchangeError, Process, Spawn, clip};
+use forkbench_ipc::{Breaker, Callee, ExchangeError, clip};
 
 use forkbench_core::settings::{self, Settings, SettingsError};
 
@@ -55,64 +55,45 @@ impl ExternalPlanner {
         self
     }
 
-    /// This thread's pooled process for the planner, or a new one that answered the hello.
-    fn take_process(&self) -> Result<(Process, u64), ExchangeError> {
-        if let Some(p) = forkbench_ipc::take_pooled(&self.cfg.pool_key(PROTOCOL, &self.dir)) {
-            return Ok(p);
-        }
-        let spawn = Spawn {
-            command: &self.cfg.command,
-            dir: &self.dir,
-            env: &self.cfg.env(),
-            what: "planner",
-        };
-        let p =
-            forkbench_ipc::start_with_hello(spawn, PROTOCOL, VERSION.into(), self.cfg.timeout())?;
-        Ok((p, 0))
-    }
-
-    /// One request, counted by the circuit breaker.
+    /// One request on this thread's pooled planner (a new one when none waits), counted
+    /// by the circuit breaker.
     fn request(&self, req: &PlanRequest) -> Result<ResponseMsg, String> {
-        let key = self.cfg.breaker_key(&self.dir);
-        BREAKER.check(&key)?;
-        let r = self.exchange(req);
-        BREAKER.record(&key, r.as_ref().is_err_and(|e| e.timed_out));
-        r.map_err(String::from)
-    }
-
-    /// One request on a (possibly new) process; the process goes back to the pool only
-    /// when the exchange kept to the protocol.
-    fn exchange(&self, req: &PlanRequest) -> Result<ResponseMsg, ExchangeError> {
-        let (mut proc, id) = self.take_process()?;
-        let line = serde_json::to_string(&RequestMsg::new(id, req))
-            .map_err(|e| ExchangeError::other(e.to_string()))?;
-        let answer = proc.exchange(&line, self.cfg.timeout())?;
-        let msg: ResponseMsg = serde_json::from_str(&answer).map_err(|e| {
-            // Python's json writes NaN and Infinity, which JSON has no numbers for.
-            let hint = if ["NaN", "Infinity", "null"]
-                .iter()
-                .any(|t| answer.contains(t))
-            {
-                "; a non-finite value (NaN, Infinity) in the path?"
-            } else {
-                ""
-            };
-            ExchangeError::other(format!(
-                "invalid JSON in the answer ({e}{hint}): {:?}",
-                clip(&answer)
-            ))
-        })?;
-        let got = match &msg {
-            ResponseMsg::Path { id, .. } | ResponseMsg::Error { id, .. } => *id,
+        let callee = Callee {
+            dir: &self.dir,
+            protocol: PROTOCOL,
+            version: VERSION.into(),
+            what: "planner",
+            breaker: &BREAKER,
         };
-        if got != id {
-            return Err(ExchangeError::other(format!(
-                "answered request {got}, expected {id}"
-            )));
-        }
-        forkbench_ipc::put_back(self.cfg.pool_key(PROTOCOL, &self.dir), proc, id + 1);
-        Ok(msg)
+        let request = |id| {
+            serde_json::to_string(&RequestMsg::new(id, req))
+                .map_err(|e| ExchangeError::other(e.to_string()))
+        };
+        self.cfg.call(callee, request, read_answer)
     }
+}
+
+/// A planner's answer line and the request id it answers.
+fn read_answer(answer: &str) -> Result<(u64, ResponseMsg), ExchangeError> {
+    let msg: ResponseMsg = serde_json::from_str(answer).map_err(|e| {
+        // Python's json writes NaN and Infinity, which JSON has no numbers for.
+        let hint = if ["NaN", "Infinity", "null"]
+            .iter()
+            .any(|t| answer.contains(t))
+        {
+            "; a non-finite value (NaN, Infinity) in the path?"
+        } else {
+            ""
+        };
+        ExchangeError::other(format!(
+            "invalid JSON in the answer ({e}{hint}): {:?}",
+            clip(answer)
+        ))
+    })?;
+    let id = match &msg {
+        ResponseMsg::Path { id, .. } | ResponseMsg::Error { id, .. } => *id,
+    };
+    Ok((id, msg))
 }
 
 impl Planner for ExternalPlanner {
