@@ -46,7 +46,7 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
         let obstacles: Vec<[[f64; 2]; 4]> = world
             .obstacles()
             .iter()
-            .map(|o| forkbench_core::geometry::rect_corners(&o.centre, o.length_m, o.width_m))
+            .map(forkbench_core::geometry::Obstacle::corners)
             .collect();
         let fig = Figure {
             title: &title,

@@ -17,6 +17,13 @@ impl Obstacle {
     pub fn corners(&self) -> [[f64; 2]; 4] {
         rect_corners(&self.centre, self.length_m, self.width_m)
     }
+
+    /// How far `p` lies inside the rectangle: positive inside (the distance to the
+    /// nearest side), 0 on a side, negative outside.
+    pub fn depth_inside(&self, p: [f64; 2]) -> f64 {
+        let l = self.centre.to_local(&Pose2::new(p[0], p[1], 0.0));
+        (self.length_m / 2.0 - l.x_m.abs()).min(self.width_m / 2.0 - l.y_m.abs())
+    }
 }
 
 /// Corners of a `length_m` × `width_m` rectangle centred on `centre` (length along its
@@ -48,5 +55,19 @@ mod tests {
                 "{c:?}"
             );
         }
+    }
+
+    #[test]
+    fn depth_inside_is_positive_inside_zero_on_a_side_negative_outside() {
+        // 4 m along y (the heading), 2 m across: x spans 0..2, y 0..4.
+        let o = Obstacle {
+            centre: Pose2::new(1.0, 2.0, std::f64::consts::FRAC_PI_2),
+            length_m: 4.0,
+            width_m: 2.0,
+        };
+        assert!((o.depth_inside([1.0, 2.0]) - 1.0).abs() < 1e-12);
+        assert!(o.depth_inside([2.0, 2.0]).abs() < 1e-12);
+        assert!((o.depth_inside([3.0, 2.0]) + 1.0).abs() < 1e-12);
+        assert!((o.depth_inside([1.0, 3.5]) - 0.5).abs() < 1e-12);
     }
 }

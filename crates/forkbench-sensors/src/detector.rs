@@ -72,3 +72,25 @@ impl PalletDetector for Pockets {
         }))
     }
 }
+
+/// Runs `detector` on named scans (shortest-reaching sensor first): builds the request
+/// the trait takes. `found.sensor` indexes `scans`.
+pub fn detect_in<S: AsRef<str>>(
+    detector: &mut dyn PalletDetector,
+    scans: &[(S, Scan)],
+    pallet: &PalletSpec,
+    prior: Option<Pose2>,
+) -> Result<Option<Found>, DetectorError> {
+    let views: Vec<SensorScan<'_>> = scans
+        .iter()
+        .map(|(sensor, scan)| SensorScan {
+            sensor: sensor.as_ref(),
+            scan,
+        })
+        .collect();
+    detector.detect(&DetectRequest {
+        scans: &views,
+        pallet,
+        prior,
+    })
+}

@@ -197,18 +197,34 @@ pub struct Fix {
     pub sigma_m: f64,
 }
 
+/// A reflector at `p` as seen from `pose`: its predicted range and bearing (in the
+/// sensor's frame, not wrapped), and their gradients with respect to (x, y, heading).
+struct Predicted {
+    range_m: f64,
+    bearing_rad: f64,
+    d_range: [f64; 3],
+    d_bearing: [f64; 3],
+}
+
+fn predict(pose: &Pose2, p: &[f64; 2]) -> Predicted {
+    let (dx, dy) = (p[0] - pose.x_m, p[1] - pose.y_m);
+    let r2 = (dx * dx + dy * dy).max(1e-12);
+    let r = r2.sqrt();
+    Predicted {
+        range_m: r,
+        bearing_rad: dy.atan2(dx) - pose.heading_rad,
+        d_range: [-dx / r, -dy / r, 0.0],
+        d_bearing: [dy / r2, -dx / r2, -1.0],
+    }
+}
+
 /// Information matrix JᵀWJ of range and bearing measurements of `pts` from `pose`.
 fn information(pose: &Pose2, pts: &[[f64; 2]], cfg: &ReflectorNavConfig) -> [[f64; 3]; 3] {
     let mut m = [[0.0; 3]; 3];
     let (wr, wb) = (cfg.range_sigma_m.powi(-2), cfg.bearing_sigma_rad.powi(-2));
     for p in pts {
-        let (dx, dy) = (p[0] - pose.x_m, p[1] - pose.y_m);
-        let r2 = (dx * dx + dy * dy).max(1e-12);
-        let r = r2.sqrt();
-        for (row, w) in [
-            ([-dx / r, -dy / r, 0.0], wr),
-            ([dy / r2, -dx / r2, -1.0], wb),
-        ] {
+        let q = predict(pose, p);
+        for (row, w) in [(q.d_range, wr), (q.d_bearing, wb)] {
             for i in 0..3 {
                 for j in 0..3 {
                     m[i][j] += w * row[i] * row[j];
@@ -271,14 +287,11 @@ pub fn solve(
         let mut g = [0.0; 3];
         let (wr, wb) = (cfg.range_sigma_m.powi(-2), cfg.bearing_sigma_rad.powi(-2));
         for (&(k, _), p) in pairs.iter().zip(&pts) {
-            let (dx, dy) = (p[0] - pose.x_m, p[1] - pose.y_m);
-            let r2 = (dx * dx + dy * dy).max(1e-12);
-            let r = r2.sqrt();
-            let er = obs[k].range_m - r;
-            let eb = wrap_angle(obs[k].bearing_rad - (dy.atan2(dx) - pose.heading_rad));
-            for i in 0..3 {
-                g[i] +=
-                    wr * [-dx / r, -dy / r, 0.0][i] * er + wb * [dy / r2, -dx / r2, -1.0][i] * eb;
+            let q = predict(&pose, p);
+            let er = obs[k].range_m - q.range_m;
+            let eb = wrap_angle(obs[k].bearing_rad - q.bearing_rad);
+            for (i, gi) in g.iter_mut().enumerate() {
+                *gi += wr * q.d_range[i] * er + wb * q.d_bearing[i] * eb;
             }
         }
         let step: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| inv[i][j] * g[j]).sum());

@@ -1,6 +1,5 @@
 //! Reflector coverage of a world: at every free cell centre, how many reflectors a NAV350 there sees past racks and walls, and the predicted 1σ position error of a fix (none below the minimum).
 
-use forkbench_core::Pose2;
 use forkbench_sensors::reflectors::{ReflectorNavConfig, predicted_sigma_m, visible};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -37,7 +36,7 @@ fn bounds(world: &World) -> Option<[[f64; 2]; 2]> {
     let mut pts: Vec<[f64; 2]> = world
         .obstacles()
         .iter()
-        .flat_map(|o| forkbench_core::geometry::rect_corners(&o.centre, o.length_m, o.width_m))
+        .flat_map(forkbench_sim::Obstacle::corners)
         .collect();
     pts.extend(world.reflector.iter().map(|r| [r.x_m, r.y_m]));
     let first = *pts.first()?;
@@ -81,12 +80,8 @@ pub fn coverage(
     }
     let fixed = world.fixed_surfaces();
     let obstacles = world.obstacles();
-    let free = |p: &Pose2| {
-        !obstacles.iter().any(|o| {
-            let l = o.centre.to_local(p);
-            l.x_m.abs() <= o.length_m / 2.0 && l.y_m.abs() <= o.width_m / 2.0
-        })
-    };
+    // A cell centre on a side counts as inside.
+    let free = |p: [f64; 2]| !obstacles.iter().any(|o| o.depth_inside(p) >= 0.0);
     let cells = (0..ny)
         .into_par_iter()
         .flat_map_iter(|j| {
@@ -96,7 +91,7 @@ pub fn coverage(
                     lo[0] + (i as f64 + 0.5) * resolution_m,
                     lo[1] + (j as f64 + 0.5) * resolution_m,
                 ];
-                free(&Pose2::new(at[0], at[1], 0.0)).then(|| {
+                free(at).then(|| {
                     let seen = visible(at, &world.reflector, fixed, cfg);
                     let pts: Vec<[f64; 2]> = seen
                         .iter()

@@ -61,6 +61,9 @@ impl Default for ScannerConfig {
     }
 }
 
+/// How far past its range a scanner is still asked for a target (the pallet's extent).
+pub const REACH_MARGIN_M: f64 = 0.5;
+
 /// The scanner models known by name.
 pub const SCANNER_PRESETS: [&str; 2] = ["tim561", "kinect2"];
 
@@ -204,6 +207,13 @@ impl ScannerConfig {
     /// Beam count: the aperture in whole steps, both ends included.
     pub fn beams(&self) -> usize {
         (self.fov_rad / self.step_rad + 1e-9).floor() as usize + 1
+    }
+
+    /// Whether a target (where the pallet should be) lies within this scanner's range
+    /// from `sensor`, with a margin for the pallet's extent: a scanner is asked only then
+    /// (a camera cannot see 8 m, and a scan costs time).
+    pub fn reaches(&self, sensor: &Pose2, target: &Pose2) -> bool {
+        sensor.distance_to(target) <= self.range_max_m + REACH_MARGIN_M
     }
 
     /// The sensor's pose in the map for a fork-root pose.

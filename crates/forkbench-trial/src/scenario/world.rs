@@ -224,11 +224,11 @@ impl World {
                     &format!("{:?} is also reflector[{j}]'s name", r.name),
                 ));
             }
-            let at = Pose2::new(r.x_m, r.y_m, 0.0);
-            if let Some(o) = obstacles.iter().find(|o| {
-                let l = o.centre.to_local(&at);
-                l.x_m.abs() < o.length_m / 2.0 && l.y_m.abs() < o.width_m / 2.0
-            }) {
+            // On a face is allowed: that is where a reflector hangs.
+            if let Some(o) = obstacles
+                .iter()
+                .find(|o| o.depth_inside([r.x_m, r.y_m]) > 0.0)
+            {
                 return Err(invalid(
                     file,
                     &f,

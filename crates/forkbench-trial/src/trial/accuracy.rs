@@ -2,7 +2,7 @@
 
 use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
-use forkbench_sensors::detector::{DetectRequest, PalletDetector, Pockets, SensorScan};
+use forkbench_sensors::detector::{Pockets, detect_in};
 use forkbench_sensors::scan::{Errors, scan};
 use serde::Serialize;
 
@@ -116,11 +116,9 @@ fn study_cell(
     let mut by_sensor = vec![0u32; sensors.len()];
     for k in 0..u64::from(draws) {
         let mut rng = stream(seed ^ k.wrapping_mul(0xA24B_AED4_963E_E407), 7);
-        let scans: Vec<(String, forkbench_core::signal::Scan)> = sensors
+        let scans: Vec<(&str, forkbench_core::signal::Scan)> = sensors
             .iter()
-            .filter(|s| {
-                s.scanner.sensor_pose(&root).distance_to(&truth) <= s.scanner.range_max_m + 0.5
-            })
+            .filter(|s| s.scanner.reaches(&s.scanner.sensor_pose(&root), &truth))
             .map(|s| {
                 let bias_m = s.scanner.draw_bias(&mut rng);
                 let errors = Errors::Modelled {
@@ -128,26 +126,17 @@ fn study_cell(
                     rng: &mut rng,
                 };
                 (
-                    s.name.clone(),
+                    s.name.as_str(),
                     scan(&s.scanner, &sim, s.scanner.sensor_pose(&root), errors),
                 )
             })
             .collect();
-        let views: Vec<SensorScan<'_>> = scans
-            .iter()
-            .map(|(sensor, scan)| SensorScan { sensor, scan })
-            .collect();
-        let req = DetectRequest {
-            scans: &views,
-            pallet: &scn.pallet,
-            prior: Some(case.pallet),
-        };
-        if let Ok(Some(found)) = detector.detect(&req) {
+        if let Ok(Some(found)) = detect_in(&mut detector, &scans, &scn.pallet, Some(case.pallet)) {
             let e = truth.to_local(&found.detection.face);
             lat.push(e.y_m);
             along.push(e.x_m);
             head.push(wrap_angle(e.heading_rad));
-            let name = views[found.sensor].sensor;
+            let name = scans[found.sensor].0;
             if let Some(i) = sensors.iter().position(|s| s.name == name) {
                 by_sensor[i] += 1;
             }

@@ -3,7 +3,7 @@
 use forkbench_core::signal::Scan;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, Signal, Style};
-use forkbench_sensors::detector::{DetectRequest, SensorScan};
+use forkbench_sensors::detector::detect_in;
 use forkbench_sensors::scan::{Errors, scan};
 use rand_chacha::ChaCha8Rng;
 
@@ -20,10 +20,6 @@ const SCAN_STYLES: [Style; 3] = [
     Style::rgba([170, 110, 255, 255]).width(0.04),
 ];
 const DETECTION_STYLE: Style = Style::rgb(255, 60, 60).width(0.03);
-
-/// A scanner is asked only when the pallet may lie within its reach (scans cost time,
-/// and a camera cannot see 8 m): the prior's face within its range plus this margin.
-const REACH_MARGIN_M: f64 = 0.5;
 
 impl Trial<'_> {
     /// A pallet estimate when the fork root is `range_m` from the face: the scenario's
@@ -94,7 +90,7 @@ impl Trial<'_> {
         let mut scans = Vec::with_capacity(sensors.len());
         for (k, s) in sensors.iter().enumerate() {
             let placed = s.scanner.sensor_pose(believed);
-            if placed.distance_to(&prior) > s.scanner.range_max_m + REACH_MARGIN_M {
+            if !s.scanner.reaches(&placed, &prior) {
                 continue;
             }
             let sc = self.scan_from(k, s, s.scanner.sensor_pose(&root), placed);
@@ -102,19 +98,11 @@ impl Trial<'_> {
             rec.signal(t, &format!("sensors/{}", s.name), &Signal::Scan(&sc), style);
             scans.push((s.name.as_str(), sc));
         }
-        let views: Vec<SensorScan<'_>> = scans
-            .iter()
-            .map(|(sensor, scan)| SensorScan { sensor, scan })
-            .collect();
-        let req = DetectRequest {
-            scans: &views,
-            pallet: &self.scn.pallet,
-            prior: Some(prior),
-        };
         let Some(detector) = self.detector.as_mut() else {
             return Ok(None);
         };
-        let Some(found) = detector.detect(&req)? else {
+        let Some(found) = detect_in(detector.as_mut(), &scans, &self.scn.pallet, Some(prior))?
+        else {
             return Ok(None);
         };
         let face = found.detection.face;
