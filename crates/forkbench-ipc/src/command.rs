@@ -56,7 +56,7 @@ impl CommandConfig {
     }
 
     /// The pool key of this command speaking `protocol`, run in `dir`.
-    pub fn pool_key(&self, protocol: &'static str, dir: &std::path::Path) -> PoolKey {
+    pub(crate) fn pool_key(&self, protocol: &'static str, dir: &std::path::Path) -> PoolKey {
         (
             protocol,
             self.command.clone(),
@@ -66,7 +66,7 @@ impl CommandConfig {
     }
 
     /// The command as the circuit breaker counts it.
-    pub fn breaker_key(&self, dir: &std::path::Path) -> String {
+    pub(crate) fn breaker_key(&self, dir: &std::path::Path) -> String {
         format!("{:?} in {}", self.command, dir.display())
     }
 }

@@ -6,7 +6,7 @@ use crate::process::{ExchangeError, Process, Spawn, clip};
 
 /// Starts a child and exchanges hellos within `timeout`: ours names `protocol` and
 /// `version`; theirs must name the same.
-pub fn start_with_hello(
+pub(crate) fn start_with_hello(
     s: Spawn,
     protocol: &str,
     version: u64,

@@ -10,6 +10,5 @@ mod process;
 pub use breaker::{BREAKER_THRESHOLD, Breaker};
 pub use call::Callee;
 pub use command::{CommandConfig, MAX_TIMEOUT_S};
-pub use hello::start_with_hello;
-pub use pool::{PoolKey, put_back, release_pooled, take_pooled};
+pub use pool::release_pooled;
 pub use process::{EnvPolicy, ExchangeError, MAX_LINE_BYTES, Process, Spawn, clip, kill_all};

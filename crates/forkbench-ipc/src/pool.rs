@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use crate::process::{EnvPolicy, Process};
 
 /// What started a pooled process: protocol, command, directory and environment.
-pub type PoolKey = (&'static str, Vec<String>, PathBuf, EnvPolicy);
+pub(crate) type PoolKey = (&'static str, Vec<String>, PathBuf, EnvPolicy);
 
 thread_local! {
     /// Each process with the id its next request gets.
@@ -16,13 +16,13 @@ thread_local! {
 
 /// This thread's process for `key`, if one waits in the pool and kept quiet there: one
 /// that printed while nobody asked broke the protocol and is retired (its group killed).
-pub fn take_pooled(key: &PoolKey) -> Option<(Process, u64)> {
+pub(crate) fn take_pooled(key: &PoolKey) -> Option<(Process, u64)> {
     let (mut p, id) = POOL.with(|p| p.borrow_mut().remove(key))?;
     (!p.has_idle_output()).then_some((p, id))
 }
 
 /// Returns a process that kept to its protocol, with its next request's id.
-pub fn put_back(key: PoolKey, p: Process, next_id: u64) {
+pub(crate) fn put_back(key: PoolKey, p: Process, next_id: u64) {
     POOL.with(|pool| pool.borrow_mut().insert(key, (p, next_id)));
 }
 

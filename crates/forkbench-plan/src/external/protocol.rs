@@ -9,7 +9,7 @@ use crate::PlanRequest;
 /// Name of the protocol in both hello messages.
 pub const PROTOCOL: &str = "forkbench-planner";
 
-/// The protocol version this forkbench speaks (the hello each way: `forkbench_ipc::start_with_hello`).
+/// The protocol version this forkbench speaks (in the hello each way).
 pub const VERSION: u32 = 1;
 
 /// An obstacle as sent: its rectangle and, for convenience, its corners.
