@@ -58,6 +58,11 @@ pub struct BatchArgs {
     /// tim561+kinect2 (default: each scenario's own [sensors.pallet]).
     #[arg(long, value_name = "KIND")]
     pub pallet_sensing: Option<String>,
+    /// Localise every scenario with this kind at its default settings: gaussian (σ
+    /// around the truth) or nav350 (the world's reflectors) (default: each scenario's
+    /// own [sensors.localizer]).
+    #[arg(long, value_name = "KIND")]
+    pub localizer: Option<String>,
     /// Batch seed; each trial's seed derives from it and the trial's identity.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -196,6 +201,13 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         Some(kind) => scenarios
             .into_iter()
             .map(|s| s.with_pallet_sensing(kind))
+            .collect::<Result<_, _>>()?,
+        None => scenarios,
+    };
+    let scenarios = match &a.localizer {
+        Some(kind) => scenarios
+            .into_iter()
+            .map(|s| s.with_localizer(kind))
             .collect::<Result<_, _>>()?,
         None => scenarios,
     };

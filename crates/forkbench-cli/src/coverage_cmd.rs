@@ -17,6 +17,9 @@ pub struct CoverageArgs {
     /// Cell size.
     #[arg(long, default_value_t = 0.25)]
     resolution_m: f64,
+    /// Reflectors (comma-separated names) to leave out: what the layout covers if they go.
+    #[arg(long, value_delimiter = ',')]
+    missing_reflectors: Vec<String>,
     #[arg(long)]
     json: bool,
     /// Draw the heatmap with racks, walls and reflectors to FILE (.svg or .png).
@@ -28,7 +31,14 @@ pub struct CoverageArgs {
 const SCALE_MAX_M: f64 = 0.010;
 
 pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
-    let world = forkbench_trial::World::load(&a.world)?;
+    let full = forkbench_trial::World::load(&a.world)?;
+    let world = full.without_reflectors(&a.missing_reflectors)?;
+    let missing: Vec<[f64; 2]> = full
+        .reflector
+        .iter()
+        .filter(|r| a.missing_reflectors.contains(&r.name))
+        .map(|r| [r.x_m, r.y_m])
+        .collect();
     let cfg = ReflectorNavConfig::default();
     let t0 = std::time::Instant::now();
     let cov = coverage(&world, a.resolution_m, &cfg)?;
@@ -38,8 +48,13 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
         let width = 1400u32;
         let height = ((f64::from(width - 160) * (hi[1] - lo[1]) / (hi[0] - lo[0])) as u32 + 90)
             .clamp(300, 2000);
+        let gone = if missing.is_empty() {
+            String::new()
+        } else {
+            format!(", {} missing", missing.len())
+        };
         let title = format!(
-            "{}: NAV350 fix 1σ with {} reflectors (grey: fewer than 3 in sight)",
+            "{}: NAV350 fix 1σ with {} reflectors{gone} (grey: fewer than 3 in sight)",
             world.name,
             world.reflector.len()
         );
@@ -57,6 +72,7 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
                 .iter()
                 .map(|r| [r.x_m, r.y_m])
                 .collect::<Vec<_>>(),
+            missing: &missing,
         };
         to_file(file, (width, height), |d| draw(d, &fig), |d| draw(d, &fig))?;
     }
@@ -100,6 +116,8 @@ struct Figure<'a> {
     /// Racks and walls, as corners.
     obstacles: &'a [[[f64; 2]; 4]],
     reflectors: &'a [[f64; 2]],
+    /// Reflectors left out (drawn as red crosses).
+    missing: &'a [[f64; 2]],
 }
 
 /// Blue (good) through yellow to red (the scale's top).
@@ -166,6 +184,17 @@ where
         .map_err(err)?
         .label("reflector")
         .legend(|(x, y)| TriangleMarker::new((x + 8, y), 5, BLACK.filled()));
+    if !fig.missing.is_empty() {
+        chart
+            .draw_series(
+                fig.missing
+                    .iter()
+                    .map(|p| Cross::new((p[0], p[1]), 7, RED.stroke_width(3))),
+            )
+            .map_err(err)?
+            .label("missing reflector")
+            .legend(|(x, y)| Cross::new((x + 8, y), 5, RED.stroke_width(3)));
+    }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))

@@ -107,6 +107,14 @@ struct TrialCli {
     /// Re-estimate the pallet at the configured ranges and replan when it moved.
     #[arg(long)]
     replan: bool,
+    /// Localise with this kind at its default settings (`gaussian`, `nav350`) instead of
+    /// the scenario's [sensors.localizer].
+    #[arg(long)]
+    localizer: Option<String>,
+    /// Reflectors (comma-separated names) missing from the world while the NAV350's map
+    /// keeps them: which legs suffer if they go.
+    #[arg(long, value_delimiter = ',')]
+    missing_reflectors: Vec<String>,
     #[arg(long)]
     json: bool,
     #[command(flatten)]
@@ -124,6 +132,7 @@ impl TrialCli {
         )?;
         let ok = trial_cmd::run(
             &self.scenario,
+            (self.localizer.as_deref(), &self.missing_reflectors),
             self.case.as_deref(),
             &opts,
             (self.json, mission),

@@ -16,11 +16,11 @@ pub fn legs_text(out: &TrialOutcome) -> String {
         }
     };
     let mut s = String::from(
-        "leg                              ok   reverse  planned  plan time  clearance  collisions  cross-track mean/max  time     smoothing\n",
+        "leg                              ok   reverse  planned  plan time  clearance  collisions  cross-track mean/max  time     no fix  fix gap  loc err  smoothing\n",
     );
     for l in &out.legs {
         s += &format!(
-            "{:<32} {:<4} {:<8} {:<8} {:<10} {:<10} {:<11} {:<21} {:<8} {}\n",
+            "{:<32} {:<4} {:<8} {:<8} {:<10} {:<10} {:<11} {:<21} {:<8} {:<7} {:<8} {:<8} {}\n",
             one_line(&l.name),
             if l.success { "yes" } else { "NO" },
             num(l.reverse_length_m, "m"),
@@ -34,6 +34,9 @@ pub fn legs_text(out: &TrialOutcome) -> String {
                 num(1e3 * l.cross_track_max_m, "mm")
             ),
             num(l.time_s, "s"),
+            l.fixes_missed,
+            num(l.largest_fix_gap_s, "s"),
+            num(1e3 * l.localization_error_max_m, "mm"),
             one_line(l.failure_detail.as_deref().unwrap_or(&l.smoothing)),
         );
     }

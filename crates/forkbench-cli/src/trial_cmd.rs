@@ -10,12 +10,19 @@ use forkbench_trial::{Scenario, TrialOptions, TrialOutcome};
 /// requires one and prints each leg): runs, records, prints; Ok(success).
 pub fn run(
     file: &Path,
+    (localizer, missing): (Option<&str>, &[String]),
     case: Option<&str>,
     opts: &TrialOptions,
     (json, mission): (bool, bool),
     rec: &crate::record::RecordArgs,
 ) -> anyhow::Result<bool> {
-    let scn = Scenario::load(file)?;
+    let mut scn = Scenario::load(file)?;
+    if let Some(kind) = localizer {
+        scn = scn.with_localizer(kind)?;
+    }
+    if !missing.is_empty() {
+        scn = scn.with_missing_reflectors(missing)?;
+    }
     if mission && scn.mission.is_none() {
         anyhow::bail!(
             "{}: has no [mission] table; `forkbench trial` runs its pick",
@@ -132,6 +139,16 @@ fn text_report(out: &TrialOutcome) -> String {
         format!(
             "insertion depth      {}",
             num(out.insertion_depth_m, 3, "m")
+        ),
+        format!(
+            "localisation         {} fixes, {} without a pose ({:.2} s); largest gap {:.2} s; \
+             error mean {} / max {:.1} mm",
+            out.fixes,
+            out.fixes_missed,
+            out.time_without_fix_s,
+            out.largest_fix_gap_s,
+            num(1e3 * out.localization_error_mean_m, 1, "mm"),
+            1e3 * out.localization_error_max_m
         ),
         format!("max steering         {:.4} rad", out.max_steer_rad),
         format!("max contact force    {:.1} N", out.max_contact_force_n),

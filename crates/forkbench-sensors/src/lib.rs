@@ -3,30 +3,23 @@
 pub mod detect;
 pub mod detector;
 pub mod external;
+pub mod localizer;
+pub mod reflector_nav;
 pub mod reflectors;
 pub mod scan;
 
-use std::collections::VecDeque;
-
 use forkbench_core::Pose2;
 use forkbench_core::SettingsError;
-use forkbench_core::units::wrap_angle;
 use rand::{Rng, RngExt as _};
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
-fn normal<R: Rng + ?Sized>(rng: &mut R, sigma: f64) -> f64 {
+pub use localizer::{Localizer, LocalizerInput, Nav350, Nav350Config, OdometryConfig, Reading};
+pub use reflector_nav::{ReflectorNav, ReflectorNavSettings};
+
+pub(crate) fn normal<R: Rng + ?Sized>(rng: &mut R, sigma: f64) -> f64 {
     let z: f64 = rng.sample(StandardNormal);
     sigma * z
-}
-
-/// A localisation sensor: pose fixes of the fork root as the controller receives them.
-pub trait Localizer: Send {
-    fn name(&self) -> &str;
-
-    /// Advances to time `t_s` with the true pose; returns the newest fix delivered by
-    /// then, if any. Draws only from `rng`.
-    fn update(&mut self, t_s: f64, truth: &Pose2, rng: &mut dyn Rng) -> Option<Pose2>;
 }
 
 /// A pallet-pose estimator (camera, laser): a noisy pallet face pose at a range.
@@ -40,16 +33,6 @@ pub trait PalletEstimator: Send {
     fn reestimate_at_m(&self) -> Vec<f64>;
 }
 
-impl Localizer for Nav350 {
-    fn name(&self) -> &str {
-        "nav350"
-    }
-
-    fn update(&mut self, t_s: f64, truth: &Pose2, rng: &mut dyn Rng) -> Option<Pose2> {
-        Nav350::update(self, t_s, truth, rng)
-    }
-}
-
 impl PalletEstimator for PalletEstimateConfig {
     fn name(&self) -> &str {
         "range_scaled_gaussian"
@@ -61,103 +44,6 @@ impl PalletEstimator for PalletEstimateConfig {
 
     fn reestimate_at_m(&self) -> Vec<f64> {
         self.reestimate_at_m.clone()
-    }
-}
-
-/// SICK NAV350: pose fixes at a fixed rate with zero-mean Gaussian noise and a latency.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Nav350Config {
-    pub rate_hz: f64,
-    /// Per-axis position σ (the datasheet's ±4 mm read as 2σ).
-    pub position_sigma_m: f64,
-    /// Heading σ (the datasheet's ±0.15° read as 2σ).
-    pub heading_sigma_rad: f64,
-    /// Time from measurement to delivery.
-    pub latency_s: f64,
-}
-
-impl Default for Nav350Config {
-    fn default() -> Self {
-        Self {
-            rate_hz: 8.0,
-            position_sigma_m: 0.002,
-            heading_sigma_rad: 0.075_f64.to_radians(),
-            latency_s: 0.0,
-        }
-    }
-}
-
-impl Nav350Config {
-    pub fn validate(&self) -> Result<(), SettingsError> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
-            return Err(SettingsError::field(
-                "rate_hz",
-                "must be a positive finite number",
-            ));
-        }
-        for (f, v) in [
-            ("position_sigma_m", self.position_sigma_m),
-            ("heading_sigma_rad", self.heading_sigma_rad),
-            ("latency_s", self.latency_s),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(SettingsError::field(f, "must be a finite number ≥ 0"));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// The NAV350 as the controller sees it.
-#[derive(Debug, Clone)]
-pub struct Nav350 {
-    cfg: Nav350Config,
-    noise: bool,
-    next_sample_s: f64,
-    in_flight: VecDeque<(f64, Pose2)>,
-}
-
-impl Nav350 {
-    pub fn new(cfg: Nav350Config, noise: bool) -> Self {
-        Self {
-            cfg,
-            noise,
-            next_sample_s: 0.0,
-            in_flight: VecDeque::new(),
-        }
-    }
-
-    /// Advances to time `t_s`; returns the newest fix delivered by then, if any.
-    pub fn update<R: Rng + ?Sized>(
-        &mut self,
-        t_s: f64,
-        truth: &Pose2,
-        rng: &mut R,
-    ) -> Option<Pose2> {
-        // Sample at the rate (at most one sample per call: callers step far faster than 8 Hz).
-        if t_s + 1e-12 >= self.next_sample_s {
-            let fix = if self.noise {
-                Pose2::new(
-                    truth.x_m + normal(rng, self.cfg.position_sigma_m),
-                    truth.y_m + normal(rng, self.cfg.position_sigma_m),
-                    wrap_angle(truth.heading_rad + normal(rng, self.cfg.heading_sigma_rad)),
-                )
-            } else {
-                *truth
-            };
-            self.in_flight.push_back((t_s + self.cfg.latency_s, fix));
-            self.next_sample_s += 1.0 / self.cfg.rate_hz;
-        }
-        let mut out = None;
-        while let Some(&(due, fix)) = self.in_flight.front() {
-            if due > t_s + 1e-12 {
-                break;
-            }
-            out = Some(fix);
-            self.in_flight.pop_front();
-        }
-        out
     }
 }
 
@@ -269,42 +155,6 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-
-    #[test]
-    fn nav350_fixes_at_8_hz_with_the_configured_noise() {
-        let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let mut nav = Nav350::new(Nav350Config::default(), true);
-        let truth = Pose2::new(1.0, 2.0, 0.3);
-        let (mut n, mut sx, mut sxx) = (0, 0.0, 0.0);
-        let dt = 0.005;
-        for k in 0..(200 * 400) {
-            if let Some(f) = nav.update(k as f64 * dt, &truth, &mut rng) {
-                n += 1;
-                sx += f.x_m - truth.x_m;
-                sxx += (f.x_m - truth.x_m).powi(2);
-            }
-        }
-        // 400 s at 8 Hz.
-        assert!((n as i64 - 3200).abs() <= 1, "{n} fixes");
-        let mean = sx / n as f64;
-        let sd = (sxx / n as f64 - mean * mean).sqrt();
-        assert!(mean.abs() < 2e-4, "mean {mean}");
-        assert!((sd - 0.002).abs() < 1e-4, "sd {sd}");
-    }
-
-    #[test]
-    fn nav350_latency_delays_delivery() {
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let cfg = Nav350Config {
-            latency_s: 0.05,
-            ..Nav350Config::default()
-        };
-        let mut nav = Nav350::new(cfg, false);
-        let truth = Pose2::new(0.0, 0.0, 0.0);
-        assert!(nav.update(0.0, &truth, &mut rng).is_none());
-        assert!(nav.update(0.04, &truth, &mut rng).is_none());
-        assert!(nav.update(0.05, &truth, &mut rng).is_some());
-    }
 
     #[test]
     fn pallet_estimate_shrinks_with_range_and_is_seeded() {

@@ -184,3 +184,81 @@ fn two_reflectors_give_no_fix_and_ambiguity_is_dropped() {
     let obs = measure(&truth, &close, &[0], &cfg, &mut rng);
     assert!(associate(&obs, &truth, &close, &cfg).is_empty());
 }
+
+mod localiser {
+    use super::*;
+    use forkbench_sensors::{Localizer, LocalizerInput, ReflectorNav, ReflectorNavSettings};
+
+    fn room() -> Vec<Reflector> {
+        vec![
+            refl("a", 0.0, 0.0),
+            refl("b", 10.0, 0.0),
+            refl("c", 10.0, 8.0),
+            refl("d", 0.0, 8.0),
+        ]
+    }
+
+    fn sweep_at(nav: &mut ReflectorNav, truth: Pose2) -> forkbench_sensors::Reading {
+        let input = LocalizerInput {
+            t_s: 0.0,
+            truth,
+            predicted: Some(Pose2::new(
+                truth.x_m + 0.05,
+                truth.y_m - 0.03,
+                truth.heading_rad,
+            )),
+        };
+        nav.update(&input, &mut ChaCha8Rng::seed_from_u64(1))
+            .expect("a reading at t = 0")
+    }
+
+    #[test]
+    fn a_mounted_scanner_without_noise_returns_the_true_fork_root() {
+        let settings = ReflectorNavSettings {
+            mount: Pose2::new(-0.8, 0.2, 0.1),
+            ..ReflectorNavSettings::default()
+        };
+        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), false);
+        let truth = Pose2::new(4.0, 3.0, 0.7);
+        let r = sweep_at(&mut nav, truth);
+        let pose = r.pose.expect("four reflectors in sight");
+        assert!(pose.distance_to(&truth) < 1e-9, "{pose:?}");
+        assert!((pose.heading_rad - truth.heading_rad).abs() < 1e-9);
+        let fix = r.fix.expect("the device's report");
+        assert_eq!((fix.used.len(), r.detected), (4, 4));
+        assert!(fix.mean_deviation_m < 1e-9);
+    }
+
+    #[test]
+    fn a_wall_hiding_two_of_four_reflectors_leaves_no_fix() {
+        // A wall along x = 7 hides the east pair from a truck at x = 4.
+        let wall = Surface::rect(&Pose2::new(7.0, 4.0, 0.0), 0.2, 20.0, Seen::Fixed);
+        let mut nav = ReflectorNav::new(
+            ReflectorNavSettings::default(),
+            &room(),
+            &wall,
+            (8.0, 0.0),
+            false,
+        );
+        let r = sweep_at(&mut nav, Pose2::new(4.0, 3.0, 0.0));
+        assert_eq!((r.pose, r.detected), (None, 2));
+    }
+
+    #[test]
+    fn a_missing_reflector_is_not_measured_but_stays_in_the_map() {
+        let settings = ReflectorNavSettings {
+            missing_reflectors: vec!["c".into(), "d".into()],
+            ..ReflectorNavSettings::default()
+        };
+        settings.validate(&room()).expect("names exist");
+        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), false);
+        let r = sweep_at(&mut nav, Pose2::new(4.0, 3.0, 0.0));
+        assert_eq!((r.pose, r.detected), (None, 2));
+        let bad = ReflectorNavSettings {
+            missing_reflectors: vec!["e".into()],
+            ..ReflectorNavSettings::default()
+        };
+        let e = bad.validate(&room()).expect_err("unknown name");
+        assert_eq!(e.field.as_deref(), Some("missing_reflectors"));
+    }
+}

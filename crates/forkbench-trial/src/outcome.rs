@@ -97,6 +97,24 @@ pub struct TrialOutcome {
     pub estimate_lateral_error_m: Option<f64>,
     #[serde(default)]
     pub estimate_heading_error_rad: Option<f64>,
+    /// Localiser measurements that gave a pose, and those that gave none (a NAV350
+    /// seeing fewer than three known reflectors).
+    #[serde(default)]
+    pub fixes: u32,
+    #[serde(default)]
+    pub fixes_missed: u32,
+    /// The time the controller ran without a fix: missed measurements × their period.
+    #[serde(default)]
+    pub time_without_fix_s: f64,
+    /// The longest time between two fixes (the start and the end count as ends of a gap).
+    #[serde(default)]
+    pub largest_fix_gap_s: f64,
+    /// The controller's own pose (the last fix carried on by odometry) against the true
+    /// fork root, over every control step: mean and largest position error.
+    #[serde(default, with = "nan_as_null")]
+    pub localization_error_mean_m: f64,
+    #[serde(default)]
+    pub localization_error_max_m: f64,
     pub path_length_m: f64,
     pub sim_time_s: f64,
     pub wall_time_ms: f64,
@@ -149,6 +167,14 @@ pub struct LegOutcome {
     pub final_position_error_m: f64,
     #[serde(with = "nan_as_null")]
     pub final_heading_error_rad: f64,
+    /// Localiser measurements without a pose on this leg, the longest time between two
+    /// fixes, and the controller's largest position error against the truth.
+    #[serde(default)]
+    pub fixes_missed: u32,
+    #[serde(default)]
+    pub largest_fix_gap_s: f64,
+    #[serde(default)]
+    pub localization_error_max_m: f64,
 }
 
 impl TrialOutcome {
@@ -218,6 +244,12 @@ impl TrialOutcome {
             estimates_missed: 0,
             estimate_lateral_error_m: None,
             estimate_heading_error_rad: None,
+            fixes: 0,
+            fixes_missed: 0,
+            time_without_fix_s: 0.0,
+            largest_fix_gap_s: 0.0,
+            localization_error_mean_m: f64::NAN,
+            localization_error_max_m: 0.0,
             path_length_m: 0.0,
             sim_time_s: 0.0,
             wall_time_ms: 0.0,

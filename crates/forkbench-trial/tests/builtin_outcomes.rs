@@ -18,11 +18,22 @@ fn committed() -> Vec<Value> {
 
 /// The record re-run at its seed, in the committed records' form.
 fn rerun(want: &Value) -> Value {
-    // The records were made with the Gaussian model, before the scanners became the default.
+    // The records were made with the Gaussian models (pallet and localisation) and exact
+    // odometry, before the scanners, the reflectors and odometry errors became the default.
     let scenarios: Vec<_> = default_scenarios()
         .expect("embedded scenarios")
         .into_iter()
-        .map(|s| s.with_pallet_sensing("gaussian").expect("kind"))
+        .map(|s| {
+            let mut s = s
+                .with_pallet_sensing("gaussian")
+                .and_then(|s| s.with_localizer("gaussian"))
+                .expect("kind");
+            s.noise.odometry = forkbench_sensors::OdometryConfig {
+                speed_scale_sigma: 0.0,
+                steer_offset_sigma_rad: 0.0,
+            };
+            s
+        })
         .collect();
     let s = |f: &str| want[f].as_str().expect("string field").to_owned();
     let scn = scenarios
@@ -53,6 +64,12 @@ fn rerun(want: &Value) -> Value {
         "estimate_heading_error_rad",
         "also_failed",
         "likely_cause",
+        "fixes",
+        "fixes_missed",
+        "time_without_fix_s",
+        "largest_fix_gap_s",
+        "localization_error_mean_m",
+        "localization_error_max_m",
     ] {
         m.remove(later);
     }

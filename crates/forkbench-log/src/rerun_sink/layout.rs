@@ -97,12 +97,15 @@ pub(super) fn blueprint() -> Blueprint {
     let errors = Tabs::new(PLOTS[..2].iter().map(|p| plot_view(p).into()));
     // Scalars any component sends (`Recorder::signal`) share the last tab.
     let signals = TimeSeriesView::new("other signals").with_origin("signals");
-    let drive = Tabs::new(
-        PLOTS[2..]
-            .iter()
-            .map(|p| plot_view(p).into())
-            .chain([signals.into()]),
-    );
+    // Localisation: the controller's pose error and each fix's quality (metres), and how
+    // many reflectors the NAV350 used (0: no fix).
+    let localisation = TimeSeriesView::new("localisation (m)").with_origin("signals/localisation");
+    let reflectors = TimeSeriesView::new("NAV350 reflectors used").with_origin("signals/nav350");
+    let drive = Tabs::new(PLOTS[2..].iter().map(|p| plot_view(p).into()).chain([
+        localisation.into(),
+        reflectors.into(),
+        signals.into(),
+    ]));
     let right = Vertical::new([
         TextDocumentView::new("verdict")
             .with_origin("verdict")

@@ -1,4 +1,4 @@
-//! The component registry: planners, trackers and pallet detectors by name, built from their scenario settings tables.
+//! The component registry: planners, trackers, pallet detectors and localisers by name, built from their scenario settings tables.
 
 mod spec;
 
@@ -6,12 +6,18 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
+use forkbench_core::ForkliftSpec;
 use forkbench_core::settings::{Settings, SettingsError};
 use forkbench_plan::external::ExternalPlanner;
 use forkbench_plan::{BsplinePlanner, Planner, SpiralPlanner};
 use forkbench_sensors::detector::{PalletDetector, Pockets};
 use forkbench_sensors::external::ExternalDetector;
-use forkbench_sensors::{Localizer, Nav350, Nav350Config, PalletEstimateConfig, PalletEstimator};
+use forkbench_sensors::reflectors::Reflector;
+use forkbench_sensors::scan::Surface;
+use forkbench_sensors::{
+    Localizer, Nav350, Nav350Config, PalletEstimateConfig, PalletEstimator, ReflectorNav,
+    ReflectorNavSettings,
+};
 use forkbench_track::{PurePursuit, RegulatedPurePursuit, Tracker};
 
 pub use spec::{ComponentSpec, Role};
@@ -33,8 +39,26 @@ pub type PlannerCtor = Ctor<Box<dyn Planner>>;
 pub type TrackerCtor = Ctor<Box<dyn Tracker>>;
 /// Builds a pallet detector from its settings table.
 pub type DetectorCtor = Ctor<Box<dyn PalletDetector>>;
-/// Builds the localisation sensor from the scenario's NAV350 settings (noise on or off).
-pub type LocalizerCtor = Arc<dyn Fn(&Nav350Config, bool) -> Box<dyn Localizer> + Send + Sync>;
+/// Builds a localiser from its settings table and the world it measures.
+pub type LocalizerCtor = Arc<
+    dyn Fn(&Settings, &LocalizerContext<'_>) -> Result<Box<dyn Localizer>, SettingsError>
+        + Send
+        + Sync,
+>;
+
+/// What a localiser is built in: the world it measures, the truck it rides on, and the
+/// scenario's NAV350 rate, latency and Gaussian σ (`[noise.nav350]`).
+#[derive(Debug, Clone, Copy)]
+pub struct LocalizerContext<'a> {
+    pub nav350: &'a Nav350Config,
+    /// Sensor noise on (off: exact measurements).
+    pub noise: bool,
+    /// The world's reflectors (the device's map).
+    pub reflectors: &'a [Reflector],
+    /// The world's surfaces (racks and walls hide reflectors).
+    pub surfaces: &'a [Surface],
+    pub truck: &'a ForkliftSpec,
+}
 /// Builds the pallet-pose estimator from the scenario's estimate settings.
 pub type EstimatorCtor =
     Arc<dyn Fn(&PalletEstimateConfig) -> Box<dyn PalletEstimator> + Send + Sync>;
@@ -45,7 +69,7 @@ pub struct Registry {
     planners: BTreeMap<String, PlannerCtor>,
     trackers: BTreeMap<String, TrackerCtor>,
     detectors: BTreeMap<String, DetectorCtor>,
-    localizer: LocalizerCtor,
+    localizers: BTreeMap<String, LocalizerCtor>,
     estimator: EstimatorCtor,
 }
 
@@ -55,6 +79,7 @@ impl std::fmt::Debug for Registry {
             .field("planners", &self.planners.keys().collect::<Vec<_>>())
             .field("trackers", &self.trackers.keys().collect::<Vec<_>>())
             .field("detectors", &self.detectors.keys().collect::<Vec<_>>())
+            .field("localizers", &self.localizers.keys().collect::<Vec<_>>())
             .finish_non_exhaustive()
     }
 }
@@ -95,9 +120,26 @@ impl Registry {
             planners: BTreeMap::new(),
             trackers: BTreeMap::new(),
             detectors: BTreeMap::new(),
-            localizer: Arc::new(|cfg, noise| Box::new(Nav350::new(cfg.clone(), noise))),
+            localizers: BTreeMap::new(),
             estimator: Arc::new(|cfg| Box::new(cfg.clone())),
         }
+        .with_localizer("gaussian", |s, cx| {
+            forkbench_core::settings::parse::<Empty>(s)?;
+            Ok(Box::new(Nav350::new(cx.nav350.clone(), cx.noise)))
+        })
+        .with_localizer("nav350", |s, cx| {
+            let settings: ReflectorNavSettings = forkbench_core::settings::parse(s)?;
+            settings.validate(cx.reflectors)?;
+            check_mount(&settings.mount, cx.truck)?;
+            let timing = (cx.nav350.rate_hz, cx.nav350.latency_s);
+            Ok(Box::new(ReflectorNav::new(
+                settings,
+                cx.reflectors,
+                cx.surfaces,
+                timing,
+                cx.noise,
+            )))
+        })
         .with_detector("pockets", |s, _| {
             Ok(Box::new(Pockets {
                 cfg: forkbench_core::settings::parse(s)?,
@@ -151,9 +193,16 @@ impl Registry {
         self
     }
 
-    /// Replaces the localisation sensor model.
-    pub fn with_localizer(mut self, ctor: LocalizerCtor) -> Self {
-        self.localizer = ctor;
+    /// Adds (or replaces) a localiser kind.
+    pub fn with_localizer(
+        mut self,
+        kind: &str,
+        ctor: impl Fn(&Settings, &LocalizerContext<'_>) -> Result<Box<dyn Localizer>, SettingsError>
+        + Send
+        + Sync
+        + 'static,
+    ) -> Self {
+        self.localizers.insert(kind.to_owned(), Arc::new(ctor));
         self
     }
 
@@ -169,6 +218,7 @@ impl Registry {
             Role::Planner => self.planners.keys().map(String::as_str).collect(),
             Role::Tracker => self.trackers.keys().map(String::as_str).collect(),
             Role::Detector => self.detectors.keys().map(String::as_str).collect(),
+            Role::Localizer => self.localizers.keys().map(String::as_str).collect(),
         }
     }
 
@@ -212,14 +262,57 @@ impl Registry {
             Role::Planner => self.planner(spec).map(drop),
             Role::Tracker => self.tracker(spec).map(drop),
             Role::Detector => self.detector(spec).map(drop),
+            // On an open floor with the default truck; a scenario checks its localiser
+            // against its own world and truck.
+            Role::Localizer => {
+                let (nav350, truck) = (Nav350Config::default(), ForkliftSpec::default());
+                let cx = LocalizerContext {
+                    nav350: &nav350,
+                    noise: true,
+                    reflectors: &[],
+                    surfaces: &[],
+                    truck: &truck,
+                };
+                self.localizer(spec, &cx).map(drop)
+            }
         }
     }
 
-    pub fn localizer(&self, cfg: &Nav350Config, noise: bool) -> Box<dyn Localizer> {
-        (self.localizer)(cfg, noise)
+    pub fn localizer(
+        &self,
+        spec: &ComponentSpec,
+        cx: &LocalizerContext<'_>,
+    ) -> Result<Box<dyn Localizer>, SettingsError> {
+        let ctor = self
+            .localizers
+            .get(&spec.kind)
+            .ok_or_else(|| self.unknown(Role::Localizer, &spec.kind))?;
+        ctor(&spec.settings, cx)
     }
 
     pub fn estimator(&self, cfg: &PalletEstimateConfig) -> Box<dyn PalletEstimator> {
         (self.estimator)(cfg)
     }
+}
+
+/// A settings table that must be empty (a kind configured elsewhere).
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Empty {}
+
+/// A localiser's mount on the truck: over its body or at the fork root (fork-root frame:
+/// the body spans x from −length to 0, y within ± half its width).
+fn check_mount(m: &forkbench_core::Pose2, truck: &ForkliftSpec) -> Result<(), SettingsError> {
+    let half = truck.body_width_m / 2.0;
+    if (-truck.body_length_m..=0.0).contains(&m.x_m) && m.y_m.abs() <= half {
+        return Ok(());
+    }
+    Err(SettingsError::field(
+        "mount",
+        format!(
+            "({}, {}) m lies outside the truck (fork-root frame: the body spans x from -{} to \
+             0 m, y within ±{half} m)",
+            m.x_m, m.y_m, truck.body_length_m
+        ),
+    ))
 }

@@ -14,6 +14,7 @@ pub enum Role {
     Planner,
     Tracker,
     Detector,
+    Localizer,
 }
 
 impl std::fmt::Display for Role {
@@ -22,6 +23,7 @@ impl std::fmt::Display for Role {
             Role::Planner => "planner",
             Role::Tracker => "tracker",
             Role::Detector => "detector",
+            Role::Localizer => "localizer",
         })
     }
 }

@@ -145,6 +145,9 @@ pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), TrialErro
     if let Err(e) = f.noise.pallet_estimate.validate() {
         return Err(invalid_setting(file, "noise.pallet_estimate", &e));
     }
+    if let Err(e) = f.noise.odometry.validate() {
+        return Err(invalid_setting(file, "noise.odometry", &e));
+    }
     check_settings(f, file)?;
     if let Some(b) = &f.estimate_bias {
         b.check(file, "estimate_bias")?;

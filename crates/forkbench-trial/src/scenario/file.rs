@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use forkbench_core::ForkliftSpec;
-use forkbench_sensors::{Nav350Config, PalletEstimateConfig};
+use forkbench_sensors::{Nav350Config, OdometryConfig, PalletEstimateConfig};
 use forkbench_sim::SimConfig;
 use serde::{Deserialize, Serialize};
 
@@ -65,6 +65,8 @@ pub struct NoiseFile {
     pub enabled: bool,
     pub nav350: Nav350Config,
     pub pallet_estimate: PalletEstimateConfig,
+    /// The truck's own odometry errors (dead reckoning between fixes).
+    pub odometry: OdometryConfig,
 }
 
 impl Default for NoiseFile {
@@ -73,6 +75,7 @@ impl Default for NoiseFile {
             enabled: true,
             nav350: Nav350Config::default(),
             pallet_estimate: PalletEstimateConfig::default(),
+            odometry: OdometryConfig::default(),
         }
     }
 }

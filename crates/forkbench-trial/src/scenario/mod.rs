@@ -121,6 +121,10 @@ pub struct Scenario {
     /// scenarios without `[sensors]` keep their settings hash.
     #[serde(skip_serializing_if = "sensors::PalletSensing::is_gaussian")]
     pub pallet_sensing: sensors::PalletSensing,
+    /// The localiser (`[sensors.localizer]`); the Gaussian default is left out of
+    /// manifests for the same reason.
+    #[serde(skip_serializing_if = "is_gaussian_localizer")]
+    pub localizer: ComponentSpec,
     /// Fixed pallet-estimate error in the pallet frame.
     pub estimate_bias: Pose2,
     /// σ of the per-trial jitter of the true pallet pose (pallet frame; heading in rad).
@@ -194,6 +198,13 @@ impl Scenario {
                 self.tracker = spec;
             }
         }
+        let localizer = f.sensors.as_ref().and_then(|s| s.localizer.as_ref());
+        if let Some(v) = localizer {
+            self.localizer =
+                ComponentSpec::from_value(Role::Localizer, v.get_ref(), None, dir.clone())
+                    .and_then(|spec| self.check_localizer(&registry, &spec).map(|()| spec))
+                    .map_err(|e| localizer_error(&self.file, text, v.span(), &e))?;
+        }
         if let sensors::PalletSensing::Scanner { detector, .. } = &mut self.pallet_sensing {
             detector.dir = dir;
             registry
@@ -251,6 +262,7 @@ impl Scenario {
             replan: f.replan.into(),
             tolerances: f.tolerances.into(),
             pallet_sensing,
+            localizer: ComponentSpec::of_kind(Role::Localizer, "gaussian"),
             estimate_bias: f.estimate_bias.map_or(zero, PoseDeg::to_pose),
             pallet_jitter: f.pallet_jitter.map_or(zero, PoseDeg::to_pose),
             world,
@@ -267,6 +279,61 @@ impl Scenario {
         Ok(self)
     }
 
+    /// The same scenario localising with `kind` (`gaussian`, `nav350`) at its default
+    /// settings: how a run compares localisation models on the same seeds.
+    pub fn with_localizer(mut self, kind: &str) -> Result<Self, TrialError> {
+        let spec = ComponentSpec::of_kind(Role::Localizer, kind);
+        let registry = Arc::clone(&self.registry);
+        self.check_localizer(&registry, &spec)
+            .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;
+        self.localizer = spec;
+        Ok(self)
+    }
+
+    /// The same scenario with `names` missing from the NAV350's world (a layout review's
+    /// "what if these go"); its map still holds them.
+    pub fn with_missing_reflectors(mut self, names: &[String]) -> Result<Self, TrialError> {
+        if self.localizer.kind != "nav350" {
+            return Err(invalid(
+                &self.file,
+                "sensors.localizer.missing_reflectors",
+                &format!(
+                    "only the nav350 localiser measures reflectors; this scenario's is {:?}",
+                    self.localizer.kind
+                ),
+            ));
+        }
+        let mut spec = self.localizer.clone();
+        let list = names
+            .iter()
+            .map(|n| toml::Value::from(n.as_str()))
+            .collect();
+        spec.settings
+            .insert("missing_reflectors".into(), toml::Value::Array(list));
+        let registry = Arc::clone(&self.registry);
+        self.check_localizer(&registry, &spec)
+            .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;
+        self.localizer = spec;
+        Ok(self)
+    }
+
+    /// Builds the localiser `spec` names once in this scenario's world, on its truck.
+    fn check_localizer(
+        &self,
+        registry: &Registry,
+        spec: &ComponentSpec,
+    ) -> Result<(), forkbench_core::SettingsError> {
+        let surfaces = self.world.fixed_surfaces();
+        let cx = crate::components::LocalizerContext {
+            nav350: &self.noise.nav350,
+            noise: true,
+            reflectors: &self.world.reflector,
+            surfaces: &surfaces,
+            truck: &self.truck,
+        };
+        registry.localizer(spec, &cx).map(drop)
+    }
+
     pub fn case(&self, name: &str) -> Result<&Case, TrialError> {
         self.cases
             .iter()
@@ -281,6 +348,31 @@ impl Scenario {
                     .collect::<Vec<_>>()
                     .join(", "),
             })
+    }
+}
+
+fn is_gaussian_localizer(spec: &ComponentSpec) -> bool {
+    spec.kind == "gaussian" && spec.settings.is_empty()
+}
+
+/// A `[sensors.localizer]` error at its line, its field under `sensors.`.
+fn localizer_error(
+    file: &str,
+    text: &str,
+    span: std::ops::Range<usize>,
+    e: &forkbench_core::SettingsError,
+) -> TrialError {
+    match component_error(file, text, Role::Localizer, span, e) {
+        TrialError::Invalid {
+            file,
+            field,
+            reason,
+        } => TrialError::Invalid {
+            file,
+            field: format!("sensors.{field}"),
+            reason,
+        },
+        other => other,
     }
 }
 
@@ -308,6 +400,8 @@ fn component_error(
             at += l.len();
             let t = l.trim_start();
             let key = t.split(['=', ' ', '\t']).next().unwrap_or("");
+            // A nested field (`measurement.range_sigma_m`) is at its outer key's line.
+            let k = k.split('.').next().unwrap_or(k);
             (key == k || key.trim_matches('"') == k).then_some(here)
         })
     });

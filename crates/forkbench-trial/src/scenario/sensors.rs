@@ -16,6 +16,9 @@ use crate::components::{ComponentSpec, Role};
 #[serde(deny_unknown_fields)]
 pub(super) struct SensorsFile {
     pallet: Option<PalletSensorFile>,
+    /// `[sensors.localizer]`: a localiser kind from the registry (`gaussian`, `nav350`)
+    /// and its settings.
+    pub(super) localizer: Option<toml::Spanned<toml::Value>>,
 }
 
 /// `[sensors.pallet]` as written: a kind (one scanner model or several joined by `+`),
@@ -160,6 +163,7 @@ pub(super) fn of_kind(
     file: &str,
 ) -> Result<PalletSensing, TrialError> {
     let f = SensorsFile {
+        localizer: None,
         pallet: Some(PalletSensorFile {
             kind: kind.to_owned(),
             scanner: None,

@@ -244,6 +244,23 @@ impl World {
     }
 
     /// Every rack's and wall's sides, as the surfaces a scanner's light can meet.
+    /// The same world without the reflectors named (each must exist).
+    pub fn without_reflectors(&self, names: &[String]) -> Result<World, TrialError> {
+        if let Some(n) = names
+            .iter()
+            .find(|n| !self.reflector.iter().any(|r| &r.name == *n))
+        {
+            return Err(super::invalid(
+                &self.name,
+                "reflector",
+                &format!("{n:?} is not a reflector of this world"),
+            ));
+        }
+        let mut w = self.clone();
+        w.reflector.retain(|r| !names.contains(&r.name));
+        Ok(w)
+    }
+
     pub fn fixed_surfaces(&self) -> Vec<forkbench_sensors::scan::Surface> {
         use forkbench_sensors::scan::{Seen, Surface};
         self.obstacles()

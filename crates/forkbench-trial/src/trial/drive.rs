@@ -28,7 +28,7 @@ impl<'a> Trial<'a> {
         reestimates.sort_by(|a, b| b.total_cmp(a));
         let deadline_s = self.sim.time_s() + self.scn.timeout_s;
         while self.sim.time_s() < deadline_s {
-            let (fix, pose) = self.sense()?;
+            let (fix, pose) = self.sense(rec)?;
             if self.run.replan
                 && reestimates
                     .first()
@@ -70,25 +70,6 @@ impl<'a> Trial<'a> {
         }
     }
 
-    /// The NAV350 fix at this instant (if one is due) and the predicted pose; Err when the
-    /// state went non-finite.
-    pub(super) fn sense(&mut self) -> Result<(Option<Pose2>, Pose2), StageError> {
-        let truth = self.sim.fork_root_pose();
-        let fix = self
-            .localizer
-            .update(self.sim.time_s(), &truth, &mut self.nav_rng);
-        if let Some(fix) = fix {
-            self.predictor.fix(fix);
-        }
-        let pose = self.predictor.pose().unwrap_or(self.first_fix);
-        if !(pose.is_finite() && truth.is_finite()) {
-            return Err(StageError::NonFinite {
-                t_s: self.sim.time_s(),
-            });
-        }
-        Ok((fix, pose))
-    }
-
     /// One physics step under `cmd`, the odometry update, collisions and the record.
     pub(super) fn physics_step<R: Recorder + ?Sized>(
         &mut self,
@@ -99,9 +80,10 @@ impl<'a> Trial<'a> {
     ) {
         let truck = &self.scn.truck;
         self.sim.step(cmd.speed_mps, cmd.steer_rad);
+        let (scale, offset) = self.odometry_error;
         self.predictor.propagate(
-            self.sim.speed_mps(),
-            self.sim.steer_rad(),
+            self.sim.speed_mps() * (1.0 + scale),
+            self.sim.steer_rad() + offset,
             truck.wheelbase_m,
             truck.fork_root_ahead_of_front_axle_m,
             self.sim.dt_s(),

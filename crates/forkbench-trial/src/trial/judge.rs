@@ -47,6 +47,8 @@ impl Trial<'_> {
         let truck = &self.scn.truck;
         let out = &mut self.out;
         out.sim_time_s = self.sim.time_s();
+        let period_s = self.localizer.period_s();
+        self.loc.finish_trial(out.sim_time_s, period_s, out);
         let root = self.sim.fork_root_pose();
         let pallet_now = self.sim.pallet_pose();
         let local = in_pallet_frame(&pallet_now, &root);

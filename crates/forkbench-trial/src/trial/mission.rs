@@ -129,13 +129,14 @@ impl Trial<'_> {
         rec: &mut R,
     ) -> LegOutcome {
         let t0 = self.sim.time_s();
+        self.leg_loc = super::localize::LocStats::new(t0);
         let mut leg = blank_leg(format!("{} → {}", from.name, to.name));
         let mut stats = DriveStats::default();
         let mut run = || -> Result<(), LegError> {
             if i > 0 {
                 self.back_out(map, m, (i, from, to), (&mut leg, &mut stats), rec)?;
             }
-            let here = self.sense()?.1;
+            let here = self.sense(rec)?.1;
             let (plan, attempts, secs) = plan_leg(
                 map,
                 m,
@@ -157,6 +158,7 @@ impl Trial<'_> {
         };
         let result = run();
         finish_leg(&mut leg, result, &stats, self.sim.time_s() - t0);
+        self.leg_loc.finish_leg(self.sim.time_s(), &mut leg);
         if leg.success {
             check_arrival(&mut leg, m, to, &self.sim.fork_root_pose());
         }
@@ -172,7 +174,7 @@ impl Trial<'_> {
         (leg, stats): (&mut LegOutcome, &mut DriveStats),
         rec: &mut R,
     ) -> Result<(), LegError> {
-        let here = self.sense()?.1;
+        let here = self.sense(rec)?.1;
         let (back, clearance) =
             plan_backout(map, m, &here, &to.pose, &self.scn.truck).ok_or_else(|| {
                 LegError::NoBackout {
@@ -206,7 +208,7 @@ impl Trial<'_> {
         tracker.reset(path, truck);
         let deadline_s = self.sim.time_s() + m.leg_timeout_s;
         while self.sim.time_s() < deadline_s {
-            let (fix, pose) = self.sense()?;
+            let (fix, pose) = self.sense(rec)?;
             let cmd = Tracker::command(&mut tracker, &self.tracker_input(pose));
             if cmd.done && self.sim.speed_mps().abs() < 0.01 {
                 return Ok(());
@@ -267,6 +269,9 @@ fn blank_leg(name: String) -> LegOutcome {
         time_s: 0.0,
         final_position_error_m: f64::NAN,
         final_heading_error_rad: f64::NAN,
+        fixes_missed: 0,
+        largest_fix_gap_s: 0.0,
+        localization_error_max_m: 0.0,
     }
 }
 

@@ -4,6 +4,7 @@ pub mod accuracy;
 mod drive;
 mod error;
 mod judge;
+mod localize;
 mod look;
 mod mission;
 mod plan;
@@ -71,13 +72,18 @@ impl Scenario {
         let own = match role {
             Role::Planner => &self.planner,
             Role::Tracker => &self.tracker,
-            Role::Detector => {
+            Role::Detector | Role::Localizer => {
+                let table = if role == Role::Detector {
+                    "sensors.pallet.detector"
+                } else {
+                    "sensors.localizer"
+                };
                 return Err(TrialError::Invalid {
                     file: self.file.clone(),
-                    field: "sensors.pallet.detector".into(),
-                    reason: "a run does not choose the detector; the scenario's \
-                             [sensors.pallet.detector] does"
-                        .into(),
+                    field: table.into(),
+                    reason: format!(
+                        "a run does not choose the {role}; the scenario's [{table}] does"
+                    ),
                 });
             }
         };

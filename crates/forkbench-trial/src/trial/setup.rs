@@ -10,7 +10,9 @@ use rand_chacha::ChaCha8Rng;
 
 use super::error::StageError;
 use super::judge::jitter;
+use super::localize::{LocStats, record_reflectors};
 use super::{Resolved, target_insertion_m};
+use crate::components::LocalizerContext;
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, Recorder, SceneInfo};
 use crate::scenario::sensors::PalletSensing;
@@ -54,6 +56,13 @@ pub struct Trial<'a> {
     pub(super) detector: Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
     pub(super) collision: bool,
     pub(super) timed_out: bool,
+    /// The odometry's speed-scale error and steering offset for this trial.
+    pub(super) odometry_error: (f64, f64),
+    /// Localisation over the whole trial, and over the current mission leg.
+    pub(super) loc: LocStats,
+    pub(super) leg_loc: LocStats,
+    /// The last reading gave no pose (the log says so once, and again when one returns).
+    pub(super) fix_lost: bool,
 }
 
 impl std::fmt::Debug for Trial<'_> {
@@ -116,21 +125,53 @@ fn scan_bias(scn: &Scenario, run: &Resolved) -> Vec<f64> {
     }
 }
 
-/// The scenario's planner, tracker and (when it scans) pallet detector, from its registry.
+/// The scenario's planner, tracker, localiser and (when it scans) pallet detector, from
+/// its registry.
 type Built = (
     Box<dyn Planner>,
     Box<dyn Tracker>,
+    Box<dyn Localizer>,
     Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
 );
 
 fn build_components(scn: &Scenario, run: &Resolved) -> Result<Built, SettingsError> {
     let planner = scn.registry.planner(&run.planner)?;
     let tracker = scn.registry.tracker(&run.tracker)?;
+    let surfaces = scn.world.fixed_surfaces();
+    let cx = LocalizerContext {
+        nav350: &scn.noise.nav350,
+        noise: run.noise,
+        reflectors: &scn.world.reflector,
+        surfaces: &surfaces,
+        truck: &scn.truck,
+    };
+    let localizer = scn.registry.localizer(&scn.localizer, &cx)?;
     let detector = match &scn.pallet_sensing {
         PalletSensing::Scanner { detector, .. } => Some(scn.registry.detector(detector)?),
         PalletSensing::Gaussian => None,
     };
-    Ok((planner, tracker, detector))
+    Ok((planner, tracker, localizer, detector))
+}
+
+/// The odometry's speed-scale error and steering offset for one trial, on a stream of
+/// their own (none with noise off).
+fn odometry_error(scn: &Scenario, run: &Resolved) -> (f64, f64) {
+    if run.noise {
+        scn.noise.odometry.draw(&mut stream(run.seed, 6))
+    } else {
+        (0.0, 0.0)
+    }
+}
+
+/// The reflectors a localiser's settings say are missing from the world.
+fn missing_reflectors(scn: &Scenario) -> Vec<String> {
+    match scn.localizer.settings.get("missing_reflectors") {
+        Some(toml::Value::Array(a)) => a
+            .iter()
+            .filter_map(|v| v.as_str().map(str::to_owned))
+            .collect(),
+        _ => Vec::new(),
+    }
 }
 
 impl<'a> Trial<'a> {
@@ -148,7 +189,7 @@ impl<'a> Trial<'a> {
             rec.event(0.0, Level::Error, &why);
             out.fail(Failure::Error, why);
         };
-        let (planner, tracker, detector) = match build_components(scn, run) {
+        let (planner, tracker, localizer, detector) = match build_components(scn, run) {
             Ok(c) => c,
             Err(e) => {
                 fail(&mut out, format!("building the components: {e}"));
@@ -175,6 +216,7 @@ impl<'a> Trial<'a> {
             start,
             tolerances: &scn.tolerances,
         });
+        record_reflectors(rec, &scn.world, &missing_reflectors(scn));
         let pallet0 = sim.pallet_pose();
         let mut trial = Trial {
             scn,
@@ -183,7 +225,7 @@ impl<'a> Trial<'a> {
             sim,
             planner,
             tracker,
-            localizer: scn.registry.localizer(&scn.noise.nav350, run.noise),
+            localizer,
             estimator: scn.registry.estimator(&run.pallet_estimate),
             nav_rng: stream(run.seed, 1),
             est_rng: stream(run.seed, 2),
@@ -199,6 +241,10 @@ impl<'a> Trial<'a> {
             detector,
             collision: false,
             timed_out: true,
+            odometry_error: odometry_error(scn, run),
+            loc: LocStats::new(0.0),
+            leg_loc: LocStats::new(0.0),
+            fix_lost: false,
         };
         if scn.mission.is_none()
             && let Err(e) = trial.first_fix_and_estimate(&true_pallet, rec)
@@ -218,10 +264,7 @@ impl<'a> Trial<'a> {
         true_pallet: &Pose2,
         rec: &mut R,
     ) -> Result<(), StageError> {
-        let truth = self.sim.fork_root_pose();
-        let fix = self
-            .localizer
-            .update(self.sim.time_s(), &truth, &mut self.nav_rng);
+        let (fix, _) = self.sense(rec)?;
         self.first_fix = fix.or(self.predictor.pose()).unwrap_or(self.first_fix);
         self.predictor.fix(self.first_fix);
         let range = self.first_fix.distance_to(true_pallet);
