@@ -28,6 +28,9 @@ def main() -> None:
         entities += [f"/map/nav/route/{i}" for i in range(len(out["legs"]))]
         entities += [f"/map/nav/route/{i}/reverse" for i, leg in enumerate(out["legs"])
                      if leg["reverse_length_m"] > 0]
+        # Localised on reflectors: they, each fix's rays and its quality.
+        entities += ["/map/nav350/reflectors", "/map/nav350/rays",
+                     "/signals/nav350/reflectors_used", "/signals/localisation/fix_sigma_m"]
     subprocess.run(["rerun", "rrd", "verify", rrd], check=True)
     printed = subprocess.run(
         ["rerun", "rrd", "print", "-vvv", rrd], check=True, capture_output=True, text=True
