@@ -1181,3 +1181,46 @@ fn scan_reports_beams_truth_and_estimate() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("known: tim561"));
 }
+
+/// `check`: a scenario's resolved components and fork fit, as text and JSON; a truck whose
+/// forks miss the pockets is refused naming the field, and the reflector flags name an
+/// unknown reflector.
+#[test]
+fn check_prints_the_resolved_scenario_and_refuses_bad_geometry() {
+    let root = repo_root();
+    let mission = root.join("scenarios/warehouse-mission.toml");
+    let out = forkbench(&["check", mission.to_str().expect("utf-8")]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("localiser nav350") && text.contains("36 reflectors"),
+        "{text}"
+    );
+    assert!(text.contains("pockets allow 0.280..0.790 m: ok"), "{text}");
+    let out = forkbench(&["check", mission.to_str().expect("utf-8"), "--json"]);
+    let v = stdout_json(&out);
+    assert_eq!(v["fork_fit"]["fork_spacing_m"], 0.535);
+    assert_eq!(v["scenario"]["localizer"]["kind"], "nav350");
+    let bad = tmp("check-wide-forks.toml");
+    let field = std::fs::read_to_string(root.join("scenarios/field-test.toml")).expect("reads");
+    std::fs::write(&bad, field + "\n[truck]\nfork_spacing_m = 1.5\n").expect("writes");
+    let out = forkbench(&["check", bad.to_str().expect("utf-8")]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("truck.fork_spacing_m") && err.contains("0.280..0.790"),
+        "{err}"
+    );
+    let out = forkbench(&[
+        "mission",
+        mission.to_str().expect("utf-8"),
+        "--missing-reflectors",
+        "west-3,nope",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("sensors.localizer.missing_reflectors") && err.contains("\"nope\""),
+        "{err}"
+    );
+}

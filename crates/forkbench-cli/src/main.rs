@@ -2,6 +2,7 @@
 
 mod accuracy_cmd;
 mod batch_cmd;
+mod check_cmd;
 mod corridor_cmd;
 mod coverage_cmd;
 mod gate_cmd;
@@ -213,6 +214,10 @@ enum Command {
     /// Reflector coverage of a world: reflectors in sight and the NAV350 fix's predicted
     /// 1σ at every free cell.
     Coverage(coverage_cmd::CoverageArgs),
+    /// Load a scenario as a run would and print what it resolved to: world, components,
+    /// how the forks fit the pallet, limits and cases (exit 1 with the file, field and
+    /// reason when it does not load).
+    Check(check_cmd::CheckArgs),
     /// Reproduce a paper's table side by side with this project's results.
     Reproduce {
         what: ReproduceArg,
@@ -317,6 +322,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Map(args) => map_cmd::run(&args).map(|()| Done::Ok),
         Command::Scan(args) => scan_cmd::run(&args).map(|()| Done::Ok),
         Command::Coverage(args) => coverage_cmd::run(&args).map(|()| Done::Ok),
+        Command::Check(args) => check_cmd::run(&args).map(|()| Done::Ok),
     }
 }
 

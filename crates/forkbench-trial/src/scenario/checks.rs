@@ -249,6 +249,50 @@ pub(super) fn resolve_cases(
     Ok(cases)
 }
 
+/// How the truck's forks fit the pallet: what `forkbench check` prints and the loader
+/// refuses when it does not hold.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ForkFit {
+    pub fork_spacing_m: f64,
+    /// Spacings that keep each fork inside its pocket.
+    pub spacing_range_m: [f64; 2],
+    pub fork_length_m: f64,
+    /// The insertion the judge requires (`tolerances.insertion_depth_m`).
+    pub insertion_depth_m: f64,
+    pub pallet_depth_m: f64,
+}
+
+impl ForkFit {
+    pub fn spacing_ok(&self) -> bool {
+        (self.spacing_range_m[0]..=self.spacing_range_m[1]).contains(&self.fork_spacing_m)
+    }
+
+    pub fn depth_ok(&self) -> bool {
+        self.insertion_depth_m <= self.fork_length_m.min(self.pallet_depth_m)
+    }
+}
+
+/// The fit of `truck`'s forks in `pallet` for a required insertion depth.
+pub fn fork_fit(
+    truck: &forkbench_core::ForkliftSpec,
+    pallet: &forkbench_core::PalletSpec,
+    insertion_depth_m: f64,
+) -> ForkFit {
+    let (half_fork, half_pocket) = (truck.fork_width_m / 2.0, pallet.pocket_width_m / 2.0);
+    let o = pallet.pocket_offsets_m()[0].abs();
+    // Each fork's centre at ±spacing/2 must keep the fork inside [o − w/2, o + w/2].
+    ForkFit {
+        fork_spacing_m: truck.fork_spacing_m,
+        spacing_range_m: [
+            2.0 * (o - half_pocket + half_fork),
+            2.0 * (o + half_pocket - half_fork),
+        ],
+        fork_length_m: truck.fork_length_m,
+        insertion_depth_m,
+        pallet_depth_m: pallet.depth_m,
+    }
+}
+
 /// The truck's forks against the pallet: each fork inside its pocket, and the required
 /// insertion depth within both the forks and the pallet. Contradictions are refused at
 /// load, naming the field and saying when the other value is a default.
@@ -262,14 +306,10 @@ pub(super) fn check_geometry(
         super::file::PalletKind::Sim1000 => "pallet_kind sim-1000",
     };
     let t = &f.truck;
-    let (half_fork, half_pocket) = (t.fork_width_m / 2.0, pallet.pocket_width_m / 2.0);
+    let fit = fork_fit(t, pallet, f.tolerances.insertion_depth_m);
     let o = pallet.pocket_offsets_m()[0].abs();
-    // Each fork's centre at ±spacing/2 must keep the fork inside [o − w/2, o + w/2].
-    let (lo, hi) = (
-        2.0 * (o - half_pocket + half_fork),
-        2.0 * (o + half_pocket - half_fork),
-    );
-    if !(lo..=hi).contains(&t.fork_spacing_m) {
+    let [lo, hi] = fit.spacing_range_m;
+    if !fit.spacing_ok() {
         return Err(invalid(
             file,
             "truck.fork_spacing_m",

@@ -17,7 +17,7 @@ use serde::Serialize;
 use crate::TrialError;
 use crate::components::{ComponentSpec, Registry, Role};
 
-pub use checks::{pallet_footprint, truck_footprint};
+pub use checks::{ForkFit, fork_fit, pallet_footprint, truck_footprint};
 pub use file::{NoiseFile, PalletKind, PalletPlacement, ReplanFile, Tolerances};
 pub use limits::{Limits, Replan};
 pub use world::{MAX_WORLD_EXTENT_M, PalletSlot, PoseDeg, RectFile, World};
@@ -332,6 +332,11 @@ impl Scenario {
             truck: &self.truck,
         };
         registry.localizer(spec, &cx).map(drop)
+    }
+
+    /// How this scenario's forks fit its pallet (checked at load; printed by `check`).
+    pub fn fork_fit(&self) -> ForkFit {
+        fork_fit(&self.truck, &self.pallet, self.tolerances.insertion_depth_m)
     }
 
     pub fn case(&self, name: &str) -> Result<&Case, TrialError> {

@@ -1,0 +1,119 @@
+//! `forkbench check SCENARIO`: loads a scenario as a run would, and prints what it resolved to and how the forks fit the pallet (JSON: the whole resolved scenario).
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+use forkbench_trial::Scenario;
+use forkbench_trial::text::one_line;
+
+#[derive(Debug, clap::Args)]
+pub struct CheckArgs {
+    scenario: PathBuf,
+    /// The whole resolved scenario (SI units) and the fork fit, as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(a: &CheckArgs) -> anyhow::Result<()> {
+    let scn = Scenario::load(&a.scenario)?;
+    let fit = scn.fork_fit();
+    if a.json {
+        let v = serde_json::json!({"scenario": scn, "fork_fit": fit});
+        let text = serde_json::to_string_pretty(&v).context("serialising the scenario")?;
+        return crate::emit(&(text + "\n"));
+    }
+    crate::emit(&summary(&scn))
+}
+
+fn summary(scn: &Scenario) -> String {
+    let fit = scn.fork_fit();
+    let w = &scn.world;
+    let sensing = match &scn.pallet_sensing {
+        forkbench_trial::scenario::sensors::PalletSensing::Gaussian => "gaussian".to_owned(),
+        forkbench_trial::scenario::sensors::PalletSensing::Scanner { sensors, detector } => {
+            let names: Vec<&str> = sensors.iter().map(|s| s.name.as_str()).collect();
+            format!("{} with detector {}", names.join(" + "), detector.kind)
+        }
+    };
+    let yes = |ok: bool| if ok { "ok" } else { "REFUSED" };
+    let mut lines = vec![
+        format!("scenario     {} ({})", one_line(&scn.name), scn.file),
+        format!(
+            "world        {}: {} walls, {} racks, {} slots, {} stations, {} reflectors",
+            one_line(&w.name),
+            w.wall.len(),
+            w.rack.len(),
+            w.pallet_slot.len(),
+            w.station.len(),
+            w.reflector.len()
+        ),
+        format!(
+            "components   planner {} ({}), tracker {} ({}), localiser {}, pallet sensing {sensing}",
+            scn.planner.name,
+            scn.planner.kind,
+            scn.tracker.name,
+            scn.tracker.kind,
+            scn.localizer.kind
+        ),
+        format!(
+            "forks        spacing {:.3} m, pockets allow {:.3}..{:.3} m: {}",
+            fit.fork_spacing_m,
+            fit.spacing_range_m[0],
+            fit.spacing_range_m[1],
+            yes(fit.spacing_ok())
+        ),
+        format!(
+            "depth        insertion {:.3} m required; forks {:.3} m, pallet {:.3} m deep: {}",
+            fit.insertion_depth_m,
+            fit.fork_length_m,
+            fit.pallet_depth_m,
+            yes(fit.depth_ok())
+        ),
+        format!(
+            "limits       lateral {} m, heading {:.2}°, contact {} N, pallet moved {} m",
+            scn.tolerances.lateral_m,
+            scn.tolerances.heading_deg(),
+            scn.tolerances.contact_force_n,
+            scn.tolerances.pallet_displacement_m
+        ),
+        format!("seed         {}; timeout {} s", scn.seed, scn.timeout_s),
+    ];
+    if let Some(m) = &scn.mission {
+        let via: Vec<&str> = m.via.iter().map(|v| v.name.as_str()).collect();
+        lines.push(format!(
+            "mission      {} → {} → the pick",
+            m.start.name,
+            if via.is_empty() {
+                "–".to_owned()
+            } else {
+                via.join(" → ")
+            }
+        ));
+    }
+    lines.extend(cases(scn));
+    lines.join("\n") + "\n"
+}
+
+/// One line per case (the first 20).
+fn cases(scn: &Scenario) -> Vec<String> {
+    let mut lines = vec![format!("cases        {}", scn.cases.len())];
+    for c in scn.cases.iter().take(20) {
+        lines.push(format!(
+            "  {:<20} start ({:.3}, {:.3}, {:.2}°), pallet face ({:.3}, {:.3}, {:.2}°)",
+            one_line(&c.name),
+            c.start.x_m,
+            c.start.y_m,
+            c.start.heading_rad.to_degrees(),
+            c.pallet.x_m,
+            c.pallet.y_m,
+            c.pallet.heading_rad.to_degrees()
+        ));
+    }
+    if scn.cases.len() > 20 {
+        lines.push(format!(
+            "  … and {} more (--json lists all)",
+            scn.cases.len() - 20
+        ));
+    }
+    lines
+}
