@@ -140,15 +140,15 @@ impl RerunRecorder {
         &mut self,
         entity: &str,
         outlines: &[[[f64; 2]; 5]],
-        rgb: [u8; 3],
+        (rgb, radius_m, order): ([u8; 3], f32, f32),
     ) {
         let strips: Vec<Vec<[f32; 2]>> = outlines.iter().map(|c| strip(c)).collect();
         self.set_once(
             entity,
             &rerun::LineStrips2D::new(strips)
                 .with_colors([color(rgb)])
-                .with_radii([0.015])
-                .with_draw_order(ORDER_TRUCK),
+                .with_radii([radius_m])
+                .with_draw_order(order),
         );
     }
 

@@ -113,12 +113,14 @@ pub(super) fn blueprint() -> Blueprint {
         errors.into(),
         drive.into(),
     ])
-    .with_row_shares([1.6, 1.2, 1.2]);
+    .with_row_shares([2.0, 1.1, 1.1]);
     Blueprint::new(
         Horizontal::new([
             Spatial2DView::new("map (y up, 1 m grid)")
                 .with_origin("/")
-                .with_contents(["map/**"])
+                // A mission's roadmap swamps its route: hidden, one click away in the
+                // blueprint panel.
+                .with_contents(["+ map/**", "- map/nav/roadmap"])
                 .into(),
             right.into(),
         ])

@@ -91,17 +91,24 @@ impl RerunRecorder {
             )
         };
         // The first failed criterion, the likely cause, then every other one broken.
+        // A tight list, so the whole verdict fits its panel.
         let mut detail = o.failure_detail.clone().unwrap_or_default();
         if let Some(c) = &o.likely_cause {
-            detail += &format!("\n\n**Likely cause:** {c}");
+            detail += &format!("\n- **likely cause:** {c}");
         }
         for other in &o.also_failed {
-            detail += &format!("\n\n❌ also {other}");
+            detail += &format!("\n- ❌ also {other}");
         }
         if o.estimates_missed > 0 {
             detail += &format!(
-                "\n\n{} of {} pallet estimates found no pallet (scans under map/sensors)",
+                "\n- {} of {} pallet estimates found no pallet (scans under map/sensors)",
                 o.estimates_missed, o.estimates
+            );
+        }
+        if o.fixes_missed > 0 {
+            detail += &format!(
+                "\n- {} NAV350 sweeps gave no pose; largest gap {:.2} s, own pose off by up to {:.3} m",
+                o.fixes_missed, o.largest_fix_gap_s, o.localization_error_max_m
             );
         }
         let [lat_limit, head_limit] = self.limits;
@@ -117,9 +124,11 @@ impl RerunRecorder {
              Map (y up, 1 m grid): white arrow start · light-blue arrow goal (pre-entry) · \
              blue plan being driven (thin: its control polygon), faded plans superseded · \
              green driven trajectory · \
-             magenta look-ahead · yellow truck · orange pallet, faint where it stood · \
-             red pallet estimate · green/red arrows true/measured NAV350 fix · \
-             mission legs: grey blocked cells, faint blue roadmap, orange A* polyline, purple backing out\n\n\
+             magenta look-ahead · yellow truck · orange (wide) pallet, faint where it stood · \
+             red (thin, on top) pallet estimate · green/red arrows true/measured NAV350 fix · \
+             white dots NAV350 reflectors, red ones missing, green rays to those the current \
+             fix used · mission legs: grey blocked cells, orange A* polyline, purple backing \
+             out (the PRM roadmap is hidden: add map/nav/roadmap in the blueprint panel)\n\n\
              **Events**\n\n```text\n{}\n```\n\n\
              **Outcome**\n\n```json\n{}\n```\n",
             num(o.lateral_error_m, &|v| format!("{v:.3} m")),
@@ -165,17 +174,20 @@ impl Recorder for RerunRecorder {
         self.draw_scene(s);
         self.styles();
         let origin = Pose2::new(0.0, 0.0, 0.0);
+        // The true pallet wide and beneath, the estimate thin and on top: where they
+        // overlap both stay visible.
         self.local_outlines(
             "map/world/pallet",
             &pallet_outlines(s.pallet, &origin),
-            PALLET_RGB,
+            (PALLET_RGB, 0.04, ORDER_TRUCK - 0.5),
         );
         self.local_outlines(
             "map/sensors/pallet_estimate",
             &pallet_outlines(s.pallet, &origin),
-            ESTIMATE_RGB,
+            (ESTIMATE_RGB, 0.01, ORDER_TRUCK + 0.5),
         );
-        self.local_outlines("map/truck", &truck_outlines(s.truck, &origin), TRUCK_RGB);
+        let truck = truck_outlines(s.truck, &origin);
+        self.local_outlines("map/truck", &truck, (TRUCK_RGB, 0.015, ORDER_TRUCK));
         // The start pose and the pallet's first pose go out with the first columns.
         self.cols.truck_start = Some(s.start);
         self.cols.pallet_pose.0.push(0.0);
