@@ -254,7 +254,10 @@ fn widths_on<DB: DrawingBackend>(
     area: DrawingArea<DB, plotters::coord::Shift>,
     v: &Vehicle,
     rows: &[Row],
-) -> anyhow::Result<()> {
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
     {
         area.fill(&WHITE).map_err(err)?;
         let ws: Vec<f64> = rows.iter().filter_map(|r| r.min_width_m).collect();
@@ -303,17 +306,13 @@ fn widths_on<DB: DrawingBackend>(
                 .label(mode.name())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(2)));
         }
-        for (label, w) in [("Li", v.inscribed_m()), ("L0", v.circumscribed_m())] {
-            chart
-                .draw_series(LineSeries::new([(a0, w), (a1, w)], BLACK.mix(0.4)))
-                .map_err(err)?
-                .label(label)
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.mix(0.4)));
-        }
+        draw_references(&mut chart, v, [a0, a1])?;
+        // Lower right: below the curves, which rise with the angle.
         chart
             .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
+            .background_style(WHITE.mix(0.9))
             .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerRight)
             .draw()
             .map_err(err)?;
         area.present().map_err(err)
@@ -334,7 +333,10 @@ fn regions_on<DB: DrawingBackend>(
     area: DrawingArea<DB, plotters::coord::Shift>,
     v: &Vehicle,
     regions: &[(f64, GRegion)],
-) -> anyhow::Result<()> {
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
     let n = regions.len().max(1);
     {
         area.fill(&WHITE).map_err(err)?;
@@ -361,7 +363,12 @@ fn regions_on<DB: DrawingBackend>(
                 .y_label_area_size(40)
                 .build_cartesian_2d(s.x0..x1, s.y0..y1)
                 .map_err(err)?;
-            chart.configure_mesh().draw().map_err(err)?;
+            chart
+                .configure_mesh()
+                .x_desc("x (m)")
+                .y_desc("y (m)")
+                .draw()
+                .map_err(err)?;
             let h = s.res.cell_m;
             let cells = (0..s.cells()).filter_map(|cell| {
                 let p = s.cell_centre(cell);
@@ -384,7 +391,87 @@ fn regions_on<DB: DrawingBackend>(
                 ))
             });
             chart.draw_series(cells).map_err(err)?;
+            region_key(&mut chart, [s.x0, s.y0])?;
         }
         area.present().map_err(err)
     }
+}
+
+/// The colour key of a G-region panel, as legend entries.
+fn region_key<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    at: [f64; 2],
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let key = [
+        ("G: the reference point passes here", RGBColor(44, 160, 44)),
+        (
+            "inside the inscribed-circle band, not in G",
+            RGBColor(214, 39, 40),
+        ),
+        ("neither", RGBColor(225, 225, 225)),
+    ];
+    for (label, c) in key {
+        // A zero-size square: only its legend entry shows.
+        chart
+            .draw_series([Rectangle::new([(at[0], at[1]), (at[0], at[1])], c.filled())])
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], c.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 12))
+        .position(SeriesLabelPosition::LowerRight)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// The vehicle's inscribed and circumscribed diameters as dashed, labelled lines.
+fn draw_references<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<
+        'a,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    v: &Vehicle,
+    [a0, a1]: [f64; 2],
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let references = [
+        (
+            "Li, inscribed-circle diameter (the width)",
+            v.inscribed_m(),
+            RGBColor(120, 120, 120),
+        ),
+        (
+            "L0, circumscribed-circle diameter",
+            v.circumscribed_m(),
+            BLACK,
+        ),
+    ];
+    for (label, w, c) in references {
+        // Dashed, so the references are not read as grid lines.
+        let dashes = (0..40).map(|k| {
+            let t = |j: f64| a0 + (a1 - a0) * (f64::from(k) * 2.0 + j) / 80.0;
+            PathElement::new([(t(0.0), w), (t(1.0), w)], c.stroke_width(2))
+        });
+        chart
+            .draw_series(dashes)
+            .map_err(err)?
+            .label(format!("{label}: {w:.3} m"))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(2)));
+    }
+    Ok(())
 }

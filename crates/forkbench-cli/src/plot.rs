@@ -6,6 +6,7 @@ use std::sync::Once;
 use anyhow::{Context as _, bail};
 use forkbench_core::{ForkliftSpec, Path};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// One path to draw.
@@ -83,6 +84,16 @@ pub const COLORS: [RGBColor; 8] = [
     RGBColor(23, 190, 207),
 ];
 
+/// The colour of series `i` of `n`: the palette's up to its size, else evenly spaced
+/// hues, so no two series share one.
+pub fn series_colour(i: usize, n: usize) -> RGBColor {
+    if n <= COLORS.len() {
+        return COLORS[i % COLORS.len()];
+    }
+    let c = HSLColor(i as f64 / n as f64, 0.7, 0.42).to_rgba();
+    RGBColor(c.0, c.1, c.2)
+}
+
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
@@ -100,6 +111,23 @@ where
     draw_curvature_panels(&right_parts, series, truck)?;
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// An arrow of length `len` from `at` along `heading`: its shaft and its head.
+type Polyline = Vec<(f64, f64)>;
+
+fn arrow(at: [f64; 2], heading: f64, len: f64) -> (Polyline, Polyline) {
+    let (s, c) = heading.sin_cos();
+    let tip = (at[0] + len * c, at[1] + len * s);
+    let back = 0.35 * len;
+    let side = 0.18 * len;
+    let base = (tip.0 - back * c, tip.1 - back * s);
+    let head = vec![
+        tip,
+        (base.0 - side * s, base.1 + side * c),
+        (base.0 + side * s, base.1 - side * c),
+    ];
+    (vec![(at[0], at[1]), base], head)
 }
 
 /// The paths in the plane, equal axis scales, with control polygons and a legend when
@@ -134,7 +162,7 @@ where
         .draw()
         .map_err(err)?;
     for (i, s) in series.iter().enumerate() {
-        let color = COLORS[i % COLORS.len()];
+        let color = series_colour(i, series.len());
         let line = chart
             .draw_series(LineSeries::new(
                 s.path.samples.iter().map(|p| (p.x_m, p.y_m)),
@@ -161,14 +189,14 @@ where
                 .map_err(err)?;
         }
     }
-    if series.len() > 1 {
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
-    }
+    draw_end_arrows(&mut chart, series, half)?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(err)?;
 
     Ok(())
 }
@@ -199,7 +227,8 @@ where
             .iter()
             .flat_map(|s| s.path.samples.iter().map(|p| map(p.curvature_per_m).abs()))
             .fold(0.0, f64::max);
-        let y = (peak * 1.15).max(0.05).min(limit * 1.1);
+        // The limit always shows, so the plot says how far below it the path stays.
+        let y = (peak * 1.15).max(limit * 1.08);
         let mut chart = ChartBuilder::on(area)
             .margin(15)
             .x_label_area_size(35)
@@ -214,7 +243,7 @@ where
             .draw()
             .map_err(err)?;
         for (i, s) in series.iter().enumerate() {
-            let color = COLORS[i % COLORS.len()];
+            let color = series_colour(i, series.len());
             chart
                 .draw_series(LineSeries::new(
                     s.path
@@ -225,13 +254,22 @@ where
                 ))
                 .map_err(err)?;
         }
-        if limit <= y {
-            for l in [limit, -limit] {
-                chart
-                    .draw_series(LineSeries::new([(0.0, l), (s_max, l)], RED.mix(0.6)))
-                    .map_err(err)?;
+        for (i, l) in [limit, -limit].into_iter().enumerate() {
+            let line = chart
+                .draw_series(LineSeries::new([(0.0, l), (s_max, l)], RED.mix(0.6)))
+                .map_err(err)?;
+            if i == 0 {
+                line.label(format!("truck limit ±{limit:.3}"))
+                    .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED.mix(0.6)));
             }
         }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(err)?;
     }
     Ok(())
 }
@@ -377,4 +415,41 @@ fn square_bounds(series: &[Series]) -> (f64, f64, f64) {
     let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
     let half = ((x1 - x0).max(y1 - y0) / 2.0 + 0.3).max(0.5);
     (cx, cy, half)
+}
+
+/// Arrows at the first series' start and goal poses, with legend entries.
+fn draw_end_arrows<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    series: &[Series],
+    half: f64,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let Some(first) = series.first() else {
+        return Ok(());
+    };
+    {
+        let ends = [first.path.samples.first(), first.path.samples.last()];
+        let len = 0.12 * half;
+        for ((p, colour), name) in ends.into_iter().zip([BLACK, GREEN]).zip(["start", "goal"]) {
+            let Some(p) = p else { continue };
+            let (shaft, head) = arrow([p.x_m, p.y_m], p.heading_rad, len);
+            chart
+                .draw_series([Polygon::new(head, colour.filled())])
+                .map_err(err)?;
+            chart
+                .draw_series(LineSeries::new(shaft, colour.stroke_width(3)))
+                .map_err(err)?
+                .label(if series.len() > 1 && name == "goal" {
+                    format!("goal pose ({})", first.label)
+                } else {
+                    format!("{name} pose")
+                })
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(3))
+                });
+        }
+    }
+    Ok(())
 }

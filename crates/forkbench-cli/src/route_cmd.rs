@@ -100,13 +100,17 @@ fn plot(
     file: &Path,
 ) -> anyhow::Result<()> {
     let route = &plan.route;
-    let title = match &route.points {
-        Some(_) => format!(
-            "{} on {}: {:.1} m",
-            a.planner.name(),
-            a.map.display(),
+    // The length the truck would drive: the smoothed path's when there is one.
+    let drivable = match &plan.smoothed {
+        Some(Ok(s)) => format!(
+            "{:.1} m smoothed ({:.1} m A* polyline)",
+            s.path.length_m(),
             route.length_m
         ),
+        _ => format!("{:.1} m A* polyline", route.length_m),
+    };
+    let title = match &route.points {
+        Some(_) => format!("{} on {}: {drivable}", a.planner.name(), a.map.display()),
         None => format!("{} on {}: no path", a.planner.name(), a.map.display()),
     };
     let band = match q.collision {

@@ -53,6 +53,9 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
             "log time goes back at {}",
             m.channel.topic
         );
+        // Simulated time 0 is the documented epoch, not 1970.
+        let epoch_ns = forkbench_log::mcap_sink::SIM_EPOCH_UNIX_S * 1_000_000_000;
+        assert!(m.log_time >= epoch_ns && m.log_time < epoch_ns + 700_000_000_000);
         last_time = m.log_time;
         assert_eq!(m.channel.message_encoding, "json");
         let schema = m.channel.schema.as_ref().expect("schema");
@@ -135,9 +138,9 @@ fn mcap_has_schemas_channels_time_order_and_the_outcome() {
         out.sim_time_s
     );
     assert_eq!(
-        last_time,
+        last_time - forkbench_log::mcap_sink::SIM_EPOCH_UNIX_S * 1_000_000_000,
         (out.sim_time_s * 1e9).round() as u64,
-        "log time is simulation time"
+        "log time is simulation time from the epoch"
     );
     // The verdict in /log and in forkbench.Outcome, beside the judged outcome's fields.
     let mut outcome_msg = outcome_msg.expect("outcome");

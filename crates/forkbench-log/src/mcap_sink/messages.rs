@@ -3,8 +3,13 @@
 use forkbench_core::Pose2;
 use serde::Serialize;
 
+/// Simulated time 0 in every MCAP file: 2000-01-01T00:00:00Z. Fixed, so the same seed
+/// writes the same file, and not 1970, which viewers show as a missing clock.
+pub const SIM_EPOCH_UNIX_S: u64 = 946_684_800;
+
+/// A simulated time as nanoseconds since the Unix epoch, from [`SIM_EPOCH_UNIX_S`].
 pub(super) fn ns(t_s: f64) -> u64 {
-    (t_s.max(0.0) * 1e9).round() as u64
+    SIM_EPOCH_UNIX_S * 1_000_000_000 + (t_s.max(0.0) * 1e9).round() as u64
 }
 
 /// Typed forms of the per-step messages: serialised straight into a reused buffer, no

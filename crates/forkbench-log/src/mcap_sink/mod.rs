@@ -9,7 +9,9 @@ use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
 use serde::Serialize;
 use serde_json::json;
 
+mod entry;
 mod messages;
+pub use messages::SIM_EPOCH_UNIX_S;
 mod schemas;
 mod signals;
 mod sink;
@@ -72,6 +74,7 @@ pub struct McapRecorder {
     /// Topics of signals registered so far, and the scalar signals' by path.
     signal_topics: std::collections::BTreeSet<String>,
     scalar_topics: Vec<(String, std::sync::Arc<str>)>,
+    entry: entry::EntryPlot,
 }
 
 impl std::fmt::Debug for McapRecorder {
@@ -100,6 +103,7 @@ impl McapRecorder {
             draw: DrawState::default(),
             signal_topics: Default::default(),
             scalar_topics: Vec::new(),
+            entry: entry::EntryPlot::default(),
         })
     }
 
@@ -223,6 +227,7 @@ impl Drop for McapRecorder {
 
 impl Recorder for McapRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
+        self.entry.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg()];
         let entities: Vec<SceneEntity> = s
             .obstacles
             .iter()
@@ -343,6 +348,7 @@ impl Recorder for McapRecorder {
 
     fn step(&mut self, s: &StepRecord) {
         self.pending.push(Item::Step(*s));
+        self.entry_step(s);
         self.draw.steps += 1;
         if self.draw.steps % TRAJECTORY_POINT_EVERY == 1 {
             self.draw.segment.push([s.truth.x_m, s.truth.y_m]);
@@ -372,6 +378,7 @@ impl Recorder for McapRecorder {
 
     fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
         self.send_trajectory(t_s);
+        self.entry_limits(t_s);
         let verdict = outcome.verdict_line();
         let level = if outcome.success { 2 } else { 4 };
         self.send(

@@ -107,7 +107,7 @@ impl McapRecorder {
     }
 
     /// Queues a scalar; its topic is registered and named once per path.
-    fn send_scalar(&mut self, t_s: f64, path: &str, value: f64) {
+    pub(super) fn send_scalar(&mut self, t_s: f64, path: &str, value: f64) {
         let topic = match self.scalar_topics.iter().find(|(p, _)| p == path) {
             Some((_, t)) => t.clone(),
             None => {

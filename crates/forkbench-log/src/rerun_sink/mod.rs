@@ -15,8 +15,6 @@ use std::io::{BufWriter, Write as _};
 use std::path::PathBuf;
 use std::sync::mpsc::Receiver;
 
-use forkbench_core::Pose2;
-
 use crate::LogError;
 use crate::writer::{WriterThread, with_causes};
 use columns::Columns;
@@ -68,8 +66,6 @@ pub struct RerunRecorder {
     rec: rerun::RecordingStream,
     sink: Sink,
     send_every: usize,
-    /// The true pallet pose at the start: the frame of the entry-error plots.
-    pallet0: Pose2,
     /// Entry limits drawn on the error plots: lateral (m) and heading (°).
     limits: [f64; 2],
     /// Plans on screen, the last one the one being driven.
@@ -190,7 +186,6 @@ impl RerunRecorder {
             rec,
             sink,
             send_every,
-            pallet0: Pose2::new(0.0, 0.0, 0.0),
             limits: [f64::NAN; 2],
             plans: 0,
             events: Vec::new(),

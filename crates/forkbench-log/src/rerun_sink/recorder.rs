@@ -157,7 +157,6 @@ impl RerunRecorder {
 
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
-        self.pallet0 = s.pallet_pose;
         self.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg()];
         let name = format!(
             "{} / {} / {} / {} / seed {}",
@@ -255,7 +254,8 @@ impl Recorder for RerunRecorder {
     }
 
     fn step(&mut self, s: &StepRecord) {
-        let local = self.pallet0.to_local(&s.truth);
+        // Against the pallet where it is now, as the judge measures the entry.
+        let local = s.pallet.to_local(&s.truth);
         let heading_deg = wrap_angle(local.heading_rad).to_degrees();
         let [lat, head] = self.limits;
         let approach = local.x_m >= -APPROACH_M;
