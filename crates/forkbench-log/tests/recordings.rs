@@ -371,11 +371,20 @@ fn rrd_holds_the_map_plots_verdict_and_the_trials_name() {
     for p in ["/plots/steering", "/plots/contact_force", "/map/track/now"] {
         assert_eq!(rows[p], steps, "{p}: {rows:?}");
     }
+    // From the tips 1.5 m before the face through the insertion: not the whole trial.
     let approach = rows["/plots/lateral_error"];
     assert!(
-        approach > 10 && approach < steps / 2,
+        approach > 10 && approach < steps * 3 / 4,
         "{approach} of {steps} steps"
     );
+    // The judged entry: one marker on each entry plot and one on the map.
+    for e in [
+        "/plots/lateral_error/entry",
+        "/plots/heading_error/entry",
+        "/map/track/entry",
+    ] {
+        assert_eq!(rows.get(e), Some(&1), "{e}: {rows:?}");
+    }
     // One row (true and measured arrow) per NAV350 fix.
     assert!(fixes.0 > 10, "{} fixes", fixes.0);
     assert_eq!(rows["/map/sensors/nav350_fix"], fixes.0, "{rows:?}");

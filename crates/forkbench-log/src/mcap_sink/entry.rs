@@ -5,8 +5,8 @@ use forkbench_trial::StepRecord;
 
 use super::McapRecorder;
 
-/// The entry plots cover the fork root's last this many metres before the pallet face (as
-/// the rerun recording's).
+/// The entry plots cover the fork tips' last this many metres before the pallet face, then
+/// the insertion (as the rerun recording's).
 const APPROACH_M: f64 = 1.5;
 
 /// What the entry plots need across steps.
@@ -14,6 +14,8 @@ const APPROACH_M: f64 = 1.5;
 pub(super) struct EntryPlot {
     /// Lateral (m) and heading (°) limits.
     pub(super) limits: [f64; 2],
+    /// The truck's fork length: the tips are this far ahead of the fork root.
+    pub(super) fork_length_m: f64,
     /// Whether the approach has begun (the limit lines start there).
     started: bool,
 }
@@ -22,7 +24,7 @@ impl McapRecorder {
     /// The entry errors at a step within the approach; the limit lines open at the first.
     pub(super) fn entry_step(&mut self, s: &StepRecord) {
         let local = s.pallet.to_local(&s.truth);
-        if local.x_m < -APPROACH_M {
+        if local.x_m + self.entry.fork_length_m < -APPROACH_M {
             return;
         }
         if !self.entry.started {

@@ -228,6 +228,7 @@ impl Drop for McapRecorder {
 impl Recorder for McapRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
         self.entry.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg()];
+        self.entry.fork_length_m = s.truck.fork_length_m;
         let entities: Vec<SceneEntity> = s
             .obstacles
             .iter()

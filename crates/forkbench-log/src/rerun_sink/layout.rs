@@ -36,7 +36,8 @@ pub(super) const ORDER_TRUCK: f32 = 3.0;
 pub(super) const ORDER_TRAJECTORY: f32 = 4.0;
 pub(super) const ORDER_MARKERS: f32 = 5.0;
 
-/// The entry-error plots cover the fork root's last this many metres before the pallet face.
+/// The entry-error plots cover the fork tips' last this many metres before the pallet face,
+/// then the insertion.
 pub(super) const APPROACH_M: f64 = 1.5;
 
 /// A plot: its entity, title and series (name, colour); several series share one entity,

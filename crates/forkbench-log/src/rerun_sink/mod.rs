@@ -68,6 +68,11 @@ pub struct RerunRecorder {
     send_every: usize,
     /// Entry limits drawn on the error plots: lateral (m) and heading (°).
     limits: [f64; 2],
+    /// Fork length and the pallet's half width: where the tips reach the face plane
+    /// (the judged entry), and the approach window the entry plots cover.
+    entry_geometry: [f64; 2],
+    /// When and where (fork root) the tips first reached the face.
+    entry_at: Option<(f64, [f64; 2])>,
     /// Plans on screen, the last one the one being driven.
     plans: u32,
     /// The event log so far, for the verdict document.
@@ -187,6 +192,8 @@ impl RerunRecorder {
             sink,
             send_every,
             limits: [f64::NAN; 2],
+            entry_geometry: [0.0; 2],
+            entry_at: None,
             plans: 0,
             events: Vec::new(),
             obstacle_outlines: Vec::new(),

@@ -80,6 +80,50 @@ impl RerunRecorder {
         self.set_once("map/sensors/nav350_fix", &fixes);
     }
 
+    /// Notes where and when the fork tips first reach the face plane within the pallet's
+    /// width; the markers go out with the outcome, carrying the judge's own numbers.
+    fn mark_entry(&mut self, s: &StepRecord, local: &Pose2) {
+        let [fork_length_m, half_width_m] = self.entry_geometry;
+        if self.entry_at.is_some()
+            || local.x_m + fork_length_m < 0.0
+            || local.y_m.abs() >= half_width_m
+        {
+            return;
+        }
+        self.entry_at = Some((s.t_s, [s.truth.x_m, s.truth.y_m]));
+    }
+
+    /// The judged entry on both entry plots and, labelled, on the map.
+    fn draw_entry(&mut self, o: &TrialOutcome) {
+        let (Some((t_s, at)), Some(lateral), Some(heading)) =
+            (self.entry_at, o.lateral_error_m, o.heading_error_rad)
+        else {
+            return;
+        };
+        let heading_deg = heading.to_degrees();
+        for (plot, v) in [
+            ("plots/lateral_error/entry", lateral),
+            ("plots/heading_error/entry", heading_deg),
+        ] {
+            let style = rerun::SeriesPoints::new()
+                .with_names(["fork entry (judged)"])
+                .with_colors([color(START_RGB)])
+                .with_marker_sizes([9.0]);
+            let r = self.rec.log_static(plot, &style);
+            self.note(r);
+            self.at(t_s);
+            let r = self.rec.log(plot, &rerun::Scalars::single(v));
+            self.note(r);
+        }
+        let point = rerun::Points2D::new([[at[0] as f32, at[1] as f32]])
+            .with_colors([color(START_RGB)])
+            .with_radii([0.06])
+            .with_labels([format!("fork entry: {lateral:.3} m, {heading_deg:.2}°")])
+            .with_draw_order(ORDER_MARKERS);
+        let r = self.rec.log("map/track/entry", &point);
+        self.note(r);
+    }
+
     /// The verdict view's text: the outcome first, then what the map's colours mean.
     fn verdict_text(&self, o: &TrialOutcome) -> String {
         let head = if o.success {
@@ -158,6 +202,7 @@ impl RerunRecorder {
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
         self.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg()];
+        self.entry_geometry = [s.truck.fork_length_m, s.pallet.width_m / 2.0];
         let name = format!(
             "{} / {} / {} / {} / seed {}",
             s.scenario, s.case, s.planner, s.tracker, s.seed
@@ -258,7 +303,9 @@ impl Recorder for RerunRecorder {
         let local = s.pallet.to_local(&s.truth);
         let heading_deg = wrap_angle(local.heading_rad).to_degrees();
         let [lat, head] = self.limits;
-        let approach = local.x_m >= -APPROACH_M;
+        // The fork tips' last metres before the face, the entry and the insertion.
+        let approach = local.x_m + self.entry_geometry[0] >= -APPROACH_M;
+        self.mark_entry(s, &local);
         let (lateral, heading): (&[f64], &[f64]) = if approach {
             (&[local.y_m, lat, -lat], &[heading_deg, head, -head])
         } else {
@@ -294,6 +341,7 @@ impl Recorder for RerunRecorder {
     }
 
     fn outcome(&mut self, t_s: f64, outcome: &TrialOutcome) {
+        self.draw_entry(outcome);
         self.at(t_s);
         self.cols.whole_strip(t_s);
         let level = if outcome.success {
