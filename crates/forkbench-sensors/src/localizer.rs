@@ -21,6 +21,10 @@ pub struct LocalizerInput {
     /// device's speed-input prior for matching what it measures to its map. `None`
     /// before the first fix.
     pub predicted: Option<Pose2>,
+    /// The fork-root pose by the truck's odometry alone, never reset by a fix (its frame
+    /// is arbitrary): how the truck moved between two moments, as a NAV350's speed input
+    /// tells it. `None` where the controller has no odometry.
+    pub odometry: Option<Pose2>,
 }
 
 /// One measurement as delivered to the controller.

@@ -1,4 +1,6 @@
-//! The NAV350 as a localiser that measures reflectors: each 8 Hz sweep ranges the reflectors the world lets it see from its mount, matches them to its map from the controller's predicted pose, and solves a pose when enough match.
+//! The NAV350 as a localiser that measures reflectors: each 8 Hz sweep ranges the reflectors the world lets it see from its mount, each at its own moment of the rotating sweep, compensates the truck's motion with its speed input, matches them to its map from the controller's predicted pose, and solves a pose when enough match.
+
+use std::collections::VecDeque;
 
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, SettingsError};
@@ -6,7 +8,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::localizer::{Cadence, Localizer, LocalizerInput, Reading};
-use crate::reflectors::{self, Reflector, ReflectorNavConfig};
+use crate::reflectors::{self, Observation, Reflector, ReflectorNavConfig};
 use crate::scan::{Seen, Surface};
 
 /// The `nav350` localiser's settings (`[sensors.localizer]`).
@@ -21,6 +23,11 @@ pub struct ReflectorNavSettings {
     pub missing_reflectors: Vec<String>,
     /// The reflector measurement and the pose solve.
     pub measurement: ReflectorNavConfig,
+    /// The device's speed input: the vehicle's odometry tells it how the truck moved
+    /// during the sweep, so each reflector, measured at its own moment of the rotation,
+    /// is carried to the sweep's end. Off, a moving truck's fix is smeared by its motion
+    /// (the operating instructions require the input for a moving vehicle).
+    pub speed_input: bool,
 }
 
 impl Default for ReflectorNavSettings {
@@ -29,6 +36,7 @@ impl Default for ReflectorNavSettings {
             mount: Pose2::new(-0.2, 0.0, 0.0),
             missing_reflectors: Vec::new(),
             measurement: ReflectorNavConfig::default(),
+            speed_input: true,
         }
     }
 }
@@ -68,6 +76,51 @@ pub struct ReflectorNav {
     /// Racks and walls: the surfaces that hide a reflector.
     blocking: Vec<Surface>,
     cadence: Cadence,
+    /// The poses over the last sweep: each reflector is measured from where the scanner
+    /// was when its beam passed it.
+    trail: Trail,
+}
+
+/// One control step's poses: the time, the true fork root, and the odometry's (what the
+/// device's speed input integrates to).
+type Mark = (f64, Pose2, Option<Pose2>);
+
+/// The fork-root poses over the last sweep.
+#[derive(Debug, Clone, Default)]
+struct Trail(VecDeque<Mark>);
+
+impl Trail {
+    fn push(&mut self, mark: Mark, keep_s: f64) {
+        self.0.push_back(mark);
+        while self.0.len() > 2 && self.0.front().is_some_and(|f| f.0 < mark.0 - keep_s) {
+            self.0.pop_front();
+        }
+    }
+
+    /// The pose `pick` takes from a mark, at `t_s` (linear between marks, held at the
+    /// ends); `None` when a mark in between lacks it.
+    fn at(&self, t_s: f64, pick: impl Fn(&Mark) -> Option<Pose2>) -> Option<Pose2> {
+        let after = self.0.iter().position(|m| m.0 >= t_s);
+        let (a, b) = match after {
+            Some(0) => (&self.0[0], &self.0[0]),
+            Some(k) => (&self.0[k - 1], &self.0[k]),
+            None => {
+                let last = self.0.back()?;
+                (last, last)
+            }
+        };
+        let (pa, pb) = (pick(a)?, pick(b)?);
+        let u = if b.0 > a.0 {
+            (t_s - a.0) / (b.0 - a.0)
+        } else {
+            0.0
+        };
+        Some(Pose2::new(
+            pa.x_m + u * (pb.x_m - pa.x_m),
+            pa.y_m + u * (pb.y_m - pa.y_m),
+            wrap_angle(pa.heading_rad + u * wrap_angle(pb.heading_rad - pa.heading_rad)),
+        ))
+    }
 }
 
 impl ReflectorNav {
@@ -101,18 +154,30 @@ impl ReflectorNav {
                 .copied()
                 .collect(),
             cadence: Cadence::new(rate_hz, latency_s),
+            trail: Trail::default(),
         }
     }
 
-    /// One sweep from the true fork-root pose, matched from the prior (the controller's
-    /// prediction, or the truth before any: the integrator's set-pose at commissioning).
-    pub fn sweep<R: Rng + ?Sized>(&self, truth: &Pose2, prior: &Pose2, rng: &mut R) -> Reading {
+    /// One sweep ending at `t_s`, from the trail of true poses, matched from the prior
+    /// (the controller's prediction, or the truth before any: the integrator's set-pose).
+    fn sweep<R: Rng + ?Sized>(&self, t_s: f64, prior: Option<Pose2>, rng: &mut R) -> Reading {
         let m = &self.settings.mount;
+        let Some(&(_, truth, _)) = self.trail.0.back() else {
+            return Reading {
+                pose: None,
+                fix: None,
+                detected: 0,
+            };
+        };
+        let prior = prior.unwrap_or(truth);
         let sensor = truth.to_world(m);
         let cfg = &self.settings.measurement;
         let seen =
             reflectors::visible([sensor.x_m, sensor.y_m], &self.present, &self.blocking, cfg);
-        let obs = reflectors::measure(&sensor, &self.present, &seen, &self.measured, rng);
+        let obs: Vec<Observation> = seen
+            .iter()
+            .map(|&i| self.measure_one(i, (t_s, &sensor), rng))
+            .collect();
         let predicted = prior.to_world(m);
         let pairs = reflectors::associate(&obs, &predicted, &self.map, cfg);
         let fix = reflectors::solve(&obs, &pairs, &self.map, &predicted, cfg);
@@ -120,6 +185,48 @@ impl ReflectorNav {
             pose: fix.as_ref().map(|f| root_of(&f.pose, m)),
             fix,
             detected: obs.len(),
+        }
+    }
+
+    /// Reflector `i` as measured when the rotating beam passed it (the head turns once
+    /// per period, from bearing 0 counter-clockwise, ending at `t_s`), carried to the
+    /// sweep's end with the speed input when the device has it.
+    fn measure_one<R: Rng + ?Sized>(
+        &self,
+        i: usize,
+        (t_s, sensor_end): (f64, &Pose2),
+        rng: &mut R,
+    ) -> Observation {
+        let m = &self.settings.mount;
+        let r = &self.present[i];
+        let bearing =
+            (r.y_m - sensor_end.y_m).atan2(r.x_m - sensor_end.x_m) - sensor_end.heading_rad;
+        let frac = bearing.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU;
+        let t_i = t_s - self.cadence.period_s() * (1.0 - frac);
+        let truth = |k: &Mark| Some(k.1);
+        let sensor_i = self
+            .trail
+            .at(t_i, truth)
+            .map_or(*sensor_end, |p| p.to_world(m));
+        let o = reflectors::measure(&sensor_i, &self.present, &[i], &self.measured, rng)[0];
+        if !self.settings.speed_input {
+            return o;
+        }
+        // How the device believes it moved since: its odometry, or none without one.
+        let own = |k: &Mark| k.2;
+        let (from, to) = match (self.trail.at(t_i, own), self.trail.at(t_s, own)) {
+            (Some(a), Some(b)) => (a.to_world(m), b.to_world(m)),
+            _ => (sensor_i, *sensor_end),
+        };
+        let p = from.to_world(&Pose2::new(
+            o.range_m * o.bearing_rad.cos(),
+            o.range_m * o.bearing_rad.sin(),
+            0.0,
+        ));
+        let local = to.to_local(&p);
+        Observation {
+            range_m: local.x_m.hypot(local.y_m),
+            bearing_rad: local.y_m.atan2(local.x_m),
         }
     }
 }
@@ -141,9 +248,10 @@ impl Localizer for ReflectorNav {
     }
 
     fn update(&mut self, input: &LocalizerInput, rng: &mut dyn Rng) -> Option<Reading> {
+        let mark = (input.t_s, input.truth, input.odometry);
+        self.trail.push(mark, 1.5 * self.cadence.period_s());
         if self.cadence.due(input.t_s) {
-            let prior = input.predicted.unwrap_or(input.truth);
-            let reading = self.sweep(&input.truth, &prior, rng);
+            let reading = self.sweep(input.t_s, input.predicted, rng);
             self.cadence.send(input.t_s, reading);
         }
         self.cadence.deliver(input.t_s)

@@ -81,13 +81,19 @@ impl<'a> Trial<'a> {
         let truck = &self.scn.truck;
         self.sim.step(cmd.speed_mps, cmd.steer_rad);
         let (scale, offset) = self.odometry_error;
-        self.predictor.propagate(
+        let (v, steer) = (
             self.sim.speed_mps() * (1.0 + scale),
             self.sim.steer_rad() + offset,
-            truck.wheelbase_m,
-            truck.fork_root_ahead_of_front_axle_m,
-            self.sim.dt_s(),
         );
+        for p in [&mut self.predictor, &mut self.odometry] {
+            p.propagate(
+                v,
+                steer,
+                truck.wheelbase_m,
+                truck.fork_root_ahead_of_front_axle_m,
+                self.sim.dt_s(),
+            );
+        }
         self.out.max_steer_rad = self.out.max_steer_rad.max(self.sim.steer_rad().abs());
         if self.sim.obstacle_contact() && !self.collision {
             rec.event(

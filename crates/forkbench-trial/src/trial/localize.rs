@@ -100,6 +100,7 @@ impl Trial<'_> {
             t_s,
             truth,
             predicted: self.predictor.pose(),
+            odometry: self.odometry.pose(),
         };
         let reading = self.localizer.update(&input, &mut self.nav_rng);
         let fix = reading.as_ref().and_then(|r| r.pose);

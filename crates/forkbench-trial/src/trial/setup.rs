@@ -37,6 +37,9 @@ pub struct Trial<'a> {
     pub(super) nav_rng: ChaCha8Rng,
     pub(super) est_rng: ChaCha8Rng,
     pub(super) predictor: PosePredictor,
+    /// The truck's odometry alone from its start, never reset by a fix (a NAV350's speed
+    /// input).
+    pub(super) odometry: PosePredictor,
     pub(super) first_fix: Pose2,
     /// The pallet pose the current plan aims at.
     pub(super) pallet_est: Pose2,
@@ -153,6 +156,13 @@ fn build_components(scn: &Scenario, run: &Resolved) -> Result<Built, SettingsErr
     Ok((planner, tracker, localizer, detector))
 }
 
+/// Dead reckoning from `start` alone (never reset by a fix).
+fn odometry_from(start: Pose2) -> PosePredictor {
+    let mut o = PosePredictor::new();
+    o.fix(start);
+    o
+}
+
 /// The odometry's speed-scale error and steering offset for one trial, on a stream of
 /// their own (none with noise off).
 fn odometry_error(scn: &Scenario, run: &Resolved) -> (f64, f64) {
@@ -230,6 +240,7 @@ impl<'a> Trial<'a> {
             nav_rng: stream(run.seed, 1),
             est_rng: stream(run.seed, 2),
             predictor: PosePredictor::new(),
+            odometry: odometry_from(start),
             first_fix: start,
             pallet_est: true_pallet,
             insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
