@@ -4,8 +4,8 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use forkbench_core::Pose2;
-use forkbench_sensors::{Localizer, LocalizerInput, ReflectorNav, ReflectorNavSettings};
 use forkbench_sensors::scan::{Errors, ScannerConfig, scan};
+use forkbench_sensors::{Localizer, LocalizerInput, ReflectorNav, ReflectorNavSettings};
 use forkbench_sim::{PalletSpec, Sim, SimConfig};
 use forkbench_trial::World;
 use rand::SeedableRng;

@@ -83,7 +83,7 @@ pub(super) const PLOTS: [Plot; 5] = [
     Plot {
         entity: "plots/contact_force",
         title: "fork contact force (N)",
-        series: &[("contact", ACTUAL_RGB)],
+        series: &[("contact", ACTUAL_RGB), ("limit", LIMIT_RGB)],
     },
 ];
 
@@ -94,19 +94,55 @@ fn plot_view(p: &Plot) -> TimeSeriesView {
 /// Map on the left; on the right the verdict (with the event log) and two tab groups of
 /// tall plots: entry errors, then the drive. Every view costs the file two chunks, so the
 /// event log is part of the verdict document rather than a view of its own.
-pub(super) fn blueprint() -> Blueprint {
-    let errors = Tabs::new(PLOTS[..2].iter().map(|p| plot_view(p).into()));
+/// Which plot a layout opens first in its tab group: the failed quantity's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Focus {
+    Lateral,
+    Heading,
+    ContactForce,
+}
+
+impl Focus {
+    pub(super) const ALL: [Focus; 3] = [Focus::Lateral, Focus::Heading, Focus::ContactForce];
+
+    /// The plot that shows why a trial failed on `failure`, when one does.
+    pub(super) fn of(failure: Option<forkbench_trial::Failure>) -> Option<Focus> {
+        use forkbench_trial::Failure as F;
+        match failure? {
+            F::LateralError | F::ForkOutsidePocket => Some(Focus::Lateral),
+            F::HeadingError => Some(Focus::Heading),
+            F::ContactForce | F::PalletDisplaced => Some(Focus::ContactForce),
+            _ => None,
+        }
+    }
+}
+
+pub(super) fn blueprint(focus: Focus) -> Blueprint {
+    let first = |i: usize, j: usize| {
+        if focus == Focus::Heading {
+            [j, i]
+        } else {
+            [i, j]
+        }
+    };
+    let errors = Tabs::new(first(0, 1).map(|k| plot_view(&PLOTS[k]).into()));
+    let drive_order: [usize; 3] = if focus == Focus::ContactForce {
+        [4, 2, 3]
+    } else {
+        [2, 3, 4]
+    };
     // Scalars any component sends (`Recorder::signal`) share the last tab.
     let signals = TimeSeriesView::new("other signals").with_origin("signals");
     // Localisation: the controller's pose error and each fix's quality (metres), and how
     // many reflectors the NAV350 used (0: no fix).
     let localisation = TimeSeriesView::new("localisation (m)").with_origin("signals/localisation");
     let reflectors = TimeSeriesView::new("NAV350 reflectors used").with_origin("signals/nav350");
-    let drive = Tabs::new(PLOTS[2..].iter().map(|p| plot_view(p).into()).chain([
-        localisation.into(),
-        reflectors.into(),
-        signals.into(),
-    ]));
+    let drive = Tabs::new(
+        drive_order
+            .map(|k| plot_view(&PLOTS[k]).into())
+            .into_iter()
+            .chain([localisation.into(), reflectors.into(), signals.into()]),
+    );
     let right = Vertical::new([
         TextDocumentView::new("verdict")
             .with_origin("verdict")

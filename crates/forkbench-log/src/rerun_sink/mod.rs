@@ -66,8 +66,8 @@ pub struct RerunRecorder {
     rec: rerun::RecordingStream,
     sink: Sink,
     send_every: usize,
-    /// Entry limits drawn on the error plots: lateral (m) and heading (°).
-    limits: [f64; 2],
+    /// Limits drawn on the plots: lateral (m) and heading (°) at entry, contact force (N).
+    limits: [f64; 3],
     /// Fork length and the pallet's half width: where the tips reach the face plane
     /// (the judged entry), and the approach window the entry plots cover.
     entry_geometry: [f64; 2],
@@ -91,37 +91,44 @@ impl std::fmt::Debug for RerunRecorder {
     }
 }
 
-/// The blueprint's messages, built once per process: building them spins up a whole
-/// in-memory recording stream, which cost as much as a short trial when done per file.
-fn blueprint_msgs() -> Result<&'static [rerun::log::LogMsg], LogError> {
+/// The blueprint's messages for a focus, each built once per process: building them
+/// spins up a whole in-memory recording stream, which cost as much as a short trial when
+/// done per file.
+fn blueprint_msgs(focus: layout::Focus) -> Result<&'static [rerun::log::LogMsg], LogError> {
     use rerun::log::LogMsg;
-    static MSGS: std::sync::OnceLock<Result<Vec<LogMsg>, String>> = std::sync::OnceLock::new();
-    MSGS.get_or_init(|| {
-        let (rec, storage) = rerun::RecordingStreamBuilder::new(APP)
-            .memory()
-            .map_err(|e| e.to_string())?;
-        layout::blueprint()
-            .send(
-                &rec,
-                rerun::blueprint::BlueprintActivation {
-                    make_active: true,
-                    make_default: true,
-                },
-            )
-            .map_err(|e| e.to_string())?;
-        rec.flush_blocking().map_err(|e| e.to_string())?;
-        // Keep only the blueprint store and its activation, not the carrier recording.
-        Ok(storage
-            .take()
-            .into_iter()
-            .filter(|m| match m {
-                LogMsg::BlueprintActivationCommand(_) => true,
-                m => m.store_id().kind() == rerun::StoreKind::Blueprint,
-            })
-            .collect())
-    })
-    .as_deref()
-    .map_err(|e| LogError::Rerun(format!("building the blueprint: {e}")))
+    type Built = std::sync::OnceLock<Result<Vec<LogMsg>, String>>;
+    static MSGS: [Built; 3] = [Built::new(), Built::new(), Built::new()];
+    let k = layout::Focus::ALL
+        .iter()
+        .position(|f| *f == focus)
+        .unwrap_or(0);
+    MSGS[k]
+        .get_or_init(|| {
+            let (rec, storage) = rerun::RecordingStreamBuilder::new(APP)
+                .memory()
+                .map_err(|e| e.to_string())?;
+            layout::blueprint(focus)
+                .send(
+                    &rec,
+                    rerun::blueprint::BlueprintActivation {
+                        make_active: true,
+                        make_default: true,
+                    },
+                )
+                .map_err(|e| e.to_string())?;
+            rec.flush_blocking().map_err(|e| e.to_string())?;
+            // Keep only the blueprint store and its activation, not the carrier recording.
+            Ok(storage
+                .take()
+                .into_iter()
+                .filter(|m| match m {
+                    LogMsg::BlueprintActivationCommand(_) => true,
+                    m => m.store_id().kind() == rerun::StoreKind::Blueprint,
+                })
+                .collect())
+        })
+        .as_deref()
+        .map_err(|e| LogError::Rerun(format!("building the blueprint: {e}")))
 }
 
 /// The application every recording belongs to (the viewer groups recordings by it).
@@ -180,7 +187,7 @@ impl RerunRecorder {
         // `sim_time` is the recording's only timeline: a wall-clock `log_time` on some
         // entities would only confuse.
         rec.set_log_time_enabled(false);
-        for msg in blueprint_msgs()? {
+        for msg in blueprint_msgs(layout::Focus::Lateral)? {
             rec.record_msg(msg.clone());
         }
         let send_every = match sink {
@@ -191,7 +198,7 @@ impl RerunRecorder {
             rec,
             sink,
             send_every,
-            limits: [f64::NAN; 2],
+            limits: [f64::NAN; 3],
             entry_geometry: [0.0; 2],
             entry_at: None,
             plans: 0,

@@ -155,7 +155,7 @@ impl RerunRecorder {
                 o.fixes_missed, o.largest_fix_gap_s, o.localization_error_max_m
             );
         }
-        let [lat_limit, head_limit] = self.limits;
+        let [lat_limit, head_limit, _] = self.limits;
         let num = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map_or("—".to_owned(), f);
         format!(
             "{head}\n\n{detail}\n\n\
@@ -201,7 +201,11 @@ impl RerunRecorder {
 
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
-        self.limits = [s.tolerances.lateral_m, s.tolerances.heading_deg()];
+        self.limits = [
+            s.tolerances.lateral_m,
+            s.tolerances.heading_deg(),
+            s.tolerances.contact_force_n,
+        ];
         self.entry_geometry = [s.truck.fork_length_m, s.pallet.width_m / 2.0];
         let name = format!(
             "{} / {} / {} / {} / seed {}",
@@ -302,7 +306,7 @@ impl Recorder for RerunRecorder {
         // Against the pallet where it is now, as the judge measures the entry.
         let local = s.pallet.to_local(&s.truth);
         let heading_deg = wrap_angle(local.heading_rad).to_degrees();
-        let [lat, head] = self.limits;
+        let [lat, head, contact] = self.limits;
         // The fork tips' last metres before the face, the entry and the insertion.
         let approach = local.x_m + self.entry_geometry[0] >= -APPROACH_M;
         self.mark_entry(s, &local);
@@ -318,7 +322,7 @@ impl Recorder for RerunRecorder {
                 heading,
                 &[s.steer_rad, s.steer_cmd_rad],
                 &[s.speed_mps, s.speed_cmd_mps],
-                &[s.contact_force_n],
+                &[s.contact_force_n, contact],
             ],
         );
         if self.cols.times.len() >= self.send_every {
@@ -356,6 +360,15 @@ impl Recorder for RerunRecorder {
         self.note(r);
         let text = self.verdict_text(outcome);
         self.log_verdict(text);
+        // A failure opens on the plot of the quantity that failed: a layout with that
+        // plot first in its tabs, made the active one.
+        let focus = super::layout::Focus::of(outcome.failure);
+        if let Some(f) = focus.filter(|f| *f != super::layout::Focus::Lateral) {
+            match super::blueprint_msgs(f) {
+                Ok(msgs) => msgs.iter().for_each(|m| self.rec.record_msg(m.clone())),
+                Err(e) => self.note::<(), _>(Err(e)),
+            }
+        }
         // The outcome is the trial's last call: close now, in parallel with other sinks.
         self.close_async();
     }
