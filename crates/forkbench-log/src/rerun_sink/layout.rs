@@ -150,7 +150,7 @@ pub(super) fn blueprint(focus: Focus) -> Blueprint {
         errors.into(),
         drive.into(),
     ])
-    .with_row_shares([2.0, 1.1, 1.1]);
+    .with_row_shares([2.4, 1.0, 1.0]);
     Blueprint::new(
         Horizontal::new([
             Spatial2DView::new("map (y up, 1 m grid)")

@@ -140,8 +140,8 @@ impl RerunRecorder {
         if let Some(c) = &o.likely_cause {
             detail += &format!("\n- **likely cause:** {c}");
         }
-        for other in &o.also_failed {
-            detail += &format!("\n- ❌ also {other}");
+        if !o.also_failed.is_empty() {
+            detail += &format!("\n- ❌ **also** {}", o.also_failed.join(" · "));
         }
         if o.estimates_missed > 0 {
             detail += &format!(
