@@ -243,7 +243,6 @@ impl World {
         Ok(())
     }
 
-    /// Every rack's and wall's sides, as the surfaces a scanner's light can meet.
     /// The same world without the reflectors named (each must exist).
     pub fn without_reflectors(&self, names: &[String]) -> Result<World, TrialError> {
         if let Some(n) = names
@@ -261,6 +260,7 @@ impl World {
         Ok(w)
     }
 
+    /// Every rack's and wall's sides, as the surfaces a scanner's light can meet.
     pub fn fixed_surfaces(&self) -> Vec<forkbench_sensors::scan::Surface> {
         use forkbench_sensors::scan::{Seen, Surface};
         self.obstacles()
