@@ -5,6 +5,9 @@ use parry2d::math::{Pose, Vector};
 use parry2d::query::{distance, intersection_test};
 use parry2d::shape::{ConvexPolygon, Cuboid, Shape};
 
+mod buckets;
+use buckets::{Bounds, Buckets};
+
 /// A rectangular vehicle body, placed relative to the vehicle's reference point (the
 /// point whose pose the planner or controller reports).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,24 +53,8 @@ impl Footprint {
 pub struct Obstacles {
     shapes: Vec<(Pose, Box<dyn Shape>)>,
     bounds: Vec<Bounds>,
-    buckets: std::collections::HashMap<(i64, i64), Vec<usize>>,
-    /// Shapes too large to bucket, tested by every query.
-    large: Vec<usize>,
+    buckets: Buckets,
 }
-
-/// Side of a bucket.
-const BUCKET_M: f64 = 2.0;
-/// Shapes spanning more buckets than this go to the always-tested list.
-const MAX_BUCKETS_PER_SHAPE: i64 = 4096;
-
-/// The bucket range (inclusive) that `b` overlaps.
-fn bucket_range(b: &Bounds) -> ([i64; 2], [i64; 2]) {
-    let cell = |v: f64| (v / BUCKET_M).floor().clamp(-1e12, 1e12) as i64;
-    ([cell(b[0]), cell(b[1])], [cell(b[2]), cell(b[3])])
-}
-
-/// Axis-aligned bounds: min x, min y, max x, max y.
-type Bounds = [f64; 4];
 
 fn bounds_of(points: &[[f64; 2]]) -> Bounds {
     points.iter().fold(
@@ -90,9 +77,16 @@ fn bounds_of(points: &[[f64; 2]]) -> Bounds {
 
 /// Distance between two bounds (0 when they overlap): a lower bound of the shapes'.
 fn bounds_gap(a: &Bounds, b: &Bounds) -> f64 {
-    let dx = (a[0] - b[2]).max(b[0] - a[2]).max(0.0);
-    let dy = (a[1] - b[3]).max(b[1] - a[3]).max(0.0);
+    let [dx, dy] = bounds_gap_xy(a, b);
     dx.hypot(dy)
+}
+
+/// The gap between two bounds along x and along y (0 where they overlap).
+fn bounds_gap_xy(a: &Bounds, b: &Bounds) -> [f64; 2] {
+    [
+        (a[0] - b[2]).max(b[0] - a[2]).max(0.0),
+        (a[1] - b[3]).max(b[1] - a[3]).max(0.0),
+    ]
 }
 
 impl std::fmt::Debug for Obstacles {
@@ -156,53 +150,23 @@ impl Obstacles {
     fn register(&mut self, b: Bounds) {
         let i = self.bounds.len();
         self.bounds.push(b);
-        let (lo, hi) = bucket_range(&b);
-        let span = (hi[0] - lo[0] + 1).saturating_mul(hi[1] - lo[1] + 1);
-        if !(b.iter().all(|v| v.is_finite()) && span <= MAX_BUCKETS_PER_SHAPE) {
-            self.large.push(i);
-            return;
-        }
-        for x in lo[0]..=hi[0] {
-            for y in lo[1]..=hi[1] {
-                self.buckets.entry((x, y)).or_default().push(i);
-            }
-        }
+        self.buckets.register(i, &b);
     }
 
-    /// Shapes whose buckets overlap `b` grown by `reach_m`, in insertion order.
-    fn near(&self, b: &Bounds, reach_m: f64) -> Vec<usize> {
-        let grown = [
-            b[0] - reach_m,
-            b[1] - reach_m,
-            b[2] + reach_m,
-            b[3] + reach_m,
-        ];
-        let (lo, hi) = bucket_range(&grown);
-        let mut out = self.large.clone();
-        let span = (hi[0] - lo[0] + 1).saturating_mul(hi[1] - lo[1] + 1);
-        if span > self.buckets.len() as i64 {
-            // A query wider than the map: every bucketed shape.
-            out.extend(self.buckets.values().flatten());
-        } else {
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    if let Some(v) = self.buckets.get(&(x, y)) {
-                        out.extend(v);
-                    }
-                }
+    /// Shapes near `b` whose bounds lie less than `within_m` from it (touching at 0),
+    /// in insertion order, each once: the only ones a query at `b` need test exactly.
+    fn candidates(&self, b: &Bounds, within_m: f64) -> Vec<usize> {
+        let mut out = Vec::new();
+        self.buckets.each_near(b, within_m, |i| {
+            let [dx, dy] = bounds_gap_xy(b, &self.bounds[i]);
+            // Touching needs no square root; only a positive reach does.
+            if (dx == 0.0 && dy == 0.0) || (within_m > 0.0 && dx.hypot(dy) < within_m) {
+                out.push(i);
             }
-        }
+        });
         out.sort_unstable();
         out.dedup();
         out
-    }
-
-    pub fn len(&self) -> usize {
-        self.shapes.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.shapes.is_empty()
     }
 
     /// The first obstacle the footprint at `reference` overlaps (touching counts), if any.
@@ -210,11 +174,10 @@ impl Obstacles {
         let body = fp.cuboid();
         let at = pose(&fp.centre(reference));
         let near = bounds_of(&fp.corners(reference));
-        self.near(&near, 0.0).into_iter().find(|&i| {
+        self.candidates(&near, 0.0).into_iter().find(|&i| {
             let (p, s) = &self.shapes[i];
             // Convex–cuboid pairs are always supported; an unsupported pair would be a bug here.
-            bounds_gap(&near, &self.bounds[i]) <= 0.0
-                && intersection_test(&at, &body, p, s.as_ref()).is_ok_and(|r| r.intersecting)
+            intersection_test(&at, &body, p, s.as_ref()).is_ok_and(|r| r.intersecting)
         })
     }
 
@@ -225,7 +188,7 @@ impl Obstacles {
         let at = pose(&fp.centre(reference));
         let near = bounds_of(&fp.corners(reference));
         let mut best = cap_m;
-        for i in self.near(&near, cap_m) {
+        for i in self.candidates(&near, cap_m) {
             let ((p, s), b) = (&self.shapes[i], &self.bounds[i]);
             if bounds_gap(&near, b) >= best {
                 continue;

@@ -1,5 +1,6 @@
 //! One global plan end to end: the map's two views (grid and shapes), the chosen planner and collision model, shortcuts and smoothing, each stage timed.
 
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use forkbench_core::geometry::Obstacle;
@@ -19,7 +20,15 @@ use crate::{
 pub struct NavMap {
     pub grid: OccupancyGrid,
     pub obstacles: Obstacles,
+    /// Inflated copies of `grid` by radius (bit pattern), made on first use: every leg
+    /// and every trial on this map asks for the same few.
+    inflated: Mutex<Vec<(u64, Arc<OccupancyGrid>)>>,
 }
+
+/// Most worlds whose maps the process keeps.
+const MAX_SHARED_MAPS: usize = 4;
+/// Most inflated copies a map keeps.
+const MAX_INFLATED: usize = 8;
 
 impl NavMap {
     /// A world's rectangles, rasterised at `resolution_m`; the grid ends at their edges.
@@ -29,16 +38,67 @@ impl NavMap {
         for o in obstacles {
             shapes.add_rect(&o.centre, o.length_m, o.width_m);
         }
-        Ok(Self {
-            grid,
-            obstacles: shapes,
-        })
+        Ok(Self::new(grid, shapes))
+    }
+
+    /// [`NavMap::from_world`], shared: a batch's trials on one world get the map built
+    /// by the first (the process keeps the last few worlds' maps).
+    pub fn shared_from_world(
+        obstacles: &[Obstacle],
+        resolution_m: f64,
+    ) -> Result<Arc<Self>, GridError> {
+        type Entry = (u64, Vec<Obstacle>, Arc<NavMap>);
+        static MAPS: Mutex<Vec<Entry>> = Mutex::new(Vec::new());
+        let key = resolution_m.to_bits();
+        let found = {
+            let maps = MAPS.lock().unwrap_or_else(|e| e.into_inner());
+            maps.iter()
+                .find(|(r, o, _)| *r == key && o.as_slice() == obstacles)
+                .map(|(_, _, m)| Arc::clone(m))
+        };
+        if let Some(m) = found {
+            return Ok(m);
+        }
+        // Built outside the lock: two threads may both build it, never wait on each other.
+        let map = Arc::new(Self::from_world(obstacles, resolution_m)?);
+        let mut maps = MAPS.lock().unwrap_or_else(|e| e.into_inner());
+        if maps.len() >= MAX_SHARED_MAPS {
+            maps.remove(0);
+        }
+        maps.push((key, obstacles.to_vec(), Arc::clone(&map)));
+        Ok(map)
     }
 
     /// A map read from a file: shapes from its occupied and unknown cells.
     pub fn from_grid(grid: OccupancyGrid) -> Self {
         let obstacles = grid_obstacles(&grid);
-        Self { grid, obstacles }
+        Self::new(grid, obstacles)
+    }
+
+    /// The two views, which must describe the same space.
+    pub fn new(grid: OccupancyGrid, obstacles: Obstacles) -> Self {
+        Self {
+            grid,
+            obstacles,
+            inflated: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The grid with its obstacles grown by `radius_m`, made once per radius.
+    pub fn inflated(&self, radius_m: f64) -> Arc<OccupancyGrid> {
+        let key = radius_m.to_bits();
+        // A poisoned lock only means another thread panicked mid-insert: the list is
+        // still a valid cache.
+        let mut cache = self.inflated.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, g)) = cache.iter().find(|(k, _)| *k == key) {
+            return Arc::clone(g);
+        }
+        let g = Arc::new(self.grid.inflated(radius_m));
+        if cache.len() >= MAX_INFLATED {
+            cache.remove(0);
+        }
+        cache.push((key, Arc::clone(&g)));
+        g
     }
 }
 
@@ -90,6 +150,8 @@ impl GlobalPlannerKind {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Algorithm {
     Prm(PrmParams),
+    /// PRM grown until the query is connected, `nodes` the most samples drawn.
+    PrmFirstSolution(PrmParams),
     Rrt(RrtParams),
     RrtConnect(RrtParams),
 }
@@ -151,11 +213,11 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
     let footprint;
     let space: &dyn FreeSpace = match q.collision {
         CollisionModel::Inflate => {
-            inflated = map.grid.inflated(q.inflate_m);
-            &inflated
+            inflated = map.inflated(q.inflate_m);
+            &*inflated
         }
         CollisionModel::Footprint => {
-            footprint = FootprintSpace::new(&map.grid, &map.obstacles, &q.truck, q.margin_m);
+            footprint = FootprintSpace::on(map, &q.truck, q.margin_m);
             &footprint
         }
     };
@@ -224,6 +286,10 @@ fn run_algorithm(
     Ok(match a {
         Algorithm::Prm(p) => {
             let (route, map) = plan_prm(space, from, to, p)?;
+            (route, Some(map))
+        }
+        Algorithm::PrmFirstSolution(p) => {
+            let (route, map) = crate::plan_prm_first(space, from, to, p)?;
             (route, Some(map))
         }
         Algorithm::Rrt(p) => (plan_rrt(space, from, to, p)?, None),

@@ -2,6 +2,7 @@
 
 pub mod global;
 pub mod grid;
+pub mod incremental;
 mod inflate;
 pub mod map_server;
 pub mod reproduce;
@@ -14,6 +15,7 @@ pub use global::{Algorithm, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap, 
 pub use grid::{Cell, GridError, OccupancyGrid};
 pub use inflate::{MAX_INFLATION_M, luo_inflation_m};
 pub use map_server::{MapError, read_map, write_map};
+pub use incremental::plan_prm_first;
 pub use roadmap::{MAX_CANDIDATE_EDGES, PrmParams, Roadmap, astar, candidate_edges, plan_prm};
 pub use rrt::{RrtParams, plan_rrt, plan_rrt_connect};
 pub use smooth::{SmoothError, SmoothParams, Smoothed, SweptHit};

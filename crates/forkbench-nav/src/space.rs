@@ -3,6 +3,9 @@
 use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_geom::{Footprint, Obstacles};
 
+use std::sync::Arc;
+
+use crate::NavMap;
 use crate::grid::{Cell, OccupancyGrid};
 
 /// Free space as the sampling planners see it: points (roadmap nodes, tree nodes) and
@@ -88,9 +91,14 @@ impl std::str::FromStr for CollisionModel {
 #[derive(Debug)]
 pub struct FootprintSpace<'a> {
     /// The map inflated by half the truck's width, for nodes.
-    nodes: OccupancyGrid,
+    nodes: Arc<OccupancyGrid>,
     obstacles: &'a Obstacles,
     parts: [Footprint; 2],
+}
+
+/// How far the node grid is inflated: half the truck's width and the margin.
+fn node_inflation_m(truck: &ForkliftSpec, margin_m: f64) -> f64 {
+    truck.body_width_m / 2.0 + margin_m
 }
 
 impl<'a> FootprintSpace<'a> {
@@ -102,8 +110,17 @@ impl<'a> FootprintSpace<'a> {
         margin_m: f64,
     ) -> Self {
         Self {
-            nodes: map.inflated(truck.body_width_m / 2.0 + margin_m),
+            nodes: Arc::new(map.inflated(node_inflation_m(truck, margin_m))),
             obstacles,
+            parts: truck_parts(truck, margin_m),
+        }
+    }
+
+    /// The same on a [`NavMap`], whose inflated grid is made once and shared.
+    pub fn on(map: &'a NavMap, truck: &ForkliftSpec, margin_m: f64) -> Self {
+        Self {
+            nodes: map.inflated(node_inflation_m(truck, margin_m)),
+            obstacles: &map.obstacles,
             parts: truck_parts(truck, margin_m),
         }
     }

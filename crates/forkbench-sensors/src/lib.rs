@@ -7,6 +7,7 @@ pub mod localizer;
 pub mod reflector_nav;
 pub mod reflectors;
 pub mod scan;
+pub mod sight;
 
 use forkbench_core::Pose2;
 use forkbench_core::SettingsError;

@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::localizer::{Cadence, Localizer, LocalizerInput, Reading};
 use crate::reflectors::{self, Observation, Reflector, ReflectorNavConfig};
-use crate::scan::{Seen, Surface};
+use crate::scan::Surface;
+use crate::sight::Sight;
 
 /// The `nav350` localiser's settings (`[sensors.localizer]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -74,7 +75,7 @@ pub struct ReflectorNav {
     /// The reflectors the world holds (the map less the missing ones).
     present: Vec<Reflector>,
     /// Racks and walls: the surfaces that hide a reflector.
-    blocking: Vec<Surface>,
+    blocking: Sight,
     cadence: Cadence,
     /// The poses over the last sweep: each reflector is measured from where the scanner
     /// was when its beam passed it.
@@ -148,11 +149,7 @@ impl ReflectorNav {
             measured,
             map: map.to_vec(),
             present,
-            blocking: surfaces
-                .iter()
-                .filter(|s| s.seen == Seen::Fixed)
-                .copied()
-                .collect(),
+            blocking: Sight::new(surfaces),
             cadence: Cadence::new(rate_hz, latency_s),
             trail: Trail::default(),
         }
@@ -208,7 +205,7 @@ impl ReflectorNav {
             .trail
             .at(t_i, truth)
             .map_or(*sensor_end, |p| p.to_world(m));
-        let o = reflectors::measure(&sensor_i, &self.present, &[i], &self.measured, rng)[0];
+        let o = reflectors::measure_one(&sensor_i, r, &self.measured, rng);
         if !self.settings.speed_input {
             return o;
         }

@@ -15,7 +15,7 @@ use rand::{Rng, RngExt as _};
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
-use crate::scan::{Seen, Surface};
+use crate::sight::Sight;
 
 /// A point reflector in the map.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -82,26 +82,12 @@ impl ReflectorNavConfig {
     }
 }
 
-/// Whether the segment from `a` to `b` crosses the segment `s`.
-fn crosses(a: [f64; 2], b: [f64; 2], s: &Surface) -> bool {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let e = [s.b[0] - s.a[0], s.b[1] - s.a[1]];
-    let den = d[0] * e[1] - d[1] * e[0];
-    if den.abs() < 1e-15 {
-        return false;
-    }
-    let w = [s.a[0] - a[0], s.a[1] - a[1]];
-    let t = (w[0] * e[1] - w[1] * e[0]) / den;
-    let u = (w[0] * d[1] - w[1] * d[0]) / den;
-    (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)
-}
-
 /// Indices of the reflectors in line of sight from `at` and within range: no fixed
 /// surface (rack, wall) between; pallets do not block.
 pub fn visible(
     at: [f64; 2],
     reflectors: &[Reflector],
-    fixed: &[Surface],
+    sight: &Sight,
     cfg: &ReflectorNavConfig,
 ) -> Vec<usize> {
     reflectors
@@ -109,11 +95,7 @@ pub fn visible(
         .enumerate()
         .filter(|(_, r)| {
             let d = (r.x_m - at[0]).hypot(r.y_m - at[1]);
-            (cfg.range_min_m..=cfg.range_max_m).contains(&d)
-                && !fixed
-                    .iter()
-                    .filter(|s| s.seen == Seen::Fixed)
-                    .any(|s| crosses(at, [r.x_m, r.y_m], s))
+            (cfg.range_min_m..=cfg.range_max_m).contains(&d) && !sight.blocked(at, [r.x_m, r.y_m])
         })
         .map(|(i, _)| i)
         .collect()
@@ -136,21 +118,24 @@ pub fn measure<R: Rng + ?Sized>(
     rng: &mut R,
 ) -> Vec<Observation> {
     seen.iter()
-        .map(|&i| {
-            let (dx, dy) = (
-                reflectors[i].x_m - sensor.x_m,
-                reflectors[i].y_m - sensor.y_m,
-            );
-            let zr: f64 = rng.sample(StandardNormal);
-            let zb: f64 = rng.sample(StandardNormal);
-            Observation {
-                range_m: dx.hypot(dy) + cfg.range_sigma_m * zr,
-                bearing_rad: wrap_angle(
-                    dy.atan2(dx) - sensor.heading_rad + cfg.bearing_sigma_rad * zb,
-                ),
-            }
-        })
+        .map(|&i| measure_one(sensor, &reflectors[i], cfg, rng))
         .collect()
+}
+
+/// One reflector as [`measure`] measures it (range draw, then bearing draw).
+pub fn measure_one<R: Rng + ?Sized>(
+    sensor: &Pose2,
+    reflector: &Reflector,
+    cfg: &ReflectorNavConfig,
+    rng: &mut R,
+) -> Observation {
+    let (dx, dy) = (reflector.x_m - sensor.x_m, reflector.y_m - sensor.y_m);
+    let zr: f64 = rng.sample(StandardNormal);
+    let zb: f64 = rng.sample(StandardNormal);
+    Observation {
+        range_m: dx.hypot(dy) + cfg.range_sigma_m * zr,
+        bearing_rad: wrap_angle(dy.atan2(dx) - sensor.heading_rad + cfg.bearing_sigma_rad * zb),
+    }
 }
 
 /// Pairs each observation with the map reflector nearest where `predicted` puts it,
@@ -168,13 +153,12 @@ pub fn associate(
             predicted.x_m + o.range_m * a.cos(),
             predicted.y_m + o.range_m * a.sin(),
         ];
-        let near: Vec<usize> = reflectors
+        let mut near = reflectors
             .iter()
             .enumerate()
             .filter(|(_, r)| (r.x_m - p[0]).hypot(r.y_m - p[1]) <= cfg.association_gate_m)
-            .map(|(i, _)| i)
-            .collect();
-        if let [i] = near[..]
+            .map(|(i, _)| i);
+        if let (Some(i), None) = (near.next(), near.next())
             && !out.iter().any(|(_, j)| *j == i)
         {
             out.push((k, i));

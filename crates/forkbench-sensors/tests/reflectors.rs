@@ -6,6 +6,7 @@ use forkbench_sensors::reflectors::{
     visible,
 };
 use forkbench_sensors::scan::{Seen, Surface};
+use forkbench_sensors::sight::Sight;
 use rand::{RngExt as _, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -86,7 +87,7 @@ fn line_of_sight_matches_an_independent_clip() {
         let want = !rects
             .iter()
             .any(|(c, l, w)| clips(at, [r.x_m, r.y_m], c, *l, *w));
-        let got = !visible(at, std::slice::from_ref(&r), &fixed, &cfg).is_empty();
+        let got = !visible(at, std::slice::from_ref(&r), &Sight::new(&fixed), &cfg).is_empty();
         assert_eq!(got, want, "from {at:?} to {r:?} past {rects:?}");
         if want {
             clear += 1;
@@ -101,7 +102,12 @@ fn line_of_sight_matches_an_independent_clip() {
     // Pallets never block: they lie below the scanner's plane.
     let pallet = Surface::rect(&Pose2::new(5.0, 0.0, 0.0), 1.2, 1.2, Seen::Pallet(0));
     assert_eq!(
-        visible([0.0, 0.0], &[refl("a", 10.0, 0.0)], &pallet, &cfg),
+        visible(
+            [0.0, 0.0],
+            &[refl("a", 10.0, 0.0)],
+            &Sight::new(&pallet),
+            &cfg
+        ),
         vec![0]
     );
 }

@@ -78,6 +78,19 @@ pub struct Sim {
     pallet_inertia: f64,
     last_fork_force_n: f64,
     last_obstacle_contact: bool,
+    /// The bodies' state as of the last step: read many times per control tick, and
+    /// each read would otherwise redo the same trigonometry on unchanged bodies.
+    now: Kinematics,
+}
+
+/// What the accessors report, computed once per step from the bodies.
+#[derive(Debug, Clone, Copy)]
+struct Kinematics {
+    axle: Pose2,
+    fork_root: Pose2,
+    pallet: Pose2,
+    speed_mps: f64,
+    lateral_speed_mps: f64,
 }
 
 impl std::fmt::Debug for Sim {
@@ -175,7 +188,7 @@ impl Sim {
         // fill it now, so the world can be seen before the first step.
         world.detect_collisions(&(), &());
 
-        Ok(Self {
+        let mut sim = Self {
             world,
             truck,
             forks,
@@ -194,7 +207,37 @@ impl Sim {
             pallet_inertia,
             last_fork_force_n: 0.0,
             last_obstacle_contact: false,
-        })
+            // Filled from the bodies just below.
+            now: Kinematics {
+                axle: *start,
+                fork_root: *start,
+                pallet: *pallet_pose,
+                speed_mps: 0.0,
+                lateral_speed_mps: 0.0,
+            },
+        };
+        sim.now = sim.kinematics();
+        Ok(sim)
+    }
+
+    /// The accessors' values, read from the bodies.
+    fn kinematics(&self) -> Kinematics {
+        let axle = self.body_pose(self.truck);
+        let fork_root = axle.to_world(&Pose2::new(
+            self.spec.fork_root_ahead_of_front_axle_m,
+            0.0,
+            0.0,
+        ));
+        let b = &self.world.bodies[self.truck];
+        let v = b.velocity_at_point(b.translation());
+        let (vx, vy) = (v.x as f64, v.y as f64);
+        Kinematics {
+            axle,
+            fork_root,
+            pallet: self.body_pose(self.pallet),
+            speed_mps: vx * axle.heading_rad.cos() + vy * axle.heading_rad.sin(),
+            lateral_speed_mps: -vx * axle.heading_rad.sin() + vy * axle.heading_rad.cos(),
+        }
     }
 
     pub fn time_s(&self) -> f64 {
@@ -218,22 +261,17 @@ impl Sim {
 
     /// Front-axle (kinematic origin) pose.
     pub fn front_axle_pose(&self) -> Pose2 {
-        self.body_pose(self.truck)
+        self.now.axle
     }
 
     /// Fork-root (path reference point) pose.
     pub fn fork_root_pose(&self) -> Pose2 {
-        let a = self.front_axle_pose();
-        a.to_world(&Pose2::new(
-            self.spec.fork_root_ahead_of_front_axle_m,
-            0.0,
-            0.0,
-        ))
+        self.now.fork_root
     }
 
     /// Pallet front-face centre pose (moves if the pallet is pushed).
     pub fn pallet_pose(&self) -> Pose2 {
-        self.body_pose(self.pallet)
+        self.now.pallet
     }
 
     pub fn pallet_spec(&self) -> &PalletSpec {
@@ -242,18 +280,12 @@ impl Sim {
 
     /// Longitudinal speed of the front axle (what the drive encoder reads).
     pub fn speed_mps(&self) -> f64 {
-        let b = &self.world.bodies[self.truck];
-        let a = self.front_axle_pose();
-        let v = b.velocity_at_point(b.translation());
-        v.x as f64 * a.heading_rad.cos() + v.y as f64 * a.heading_rad.sin()
+        self.now.speed_mps
     }
 
     /// Lateral (side-slip) speed of the front axle.
     pub fn lateral_speed_mps(&self) -> f64 {
-        let b = &self.world.bodies[self.truck];
-        let a = self.front_axle_pose();
-        let v = b.velocity_at_point(b.translation());
-        -(v.x as f64) * a.heading_rad.sin() + v.y as f64 * a.heading_rad.cos()
+        self.now.lateral_speed_mps
     }
 
     pub fn yaw_rate_radps(&self) -> f64 {
@@ -295,6 +327,7 @@ impl Sim {
         self.world.step();
         self.steps += 1;
         self.read_contacts(dt);
+        self.now = self.kinematics();
     }
 
     /// Drive/brake force at the front axle from a proportional speed controller.
@@ -329,18 +362,12 @@ impl Sim {
         let hr = a.heading_rad - self.steer_rad;
         let nr = [-hr.sin(), hr.cos()];
         let pts = [(pf, nf), (pr, nr)];
-        let r: Vec<[f64; 2]> = pts
-            .iter()
-            .map(|(p, _)| [p[0] - com[0], p[1] - com[1]])
-            .collect();
-        let u: Vec<f64> = pts
-            .iter()
-            .zip(&r)
-            .map(|((_, n), ri)| {
-                let vp = [lin[0] - w * ri[1], lin[1] + w * ri[0]];
-                vp[0] * n[0] + vp[1] * n[1]
-            })
-            .collect();
+        let r = pts.map(|(p, _)| [p[0] - com[0], p[1] - com[1]]);
+        let u = [0, 1].map(|k| {
+            let ((_, n), ri) = (pts[k], r[k]);
+            let vp = [lin[0] - w * ri[1], lin[1] + w * ri[0]];
+            vp[0] * n[0] + vp[1] * n[1]
+        });
         let (m, i) = (self.truck_mass_kg, self.truck_inertia);
         let k = |a: usize, bb: usize| {
             let (na, nb) = (pts[a].1, pts[bb].1);
@@ -402,10 +429,15 @@ impl Sim {
         }
         self.last_fork_force_n = fork_force;
         let truck_colliders = [self.chassis, self.forks[0], self.forks[1]];
+        // The truck's own pairs, not every (truck, obstacle) pair: a warehouse has many racks.
         self.last_obstacle_contact = truck_colliders.iter().any(|&t| {
-            self.obstacles.iter().any(|&o| {
-                np.contact_pair(t, o)
-                    .is_some_and(|p| p.has_any_active_contact())
+            np.contact_pairs_with(t).any(|p| {
+                let other = if p.collider1 == t {
+                    p.collider2
+                } else {
+                    p.collider1
+                };
+                p.has_any_active_contact() && self.obstacles.contains(&other)
             })
         });
     }

@@ -1,7 +1,7 @@
 //! Pure pursuit on the fork-root reference point, with fixed or speed-scaled look-ahead and a slow final approach.
 
 use forkbench_core::units::wrap_angle;
-use forkbench_core::{ForkliftSpec, Path, Pose2, SettingsError};
+use forkbench_core::{ForkliftSpec, Path, PathSample, Pose2, SettingsError};
 use serde::{Deserialize, Serialize};
 
 use crate::{Tracker, TrackerInput};
@@ -101,7 +101,15 @@ pub struct PurePursuit {
     cfg: TrackerConfig,
     idx: usize,
     root_ahead_m: f64,
+    /// Straight-line distance summed from the first sample to each: no sample can be
+    /// farther from another than the difference, which lets the searches skip samples.
+    chord_m: Vec<f64>,
+    /// Sine and cosine of the goal heading, asked for every tick.
+    goal_sin_cos: (f64, f64),
 }
+
+/// Slack on the skip bounds, far above the rounding of the distances it compares.
+const SKIP_MARGIN_M: f64 = 1e-9;
 
 impl PurePursuit {
     /// `root_ahead_m`: how far the tracked (fork-root) point sits ahead of the front axle.
@@ -115,12 +123,74 @@ impl PurePursuit {
                 p.heading_rad = wrap_angle(p.heading_rad + std::f64::consts::PI);
             }
         }
+        let mut chord_m = Vec::with_capacity(path.samples.len());
+        let mut sum = 0.0;
+        for (i, p) in path.samples.iter().enumerate() {
+            if let Some(q) = i.checked_sub(1).map(|j| &path.samples[j]) {
+                sum += (p.x_m - q.x_m).hypot(p.y_m - q.y_m);
+            }
+            chord_m.push(sum);
+        }
+        let goal_sin_cos = path
+            .samples
+            .last()
+            .map_or((0.0, 1.0), |g| g.heading_rad.sin_cos());
         Self {
             path,
             cfg,
             idx: 0,
             root_ahead_m,
+            chord_m,
+            goal_sin_cos,
         }
+    }
+
+    /// The first sample in `from..to` past `from` whose summed chord exceeds `reach_m`
+    /// (`to` when none does).
+    fn first_beyond(&self, from: usize, to: usize, reach_m: f64) -> usize {
+        // Galloping: most skips are short, and a bisection of the whole window would
+        // cost more than the distances it saves.
+        let (mut lo, mut step) = (from + 1, 1);
+        while lo + step < to && self.chord_m[lo + step] <= reach_m {
+            lo += step;
+            step *= 2;
+        }
+        let hi = (lo + step).min(to);
+        lo + self.chord_m[lo..hi].partition_point(|&c| c <= reach_m)
+    }
+
+    /// The sample closest to `pose` in the window of 400 samples from the last
+    /// progress (the first of equals). A sample within summed chord `c` of one at
+    /// distance `d` is at least `d − c` away, so those that cannot beat the best are
+    /// skipped; the result is that of the full scan.
+    fn closest(&self, pose: &Pose2) -> usize {
+        let d2 = |i: usize| {
+            let p = &self.path.samples[i];
+            (p.x_m - pose.x_m).powi(2) + (p.y_m - pose.y_m).powi(2)
+        };
+        let window = (self.idx + 400).min(self.path.samples.len());
+        let mut best = self.idx;
+        let mut best_d2 = d2(best);
+        let mut i = self.idx + 1;
+        while i < window {
+            let di2 = d2(i);
+            if di2 < best_d2 {
+                best = i;
+                best_d2 = di2;
+            }
+            // No closer than the best: nothing to skip, and no square roots to take.
+            if di2 <= best_d2 {
+                i += 1;
+                continue;
+            }
+            let slack = di2.sqrt() - best_d2.sqrt() - SKIP_MARGIN_M;
+            i = if slack > 0.0 {
+                self.first_beyond(i, window, self.chord_m[i] + slack)
+            } else {
+                i + 1
+            };
+        }
+        best
     }
 
     /// The front-axle path being tracked.
@@ -168,20 +238,9 @@ impl PurePursuit {
             axle.heading_rad = wrap_angle(axle.heading_rad + std::f64::consts::PI);
         }
         let pose = &axle;
-        let n = self.path.samples.len();
         let last = self.path.samples.last().copied()?;
         // Closest sample, searched forward from the last progress over a bounded window.
-        let d2 = |i: usize| {
-            let p = &self.path.samples[i];
-            (p.x_m - pose.x_m).powi(2) + (p.y_m - pose.y_m).powi(2)
-        };
-        let window = (self.idx + 400).min(n);
-        let mut best = self.idx;
-        for i in self.idx..window {
-            if d2(i) < d2(best) {
-                best = i;
-            }
-        }
+        let best = self.closest(pose);
         self.idx = best;
         let near = self.path.samples[best];
         let (sn, cn) = near.heading_rad.sin_cos();
@@ -190,7 +249,7 @@ impl PurePursuit {
         let cross_track_m = -sn * dx + cn * dy;
         let along = cn * dx + sn * dy;
         // Distance to go, measured along the goal heading at the end so the stop is exact.
-        let (gs, gc) = last.heading_rad.sin_cos();
+        let (gs, gc) = self.goal_sin_cos;
         let to_goal_along_heading = gc * (last.x_m - pose.x_m) + gs * (last.y_m - pose.y_m);
         let remaining_m = if self.path.length_m() - near.s_m < 0.5 {
             to_goal_along_heading
@@ -228,11 +287,8 @@ impl PurePursuit {
         let Some(last) = self.path.samples.last().copied() else {
             return [pose.x_m, pose.y_m];
         };
-        let (gs, gc) = last.heading_rad.sin_cos();
-        let d2 = |p: &forkbench_core::PathSample| {
-            (p.x_m - pose.x_m).powi(2) + (p.y_m - pose.y_m).powi(2)
-        };
-        if let Some(p) = self.path.samples[from..].iter().find(|p| d2(p) >= ld * ld) {
+        let (gs, gc) = self.goal_sin_cos;
+        if let Some(p) = self.first_at_least(pose, from, ld) {
             return [p.x_m, p.y_m];
         }
         let ext = ld.max(0.05);
@@ -244,6 +300,30 @@ impl PurePursuit {
         let fwd = (ext * ext - lat * lat).max(0.0).sqrt();
         let t = t_along + fwd;
         [last.x_m + gc * t, last.y_m + gs * t]
+    }
+}
+
+impl PurePursuit {
+    /// The first sample from `from` at least `ld` from `pose`. A sample within summed
+    /// chord `c` of one at distance `d` is at most `d + c` away, so those that cannot
+    /// reach `ld` are skipped; the result is that of the full scan.
+    fn first_at_least(&self, pose: &Pose2, from: usize, ld: f64) -> Option<PathSample> {
+        let n = self.path.samples.len();
+        let mut i = from;
+        while i < n {
+            let p = self.path.samples[i];
+            let d2 = (p.x_m - pose.x_m).powi(2) + (p.y_m - pose.y_m).powi(2);
+            if d2 >= ld * ld {
+                return Some(p);
+            }
+            let slack = ld - d2.sqrt() - SKIP_MARGIN_M;
+            i = if slack > 0.0 && i + 1 < n {
+                self.first_beyond(i, n, self.chord_m[i] + slack)
+            } else {
+                i + 1
+            };
+        }
+        None
     }
 }
 
@@ -315,49 +395,4 @@ impl Tracker for PurePursuit {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn straight(len: f64) -> Path {
-        Path::straight(&Pose2::new(0.0, 0.0, 0.0), len, 0.01)
-    }
-
-    #[test]
-    fn steers_back_toward_the_path() {
-        let truck = ForkliftSpec::default();
-        let mut pp = PurePursuit::new(straight(5.0), TrackerConfig::default(), 0.0);
-        let left = pp.command(&Pose2::new(1.0, 0.2, 0.0), 0.5, &truck);
-        assert!(left.steer_rad < 0.0, "left of the path must steer right");
-        assert!((left.cross_track_m - 0.2).abs() < 1e-9);
-        let mut pp = PurePursuit::new(straight(5.0), TrackerConfig::default(), 0.0);
-        let right = pp.command(&Pose2::new(1.0, -0.2, 0.0), 0.5, &truck);
-        assert!(right.steer_rad > 0.0);
-    }
-
-    #[test]
-    fn slows_near_the_goal_and_stops_there() {
-        let truck = ForkliftSpec::default();
-        let mut pp = PurePursuit::new(straight(5.0), TrackerConfig::default(), 0.0);
-        let far = pp.command(&Pose2::new(0.5, 0.0, 0.0), 0.8, &truck);
-        assert!((far.speed_mps - 0.8).abs() < 1e-9);
-        let near = pp.command(&Pose2::new(4.0, 0.0, 0.0), 0.3, &truck);
-        assert!(near.speed_mps <= 0.3 + 1e-9);
-        let end = pp.command(&Pose2::new(4.999, 0.0, 0.0), 0.05, &truck);
-        assert!(end.done && end.speed_mps == 0.0);
-    }
-
-    #[test]
-    fn speed_scaled_lookahead_grows_with_speed() {
-        let truck = ForkliftSpec::default();
-        let cfg = TrackerConfig {
-            lookahead_gain_s: Some(1.5),
-            ..TrackerConfig::default()
-        };
-        let mut pp = PurePursuit::new(straight(8.0), cfg.clone(), 0.0);
-        let slow = pp.command(&Pose2::new(1.0, 0.0, 0.0), 0.1, &truck);
-        let mut pp = PurePursuit::new(straight(8.0), cfg, 0.0);
-        let fast = pp.command(&Pose2::new(1.0, 0.0, 0.0), 0.8, &truck);
-        assert!((slow.lookahead_point[0] - 1.3).abs() < 0.02);
-        assert!((fast.lookahead_point[0] - 2.2).abs() < 0.02);
-    }
-}
+mod tests;

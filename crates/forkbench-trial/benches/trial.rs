@@ -1,4 +1,4 @@
-//! Wall time of one 6.5 m pick trial (issue target: ≤ 20 ms on one core, ≥ 500× real time).
+//! Wall time of one trial: a 6.5 m pick with each planner and sensing, and one trial of each kind the main job runs.
 
 use std::path::Path;
 
@@ -57,9 +57,36 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
+/// One trial of each kind the main job runs, at the embedded scenarios' own settings
+/// (TiM561 scans, NAV350 reflector fixes, odometry errors), plan once, fixed seed.
+fn kinds(c: &mut Criterion) {
+    let scenarios = forkbench_trial::defaults::default_scenarios().expect("embedded scenarios");
+    let mut g = c.benchmark_group("kind");
+    for (name, case) in [
+        ("bspline-table2", "1"),
+        ("spiral-table2", "1"),
+        ("rack-pick", ""),
+        ("field-test", ""),
+        ("warehouse-mission", ""),
+    ] {
+        let scn = scenarios
+            .iter()
+            .find(|s| s.name == name)
+            .expect("embedded scenario");
+        let case = scn.case(case).unwrap_or(&scn.cases[0]);
+        let opts = TrialOptions {
+            seed: Some(7),
+            replan: Some(false),
+            ..TrialOptions::default()
+        };
+        g.bench_function(name, |b| b.iter(|| run_trial(scn, case, &opts)));
+    }
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2));
-    targets = bench
+    targets = bench, kinds
 }
 criterion_main!(benches);

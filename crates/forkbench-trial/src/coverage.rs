@@ -1,6 +1,7 @@
 //! Reflector coverage of a world: at every free cell centre, how many reflectors a NAV350 there sees past racks and walls, and the predicted 1σ position error of a fix (none below the minimum).
 
 use forkbench_sensors::reflectors::{ReflectorNavConfig, predicted_sigma_m, visible};
+use forkbench_sensors::sight::Sight;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -78,7 +79,7 @@ pub fn coverage(
             "gives {nx} × {ny} cells, more than {MAX_CELLS}; choose a coarser resolution"
         )));
     }
-    let fixed = world.fixed_surfaces();
+    let fixed = Sight::new(&world.fixed_surfaces());
     let obstacles = world.obstacles();
     // A cell centre on a side counts as inside.
     let free = |p: [f64; 2]| !obstacles.iter().any(|o| o.depth_inside(p) >= 0.0);

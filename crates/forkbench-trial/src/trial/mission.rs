@@ -88,7 +88,7 @@ impl Trial<'_> {
         staging: &Waypoint,
         rec: &mut R,
     ) -> Result<(), StageError> {
-        let map = NavMap::from_world(&self.obstacles, m.global.resolution_m)?;
+        let map = NavMap::shared_from_world(&self.obstacles, m.global.resolution_m)?;
         rec.signal(
             self.sim.time_s(),
             "nav/occupied",

@@ -1,0 +1,120 @@
+//! PRM to the first solution: samples added one at a time, each joined to its nearest neighbours within the connection distance (OMPL's PRM strategy), until start and goal share a component; then A*.
+
+use std::num::NonZero;
+use std::time::Instant;
+
+use kiddo::{KdTree, SquaredEuclidean};
+use rand::{RngExt as _, SeedableRng as _};
+use rand_chacha::ChaCha8Rng;
+
+use crate::roadmap::{MAX_NODES, astar};
+use crate::space::FreeSpace;
+use crate::{NavError, PrmParams, Roadmap, Route, Timing};
+
+/// Neighbours each new node tries to join (OMPL's PRM default).
+pub const NEIGHBOURS: usize = 10;
+
+/// Plans from `start` to `goal`, drawing at most `p.nodes` samples: the first route the
+/// growing roadmap holds, with the roadmap as it stood then.
+pub fn plan_prm_first<S: FreeSpace + ?Sized>(
+    space: &S,
+    start: [f64; 2],
+    goal: [f64; 2],
+    p: &PrmParams,
+) -> Result<(Route, Roadmap), NavError> {
+    crate::check_endpoints(space, start, goal)?;
+    if p.nodes > MAX_NODES {
+        return Err(NavError::Params(format!(
+            "{} samples: at most {MAX_NODES}",
+            p.nodes
+        )));
+    }
+    if p.connect_m.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
+        return Err(NavError::Params(
+            "the connection distance must be a positive number of metres".into(),
+        ));
+    }
+    let t0 = Instant::now();
+    let mut g = Growing::new(space, p.connect_m);
+    g.add(start);
+    g.add(goal);
+    let (lo, hi) = space.extent();
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+    let mut drawn = 0;
+    while !g.connected() && drawn < p.nodes {
+        drawn += 1;
+        let q = [
+            rng.random_range(lo[0]..hi[0]),
+            rng.random_range(lo[1]..hi[1]),
+        ];
+        if space.point_free(q) {
+            g.add(q);
+        }
+    }
+    let grown = Instant::now();
+    let found = g.connected().then(|| astar(&g.map, 0, 1)).flatten();
+    let timing = Timing {
+        sampling_s: 0.0,
+        connection_s: (grown - t0).as_secs_f64(),
+        search_s: grown.elapsed().as_secs_f64(),
+    };
+    let points = found.map(|ids| ids.iter().map(|&i| g.map.nodes[i]).collect());
+    Ok((Route::new(points, timing, g.map.nodes.len()), g.map))
+}
+
+/// A roadmap being grown, its nodes in a k-d tree and its components in a union-find.
+struct Growing<'a, S: ?Sized> {
+    space: &'a S,
+    map: Roadmap,
+    tree: KdTree<f64, 2>,
+    parent: Vec<usize>,
+    reach2: f64,
+}
+
+impl<'a, S: FreeSpace + ?Sized> Growing<'a, S> {
+    fn new(space: &'a S, connect_m: Option<f64>) -> Self {
+        Self {
+            space,
+            map: Roadmap::default(),
+            tree: KdTree::new(),
+            parent: Vec::new(),
+            reach2: connect_m.map_or(f64::INFINITY, |r| r * r),
+        }
+    }
+
+    /// Adds `q` and joins it to its nearest neighbours in view.
+    fn add(&mut self, q: [f64; 2]) {
+        let i = self.map.nodes.len();
+        self.map.nodes.push(q);
+        self.map.edges.push(Vec::new());
+        self.parent.push(i);
+        let k = NonZero::new(NEIGHBOURS).unwrap_or(NonZero::<usize>::MIN);
+        for nb in self
+            .tree
+            .nearest_n_within::<SquaredEuclidean>(&q, self.reach2, k, true)
+        {
+            let j = nb.item as usize;
+            if self.space.segment_free(q, self.map.nodes[j]) {
+                let d = nb.distance.sqrt();
+                self.map.edges[i].push((j, d));
+                self.map.edges[j].push((i, d));
+                let (a, b) = (self.root(i), self.root(j));
+                self.parent[a] = b;
+            }
+        }
+        self.tree.add(&q, i as u64);
+    }
+
+    fn root(&mut self, mut i: usize) -> usize {
+        while self.parent[i] != i {
+            self.parent[i] = self.parent[self.parent[i]];
+            i = self.parent[i];
+        }
+        i
+    }
+
+    /// Whether the start (node 0) and the goal (node 1) share a component.
+    fn connected(&mut self) -> bool {
+        self.parent.len() > 1 && self.root(0) == self.root(1)
+    }
+}

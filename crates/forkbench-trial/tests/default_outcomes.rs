@@ -1,0 +1,94 @@
+//! The speed work changed no result at the defaults: every committed trial record of the
+//! main job (the embedded scenarios with their own sensing: TiM561 scans, NAV350
+//! reflector fixes, odometry errors, the warehouse mission; two trials of every scenario
+//! × case × planner × mode), re-run at its own seed, gives the same outcome to the bit.
+
+use forkbench_trial::defaults::default_scenarios;
+use forkbench_trial::{TrialOptions, run_trial};
+use rayon::prelude::*;
+use serde_json::Value;
+
+/// Records made before the change by `batch --trials 20` (trials 0 and 1 of each row),
+/// with the wall and planning times removed.
+fn committed() -> Vec<Value> {
+    include_str!("data/default_outcomes.jsonl")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("json"))
+        .collect()
+}
+
+/// Removes what a re-run cannot reproduce: the times measured on the clock.
+fn without_clock_times(v: &mut Value) {
+    let m = v.as_object_mut().expect("object");
+    m.remove("wall_time_ms");
+    if let Some(Value::Array(legs)) = m.get_mut("legs") {
+        for leg in legs {
+            leg.as_object_mut()
+                .expect("leg object")
+                .remove("planning_time_s");
+        }
+    }
+}
+
+/// The record re-run at its seed, in the committed records' form.
+fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario]) -> Value {
+    let s = |f: &str| want[f].as_str().expect("string field").to_owned();
+    let scn = scenarios
+        .iter()
+        .find(|x| x.name == s("scenario"))
+        .expect("scenario");
+    let case = scn.case(&s("case")).expect("case");
+    let replan = want["replan"].as_bool().expect("replan");
+    let opts = TrialOptions {
+        seed: Some(want["seed"].as_u64().expect("seed")),
+        planner: Some(s("planner")),
+        tracker: Some(s("tracker")),
+        no_noise: false,
+        pallet_noise_scale: None,
+        replan: Some(replan),
+    };
+    let mut v = serde_json::to_value(run_trial(scn, case, &opts)).expect("serialises");
+    without_clock_times(&mut v);
+    let m = v.as_object_mut().expect("object");
+    m.insert("replan".into(), Value::Bool(replan));
+    m.insert("trial".into(), want["trial"].clone());
+    v
+}
+
+#[test]
+fn default_outcomes_are_identical_to_the_records_before_the_change() {
+    let want = committed();
+    let scenarios = default_scenarios().expect("embedded scenarios");
+    let rows: std::collections::BTreeSet<_> = want
+        .iter()
+        .map(|w| {
+            (
+                w["scenario"].to_string(),
+                w["case"].to_string(),
+                w["replan"].to_string(),
+            )
+        })
+        .collect();
+    assert_eq!(want.len(), 2 * rows.len(), "two trials of every row");
+    assert!(
+        want.iter().any(|w| w["scenario"] == "warehouse-mission"),
+        "the mission is among the records"
+    );
+    let differing: Vec<String> = want
+        .par_iter()
+        .filter(|w| rerun(w, &scenarios) != **w)
+        .map(|w| {
+            format!(
+                "{} / {} / {} / replan {} / seed {}",
+                w["scenario"], w["case"], w["planner"], w["replan"], w["seed"]
+            )
+        })
+        .collect();
+    assert!(
+        differing.is_empty(),
+        "{} of {} trials differ, first: {:?}",
+        differing.len(),
+        want.len(),
+        differing.first()
+    );
+}
