@@ -154,6 +154,56 @@ fn every_global_planner_finds_the_shelf_and_a_blocked_goal_is_refused() {
     );
 }
 
+/// `--first-solution` stops at the first connection, `--runs` plans seed after seed in one
+/// process, and every route comes with its simplified form, free and no longer.
+#[test]
+fn first_solution_prm_runs_seed_after_seed_with_simplified_routes() {
+    let out = forkbench(&[
+        "plan",
+        "prm",
+        "--first-solution",
+        "--runs",
+        "5",
+        "--seed",
+        "10",
+        "--map",
+        &world("warehouse.toml"),
+        "--start",
+        START,
+        "--goal",
+        GOAL,
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let runs: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect();
+    assert_eq!(runs.len(), 5);
+    for (k, v) in runs.iter().enumerate() {
+        assert_eq!(v["seed"], 10 + k as u64);
+        assert_eq!(v["success"], true, "{v}");
+        assert_eq!(v["first_solution"], true);
+        // Stopped well before the 5000-sample cap.
+        assert!(v["roadmap_nodes"].as_u64().expect("nodes") < 1000, "{v}");
+        let raw = v["length_m"].as_f64().expect("length");
+        let short = v["simplified"]["length_m"].as_f64().expect("simplified");
+        assert!(short <= raw + 1e-9 && short > 27.0, "{raw} → {short}");
+    }
+    for bad in [vec!["bspline"], vec!["rrt-connect"]] {
+        let mut args = vec!["plan"];
+        args.extend(bad);
+        args.extend(["--first-solution", "--start", START, "--goal", GOAL]);
+        let out = forkbench(&args);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--first-solution is for prm"));
+    }
+}
+
 #[test]
 fn a_footprint_plan_smooths_into_a_drivable_path_with_its_clearance() {
     let v = json_of(&forkbench(&[

@@ -1,151 +1,151 @@
 #!/usr/bin/env python3
-"""forkbench's PRM and RRT-Connect against OMPL's on the same occupancy grid, start and goal.
+"""forkbench's PRM and RRT-Connect against OMPL's C++ library on the same grid, start and goal.
 
-    python3 tools/ompl_compare.py [--runs N] [--forkbench PATH] [--timeout-s T]
+    python3 tools/ompl_compare.py [--runs N] [--forkbench PATH] [--json FILE]
 
-Installs OMPL's Python bindings from PyPI (`pip install ompl`) when they are missing. The
-map is the warehouse world rasterised at 5 cm with the obstacles grown by Luo's 0.815 m
-(`forkbench map --inflate-m`), written as a ROS map; both libraries plan on that file:
-forkbench with `plan prm|rrt-connect --map MAP.yaml --inflate-m 0`, OMPL in a 2-D
-real-vector space whose validity checker reads the same cells. The leg is
-`reproduce prm`'s: the charging station (3, 3) to the aisle before row 2b, bay 3.
+OMPL is Debian's `libompl-dev` (1.5.2), driven by `tools/ompl_bench.cpp`, which this script
+builds with g++ (installing `libompl-dev g++` with apt-get when they are missing and it
+runs as root). The map is the warehouse world rasterised at 5 cm with the obstacles grown
+by Luo's 0.815 m (`forkbench map --inflate-m`), written as a ROS map; both libraries plan
+on that file: forkbench with `plan … --map MAP.yaml --inflate-m 0`, OMPL in a 2-D real
+vector space whose validity checker reads the same cells, motions checked every half cell
+(forkbench walks every cell). The leg is `reproduce prm`'s: the charging station (3, 3) to
+the aisle before row 2b, bay 3.
 
-Times: forkbench reports its own planning time (sampling, connection, search; the map is
-loaded before); OMPL's is the wall time of `SimpleSetup.solve` to its first solution, which
-includes its Python validity callbacks. Lengths are of the raw paths (no simplification).
+Times are the planners' own, map loaded before, every run of a planner in one process (warm
+caches on both sides): forkbench's sampling, connection and search (`plan --runs`); OMPL's
+`solve` to its first exact solution (setup done before). Lengths: the first
+solution, then after each library's simplification (OMPL: `SimpleSetup::simplifySolution`;
+forkbench: vertex shortcuts then seeded random shortcuts, `nav::simplify`). Every run has
+its own seed (forkbench) or its place in one seeded stream (OMPL).
 """
 import argparse
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 START, GOAL = (3.0, 3.0), (30.75, 10.25)
 INFLATE_M = 0.815
+OMPL_INCLUDE = "/usr/include/ompl-1.5"
 
 
 def ensure_ompl():
-    try:
-        import ompl  # noqa: F401
-        import yaml  # noqa: F401
-    except ImportError:
-        subprocess.run([sys.executable, "-m", "pip", "install", "-q", "ompl", "pyyaml"], check=True)
+    """The C++ toolchain and OMPL's headers, installed with apt-get when missing."""
+    if shutil.which("g++") and os.path.isdir(OMPL_INCLUDE):
+        return
+    if os.geteuid() != 0:
+        sys.exit("needs g++ and libompl-dev (apt-get install g++ libompl-dev)")
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    subprocess.run(["apt-get", "update", "-qq"], check=True, env=env)
+    subprocess.run(["apt-get", "install", "-y", "-q", "g++", "libompl-dev"], check=True,
+                   env=env, stdout=subprocess.DEVNULL)
 
 
-def read_map(yaml_path):
-    """The ROS map: (free mask rows from the bottom, resolution, origin)."""
-    import yaml
-    meta = yaml.safe_load(open(yaml_path))
-    res = float(meta["resolution"])
-    origin = [float(v) for v in meta["origin"][:2]]
-    pgm = open(os.path.join(os.path.dirname(yaml_path), meta["image"]), "rb").read()
-    fields, pos = [], 0
-    while len(fields) < 4:  # magic, width, height, maxval, with `#` comments between
-        while pgm[pos:pos + 1].isspace():
-            pos += 1
-        if pgm[pos:pos + 1] == b"#":
-            pos = pgm.index(b"\n", pos)
-            continue
-        end = pos
-        while not pgm[end:end + 1].isspace():
-            end += 1
-        fields.append(pgm[pos:end])
-        pos = end
-    w, h = int(fields[1]), int(fields[2])
-    data = pgm[pos + 1:pos + 1 + w * h]
-    # Rows are top first in the image; 254 is free in map_server's trinary export.
-    free = [[data[(h - 1 - r) * w + c] == 254 for c in range(w)] for r in range(h)]
-    return free, res, origin, w, h
+def build_bench(out_dir):
+    exe = os.path.join(out_dir, "ompl_bench")
+    src = os.path.join(ROOT, "tools", "ompl_bench.cpp")
+    subprocess.run(["g++", "-O2", "-std=c++17", src, f"-I{OMPL_INCLUDE}", "-I/usr/include/eigen3",
+                    "-lompl", "-o", exe], check=True)
+    return exe
 
 
-def forkbench_runs(exe, yaml_path, planner, runs):
+def forkbench_runs(exe, yaml_path, planner, runs, extra):
+    """`runs` plans in one process (seeds 0, 1, …), as OMPL's runs share one process."""
+    cmd = [exe, "plan", planner, "--map", yaml_path, "--inflate-m", "0", "--connect-m", "10",
+           "--seed", "0", "--runs", str(runs), "--json", "--start", "%g,%g,0" % START,
+           "--goal", "%g,%g,0" % GOAL] + extra
     out = []
-    for seed in range(runs):
-        cmd = [exe, "plan", planner, "--map", yaml_path, "--inflate-m", "0", "--nodes", "500",
-               "--connect-m", "10", "--seed", str(seed), "--json",
-               "--start", "%g,%g,0" % START, "--goal", "%g,%g,0" % GOAL]
-        v = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
-        out.append((v["success"], v["timing_s"]["total"], v["length_m"]))
+    for line in subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.splitlines():
+        v = json.loads(line)
+        t = v["timing_s"]
+        simple = v.get("simplified") or {}
+        out.append({"success": v["success"], "time_s": t["sampling"] + t["connection"] + t["search"],
+                    "length_m": v["length_m"], "simplified_length_m": simple.get("length_m"),
+                    "simplify_s": simple.get("time_s")})
     return out
 
 
-def ompl_runs(yaml_path, planner, runs, timeout_s):
-    from ompl import base as ob, geometric as og
-    free, res, origin, w, h = read_map(yaml_path)
-    space = ob.RealVectorStateSpace(2)
-    bounds = ob.RealVectorBounds(2)
-    bounds.setLow(0, origin[0]); bounds.setHigh(0, origin[0] + w * res)
-    bounds.setLow(1, origin[1]); bounds.setHigh(1, origin[1] + h * res)
-    space.setBounds(bounds)
-
-    def valid(s):
-        c, r = int((s[0] - origin[0]) / res), int((s[1] - origin[1]) / res)
-        return 0 <= c < w and 0 <= r < h and free[r][c]
-
-    out = []
-    for _ in range(runs):
-        ss = og.SimpleSetup(space)
-        ss.setStateValidityChecker(valid)
-        si = ss.getSpaceInformation()
-        # Edges are checked every half cell, as fine as forkbench's cell walk.
-        si.setStateValidityCheckingResolution(0.5 * res / space.getMaximumExtent())
-        start, goal = space.allocState(), space.allocState()
-        start[0], start[1] = START
-        goal[0], goal[1] = GOAL
-        ss.setStartAndGoalStates(start, goal)
-        p = og.PRM(si) if planner == "prm" else og.RRTConnect(si)
-        if planner == "rrt-connect":
-            p.setRange(1.0)  # forkbench's RRT step
-        ss.setPlanner(p)
-        t0 = time.perf_counter()
-        solved = ss.solve(timeout_s)
-        t = time.perf_counter() - t0
-        ok = bool(solved) and ss.haveExactSolutionPath()
-        out.append((ok, t, ss.getSolutionPath().length() if ok else None))
+def ompl_runs(bench, yaml_path, planner, runs, timeout_s):
+    cmd = [bench, yaml_path, planner, str(runs), "1", *(str(v) for v in START + GOAL), str(timeout_s), "1.0"]
+    lines = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.splitlines()
+    out = [json.loads(line) for line in lines]
+    for r in out:
+        if not r["success"]:
+            r["length_m"] = r["simplified_length_m"] = None
     return out
 
 
-def row(name, planner, runs):
-    ok = [r for r in runs if r[0]]
-    t = statistics.median(r[1] for r in runs)
-    length = statistics.median(r[2] for r in ok) if ok else float("nan")
-    return {"library": name, "planner": planner, "success": len(ok), "runs": len(runs),
-            "median_time_ms": 1e3 * t, "median_length_m": length}
+def pct(values, q):
+    v = sorted(values)
+    return v[min(len(v) - 1, int(q * len(v)))] if v else float("nan")
+
+
+def row(library, planner, runs):
+    ok = [r for r in runs if r["success"]]
+    med = lambda k: statistics.median(r[k] for r in ok) if ok else float("nan")
+    p90 = lambda k: pct([r[k] for r in ok], 0.9)
+    times = [r["time_s"] for r in runs]
+    return {"library": library, "planner": planner, "success": len(ok), "runs": len(runs),
+            "time_median_ms": 1e3 * statistics.median(times), "time_p90_ms": 1e3 * pct(times, 0.9),
+            "length_median_m": med("length_m"), "length_p90_m": p90("length_m"),
+            "simplified_median_m": med("simplified_length_m"), "simplified_p90_m": p90("simplified_length_m"),
+            "simplify_median_ms": 1e3 * med("simplify_s")}
+
+
+def table(rows, runs):
+    lines = [f"warehouse map, 5 cm cells inflated by {INFLATE_M} m; {START} → {GOAL}; {runs} seeds each\n",
+             "| library | planner | success | time to first solution, median / p90 | length median / p90 "
+             "| simplified length median / p90 (time) | OMPL time / forkbench |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        ratio = f"{r['ratio']:.1f}×" if "ratio" in r else ""
+        lines.append(
+            f"| {r['library']} | {r['planner']} | {r['success']}/{r['runs']} | "
+            f"{r['time_median_ms']:.3f} / {r['time_p90_ms']:.3f} ms | "
+            f"{r['length_median_m']:.2f} / {r['length_p90_m']:.2f} m | "
+            f"{r['simplified_median_m']:.2f} / {r['simplified_p90_m']:.2f} m ({r['simplify_median_ms']:.2f} ms) | {ratio} |")
+    return "\n".join(lines)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=20)
+    ap.add_argument("--runs", type=int, default=100)
     ap.add_argument("--timeout-s", type=float, default=10.0)
+    ap.add_argument("--json", help="also write the rows to FILE")
+    ap.add_argument("--check", action="store_true",
+                    help="exit 1 unless forkbench succeeds as often as OMPL with each planner")
     ap.add_argument("--forkbench", default=os.path.join(
         os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")), "release", "forkbench"))
     a = ap.parse_args()
     ensure_ompl()
-    import ompl.util as ou
-    ou.setLogLevel(ou.LogLevel.LOG_WARN)
     tmp = tempfile.mkdtemp(prefix="ompl-compare-")
+    bench = build_bench(tmp)
     subprocess.run([a.forkbench, "map", os.path.join(ROOT, "worlds", "warehouse.toml"),
                     "--margin-m", "0", "--inflate-m", str(INFLATE_M), "--out", tmp],
                    check=True, capture_output=True)
     yaml_path = os.path.join(tmp, "warehouse.yaml")
-    rows = []
-    for planner in ["prm", "rrt-connect"]:
-        fb = row("forkbench", planner, forkbench_runs(a.forkbench, yaml_path, planner, a.runs))
-        om = row("OMPL", planner, ompl_runs(yaml_path, planner, a.runs, a.timeout_s))
-        om["time_ratio"] = om["median_time_ms"] / fb["median_time_ms"]
-        rows += [fb, om]
-    print(f"warehouse map, 5 cm cells inflated by {INFLATE_M} m; {START} → {GOAL}; {a.runs} runs each\n")
-    print("| library | planner | success | median time to first solution | median length | OMPL / forkbench time |")
-    print("|---|---|---|---|---|---|")
-    for r in rows:
-        ratio = f"{r['time_ratio']:.0f}×" if "time_ratio" in r else ""
-        print(f"| {r['library']} | {r['planner']} | {r['success']}/{r['runs']} | "
-              f"{r['median_time_ms']:.2f} ms | {r['median_length_m']:.1f} m | {ratio} |")
-    json.dump(rows, open(os.path.join(tmp, "ompl_compare.json"), "w"), indent=1)
+    om_prm = row("OMPL", "prm", ompl_runs(bench, yaml_path, "prm", a.runs, a.timeout_s))
+    om_rrt = row("OMPL", "rrt-connect", ompl_runs(bench, yaml_path, "rrt-connect", a.runs, a.timeout_s))
+    fb_first = row("forkbench", "prm --first-solution",
+                   forkbench_runs(a.forkbench, yaml_path, "prm", a.runs, ["--first-solution"]))
+    fb_500 = row("forkbench", "prm (500 nodes, the paper's)",
+                 forkbench_runs(a.forkbench, yaml_path, "prm", a.runs, ["--nodes", "500"]))
+    fb_rrt = row("forkbench", "rrt-connect", forkbench_runs(a.forkbench, yaml_path, "rrt-connect", a.runs, []))
+    for fb, om in [(fb_first, om_prm), (fb_500, om_prm), (fb_rrt, om_rrt)]:
+        fb["ratio"] = om["time_median_ms"] / fb["time_median_ms"]
+    rows = [om_prm, fb_first, fb_500, om_rrt, fb_rrt]
+    print(table(rows, a.runs))
+    if a.json:
+        json.dump(rows, open(a.json, "w"), indent=1)
+    short = [f"{fb['planner']}: {fb['success']} < {om['success']}"
+             for fb, om in [(fb_first, om_prm), (fb_500, om_prm), (fb_rrt, om_rrt)] if fb["success"] < om["success"]]
+    if a.check and short:
+        sys.exit("forkbench succeeds less often than OMPL: " + "; ".join(short))
 
 
 if __name__ == "__main__":

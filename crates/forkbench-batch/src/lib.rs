@@ -403,7 +403,9 @@ pub fn run_batch(
         .map_err(|e| BatchError::Invalid(format!("thread pool: {e}")))?;
     let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
     pool.install(|| {
-        todo.par_iter().for_each(|j| {
+        // One job per task: rayon's default leaves are long runs of jobs that a thread
+        // finishing early cannot steal from, which idles it through a batch's tail.
+        todo.par_iter().with_max_len(1).for_each(|j| {
             let rec = spec.run_job(j);
             let line = serde_json::to_string(&rec)
                 .unwrap_or_else(|e| format!("{{\"serialisation_error\":\"{e}\"}}"));

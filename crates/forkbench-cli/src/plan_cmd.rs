@@ -48,15 +48,25 @@ pub struct PlanCli {
     /// YAML.
     #[arg(long)]
     pub map: Option<PathBuf>,
-    /// PRM: samples drawn over the map.
-    #[arg(long, default_value_t = 500)]
-    pub nodes: usize,
+    /// PRM: samples drawn over the map (the paper's 500); with --first-solution, the
+    /// most samples drawn before giving up (default 5000).
+    #[arg(long)]
+    pub nodes: Option<usize>,
+    /// PRM: grow the roadmap one sample at a time, each joined to its 10 nearest
+    /// neighbours within --connect-m (OMPL's PRM strategy), and stop as soon as start
+    /// and goal are connected: the time to a first solution.
+    #[arg(long)]
+    pub first_solution: bool,
     /// PRM: connection distance in metres, or `inf`.
     #[arg(long, default_value = "10", value_parser = crate::route_cmd::parse_connect)]
     pub connect_m: f64,
     /// Global planners: seed of the samples.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Global planners: plan this many times in one process (the map loaded once), with
+    /// seeds --seed, --seed + 1, …; one report (one JSON line with --json) per plan.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub runs: u64,
     /// Global planners: cell size when the map is a world file.
     #[arg(long, default_value_t = 0.05)]
     pub resolution_m: f64,
@@ -88,8 +98,14 @@ impl PlanCli {
     /// A global planner's arguments, when `planner` is one.
     pub fn route(&self) -> anyhow::Result<Option<crate::route_cmd::RouteArgs>> {
         let Some(planner) = forkbench_nav::GlobalPlannerKind::from_name(&self.planner) else {
+            if self.first_solution {
+                anyhow::bail!("plan {}: --first-solution is for prm", self.planner);
+            }
             return Ok(None);
         };
+        if self.first_solution && planner != forkbench_nav::GlobalPlannerKind::Prm {
+            anyhow::bail!("plan {}: --first-solution is for prm", self.planner);
+        }
         let map = self.map.clone().ok_or_else(|| {
             anyhow::anyhow!(
                 "plan {}: --map WORLD.toml|MAP.yaml is required",
@@ -101,7 +117,11 @@ impl PlanCli {
             map,
             start: self.start,
             goal: self.goal,
-            nodes: self.nodes,
+            nodes: self
+                .nodes
+                .unwrap_or(if self.first_solution { 5000 } else { 500 }),
+            first_solution: self.first_solution,
+            runs: self.runs as usize,
             connect_m: self.connect_m.is_finite().then_some(self.connect_m),
             seed: self.seed,
             resolution_m: self.resolution_m,

@@ -1,13 +1,15 @@
 //! `forkbench plan prm|rrt|rrt-connect --map …`: one global plan on an occupancy grid (Luo's PRM + A*, RRT baselines).
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use anyhow::Context as _;
 use forkbench_core::ForkliftSpec;
 use forkbench_core::Pose2;
+use forkbench_nav::simplify::simplify as simplify_in;
 use forkbench_nav::{
-    CollisionModel, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap, OccupancyGrid, plan_global,
-    read_map,
+    CollisionModel, FootprintSpace, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap,
+    OccupancyGrid, plan_global, read_map,
 };
 use serde_json::json;
 
@@ -19,6 +21,10 @@ pub struct RouteArgs {
     pub start: Pose2,
     pub goal: Pose2,
     pub nodes: usize,
+    /// PRM: grow until the query is connected (`nodes` the most samples drawn).
+    pub first_solution: bool,
+    /// Plans this many times in one process, seeds `seed`, `seed + 1`, … (one report each).
+    pub runs: usize,
     /// `None`: unlimited.
     pub connect_m: Option<f64>,
     pub seed: u64,
@@ -61,9 +67,12 @@ pub fn load_map(map: &Path, resolution_m: f64) -> anyhow::Result<NavMap> {
 
 impl RouteArgs {
     fn query(&self) -> GlobalQuery {
-        let algorithm = self
+        let mut algorithm = self
             .planner
             .algorithm(self.nodes, self.connect_m, self.seed);
+        if let (true, forkbench_nav::Algorithm::Prm(p)) = (self.first_solution, algorithm) {
+            algorithm = forkbench_nav::Algorithm::PrmFirstSolution(p);
+        }
         GlobalQuery {
             start: self.start,
             goal: self.goal,
@@ -83,13 +92,53 @@ impl RouteArgs {
 
 pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
     let map = load_map(&a.map, a.resolution_m)?;
-    let q = a.query();
-    let plan = plan_global(&map, &q)
-        .with_context(|| format!("plan {} on {}", a.planner.name(), a.map.display()))?;
-    if let Some(file) = &a.plot {
-        plot(a, &map, &q, &plan, file)?;
+    let mut a = a.clone();
+    for run in 0..a.runs.max(1) {
+        let q = a.query();
+        let plan = plan_global(&map, &q)
+            .with_context(|| format!("plan {} on {}", a.planner.name(), a.map.display()))?;
+        if let (Some(file), 0) = (&a.plot, run) {
+            plot(&a, &map, &q, &plan, file)?;
+        }
+        let simplified = if q.smooth {
+            None
+        } else {
+            simplify(&map, &q, &plan, a.seed)
+        };
+        crate::emit(&report(&a, &map.grid, &q, &plan, simplified.as_ref()))?;
+        a.seed = a.seed.wrapping_add(1);
     }
-    crate::emit(&report(a, &map.grid, &q, &plan))
+    Ok(())
+}
+
+/// A route after greedy shortcuts, and the time they took.
+struct Simplified {
+    points: Vec<[f64; 2]>,
+    length_m: f64,
+    time_s: f64,
+}
+
+/// The route simplified ([`forkbench_nav::simplify::simplify`], seeded with the plan's
+/// seed) in the space it was planned in; `None` without a route.
+fn simplify(map: &NavMap, q: &GlobalQuery, plan: &GlobalPlan, seed: u64) -> Option<Simplified> {
+    let points = plan.route.points.as_ref()?;
+    let t0 = Instant::now();
+    let short = match q.collision {
+        CollisionModel::Inflate => simplify_in(&*map.inflated(q.inflate_m), points, seed),
+        CollisionModel::Footprint => {
+            simplify_in(&FootprintSpace::on(map, &q.truck, q.margin_m), points, seed)
+        }
+    };
+    let time_s = t0.elapsed().as_secs_f64();
+    let length_m = short
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    Some(Simplified {
+        points: short,
+        length_m,
+        time_s,
+    })
 }
 
 fn plot(
@@ -175,7 +224,13 @@ fn smoothing_text(plan: &GlobalPlan) -> String {
     }
 }
 
-fn report(a: &RouteArgs, grid: &OccupancyGrid, q: &GlobalQuery, plan: &GlobalPlan) -> String {
+fn report(
+    a: &RouteArgs,
+    grid: &OccupancyGrid,
+    q: &GlobalQuery,
+    plan: &GlobalPlan,
+    simplified: Option<&Simplified>,
+) -> String {
     let r = &plan.route;
     let t = &r.timing;
     let total = t.total_s() + plan.smoothing_s;
@@ -192,6 +247,8 @@ fn report(a: &RouteArgs, grid: &OccupancyGrid, q: &GlobalQuery, plan: &GlobalPla
             "success": r.found() && (!a.smooth || plan.drivable().is_some()),
             "polyline_m": r.points,
             "length_m": r.found().then_some(r.length_m),
+            "first_solution": a.first_solution,
+            "simplified": simplified.map(|s| json!({"polyline_m": s.points, "length_m": s.length_m, "time_s": s.time_s})),
             "roadmap_nodes": r.nodes,
             "roadmap_edges": plan.roadmap.as_ref().map(forkbench_nav::Roadmap::edge_count),
             "smoothing": smoothing_json(plan),
@@ -229,7 +286,15 @@ fn report(a: &RouteArgs, grid: &OccupancyGrid, q: &GlobalQuery, plan: &GlobalPla
         Some(p) => format!("path found: {} waypoints, {:.2} m\n", p.len(), r.length_m),
         None => "no path found\n".to_owned(),
     };
-    head + &body + &smoothing_text(plan) + &timing
+    let short = simplified.map_or(String::new(), |s| {
+        format!(
+            "simplified (shortcuts): {} waypoints, {:.2} m, in {:.3} ms\n",
+            s.points.len(),
+            s.length_m,
+            1e3 * s.time_s
+        )
+    });
+    head + &body + &short + &smoothing_text(plan) + &timing
 }
 
 /// The warehouse leg the reproduction plans: charging station to the aisle in front of a

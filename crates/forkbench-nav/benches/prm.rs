@@ -1,4 +1,4 @@
-//! PRM on the warehouse map: roadmap build and A* query, 500 nodes at 10 m (target: median ≤ 5 ms), RRT-Connect beside it, and a footprint-checked, smoothed plan.
+//! PRM on the warehouse map: roadmap build and A* query, 500 nodes at 10 m (target: median ≤ 5 ms), PRM to the first solution, RRT-Connect (and a simplified RRT-Connect route) beside it, and a footprint-checked, smoothed plan.
 
 use std::path::Path;
 
@@ -36,6 +36,31 @@ fn bench(c: &mut Criterion) {
                 seed,
             };
             plan_prm(&grid, start, goal, &p).expect("plans").0
+        })
+    });
+    g.bench_function("prm-first-solution-10m", |b| {
+        b.iter(|| {
+            seed += 1;
+            let p = PrmParams {
+                nodes: 5000,
+                connect_m: Some(10.0),
+                seed,
+            };
+            forkbench_nav::plan_prm_first(&grid, start, goal, &p)
+                .expect("plans")
+                .0
+        })
+    });
+    g.bench_function("simplify-rrt-connect-route", |b| {
+        b.iter(|| {
+            seed += 1;
+            let p = RrtParams {
+                seed,
+                ..RrtParams::default()
+            };
+            let route = plan_rrt_connect(&grid, start, goal, &p).expect("plans");
+            let points = route.points.expect("a route");
+            forkbench_nav::simplify::simplify(&grid, &points, seed)
         })
     });
     g.bench_function("rrt-connect", |b| {

@@ -118,3 +118,85 @@ impl<'a, S: FreeSpace + ?Sized> Growing<'a, S> {
         self.parent.len() > 1 && self.root(0) == self.root(1)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::OccupancyGrid;
+    use forkbench_core::Pose2;
+    use forkbench_core::geometry::Obstacle;
+
+    /// A room split by a wall with a gap at the top.
+    fn room() -> OccupancyGrid {
+        let rect = |x: f64, y: f64, l: f64, w: f64| Obstacle {
+            centre: Pose2::new(x, y, 0.0),
+            length_m: l,
+            width_m: w,
+        };
+        let walls = [
+            rect(10.0, -0.5, 21.0, 1.0),
+            rect(10.0, 10.5, 21.0, 1.0),
+            rect(10.0, 4.0, 1.0, 8.0),
+        ];
+        OccupancyGrid::from_obstacles(&walls, &[], 0.1, 0.0).expect("grid")
+    }
+
+    fn params(nodes: usize, seed: u64) -> PrmParams {
+        PrmParams {
+            nodes,
+            connect_m: Some(5.0),
+            seed,
+        }
+    }
+
+    /// It stops at the first connection, through the gap, every edge free, the same
+    /// route for the same seed.
+    #[test]
+    fn the_first_route_goes_through_the_gap() {
+        let g = room();
+        let (start, goal) = ([2.0, 2.0], [18.0, 2.0]);
+        let mut nodes = Vec::new();
+        for seed in 0..20 {
+            let (route, map) = plan_prm_first(&g, start, goal, &params(5000, seed)).expect("plans");
+            let pts = route.points.expect("a route");
+            assert_eq!((pts[0], *pts.last().expect("end")), (start, goal));
+            assert!(pts.windows(2).all(|w| g.segment_free(w[0], w[1])));
+            assert!(pts.iter().any(|p| p[1] > 8.0), "through the gap: {pts:?}");
+            // Each node joined at most its nearest NEIGHBOURS among those before it.
+            assert!(
+                map.edges
+                    .iter()
+                    .enumerate()
+                    .all(|(i, e)| e.iter().filter(|(j, _)| *j < i).count() <= NEIGHBOURS)
+            );
+            let again = plan_prm_first(&g, start, goal, &params(5000, seed)).expect("plans");
+            assert_eq!(again.0.points.as_deref(), Some(&pts[..]), "seeded");
+            nodes.push(map.nodes.len());
+        }
+        // Far fewer samples than the cap: it stopped when connected.
+        assert!(nodes.iter().all(|&n| n < 1000), "{nodes:?}");
+    }
+
+    /// No route when the samples run out, or when a wall closes the gap.
+    #[test]
+    fn no_route_when_the_cap_is_reached_or_the_way_is_shut() {
+        let g = room();
+        let (route, map) =
+            plan_prm_first(&g, [2.0, 2.0], [18.0, 2.0], &params(3, 1)).expect("plans");
+        assert!(route.points.is_none() && map.nodes.len() <= 5);
+        let mut shut = g.clone();
+        for ix in 0..shut.width {
+            let x = shut.origin_m[0] + (ix as f64 + 0.5) * shut.resolution_m;
+            if (9.5..10.5).contains(&x) {
+                for iy in 0..shut.height {
+                    shut.set(ix, iy, crate::Cell::Occupied);
+                }
+            }
+        }
+        let (route, _) =
+            plan_prm_first(&shut, [2.0, 2.0], [18.0, 2.0], &params(2000, 1)).expect("plans");
+        assert!(route.points.is_none());
+        let err = plan_prm_first(&g, [2.0, 2.0], [18.0, 2.0], &params(MAX_NODES + 1, 1));
+        assert!(matches!(err, Err(NavError::Params(_))));
+    }
+}

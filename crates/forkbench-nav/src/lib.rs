@@ -8,14 +8,15 @@ pub mod map_server;
 pub mod reproduce;
 pub mod roadmap;
 pub mod rrt;
+pub mod simplify;
 pub mod smooth;
 pub mod space;
 
 pub use global::{Algorithm, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap, plan_global};
 pub use grid::{Cell, GridError, OccupancyGrid};
+pub use incremental::plan_prm_first;
 pub use inflate::{MAX_INFLATION_M, luo_inflation_m};
 pub use map_server::{MapError, read_map, write_map};
-pub use incremental::plan_prm_first;
 pub use roadmap::{MAX_CANDIDATE_EDGES, PrmParams, Roadmap, astar, candidate_edges, plan_prm};
 pub use rrt::{RrtParams, plan_rrt, plan_rrt_connect};
 pub use smooth::{SmoothError, SmoothParams, Smoothed, SweptHit};
