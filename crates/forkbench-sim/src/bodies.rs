@@ -60,12 +60,13 @@ pub(crate) fn insert_pallet(
     pallet_pose: &Pose2,
     cfg: &SimConfig,
 ) -> (RigidBodyHandle, Vec<ColliderHandle>) {
-    // Pallet: stringers run along its heading from the face to the back.
+    // Pallet: stringers run along its heading from the face to the back. It may sleep
+    // while it stands untouched (a contact wakes it), which spares the solver its body.
     let pallet = world.insert_body(
         RigidBodyBuilder::dynamic()
             .translation(v2(pallet_pose.x_m, pallet_pose.y_m))
             .rotation(pallet_pose.heading_rad as Real)
-            .can_sleep(false),
+            .can_sleep(true),
     );
     let sw = pallet_spec.stringer_width_m();
     let mut stringers = Vec::new();

@@ -171,19 +171,21 @@ impl PurePursuit {
         let window = (self.idx + 400).min(self.path.samples.len());
         let mut best = self.idx;
         let mut best_d2 = d2(best);
+        let mut best_d = best_d2.sqrt();
         let mut i = self.idx + 1;
         while i < window {
             let di2 = d2(i);
             if di2 < best_d2 {
                 best = i;
                 best_d2 = di2;
+                best_d = di2.sqrt();
             }
             // No closer than the best: nothing to skip, and no square roots to take.
             if di2 <= best_d2 {
                 i += 1;
                 continue;
             }
-            let slack = di2.sqrt() - best_d2.sqrt() - SKIP_MARGIN_M;
+            let slack = di2.sqrt() - best_d - SKIP_MARGIN_M;
             i = if slack > 0.0 {
                 self.first_beyond(i, window, self.chord_m[i] + slack)
             } else {
