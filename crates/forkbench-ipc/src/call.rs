@@ -6,7 +6,7 @@ use crate::breaker::Breaker;
 use crate::command::CommandConfig;
 use crate::hello::start_with_hello;
 use crate::pool::{put_back, take_pooled};
-use crate::process::{ExchangeError, Spawn};
+use crate::process::{ExchangeError, Spawn, clip};
 
 /// Who is called: where the command runs, the protocol it speaks, what it is called in
 /// messages, and the breaker that counts its timeouts.
@@ -21,6 +21,26 @@ pub struct Callee<'a> {
 }
 
 impl CommandConfig {
+    /// [`CommandConfig::call`] with JSON both ways: `message` builds the request for the
+    /// request id, and the answer is parsed as `T`, whose `id_of` is the id it answers.
+    pub fn call_json<M: serde::Serialize, T: serde::de::DeserializeOwned>(
+        &self,
+        callee: Callee<'_>,
+        message: impl FnOnce(u64) -> M,
+        id_of: impl FnOnce(&T) -> u64,
+    ) -> Result<T, String> {
+        let request = |id| {
+            serde_json::to_string(&message(id)).map_err(|e| ExchangeError::other(e.to_string()))
+        };
+        let read = |answer: &str| {
+            let msg: T = serde_json::from_str(answer).map_err(|e| {
+                ExchangeError::other(format!("invalid answer ({e}): {:?}", clip(answer)))
+            })?;
+            Ok((id_of(&msg), msg))
+        };
+        self.call(callee, request, read)
+    }
+
     /// Sends the line `request` writes for the request id, and reads the answer with
     /// `read`, which returns the id it answered and the value. Err: why, for that trial.
     pub fn call<T>(

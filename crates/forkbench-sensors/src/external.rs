@@ -5,7 +5,7 @@ use std::sync::LazyLock;
 
 use forkbench_core::settings::{self, Settings, SettingsError};
 use forkbench_core::{PalletSpec, Pose2};
-use forkbench_ipc::{Breaker, Callee, ExchangeError, clip};
+use forkbench_ipc::{Breaker, Callee, clip};
 use serde::{Deserialize, Serialize};
 
 use crate::detect::Detection;
@@ -144,23 +144,14 @@ impl ExternalDetector {
             what: "detector",
             breaker: &BREAKER,
         };
-        let request = |id| {
-            let msg = RequestMsg {
-                kind: "detect",
-                id,
-                pallet: pallet_msg(req.pallet),
-                prior: req.prior,
-                scans: req.scans.iter().map(scan_msg).collect(),
-            };
-            serde_json::to_string(&msg).map_err(|e| ExchangeError::other(e.to_string()))
+        let message = |id| RequestMsg {
+            kind: "detect",
+            id,
+            pallet: pallet_msg(req.pallet),
+            prior: req.prior,
+            scans: req.scans.iter().map(scan_msg).collect(),
         };
-        let read = |answer: &str| {
-            let msg: ResponseMsg = serde_json::from_str(answer).map_err(|e| {
-                ExchangeError::other(format!("invalid answer ({e}): {:?}", clip(answer)))
-            })?;
-            Ok((msg.id(), msg))
-        };
-        self.cfg.call(callee, request, read)
+        self.cfg.call_json(callee, message, ResponseMsg::id)
     }
 }
 

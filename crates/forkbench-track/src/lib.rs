@@ -1,10 +1,12 @@
-//! Path tracking for a rear-steered forklift: the `Tracker` trait, pure pursuit, regulated pure pursuit, odometry prediction.
+//! Path tracking for a rear-steered forklift: the `Tracker` trait, pure pursuit, regulated pure pursuit, trackers in other languages (`external`), odometry prediction.
 
+pub mod external;
 mod predictor;
 mod pursuit;
 mod regulated;
 mod tracker;
 
+pub use external::ExternalTracker;
 pub use predictor::PosePredictor;
 pub use pursuit::{Command, PurePursuit, TrackerConfig};
 pub use regulated::{RegulatedConfig, RegulatedPurePursuit};

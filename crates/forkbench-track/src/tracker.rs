@@ -29,4 +29,10 @@ pub trait Tracker: Send {
 
     /// Steering and speed for this tick; `done` once the goal is reached.
     fn command(&mut self, input: &TrackerInput) -> Command;
+
+    /// Why this tracker can no longer steer (an external one hung, crashed or broke its
+    /// protocol): the trial stops there as an error. In-process trackers never fail.
+    fn fault(&self) -> Option<String> {
+        None
+    }
 }

@@ -18,7 +18,7 @@ use forkbench_sensors::{
     Localizer, Nav350, Nav350Config, PalletEstimateConfig, PalletEstimator, ReflectorNav,
     ReflectorNavSettings,
 };
-use forkbench_track::{PurePursuit, RegulatedPurePursuit, Tracker};
+use forkbench_track::{ExternalTracker, PurePursuit, RegulatedPurePursuit, Tracker};
 
 pub use spec::{ComponentSpec, Role};
 
@@ -104,6 +104,13 @@ impl Registry {
             })
             .with_tracker("regulated_pure_pursuit", |s, _| {
                 Ok(Box::new(RegulatedPurePursuit::from_settings(s)?))
+            })
+            .with_tracker("external", |s, cx| {
+                Ok(Box::new(ExternalTracker::from_settings(
+                    s,
+                    cx.dir.clone(),
+                    &cx.name,
+                )?))
             })
     }
 

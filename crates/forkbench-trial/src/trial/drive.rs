@@ -38,6 +38,12 @@ impl<'a> Trial<'a> {
                 self.reestimate(&pose, rec)?;
             }
             let cmd = self.tracker.command(&self.tracker_input(pose));
+            if let Some(reason) = self.tracker.fault() {
+                return Err(StageError::Tracker {
+                    tracker: self.tracker.name().to_owned(),
+                    reason,
+                });
+            }
             if cmd.done && self.sim.speed_mps().abs() < 0.01 {
                 self.timed_out = false;
                 break;

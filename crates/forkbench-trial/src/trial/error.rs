@@ -21,6 +21,9 @@ pub enum StageError {
     /// protocol).
     #[error(transparent)]
     Detector(#[from] forkbench_sensors::detector::DetectorError),
+    /// The tracker could not steer (an external one hung, crashed or broke the protocol).
+    #[error("tracker {tracker}: {reason}")]
+    Tracker { tracker: String, reason: String },
     /// A mission leg failed; `detail` is the leg's recorded failure.
     #[error("leg {number} {name}: {detail}")]
     Leg {
