@@ -97,15 +97,13 @@ pub struct PlanCli {
 impl PlanCli {
     /// A global planner's arguments, when `planner` is one.
     pub fn route(&self) -> anyhow::Result<Option<crate::route_cmd::RouteArgs>> {
-        let Some(planner) = forkbench_nav::GlobalPlannerKind::from_name(&self.planner) else {
-            if self.first_solution {
-                anyhow::bail!("plan {}: --first-solution is for prm", self.planner);
-            }
-            return Ok(None);
-        };
-        if self.first_solution && planner != forkbench_nav::GlobalPlannerKind::Prm {
+        let kind = forkbench_nav::GlobalPlannerKind::from_name(&self.planner);
+        if self.first_solution && kind != Some(forkbench_nav::GlobalPlannerKind::Prm) {
             anyhow::bail!("plan {}: --first-solution is for prm", self.planner);
         }
+        let Some(planner) = kind else {
+            return Ok(None);
+        };
         let map = self.map.clone().ok_or_else(|| {
             anyhow::anyhow!(
                 "plan {}: --map WORLD.toml|MAP.yaml is required",

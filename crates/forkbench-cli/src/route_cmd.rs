@@ -111,7 +111,7 @@ pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A route after greedy shortcuts, and the time they took.
+/// A route after simplification, its length, and the time simplifying took.
 struct Simplified {
     points: Vec<[f64; 2]>,
     length_m: f64,
@@ -130,13 +130,9 @@ fn simplify(map: &NavMap, q: &GlobalQuery, plan: &GlobalPlan, seed: u64) -> Opti
         }
     };
     let time_s = t0.elapsed().as_secs_f64();
-    let length_m = short
-        .windows(2)
-        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
-        .sum();
     Some(Simplified {
+        length_m: forkbench_nav::polyline_length_m(&short),
         points: short,
-        length_m,
         time_s,
     })
 }

@@ -7,12 +7,13 @@ use kiddo::{KdTree, SquaredEuclidean};
 use rand::{RngExt as _, SeedableRng as _};
 use rand_chacha::ChaCha8Rng;
 
-use crate::roadmap::{MAX_NODES, astar};
+use crate::roadmap::{MAX_NODES, astar, check_connect_m};
 use crate::space::FreeSpace;
 use crate::{NavError, PrmParams, Roadmap, Route, Timing};
 
 /// Neighbours each new node tries to join (OMPL's PRM default).
 pub const NEIGHBOURS: usize = 10;
+const K: NonZero<usize> = NonZero::new(NEIGHBOURS).expect("NEIGHBOURS is positive");
 
 /// Plans from `start` to `goal`, drawing at most `p.nodes` samples: the first route the
 /// growing roadmap holds, with the roadmap as it stood then.
@@ -29,11 +30,7 @@ pub fn plan_prm_first<S: FreeSpace + ?Sized>(
             p.nodes
         )));
     }
-    if p.connect_m.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
-        return Err(NavError::Params(
-            "the connection distance must be a positive number of metres".into(),
-        ));
-    }
+    check_connect_m(p.connect_m)?;
     let t0 = Instant::now();
     let mut g = Growing::new(space, p.connect_m);
     g.add(start);
@@ -88,10 +85,9 @@ impl<'a, S: FreeSpace + ?Sized> Growing<'a, S> {
         self.map.nodes.push(q);
         self.map.edges.push(Vec::new());
         self.parent.push(i);
-        let k = NonZero::new(NEIGHBOURS).unwrap_or(NonZero::<usize>::MIN);
         for nb in self
             .tree
-            .nearest_n_within::<SquaredEuclidean>(&q, self.reach2, k, true)
+            .nearest_n_within::<SquaredEuclidean>(&q, self.reach2, K, true)
         {
             let j = nb.item as usize;
             if self.space.segment_free(q, self.map.nodes[j]) {

@@ -63,11 +63,7 @@ pub struct Route {
 
 impl Route {
     pub fn new(points: Option<Vec<[f64; 2]>>, timing: Timing, nodes: usize) -> Self {
-        let length_m = points.as_ref().map_or(f64::NAN, |p| {
-            p.windows(2)
-                .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
-                .sum()
-        });
+        let length_m = points.as_deref().map_or(f64::NAN, polyline_length_m);
         Self {
             points,
             length_m,
@@ -79,6 +75,14 @@ impl Route {
     pub fn found(&self) -> bool {
         self.points.is_some()
     }
+}
+
+/// Length of a polyline: its legs summed.
+pub fn polyline_length_m(points: &[[f64; 2]]) -> f64 {
+    points
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum()
 }
 
 /// Start and goal must lie on the map in free cells.

@@ -71,11 +71,7 @@ pub fn plan_prm<S: FreeSpace + ?Sized>(
             p.nodes
         )));
     }
-    if p.connect_m.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
-        return Err(NavError::Params(
-            "the connection distance must be a positive number of metres".into(),
-        ));
-    }
+    check_connect_m(p.connect_m)?;
     let (lo, hi) = grid.extent();
     let edges = candidate_edges(p.nodes, p.connect_m, (hi[0] - lo[0]) * (hi[1] - lo[1]));
     if edges > MAX_CANDIDATE_EDGES {
@@ -128,6 +124,16 @@ pub fn plan_prm<S: FreeSpace + ?Sized>(
     };
     let points = found.map(|ids| ids.iter().map(|&i| roadmap.nodes[i]).collect());
     Ok((Route::new(points, timing, roadmap.nodes.len()), roadmap))
+}
+
+/// A connection distance must be a positive number of metres (`None`: unlimited).
+pub(crate) fn check_connect_m(connect_m: Option<f64>) -> Result<(), NavError> {
+    if connect_m.is_some_and(|c| !(c.is_finite() && c > 0.0)) {
+        return Err(NavError::Params(
+            "the connection distance must be a positive number of metres".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// A* over the roadmap from node `from` to node `to` (Euclidean heuristic, admissible

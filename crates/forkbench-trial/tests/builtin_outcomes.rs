@@ -3,17 +3,15 @@
 //! gives the same outcome. Seeds are taken from the records, so the check does not depend
 //! on how a batch derives them.
 
+mod common;
+
 use forkbench_trial::defaults::default_scenarios;
 use forkbench_trial::{TrialOptions, run_trial};
-use rayon::prelude::*;
 use serde_json::Value;
 
 /// Records committed before the change (`wall_time_ms` removed, `replan` filled in).
 fn committed() -> Vec<Value> {
-    include_str!("data/builtin_outcomes.jsonl")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("json"))
-        .collect()
+    common::records(include_str!("data/builtin_outcomes.jsonl"))
 }
 
 /// The record re-run at its seed, in the committed records' form.
@@ -35,16 +33,11 @@ fn rerun(want: &Value) -> Value {
             s
         })
         .collect();
-    let s = |f: &str| want[f].as_str().expect("string field").to_owned();
-    let scn = scenarios
-        .iter()
-        .find(|x| x.name == s("scenario"))
-        .expect("scenario");
-    let case = scn.case(&s("case")).expect("case");
+    let (scn, case) = common::case_of(&scenarios, want);
     let replan = want["replan"].as_bool().expect("replan");
     let opts = TrialOptions {
         seed: Some(want["seed"].as_u64().expect("seed")),
-        planner: Some(s("planner")),
+        planner: Some(common::text(want, "planner")),
         tracker: None,
         no_noise: false,
         pallet_noise_scale: None,
@@ -87,21 +80,5 @@ fn built_in_outcomes_are_identical_to_the_records_before_the_change() {
         344,
         "both planners, every pick case, 2 trials, 2 modes"
     );
-    let differing: Vec<String> = want
-        .par_iter()
-        .filter(|w| rerun(w) != **w)
-        .map(|w| {
-            format!(
-                "{} / {} / {} / seed {}",
-                w["scenario"], w["case"], w["planner"], w["seed"]
-            )
-        })
-        .collect();
-    assert!(
-        differing.is_empty(),
-        "{} of {} trials differ, first: {:?}",
-        differing.len(),
-        want.len(),
-        differing.first()
-    );
+    common::assert_reruns_equal(&want, rerun);
 }

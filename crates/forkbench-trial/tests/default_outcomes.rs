@@ -3,18 +3,16 @@
 //! reflector fixes, odometry errors, the warehouse mission; two trials of every scenario
 //! × case × planner × mode), re-run at its own seed, gives the same outcome to the bit.
 
+mod common;
+
 use forkbench_trial::defaults::default_scenarios;
 use forkbench_trial::{TrialOptions, run_trial};
-use rayon::prelude::*;
 use serde_json::Value;
 
 /// Records made before the change by `batch --trials 20` (trials 0 and 1 of each row),
 /// with the wall and planning times removed.
 fn committed() -> Vec<Value> {
-    include_str!("data/default_outcomes.jsonl")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("json"))
-        .collect()
+    common::records(include_str!("data/default_outcomes.jsonl"))
 }
 
 /// Removes what a re-run cannot reproduce: the times measured on the clock.
@@ -32,17 +30,12 @@ fn without_clock_times(v: &mut Value) {
 
 /// The record re-run at its seed, in the committed records' form.
 fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario]) -> Value {
-    let s = |f: &str| want[f].as_str().expect("string field").to_owned();
-    let scn = scenarios
-        .iter()
-        .find(|x| x.name == s("scenario"))
-        .expect("scenario");
-    let case = scn.case(&s("case")).expect("case");
+    let (scn, case) = common::case_of(scenarios, want);
     let replan = want["replan"].as_bool().expect("replan");
     let opts = TrialOptions {
         seed: Some(want["seed"].as_u64().expect("seed")),
-        planner: Some(s("planner")),
-        tracker: Some(s("tracker")),
+        planner: Some(common::text(want, "planner")),
+        tracker: Some(common::text(want, "tracker")),
         no_noise: false,
         pallet_noise_scale: None,
         replan: Some(replan),
@@ -74,21 +67,5 @@ fn default_outcomes_are_identical_to_the_records_before_the_change() {
         want.iter().any(|w| w["scenario"] == "warehouse-mission"),
         "the mission is among the records"
     );
-    let differing: Vec<String> = want
-        .par_iter()
-        .filter(|w| rerun(w, &scenarios) != **w)
-        .map(|w| {
-            format!(
-                "{} / {} / {} / replan {} / seed {}",
-                w["scenario"], w["case"], w["planner"], w["replan"], w["seed"]
-            )
-        })
-        .collect();
-    assert!(
-        differing.is_empty(),
-        "{} of {} trials differ, first: {:?}",
-        differing.len(),
-        want.len(),
-        differing.first()
-    );
+    common::assert_reruns_equal(&want, |w| rerun(w, &scenarios));
 }
