@@ -39,7 +39,8 @@ def long_functions(path, lines):
 def main():
     root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
     breaches = []
-    for p in sorted(root.glob("crates/*/src/**/*.rs")):
+    files = list(root.glob("crates/*/src/**/*.rs")) + list(root.glob("python/src/**/*.rs"))
+    for p in sorted(files):
         lines = p.read_text().splitlines()
         if len(lines) > FILE_LIMIT:
             breaches.append(f"{p}: {len(lines)} lines (limit {FILE_LIMIT})")

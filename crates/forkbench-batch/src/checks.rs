@@ -4,7 +4,7 @@ use crate::{BatchError, BatchSpec, DEFAULT_ALPHA, MAX_JOBS, paired_trials_needed
 
 impl BatchSpec {
     /// The batch's own arguments: trials, shard, worker threads and unique names.
-    pub(crate) fn check(&self, jobs: usize) -> Result<(), BatchError> {
+    pub fn check(&self, jobs: usize) -> Result<(), BatchError> {
         if self.trials == 0 {
             return Err(BatchError::Invalid("trials: must be at least 1".into()));
         }

@@ -272,7 +272,8 @@ impl BatchSpec {
         )
     }
 
-    fn key(&self, j: &Job) -> TrialKey {
+    /// The identity of the trial a job runs.
+    pub fn key(&self, j: &Job) -> TrialKey {
         let s = &self.scenarios[j.scenario];
         (
             s.name.clone(),

@@ -1,6 +1,7 @@
 //! Recording sinks for forkbench trials: MCAP (Foxglove schemas, JSON) and rerun (.rrd or a live viewer).
 
 pub mod mcap_sink;
+#[cfg(feature = "rerun")]
 pub mod rerun_sink;
 mod writer;
 
@@ -10,6 +11,7 @@ use forkbench_core::geometry::rect_outline;
 use forkbench_core::{PalletSpec, Pose2};
 
 pub use mcap_sink::McapRecorder;
+#[cfg(feature = "rerun")]
 pub use rerun_sink::{RerunRecorder, RerunTarget};
 
 /// The rerun SDK this crate is built against (pinned with `=` in the workspace; a test

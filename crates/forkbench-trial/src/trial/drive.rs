@@ -10,14 +10,40 @@ use super::setup::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
 use forkbench_core::{Signal, Style};
 
+/// Where a drive stands between control ticks.
+#[derive(Debug, Clone)]
+pub(crate) struct DriveState {
+    /// Re-estimate ranges still ahead, nearest last.
+    reestimates: Vec<f64>,
+    pub(super) deadline_s: f64,
+    /// This tick's localiser fix (none between sweeps) and the controller's pose.
+    pub(super) fix: Option<Pose2>,
+    pub(super) pose: Pose2,
+}
+
 /// The trial's own scalar signals go out every this many control steps.
 const SIGNAL_EVERY_STEPS: u64 = 10;
 
 impl<'a> Trial<'a> {
     /// Drives until the tracker reports the goal reached and the truck stands, or the
-    /// scenario's time limit. Err: the state went non-finite.
+    /// scenario's time limit. Err: the state went non-finite, or the tracker failed.
     pub(super) fn drive<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), StageError> {
-        // Re-estimate ranges still ahead of the truck, nearest last.
+        let mut at = self.begin_drive();
+        while self.sim.time_s() < at.deadline_s {
+            self.sense_tick(&mut at, rec)?;
+            let cmd = self.tracker_command(at.pose)?;
+            if cmd.done && self.stands() {
+                self.timed_out = false;
+                break;
+            }
+            self.step(&cmd, at.fix, at.pose, rec);
+        }
+        Ok(())
+    }
+
+    /// The drive's schedule: re-estimate ranges still ahead of the truck (nearest last)
+    /// and the deadline.
+    pub(super) fn begin_drive(&self) -> DriveState {
         let start_range = self.first_fix.distance_to(&self.pallet_est);
         let schedule = self.scn.replan.reestimate_at_m.clone();
         let mut reestimates: Vec<f64> = schedule
@@ -26,35 +52,54 @@ impl<'a> Trial<'a> {
             .filter(|r| *r < start_range)
             .collect();
         reestimates.sort_by(|a, b| b.total_cmp(a));
-        let deadline_s = self.sim.time_s() + self.scn.timeout_s;
-        while self.sim.time_s() < deadline_s {
-            let (fix, pose) = self.sense(rec)?;
-            if self.run.replan
-                && reestimates
-                    .first()
-                    .is_some_and(|r| pose.distance_to(&self.pallet_est) <= *r)
-            {
-                reestimates.remove(0);
-                self.reestimate(&pose, rec)?;
-            }
-            let cmd = self.tracker.command(&self.tracker_input(pose));
-            if let Some(reason) = self.tracker.fault() {
-                return Err(StageError::Tracker {
-                    tracker: self.tracker.name().to_owned(),
-                    reason,
-                });
-            }
-            if cmd.done && self.sim.speed_mps().abs() < 0.01 {
-                self.timed_out = false;
-                break;
-            }
-            self.step(&cmd, fix, pose, rec);
+        DriveState {
+            reestimates,
+            deadline_s: self.sim.time_s() + self.scn.timeout_s,
+            fix: None,
+            pose: self.first_fix,
+        }
+    }
+
+    /// The start of a control tick: the localiser's reading, and a re-estimate (maybe a
+    /// replan) when the truck came within the next re-estimate range.
+    pub(super) fn sense_tick<R: Recorder + ?Sized>(
+        &mut self,
+        at: &mut DriveState,
+        rec: &mut R,
+    ) -> Result<(), StageError> {
+        let (fix, pose) = self.sense(rec)?;
+        (at.fix, at.pose) = (fix, pose);
+        if self.run.replan
+            && at
+                .reestimates
+                .first()
+                .is_some_and(|r| pose.distance_to(&self.pallet_est) <= *r)
+        {
+            at.reestimates.remove(0);
+            self.reestimate(&pose, rec)?;
         }
         Ok(())
     }
 
+    /// The scenario's tracker's command at the measured `pose`. Err: it failed.
+    pub(super) fn tracker_command(&mut self, pose: Pose2) -> Result<Command, StageError> {
+        let cmd = self.tracker.command(&self.tracker_input(pose));
+        match self.tracker.fault() {
+            Some(reason) => Err(StageError::Tracker {
+                tracker: self.tracker.name().to_owned(),
+                reason,
+            }),
+            None => Ok(cmd),
+        }
+    }
+
+    /// The truck stands (for the end of a drive).
+    pub(super) fn stands(&self) -> bool {
+        self.sim.speed_mps().abs() < 0.01
+    }
+
     /// One physics step under `cmd`, its record, and the entry check.
-    fn step<R: Recorder + ?Sized>(
+    pub(super) fn step<R: Recorder + ?Sized>(
         &mut self,
         cmd: &Command,
         fix: Option<Pose2>,
@@ -227,6 +272,7 @@ impl<'a> Trial<'a> {
                     ),
                 );
                 self.tracker.reset(&p.path, &self.scn.truck);
+                self.path = p.path;
                 self.adopt_estimate(new_est, &truth);
                 self.out.replans += 1;
             }

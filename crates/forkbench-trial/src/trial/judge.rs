@@ -44,6 +44,12 @@ pub(super) fn insertion_depth(pallet: &Pose2, root: &Pose2, truck: &ForkliftSpec
 impl Trial<'_> {
     /// Final measurements and the verdict.
     pub(super) fn judge(mut self) -> TrialOutcome {
+        self.conclude();
+        self.out
+    }
+
+    /// Writes the final measurements and the verdict into the outcome.
+    pub(super) fn conclude(&mut self) {
         let truck = &self.scn.truck;
         let out = &mut self.out;
         out.sim_time_s = self.sim.time_s();
@@ -65,18 +71,17 @@ impl Trial<'_> {
             // Lateral position of the fork's middle in the pallet frame, against its pocket.
             .map(|(mid, py)| (pallet_now.to_local(mid).y_m - py).abs())
             .fold(0.0, f64::max);
-        let mut broken = violations(&self, worst_pocket_miss).into_iter();
+        let mut broken = violations(self, worst_pocket_miss).into_iter();
         match broken.next() {
             Some((f, why)) => {
                 self.out.also_failed = broken
                     .map(|(f, why)| format!("{}: {}", f.name(), compact_numbers(&why)))
                     .collect();
-                self.out.likely_cause = likely_cause(&self);
+                self.out.likely_cause = likely_cause(self);
                 self.out.fail(f, why);
             }
             None => self.out.success = true,
         }
-        self.out
     }
 }
 

@@ -9,6 +9,7 @@ mod look;
 mod mission;
 mod plan;
 mod sense;
+mod session;
 mod setup;
 
 use std::time::Instant;
@@ -22,6 +23,7 @@ use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
 pub use look::{ScanReport, scan_once};
+pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use setup::Trial;
 
 /// Per-run choices on top of the scenario file.
@@ -159,9 +161,32 @@ fn run_stages<R: Recorder + ?Sized>(
     run: &Resolved,
     rec: &mut R,
 ) -> TrialOutcome {
-    let mut trial = match Trial::setup(scn, case, run, rec) {
+    let mut trial = match prepare(scn, case, run, rec) {
         Ok(t) => t,
         Err(out) => return *out,
+    };
+    if let Err(why) = trial.drive(rec) {
+        let why = why.to_string();
+        rec.event(trial.sim.time_s(), Level::Error, &why);
+        trial.out.fail(Failure::Error, why);
+        return trial.out;
+    }
+    trial.judge()
+}
+
+/// A trial up to its drive: the world and components, the mission's legs, the first fix
+/// and estimate, the first plan handed to the tracker. Err: the outcome of a trial that
+/// ended before driving to the pallet.
+pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
+    scn: &'a Scenario,
+    case: &Case,
+    run: &'a Resolved,
+    rec: &mut R,
+) -> Result<Trial<'a>, Box<TrialOutcome>> {
+    let mut trial = Trial::setup(scn, case, run, rec)?;
+    let end = |mut trial: Trial<'a>, failure: Failure, why: String| {
+        trial.out.fail(failure, why);
+        Err::<Trial<'a>, _>(Box::new(trial.out))
     };
     if let Some(m) = &scn.mission {
         let staging = crate::scenario::mission::Waypoint {
@@ -174,36 +199,25 @@ fn run_stages<R: Recorder + ?Sized>(
         };
         if let Err(why) = trial.run_legs(m, &staging, rec) {
             trial.out.sim_time_s = trial.sim.time_s();
-            trial.out.fail(Failure::LegFailed, why.to_string());
-            return trial.out;
+            return end(trial, Failure::LegFailed, why.to_string());
         }
         let pallet = trial.sim.pallet_pose();
         if let Err(e) = trial.first_fix_and_estimate(&pallet, rec) {
             let why = e.to_string();
             rec.event(trial.sim.time_s(), Level::Error, &why);
-            trial.out.fail(Failure::Error, why);
-            return trial.out;
+            return end(trial, Failure::Error, why);
         }
     }
     if trial.out.estimates_missed == trial.out.estimates && trial.out.estimates > 0 {
         let why = "the pallet sensing found no pallet from the start pose".to_owned();
         rec.event(trial.sim.time_s(), Level::Error, &why);
-        trial.out.fail(Failure::PalletNotFound, why);
-        return trial.out;
+        return end(trial, Failure::PalletNotFound, why);
     }
     let path = match trial.first_plan(rec) {
         Ok(p) => p,
-        Err((failure, why)) => {
-            trial.out.fail(failure, why);
-            return trial.out;
-        }
+        Err((failure, why)) => return end(trial, failure, why),
     };
     trial.tracker.reset(&path, &scn.truck);
-    if let Err(why) = trial.drive(rec) {
-        let why = why.to_string();
-        rec.event(trial.sim.time_s(), Level::Error, &why);
-        trial.out.fail(Failure::Error, why);
-        return trial.out;
-    }
-    trial.judge()
+    trial.path = path;
+    Ok(trial)
 }

@@ -43,6 +43,8 @@ pub struct Trial<'a> {
     pub(super) first_fix: Pose2,
     /// The pallet pose the current plan aims at.
     pub(super) pallet_est: Pose2,
+    /// The path the tracker follows now (the first plan or the last replan).
+    pub(super) path: forkbench_core::Path,
     /// Depth the forks are driven to past the face.
     pub(super) insertion_m: f64,
     pub(super) obstacles: Vec<forkbench_sim::Obstacle>,
@@ -184,6 +186,32 @@ fn missing_reflectors(scn: &Scenario) -> Vec<String> {
     }
 }
 
+/// The scene a recording opens with: the world, the truck's start, the true pallet, the
+/// reflectors.
+fn record_scene<R: Recorder + ?Sized>(
+    rec: &mut R,
+    scn: &Scenario,
+    case: &Case,
+    run: &Resolved,
+    (start, pallet_pose): (Pose2, Pose2),
+    obstacles: &[forkbench_sim::Obstacle],
+) {
+    rec.scene(&SceneInfo {
+        scenario: &scn.name,
+        case: &case.name,
+        planner: &run.planner.name,
+        tracker: &run.tracker.name,
+        seed: run.seed,
+        truck: &scn.truck,
+        pallet: &scn.pallet,
+        pallet_pose,
+        obstacles,
+        start,
+        tolerances: &scn.tolerances,
+    });
+    record_reflectors(rec, &scn.world, &missing_reflectors(scn));
+}
+
 impl<'a> Trial<'a> {
     /// Builds the world and components and takes the first fix and pallet estimate. A
     /// world that cannot be built ends the trial here, as an `error` outcome.
@@ -213,20 +241,7 @@ impl<'a> Trial<'a> {
                 return Err(Box::new(out));
             }
         };
-        rec.scene(&SceneInfo {
-            scenario: &scn.name,
-            case: &case.name,
-            planner: &run.planner.name,
-            tracker: &run.tracker.name,
-            seed: run.seed,
-            truck: &scn.truck,
-            pallet: &scn.pallet,
-            pallet_pose: true_pallet,
-            obstacles: &obstacles,
-            start,
-            tolerances: &scn.tolerances,
-        });
-        record_reflectors(rec, &scn.world, &missing_reflectors(scn));
+        record_scene(rec, scn, case, run, (start, true_pallet), &obstacles);
         let pallet0 = sim.pallet_pose();
         let mut trial = Trial {
             scn,
@@ -243,6 +258,7 @@ impl<'a> Trial<'a> {
             odometry: odometry_from(start),
             first_fix: start,
             pallet_est: true_pallet,
+            path: forkbench_core::Path::default(),
             insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
             obstacles,
             footprints: scn.world.footprint_obstacles(),

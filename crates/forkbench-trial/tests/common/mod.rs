@@ -18,6 +18,7 @@ pub fn text(record: &Value, field: &str) -> String {
 }
 
 /// The scenario and case a record was run on.
+#[allow(dead_code)] // the session test finds its shared scenarios itself
 pub fn case_of<'a>(scenarios: &'a [Scenario], record: &Value) -> (&'a Scenario, &'a Case) {
     let name = text(record, "scenario");
     let scn = scenarios.iter().find(|x| x.name == name).expect("scenario");

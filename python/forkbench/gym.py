@@ -1,0 +1,212 @@
+"""Gymnasium environments of a forkbench pick trial: ``forkbench/PalletPick-v0``.
+
+An episode is one pick trial of a scenario case: the truck starts where the case puts it
+(after a mission's legs, when the scenario has a mission), with the first localiser fix,
+pallet estimate and plan made. Each step is one 10 ms control tick (or
+``ticks_per_step`` of them): the agent's command, a rapier2d physics step, the judging,
+the next tick's sensing.
+
+Observation (float32; the first 13 fields are ``forkbench.OBSERVATION_FIELDS``): what the
+truck's controller knows, never the truth: the localiser's fork-root pose (x, y,
+heading), the pallet estimate (face pose), the goal (fork root at the target depth in the
+estimate) in the truck's frame, measured speed and steering angle, time left, whether
+this tick brought a localiser fix; then, with ``path_points=K``, K (x, y) points of the
+planned path ahead in the truck's frame, ``path_spacing_m`` apart.
+
+Action (float32): speed (m/s, forward positive) and equivalent steering angle (rad,
+positive left), bounded by the truck's limits.
+
+Episode end: terminated when the truck stands with the forks at the required depth, or
+as soon as a criterion fails for good (a rack or wall touched, fork contact force,
+pallet moved or turned, entry outside the lateral or heading limit); truncated at the
+scenario's time limit. ``info["outcome"]`` is then the trial's judged outcome, the same
+record a batch writes, with ``info["success"]`` and ``info["failure"]``.
+
+Default reward: the decrease, per step, of the true fork root's distance to the true goal
+plus 1 m per radian of heading error; minus 0.1 per simulated second; plus 10 when the
+trial is judged a success, minus 10 when judged a failure before the time limit (0 at
+the time limit). ``reward=(success, failure, time_per_s, heading_m_per_rad)`` changes the
+weights.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Sequence, Union
+import os
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from . import _forkbench
+from ._forkbench import Scenario
+
+ENV_ID = "forkbench/PalletPick-v0"
+DEFAULT_SCENARIO = "field-test"
+Reward = tuple[float, float, float, float]
+
+
+def _scenario(scenario: Union[Scenario, str, "os.PathLike[str]"]) -> Scenario:
+    from . import load
+
+    return load(scenario)
+
+
+def _reward(reward: Sequence[float]) -> Reward:
+    """The reward weights as the four floats the core takes."""
+    r = [float(x) for x in reward]
+    if len(r) != 4:
+        raise ValueError(f"reward {reward!r}: expected (success, failure, time_per_s, heading_m_per_rad)")
+    return (r[0], r[1], r[2], r[3])
+
+
+def _spaces(scn: Scenario, size: int) -> tuple[spaces.Box, spaces.Box]:
+    speed, steer = scn.command_limits
+    obs = spaces.Box(-np.inf, np.inf, shape=(size,), dtype=np.float32)
+    act = spaces.Box(
+        np.array([-speed, -steer], dtype=np.float32),
+        np.array([speed, steer], dtype=np.float32),
+        dtype=np.float32,
+    )
+    return obs, act
+
+
+class PalletPickEnv(gymnasium.Env):
+    """One forkbench pick trial per episode (see the module's documentation).
+
+    ``scenario``: a `Scenario`, an embedded scenario's name or a scenario file;
+    ``case``: a fixed case (default: each episode draws one); ``planner``, ``tracker``,
+    ``noise``, ``replan``: as for `run_trial` (the tracker only drives `expert_step`).
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(
+        self,
+        scenario: Union[Scenario, str, "os.PathLike[str]"] = DEFAULT_SCENARIO,
+        *,
+        case: Optional[str] = None,
+        planner: Optional[str] = None,
+        tracker: Optional[str] = None,
+        noise: bool = True,
+        replan: Optional[bool] = None,
+        ticks_per_step: int = 1,
+        path_points: int = 0,
+        path_spacing_m: float = 0.5,
+        reward: Reward = (10.0, 10.0, 0.1, 1.0),
+    ) -> None:
+        self.scenario = _scenario(scenario)
+        self._case = case
+        self._core = _forkbench.PickEnv(
+            self.scenario, case=case, planner=planner, tracker=tracker, noise=noise,
+            replan=replan, ticks_per_step=ticks_per_step, path_points=path_points,
+            path_spacing_m=path_spacing_m, reward=_reward(reward),
+        )
+        self.observation_space, self.action_space = _spaces(
+            self.scenario, self._core.observation_size
+        )
+
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Starts an episode; ``options={"case": name}`` chooses its case."""
+        super().reset(seed=seed)
+        case = (options or {}).get("case") or self._case
+        if case is None:
+            cases = self.scenario.cases
+            case = cases[int(self.np_random.integers(len(cases)))]
+        trial_seed = int(self.np_random.integers(0, 2**63 - 1))
+        return self._core.reset(trial_seed, case)
+
+    def step(
+        self, action: Any
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        a = np.asarray(action, dtype=np.float64).reshape(2)
+        return self._core.step(float(a[0]), float(a[1]))
+
+    def expert_step(self) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """One step under the scenario's own tracker (a reference to compare against)."""
+        return self._core.expert_step()
+
+
+class PalletPickVectorEnv(VectorEnv):
+    """``num_envs`` pick environments stepped in parallel in Rust on ``threads`` threads
+    (default: all cores), with next-step autoreset: the step after an episode ends
+    starts the next one and ignores that environment's action. Environment i draws its
+    episodes' cases and trial seeds from a stream seeded by ``reset(seed)`` and i, so
+    results do not depend on the thread count."""
+
+    metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(
+        self,
+        num_envs: int = 8,
+        scenario: Union[Scenario, str, "os.PathLike[str]"] = DEFAULT_SCENARIO,
+        *,
+        threads: Optional[int] = None,
+        case: Optional[str] = None,
+        planner: Optional[str] = None,
+        tracker: Optional[str] = None,
+        noise: bool = True,
+        replan: Optional[bool] = None,
+        ticks_per_step: int = 1,
+        path_points: int = 0,
+        path_spacing_m: float = 0.5,
+        reward: Reward = (10.0, 10.0, 0.1, 1.0),
+    ) -> None:
+        self.scenario = _scenario(scenario)
+        self._core = _forkbench.PickVecEnv(
+            self.scenario, num_envs, case=case, planner=planner, tracker=tracker,
+            noise=noise, replan=replan, ticks_per_step=ticks_per_step,
+            path_points=path_points, path_spacing_m=path_spacing_m,
+            reward=_reward(reward), threads=threads,
+        )
+        self.num_envs = num_envs
+        self.single_observation_space, self.single_action_space = _spaces(
+            self.scenario, self._core.observation_size
+        )
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+
+    def reset(
+        self,
+        *,
+        seed: Optional[Union[int, Sequence[int]]] = None,
+        options: Optional[dict[str, Any]] = None,
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        if seed is None:
+            seed = int(np.random.SeedSequence().generate_state(1, np.uint64)[0])
+        elif not isinstance(seed, int):
+            seed = int(seed[0])
+        self._np_random_seed = seed
+        obs, infos = self._core.reset(seed)
+        return obs, self._batch_infos(infos)
+
+    def step(
+        self, actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        a = np.ascontiguousarray(actions, dtype=np.float64).reshape(self.num_envs, 2)
+        obs, rewards, terminated, truncated, ended = self._core.step(a)
+        return obs, rewards, terminated, truncated, self._batch_infos(ended)
+
+    def _batch_infos(self, infos: Sequence[Optional[dict[str, Any]]]) -> dict[str, Any]:
+        """Per-environment dicts as Gymnasium's vector info: a key's values in an array,
+        ``_key`` marking the environments that have it."""
+        out: dict[str, Any] = {}
+        for i, info in enumerate(infos):
+            for key, value in (info or {}).items():
+                if key not in out:
+                    out[key] = np.full(self.num_envs, None, dtype=object)
+                    out["_" + key] = np.zeros(self.num_envs, dtype=bool)
+                out[key][i] = value
+                out["_" + key][i] = True
+        return out
+
+
+gymnasium.register(
+    id=ENV_ID,
+    entry_point="forkbench.gym:PalletPickEnv",
+    vector_entry_point="forkbench.gym:PalletPickVectorEnv",
+)

@@ -1,0 +1,182 @@
+//! `run_trial` and `run_batch`: one trial (optionally recorded to MCAP) or a parallel batch, with the CLI's seeds and outcomes, as Python dicts.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+use forkbench_batch::{BatchSpec, ReplanModes, TrialRecord};
+use forkbench_trial::{Recorder, TrialOptions, run_trial_recorded};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+
+use crate::convert::{BatchError, RecordingError, scenario_error, serde_to_py};
+use crate::scenario::Scenario;
+
+/// Runs one case of `scenario` to its judged outcome (a dict: the CLI's `trial --json`).
+/// `case` may be omitted when the scenario has one case. `mcap` records the trial to
+/// that file (Foxglove schemas; .rrd recordings come from the CLI).
+#[pyfunction]
+#[pyo3(signature = (scenario, case=None, *, seed=None, planner=None, tracker=None,
+                    noise=true, pallet_noise_scale=None, replan=None, mcap=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_trial<'py>(
+    py: Python<'py>,
+    scenario: &Scenario,
+    case: Option<&str>,
+    seed: Option<u64>,
+    planner: Option<String>,
+    tracker: Option<String>,
+    noise: bool,
+    pallet_noise_scale: Option<f64>,
+    replan: Option<bool>,
+    mcap: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let scn = &scenario.inner;
+    let case = match case {
+        Some(name) => scn.case(name).map_err(|e| scenario_error(py, &e))?,
+        None if scn.cases.len() == 1 => &scn.cases[0],
+        None => {
+            let e = forkbench_trial::TrialError::Invalid {
+                file: scn.file.clone(),
+                field: "case".into(),
+                reason: format!(
+                    "{} cases; choose one (cases: {})",
+                    scn.cases.len(),
+                    scenario.cases_text()
+                ),
+            };
+            return Err(scenario_error(py, &e));
+        }
+    };
+    let opts = TrialOptions {
+        seed,
+        planner,
+        tracker,
+        no_noise: !noise,
+        pallet_noise_scale,
+        replan,
+    };
+    let run = scn.resolve(&opts).map_err(|e| scenario_error(py, &e))?;
+    let out = match mcap {
+        None => py.detach(|| forkbench_trial::run_trial(scn, case, &opts)),
+        Some(path) => {
+            let meta = forkbench_log::mcap_metadata(
+                [&scn.name, &case.name, &run.planner.name, &run.tracker.name],
+                run.seed,
+                env!("CARGO_PKG_VERSION"),
+            );
+            let fail = |e: forkbench_log::LogError| RecordingError::new_err(e.to_string());
+            forkbench_log::check_writable(&path, true).map_err(fail)?;
+            let mut rec = forkbench_log::McapRecorder::create(&path, meta).map_err(fail)?;
+            let out = py.detach(|| {
+                let r: &mut dyn Recorder = &mut rec;
+                run_trial_recorded(scn, case, &opts, r)
+            });
+            rec.finish().map_err(fail)?;
+            out
+        }
+    };
+    serde_to_py(py, &out)
+}
+
+impl Scenario {
+    fn cases_text(&self) -> String {
+        self.inner
+            .cases
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// Runs a batch as the CLI's `batch` does (the same trial seeds from `seed` and each
+/// trial's identity, so the same outcomes), in parallel on `jobs` threads, and returns
+/// its records (dicts: the lines of `trials.jsonl`) in the batch's job order. Without
+/// `scenarios`, the embedded defaults in both replanning modes (the README's main job).
+/// With `out`, also writes (or resumes) the CLI's batch directory there.
+#[pyfunction]
+#[pyo3(signature = (scenarios=None, *, trials=20, seed=1, planners=None, trackers=None,
+                    modes=None, pallet_noise_scale=None, jobs=None, out=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_batch<'py>(
+    py: Python<'py>,
+    scenarios: Option<Vec<Scenario>>,
+    trials: u64,
+    seed: u64,
+    planners: Option<Vec<String>>,
+    trackers: Option<Vec<String>>,
+    modes: Option<&str>,
+    pallet_noise_scale: Option<f64>,
+    jobs: Option<usize>,
+    out: Option<PathBuf>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let embedded = scenarios.is_none();
+    let scenarios = match scenarios {
+        Some(s) => s.iter().map(|s| (*s.inner).clone()).collect(),
+        None => crate::scenario::default_scenarios(py)?
+            .iter()
+            .map(|s| (*s.inner).clone())
+            .collect(),
+    };
+    let asked = match modes {
+        None => None,
+        Some("scenario") => Some(ReplanModes::Scenario),
+        Some("replan") => Some(ReplanModes::Replan),
+        Some("both") => Some(ReplanModes::Both),
+        Some(other) => {
+            return Err(BatchError::new_err(format!(
+                "modes {other:?}: expected \"scenario\", \"replan\" or \"both\""
+            )));
+        }
+    };
+    let (replan, compare_replanning) = ReplanModes::choose(false, asked, embedded).spec_fields();
+    let spec = BatchSpec {
+        scenarios,
+        planners: planners.unwrap_or_default(),
+        trackers: trackers.unwrap_or_default(),
+        trials,
+        seed,
+        shard: (0, 1),
+        pallet_noise_scale,
+        replan,
+        compare_replanning,
+        force_new: false,
+    };
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let records = py
+        .detach(|| run(&spec, jobs, out.as_deref()))
+        .map_err(|e| BatchError::new_err(e.to_string()))?;
+    records.iter().map(|r| serde_to_py(py, r)).collect()
+}
+
+/// The batch's records in job order: run here, or through the CLI's batch directory.
+fn run(
+    spec: &BatchSpec,
+    jobs: usize,
+    out: Option<&std::path::Path>,
+) -> Result<Vec<TrialRecord>, forkbench_batch::BatchError> {
+    spec.check(jobs)?;
+    let todo = spec.jobs();
+    let Some(dir) = out else {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs)
+            .build()
+            .map_err(|e| forkbench_batch::BatchError::Invalid(format!("thread pool: {e}")))?;
+        return Ok(pool.install(|| {
+            todo.par_iter()
+                .with_max_len(1)
+                .map(|j| spec.run_job(j))
+                .collect()
+        }));
+    };
+    forkbench_batch::run_batch(spec, dir, jobs, &|_| {})?;
+    let order: HashMap<_, usize> = todo
+        .iter()
+        .enumerate()
+        .map(|(i, j)| (spec.key(j), i))
+        .collect();
+    let mut records = forkbench_batch::read_records(&dir.join("trials.jsonl"))?;
+    records.retain(|r| order.contains_key(&r.key()));
+    records.sort_by_key(|r| order[&r.key()]);
+    Ok(records)
+}

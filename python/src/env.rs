@@ -1,0 +1,307 @@
+//! The Gymnasium environments' Rust core: one pick trial per episode stepped a control tick at a time, singly (`PickEnv`) or many in parallel with automatic resets (`PickVecEnv`).
+
+use std::sync::Arc;
+
+use forkbench_trial::trial::{Control, Session, SessionEnd};
+use forkbench_trial::{Scenario as Inner, TrialError, TrialOptions};
+use numpy::PyArray1;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{scenario_error, serde_to_py};
+use crate::obs::{self, ObsConfig, RewardConfig};
+use crate::scenario::Scenario;
+
+/// What every episode of an environment shares.
+#[derive(Debug, Clone)]
+pub(crate) struct Setup {
+    pub(crate) scn: Arc<Inner>,
+    /// The case every episode runs; `None`: drawn per episode.
+    pub(crate) case: Option<String>,
+    opts: TrialOptions,
+    pub(crate) obs: ObsConfig,
+    reward: RewardConfig,
+    ticks_per_step: u32,
+}
+
+/// One environment: the episode's session and the reward's running potential.
+#[derive(Debug)]
+pub(crate) struct Core {
+    session: Session,
+    potential: f64,
+    seed: u64,
+    case: String,
+}
+
+/// One step's result.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct StepOut {
+    pub(crate) reward: f64,
+    pub(crate) terminated: bool,
+    pub(crate) truncated: bool,
+}
+
+impl Core {
+    pub(crate) fn start(s: &Setup, seed: u64, case: &str) -> Result<Self, TrialError> {
+        let opts = TrialOptions {
+            seed: Some(seed),
+            ..s.opts.clone()
+        };
+        let session = Session::start(s.scn.clone(), case, &opts)?;
+        let potential = s.reward.distance(session.truth());
+        Ok(Core {
+            session,
+            potential,
+            seed,
+            case: case.to_owned(),
+        })
+    }
+
+    /// Whether the episode has ended.
+    pub(crate) fn ended(&self) -> bool {
+        self.session.ended().is_some()
+    }
+
+    /// Up to `ticks_per_step` ticks under `control`, their summed reward, and the end.
+    pub(crate) fn step(&mut self, s: &Setup, control: Control) -> StepOut {
+        let mut out = StepOut::default();
+        for _ in 0..s.ticks_per_step {
+            let t0 = self.session.observation().t_s;
+            let end = match self.session.ended() {
+                Some((_, end)) => Some(end),
+                None => self.session.step(control),
+            };
+            let now = s.reward.distance(self.session.truth());
+            let dt = self.session.observation().t_s - t0;
+            out.reward += self.potential - now - s.reward.time_per_s * dt;
+            self.potential = now;
+            if let Some(end) = end {
+                if let Some((o, _)) = self.session.ended() {
+                    out.reward += s.reward.terminal(o, end);
+                }
+                out.terminated = end == SessionEnd::Judged;
+                out.truncated = end == SessionEnd::TimeLimit;
+                break;
+            }
+        }
+        out
+    }
+
+    pub(crate) fn write_obs(&self, s: &Setup, out: &mut [f32]) {
+        obs::write(self.session.observation(), self.session.path(), &s.obs, out);
+    }
+
+    /// The step's `info`: time, seed, case, fix; and the judged outcome at the end.
+    pub(crate) fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let o = self.session.observation();
+        d.set_item("t_s", o.t_s)?;
+        d.set_item("fix", o.fix)?;
+        d.set_item("seed", self.seed)?;
+        d.set_item("case", &self.case)?;
+        if let Some((out, _)) = self.session.ended() {
+            d.set_item("success", out.success)?;
+            d.set_item("failure", out.failure.map(|f| f.name()))?;
+            d.set_item("outcome", serde_to_py(py, out)?)?;
+        }
+        Ok(d)
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn setup(
+    py: Python<'_>,
+    scenario: &Scenario,
+    case: Option<String>,
+    planner: Option<String>,
+    tracker: Option<String>,
+    noise: bool,
+    replan: Option<bool>,
+    ticks_per_step: u32,
+    path_points: usize,
+    path_spacing_m: f64,
+    reward: (f64, f64, f64, f64),
+) -> PyResult<Setup> {
+    let scn = scenario.inner.clone();
+    if let Some(c) = &case {
+        scn.case(c).map_err(|e| scenario_error(py, &e))?;
+    }
+    let opts = TrialOptions {
+        planner,
+        tracker,
+        no_noise: !noise,
+        replan,
+        ..TrialOptions::default()
+    };
+    scn.resolve(&opts).map_err(|e| scenario_error(py, &e))?;
+    if ticks_per_step == 0 || !(path_spacing_m.is_finite() && path_spacing_m > 0.0) {
+        return Err(PyValueError::new_err(
+            "ticks_per_step must be at least 1 and path_spacing_m a positive length",
+        ));
+    }
+    let (success, failure, time_per_s, heading_m_per_rad) = reward;
+    if ![success, failure, time_per_s, heading_m_per_rad]
+        .iter()
+        .all(|v| v.is_finite())
+    {
+        return Err(PyValueError::new_err("the reward weights must be finite"));
+    }
+    Ok(Setup {
+        scn,
+        case,
+        opts,
+        obs: ObsConfig {
+            path_points,
+            path_spacing_m,
+        },
+        reward: RewardConfig {
+            success,
+            failure,
+            time_per_s,
+            heading_m_per_rad,
+        },
+        ticks_per_step,
+    })
+}
+
+/// A command from Python: finite numbers (the session clamps them to the truck's limits).
+pub(crate) fn command(speed_mps: f64, steer_rad: f64) -> PyResult<Control> {
+    if !(speed_mps.is_finite() && steer_rad.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "action ({speed_mps}, {steer_rad}): speed and steering must be finite"
+        )));
+    }
+    Ok(Control::Command {
+        speed_mps,
+        steer_rad,
+    })
+}
+
+/// One pick trial per episode, stepped from Python (see `forkbench.gym.PalletPickEnv`).
+#[pyclass(module = "forkbench")]
+#[derive(Debug)]
+pub struct PickEnv {
+    setup: Setup,
+    /// Behind a mutex only so the class may be shared with other Python threads; the
+    /// methods take it exclusively and never lock.
+    core: std::sync::Mutex<Option<Core>>,
+}
+
+type StepTuple<'py> = (
+    Bound<'py, PyArray1<f32>>,
+    f64,
+    bool,
+    bool,
+    Bound<'py, PyDict>,
+);
+
+#[pymethods]
+impl PickEnv {
+    #[new]
+    #[pyo3(signature = (scenario, *, case=None, planner=None, tracker=None, noise=true,
+                        replan=None, ticks_per_step=1, path_points=0, path_spacing_m=0.5,
+                        reward=(10.0, 10.0, 0.1, 1.0)))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        scenario: &Scenario,
+        case: Option<String>,
+        planner: Option<String>,
+        tracker: Option<String>,
+        noise: bool,
+        replan: Option<bool>,
+        ticks_per_step: u32,
+        path_points: usize,
+        path_spacing_m: f64,
+        reward: (f64, f64, f64, f64),
+    ) -> PyResult<Self> {
+        let setup = setup(
+            py,
+            scenario,
+            case,
+            planner,
+            tracker,
+            noise,
+            replan,
+            ticks_per_step,
+            path_points,
+            path_spacing_m,
+            reward,
+        )?;
+        Ok(PickEnv {
+            setup,
+            core: std::sync::Mutex::new(None),
+        })
+    }
+
+    /// Length of an observation vector.
+    #[getter]
+    fn observation_size(&self) -> usize {
+        self.setup.obs.size()
+    }
+
+    /// Starts an episode: case `case` (or the environment's) with trial seed `seed`.
+    #[pyo3(signature = (seed, case=None))]
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        seed: u64,
+        case: Option<String>,
+    ) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
+        let case = case
+            .or_else(|| self.setup.case.clone())
+            .ok_or_else(|| PyValueError::new_err("no case given and none fixed"))?;
+        let setup = &self.setup;
+        let core = py
+            .detach(|| Core::start(setup, seed, &case))
+            .map_err(|e| scenario_error(py, &e))?;
+        let slot = self
+            .core
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let core = slot.insert(core);
+        Ok((observation(py, &self.setup, core), core.info(py)?))
+    }
+
+    /// One step under the caller's command (speed m/s, steering rad).
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        speed_mps: f64,
+        steer_rad: f64,
+    ) -> PyResult<StepTuple<'py>> {
+        self.advance(py, command(speed_mps, steer_rad)?)
+    }
+
+    /// One step under the scenario's own tracker (the bench's reference controller).
+    fn expert_step<'py>(&mut self, py: Python<'py>) -> PyResult<StepTuple<'py>> {
+        self.advance(py, Control::Tracker)
+    }
+}
+
+impl PickEnv {
+    fn advance<'py>(&mut self, py: Python<'py>, control: Control) -> PyResult<StepTuple<'py>> {
+        let setup = &self.setup;
+        let core = self
+            .core
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .as_mut()
+            .ok_or_else(|| PyRuntimeError::new_err("step before reset"))?;
+        let out = core.step(setup, control);
+        Ok((
+            observation(py, setup, core),
+            out.reward,
+            out.terminated,
+            out.truncated,
+            core.info(py)?,
+        ))
+    }
+}
+
+fn observation<'py>(py: Python<'py>, s: &Setup, core: &Core) -> Bound<'py, PyArray1<f32>> {
+    let mut v = vec![0.0f32; s.obs.size()];
+    core.write_obs(s, &mut v);
+    PyArray1::from_vec(py, v)
+}

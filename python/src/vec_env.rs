@@ -1,0 +1,271 @@
+//! `PickVecEnv`: many pick environments stepped in parallel in Rust (rayon, the GIL released), each resetting itself on the step after its episode ends (Gymnasium's next-step autoreset).
+
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use crate::env::{Core, Setup, StepOut, command, setup};
+use crate::scenario::Scenario;
+use forkbench_trial::trial::Control;
+
+/// One environment of the vector: its episode, and the stream its episodes' seeds and
+/// cases come from (its own, so results do not depend on the thread count).
+#[derive(Debug)]
+struct Slot {
+    core: Option<Core>,
+    rng: ChaCha8Rng,
+    /// The episode ended on the last step: this step resets it.
+    pending_reset: bool,
+    error: Option<String>,
+}
+
+impl Slot {
+    /// A new episode from this slot's stream.
+    fn restart(&mut self, s: &Setup) {
+        let seed = self.rng.random::<u64>() >> 1;
+        let case = match &s.case {
+            Some(c) => c.clone(),
+            None => s.scn.cases[self.rng.random_range(0..s.scn.cases.len())]
+                .name
+                .clone(),
+        };
+        match Core::start(s, seed, &case) {
+            Ok(core) => self.core = Some(core),
+            Err(e) => self.error = Some(e.to_string()),
+        }
+        self.pending_reset = false;
+    }
+
+    fn step(&mut self, s: &Setup, control: Control, obs: &mut [f32]) -> StepOut {
+        let out = if self.pending_reset {
+            self.restart(s);
+            StepOut::default()
+        } else {
+            match self.core.as_mut() {
+                Some(core) => core.step(s, control),
+                None => StepOut::default(),
+            }
+        };
+        if let Some(core) = &self.core {
+            self.pending_reset = core.ended();
+            core.write_obs(s, obs);
+        }
+        out
+    }
+}
+
+/// Many pick environments stepped together (see `forkbench.gym.PalletPickVectorEnv`).
+#[pyclass(module = "forkbench")]
+#[derive(Debug)]
+pub struct PickVecEnv {
+    setup: Setup,
+    n: usize,
+    /// Behind a mutex only so the class may be shared with other Python threads; the
+    /// methods take it exclusively and never lock.
+    slots: std::sync::Mutex<Vec<Slot>>,
+    pool: rayon::ThreadPool,
+}
+
+type VecReset<'py> = (Bound<'py, PyArray2<f32>>, Vec<Bound<'py, PyDict>>);
+
+type VecStep<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Vec<Option<Bound<'py, PyDict>>>,
+);
+
+#[pymethods]
+impl PickVecEnv {
+    #[new]
+    #[pyo3(signature = (scenario, num_envs, *, case=None, planner=None, tracker=None,
+                        noise=true, replan=None, ticks_per_step=1, path_points=0,
+                        path_spacing_m=0.5, reward=(10.0, 10.0, 0.1, 1.0), threads=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        scenario: &Scenario,
+        num_envs: usize,
+        case: Option<String>,
+        planner: Option<String>,
+        tracker: Option<String>,
+        noise: bool,
+        replan: Option<bool>,
+        ticks_per_step: u32,
+        path_points: usize,
+        path_spacing_m: f64,
+        reward: (f64, f64, f64, f64),
+        threads: Option<usize>,
+    ) -> PyResult<Self> {
+        if !(1..=65_536).contains(&num_envs) {
+            return Err(PyValueError::new_err(format!(
+                "num_envs {num_envs}: must be 1 to 65536"
+            )));
+        }
+        let setup = setup(
+            py,
+            scenario,
+            case,
+            planner,
+            tracker,
+            noise,
+            replan,
+            ticks_per_step,
+            path_points,
+            path_spacing_m,
+            reward,
+        )?;
+        let threads =
+            threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.clamp(1, 256))
+            .build()
+            .map_err(|e| PyRuntimeError::new_err(format!("thread pool: {e}")))?;
+        let slots = (0..num_envs)
+            .map(|_| Slot {
+                core: None,
+                rng: ChaCha8Rng::seed_from_u64(0),
+                pending_reset: false,
+                error: None,
+            })
+            .collect();
+        Ok(PickVecEnv {
+            setup,
+            n: num_envs,
+            slots: std::sync::Mutex::new(slots),
+            pool,
+        })
+    }
+
+    #[getter]
+    fn num_envs(&self) -> usize {
+        self.n
+    }
+
+    #[getter]
+    fn observation_size(&self) -> usize {
+        self.setup.obs.size()
+    }
+
+    /// Starts every environment: environment i draws its episodes from a stream seeded
+    /// by `seed` and i.
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<VecReset<'py>> {
+        for (i, slot) in self.slots().iter_mut().enumerate() {
+            slot.rng =
+                ChaCha8Rng::seed_from_u64(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+            slot.pending_reset = true;
+            slot.error = None;
+        }
+        let controls = vec![Control::Tracker; self.n];
+        let (obs, _) = self.run(py, &controls)?;
+        let infos = self
+            .slots()
+            .iter()
+            .map(|s| match &s.core {
+                Some(core) => core.info(py),
+                None => Ok(PyDict::new(py)),
+            })
+            .collect::<PyResult<_>>()?;
+        Ok((obs.into_pyarray(py), infos))
+    }
+
+    /// One step of every environment under `actions` (num_envs × 2: speed m/s, steering
+    /// rad). Returns observations, rewards, terminated, truncated, and the judged outcome
+    /// of each environment whose episode ended on this step (else None).
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<VecStep<'py>> {
+        let a = actions.as_array();
+        if a.shape() != [self.n, 2] {
+            return Err(PyValueError::new_err(format!(
+                "actions of shape {:?}: expected ({}, 2)",
+                a.shape(),
+                self.n
+            )));
+        }
+        let controls = a
+            .rows()
+            .into_iter()
+            .map(|r| command(r[0], r[1]))
+            .collect::<PyResult<Vec<_>>>()?;
+        let (obs, outs) = self.run(py, &controls)?;
+        let outcomes = self
+            .slots()
+            .iter()
+            .map(|s| match &s.core {
+                Some(core) if s.pending_reset => core.info(py).map(Some),
+                _ => Ok(None),
+            })
+            .collect::<PyResult<_>>()?;
+        let col = |f: fn(&StepOut) -> bool| outs.iter().map(f).collect::<Vec<_>>().into_pyarray(py);
+        Ok((
+            obs.into_pyarray(py),
+            outs.iter()
+                .map(|o| o.reward)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+            col(|o| o.terminated),
+            col(|o| o.truncated),
+            outcomes,
+        ))
+    }
+}
+
+impl PickVecEnv {
+    fn slots(&mut self) -> &mut Vec<Slot> {
+        self.slots
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// Every slot's step in parallel, without the GIL.
+    fn run(
+        &mut self,
+        py: Python<'_>,
+        controls: &[Control],
+    ) -> PyResult<(Array2<f32>, Vec<StepOut>)> {
+        let n = self.setup.obs.size();
+        let mut obs = Array2::<f32>::zeros((self.n, n));
+        let (setup, pool) = (&self.setup, &self.pool);
+        let slots = self
+            .slots
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let flat = obs
+            .as_slice_mut()
+            .ok_or_else(|| PyRuntimeError::new_err("observation buffer not contiguous"))?;
+        let outs = py.detach(|| {
+            // One thread: no hand-over to the pool (it costs more than a tick).
+            if pool.current_num_threads() == 1 {
+                return slots
+                    .iter_mut()
+                    .zip(flat.chunks_mut(n.max(1)))
+                    .zip(controls)
+                    .map(|((slot, row), c)| slot.step(setup, *c, row))
+                    .collect::<Vec<_>>();
+            }
+            pool.install(|| {
+                slots
+                    .par_iter_mut()
+                    .zip(flat.par_chunks_mut(n.max(1)))
+                    .zip(controls.par_iter())
+                    .map(|((slot, row), c)| slot.step(setup, *c, row))
+                    .collect::<Vec<_>>()
+            })
+        });
+        if let Some(e) = self.slots().iter_mut().find_map(|s| s.error.take()) {
+            return Err(PyRuntimeError::new_err(format!(
+                "an episode could not start: {e}"
+            )));
+        }
+        Ok((obs, outs))
+    }
+}

@@ -1,0 +1,98 @@
+"""The Gymnasium environments: Gymnasium's own checker, determinism under a seed, the expert equal to a batch trial, episode ends judged by the bench, and the vector form independent of its thread count."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import forkbench
+from forkbench.gym import PalletPickEnv, PalletPickVectorEnv
+from conftest import without_clock
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+@pytest.mark.parametrize("kwargs", [{}, {"path_points": 6, "ticks_per_step": 5}])
+def test_gymnasiums_checker_passes(kwargs):
+    env = gym.make("forkbench/PalletPick-v0", **kwargs)
+    check_env(env.unwrapped, skip_render_check=True)
+    assert env.observation_space.shape == (13 + 2 * kwargs.get("path_points", 0),)
+
+
+def rollout(env, seed, steps=400):
+    obs, _ = env.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    seen = [obs]
+    for _ in range(steps):
+        obs, reward, term, trunc, info = env.step(rng.uniform(-1, 1, 2) * [0.8, 1.0])
+        seen.append(np.append(obs, [reward, term, trunc]))
+        if term or trunc:
+            break
+    return np.concatenate(seen)
+
+
+def test_same_seed_same_episode():
+    a, b = PalletPickEnv(), PalletPickEnv()
+    assert np.array_equal(rollout(a, 11), rollout(b, 11))
+    assert not np.array_equal(rollout(a, 11), rollout(a, 12))
+
+
+def test_the_expert_reproduces_the_batch_trial_at_the_episode_seed():
+    scn = forkbench.load("bspline-table2")
+    env = PalletPickEnv(scn)
+    for seed in range(3):
+        _, info = env.reset(seed=seed)
+        total, steps = 0.0, 0
+        while True:
+            _, reward, term, trunc, end = env.expert_step()
+            total, steps = total + reward, steps + 1
+            if term or trunc:
+                break
+        want = forkbench.run_trial(scn, info["case"], seed=info["seed"])
+        assert without_clock(end["outcome"]) == without_clock(want)
+        assert end["success"] == want["success"] and end["failure"] == want["failure"]
+        assert term and steps >= round(want["sim_time_s"] / 0.01)
+
+
+def test_episodes_end_as_the_bench_judges():
+    env = PalletPickEnv()
+    env.reset(seed=1)
+    steps = 0
+    while True:  # standing still: truncated at the scenario's time limit
+        _, reward, term, trunc, info = env.step([0.0, 0.0])
+        steps += 1
+        if term or trunc:
+            break
+    assert trunc and not term and info["failure"] == "timeout"
+    assert steps == round(env.scenario.timeout_s / 0.01)
+    with pytest.raises(ValueError, match="finite"):
+        env.step([float("nan"), 0.0])
+
+
+def vector_rollout(threads, steps=300):
+    env = PalletPickVectorEnv(6, "field-test", threads=threads, ticks_per_step=10)
+    obs, _ = env.reset(seed=5)
+    rng = np.random.default_rng(0)
+    out, ended = [obs], 0
+    for _ in range(steps):
+        actions = rng.uniform(-1, 1, (6, 2)) * [0.8, 1.0] + [0.5, 0.0]
+        obs, rewards, term, trunc, info = env.step(actions)
+        out += [obs, rewards[:, None], term[:, None], trunc[:, None]]
+        ended += int(info.get("_outcome", np.zeros(6, bool)).sum())
+    return np.concatenate([np.asarray(x, dtype=np.float64).ravel() for x in out]), ended
+
+
+def test_the_vector_env_is_independent_of_its_thread_count_and_autoresets():
+    one, ended = vector_rollout(1)
+    two, ended2 = vector_rollout(2)
+    assert np.array_equal(one, two) and ended == ended2
+    assert ended > 0, "no episode ended in 300 × 0.1 s of random driving"
+
+
+def test_make_vec_uses_the_rust_vector():
+    env = gym.make_vec("forkbench/PalletPick-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (3, 13) and obs.dtype == np.float32
+    obs, rewards, term, trunc, _ = env.step(env.action_space.sample())
+    assert rewards.shape == (3,) and term.dtype == np.bool_

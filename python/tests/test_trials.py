@@ -1,0 +1,81 @@
+"""Trials and batches from Python equal the CLI's at the same seeds; outcomes become a DataFrame; bad input raises exceptions naming file, field and reason."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import forkbench
+from conftest import ROOT, read_jsonl, without_clock
+
+
+def test_a_trial_equals_the_clis_at_the_same_seed(cli):
+    for scenario, case, seed in [("field-test", None, 3), ("bspline-table2", "18", 4)]:
+        args = ["trial", f"scenarios/{scenario}.toml", "--seed", str(seed), "--json"]
+        if case:
+            args += ["--case", case]
+        want = json.loads(cli(*args))
+        got = forkbench.run_trial(forkbench.load(scenario), case, seed=seed)
+        assert without_clock(got) == without_clock(want)
+
+
+def test_a_batch_equals_the_clis_and_becomes_a_dataframe(cli, tmp_path):
+    out = tmp_path / "cli"
+    cli("batch", "scenarios/field-test.toml", "scenarios/rack-pick.toml", "--trials", "3",
+        "--seed", "7", "--out", str(out))
+    want = sorted(read_jsonl(out / "trials.jsonl"), key=lambda r: (r["scenario"], r["case"], r["trial"]))
+    scenarios = [forkbench.load(ROOT / "scenarios/field-test.toml"),
+                 forkbench.load(ROOT / "scenarios/rack-pick.toml")]
+    for jobs in (1, 2):
+        got = forkbench.run_batch(scenarios, trials=3, seed=7, jobs=jobs)
+        got = sorted(got, key=lambda r: (r["scenario"], r["case"], r["trial"]))
+        assert [without_clock(r) for r in got] == [without_clock(r) for r in want]
+    # The CLI's batch directory, written from Python, holds the same trials.
+    written = forkbench.run_batch(scenarios, trials=3, seed=7, out=tmp_path / "py")
+    assert len(written) == len(want) == len(read_jsonl(tmp_path / "py" / "trials.jsonl"))
+    assert (tmp_path / "py" / "summary.json").exists()
+    df = forkbench.to_dataframe(got)
+    assert len(df) == len(want)
+    assert {"scenario", "case", "seed", "success", "failure", "lateral_error_m"} <= set(df.columns)
+    assert df.groupby("scenario")["success"].mean().between(0, 1).all()
+
+
+def test_the_external_python_tracker_runs_in_a_batch_beside_pure_pursuit():
+    scn = forkbench.load(ROOT / "examples/trackers/stanley-field-test.toml")
+    records = forkbench.run_batch([scn], trials=4, trackers=["stanley", "pure_pursuit"])
+    by = {t: [r for r in records if r["tracker"] == t] for t in ("stanley", "pure_pursuit")}
+    assert len(by["stanley"]) == len(by["pure_pursuit"]) == 4
+    assert [r["seed"] for r in by["stanley"]] == [r["seed"] for r in by["pure_pursuit"]]
+    assert all(r["failure"] != "error" for r in records), [r["failure_detail"] for r in records]
+
+
+def test_a_trial_records_to_mcap(tmp_path):
+    path = tmp_path / "field.mcap"
+    out = forkbench.run_trial(forkbench.load("field-test"), seed=1, noise=False, mcap=path)
+    data = path.read_bytes()
+    assert out["success"] and data[:8] == b"\x89MCAP0\r\n" and len(data) > 10_000
+
+
+def test_bad_input_names_file_field_and_reason(tmp_path):
+    bad = tmp_path / "bad.toml"
+    text = (ROOT / "scenarios/field-test.toml").read_text()
+    bad.write_text(text.replace("[tolerances]", "[tolerances]\nlateral_m = -1.0", 1)
+                   if "[tolerances]" in text else text + "\n[tolerances]\nlateral_m = -1.0\n")
+    with pytest.raises(forkbench.ScenarioError) as e:
+        forkbench.Scenario.load(bad)
+    assert e.value.file.endswith("bad.toml") and "lateral_m" in e.value.field, (e.value.file, e.value.field)
+    assert e.value.reason
+    with pytest.raises(forkbench.ScenarioError) as e:
+        forkbench.Scenario.embedded("no-such-scenario")
+    assert e.value.field == "name" and "field-test" in e.value.reason
+    with pytest.raises(forkbench.ScenarioError) as e:
+        forkbench.run_trial(forkbench.load("bspline-table2"), "no-such-case")
+    assert e.value.field == "case"
+    with pytest.raises(forkbench.ScenarioError) as e:
+        forkbench.run_trial(forkbench.load("field-test"), planner="no-such-planner")
+    assert e.value.field == "planner"
+    with pytest.raises(forkbench.BatchError, match="modes"):
+        forkbench.run_batch([forkbench.load("field-test")], trials=1, modes="sometimes")
+    with pytest.raises(forkbench.BatchError, match="trials"):
+        forkbench.run_batch([forkbench.load("field-test")], trials=0)
