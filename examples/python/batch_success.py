@@ -25,12 +25,16 @@ print(f"{len(records)} trials in {time.perf_counter() - t0:.1f} s")
 # %% One row per trial; columns as the outcome names them (SI units).
 df = forkbench.to_dataframe(records)
 df["mode"] = df["replan"].map({True: "replan", False: "plan once"})
-print(df[["scenario", "case", "planner", "mode", "seed", "success", "failure",
-          "lateral_error_m"]].head())
+print(
+    df[
+        ["scenario", "case", "planner", "mode", "seed", "success", "failure", "lateral_error_m"]
+    ].head()
+)
 
 # %% Success per scenario, planner and mode: what `batch` prints.
-table = df.pivot_table(index=["scenario", "planner"], columns="mode", values="success",
-                       aggfunc="mean")
+table = df.pivot_table(
+    index=["scenario", "planner"], columns="mode", values="success", aggfunc="mean"
+)
 print((100 * table).round(1).to_string())
 
 # %% Success per case, and what the failures were.
@@ -43,8 +47,7 @@ if args.plot:
     import matplotlib.pyplot as plt
 
     scenarios = list(dict.fromkeys(df["scenario"]))  # in the batch's order
-    fig, axes = plt.subplots(len(scenarios), 1, figsize=(9, 2.2 * len(scenarios)),
-                             squeeze=False)
+    fig, axes = plt.subplots(len(scenarios), 1, figsize=(9, 2.2 * len(scenarios)), squeeze=False)
     for ax, name in zip(axes[:, 0], scenarios):
         rows = df[df["scenario"] == name]
         cases = list(dict.fromkeys(rows["case"]))  # the scenario file's order

@@ -35,8 +35,9 @@ def act(params: np.ndarray, obs: np.ndarray, limits: np.ndarray) -> np.ndarray:
 def evaluate(params: np.ndarray, seed: int) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Each parameter set's return, success and failure over its first episode (one
     environment each)."""
-    env = PalletPickVectorEnv(len(params), "field-test", ticks_per_step=TICKS_PER_STEP,
-                              path_points=PATH_POINTS)
+    env = PalletPickVectorEnv(
+        len(params), "field-test", ticks_per_step=TICKS_PER_STEP, path_points=PATH_POINTS
+    )
     limits = np.array(env.scenario.command_limits)
     obs, _ = env.reset(seed=seed)
     returns, success = np.zeros(len(params)), np.zeros(len(params), bool)
@@ -68,7 +69,9 @@ def compare(policies: dict[str, np.ndarray], seeds: range) -> dict[str, dict[str
             total = 0.0
             while True:
                 if name in policies:
-                    obs, r, term, trunc, info = env.step(act(policies[name][None], obs[None], limits)[0])
+                    obs, r, term, trunc, info = env.step(
+                        act(policies[name][None], obs[None], limits)[0]
+                    )
                 elif name.startswith("uniform"):
                     obs, r, term, trunc, info = env.step(sampler.uniform(-limits, limits))
                 else:
@@ -100,26 +103,38 @@ def main() -> None:
     for it in range(a.iterations):
         params = mean + std * rng.normal(size=(a.population, *shape))
         returns, _, _ = evaluate(params, seed=a.seed * 1000 + it)
-        elite = params[np.argsort(returns)[-a.elite:]]
+        elite = params[np.argsort(returns)[-a.elite :]]
         # A floor on the spread keeps the search from settling on its first plateau.
         mean, std = elite.mean(axis=0), np.maximum(elite.std(axis=0), a.min_std)
-        test_returns, test_success, failures = evaluate(np.repeat(mean[None], 32, axis=0),
-                                                        seed=10**6 + it)
-        row = {"iteration": it, "population_return": float(returns.mean()),
-               "elite_return": float(np.sort(returns)[-a.elite:].mean()),
-               "mean_policy_return": float(test_returns.mean()),
-               "mean_policy_success": float(test_success.mean()),
-               "mean_policy_ends": {f: failures.count(f) for f in sorted(set(failures))},
-               "elapsed_s": time.perf_counter() - t0, "policy": mean.tolist()}
+        test_returns, test_success, failures = evaluate(
+            np.repeat(mean[None], 32, axis=0), seed=10**6 + it
+        )
+        row = {
+            "iteration": it,
+            "population_return": float(returns.mean()),
+            "elite_return": float(np.sort(returns)[-a.elite :].mean()),
+            "mean_policy_return": float(test_returns.mean()),
+            "mean_policy_success": float(test_success.mean()),
+            "mean_policy_ends": {f: failures.count(f) for f in sorted(set(failures))},
+            "elapsed_s": time.perf_counter() - t0,
+            "policy": mean.tolist(),
+        }
         curve.append(row)
-        print(f"iter {it:2d}  population {row['population_return']:7.2f}  elite {row['elite_return']:7.2f}  "
-              f"mean policy {row['mean_policy_return']:7.2f} (success {row['mean_policy_success']:.0%}; "
-              f"{', '.join(f'{k} {v}' for k, v in row['mean_policy_ends'].items())})  "
-              f"{row['elapsed_s']:.0f} s", flush=True)
+        print(
+            f"iter {it:2d}  population {row['population_return']:7.2f}  elite {row['elite_return']:7.2f}  "
+            f"mean policy {row['mean_policy_return']:7.2f} (success {row['mean_policy_success']:.0%}; "
+            f"{', '.join(f'{k} {v}' for k, v in row['mean_policy_ends'].items())})  "
+            f"{row['elapsed_s']:.0f} s",
+            flush=True,
+        )
     best = max(curve, key=lambda r: r["mean_policy_return"])
-    ref = compare({"CEM policy (best iteration's mean)": np.array(best["policy"]),
-                   "random policy (initial distribution)": rng.normal(size=shape)},
-                  range(2000, 2000 + a.compare_episodes))
+    ref = compare(
+        {
+            "CEM policy (best iteration's mean)": np.array(best["policy"]),
+            "random policy (initial distribution)": rng.normal(size=shape),
+        },
+        range(2000, 2000 + a.compare_episodes),
+    )
     print(f"on {a.compare_episodes} further episodes, the same for each:")
     for name, r in ref.items():
         print(f"  {name:40} return {r['return']:7.2f}  success {r['success']:.0%}")
@@ -129,10 +144,15 @@ def main() -> None:
     if a.plot:
         import matplotlib.pyplot as plt
 
-        it = [r["iteration"] for r in curve]
+        iters = [r["iteration"] for r in curve]
         plt.figure(figsize=(7, 4))
-        plt.plot(it, [r["mean_policy_return"] for r in curve], "o-", label="CEM mean policy (32 episodes)")
-        plt.plot(it, [r["population_return"] for r in curve], ".-", label="CEM population")
+        plt.plot(
+            iters,
+            [r["mean_policy_return"] for r in curve],
+            "o-",
+            label="CEM mean policy (32 episodes)",
+        )
+        plt.plot(iters, [r["population_return"] for r in curve], ".-", label="CEM population")
         styles = {"pure": (":", "green"), "random": ("--", "grey"), "uniform": ("-.", "red")}
         for name, r in ref.items():
             key = name.split()[0]

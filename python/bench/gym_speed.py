@@ -9,6 +9,7 @@ measurement repeated (interleaved) and the median printed.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import statistics
@@ -28,8 +29,9 @@ class KinematicForkliftEnv(gym.Env):
 
     def __init__(self) -> None:
         self.observation_space = spaces.Box(-np.inf, np.inf, (13,), np.float32)
-        self.action_space = spaces.Box(np.array([-0.8, -1.05], np.float32),
-                                       np.array([0.8, 1.05], np.float32), dtype=np.float32)
+        self.action_space = spaces.Box(
+            np.array([-0.8, -1.05], np.float32), np.array([0.8, 1.05], np.float32), dtype=np.float32
+        )
         self.dt, self.wheelbase = 0.01, 1.6
 
     def _obs(self) -> np.ndarray:
@@ -37,8 +39,24 @@ class KinematicForkliftEnv(gym.Env):
         gx, gy, gh = self.goal
         dx, dy = gx - x, gy - y
         c, s = math.cos(h), math.sin(h)
-        return np.array([x, y, h, gx, gy, gh, c * dx + s * dy, -s * dx + c * dy, gh - h,
-                         self.v, self.steer, 120.0 - self.t, 1.0], np.float32)
+        return np.array(
+            [
+                x,
+                y,
+                h,
+                gx,
+                gy,
+                gh,
+                c * dx + s * dy,
+                -s * dx + c * dy,
+                gh - h,
+                self.v,
+                self.steer,
+                120.0 - self.t,
+                1.0,
+            ],
+            np.float32,
+        )
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
@@ -52,8 +70,11 @@ class KinematicForkliftEnv(gym.Env):
         x, y, h = self.pose
         self.v, self.steer = v, steer
         # Rear-wheel steering: the heading turns against the steering angle's sign.
-        self.pose = [x + v * math.cos(h) * self.dt, y + v * math.sin(h) * self.dt,
-                     h + v * math.tan(steer) / self.wheelbase * self.dt]
+        self.pose = [
+            x + v * math.cos(h) * self.dt,
+            y + v * math.sin(h) * self.dt,
+            h + v * math.tan(steer) / self.wheelbase * self.dt,
+        ]
         self.t += self.dt
         d = math.hypot(self.goal[0] - self.pose[0], self.goal[1] - self.pose[1])
         terminated = d < 0.05 or abs(self.pose[0]) > 30 or abs(self.pose[1]) > 30
@@ -84,6 +105,10 @@ def vectorised(env, steps: int) -> float:
     return iters * n / (time.perf_counter() - t0)
 
 
+def vectorised_rust(num_envs: int, threads: int, steps: int) -> float:
+    return vectorised(PalletPickVectorEnv(num_envs, threads=threads), steps)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=20000)
@@ -92,23 +117,33 @@ def main() -> None:
     a = ap.parse_args()
     cases = {
         "forkbench PalletPickEnv (raw)": lambda: single(PalletPickEnv(), a.steps),
-        "forkbench gym.make (checker wrappers)": lambda: single(gym.make("forkbench/PalletPick-v0"), a.steps),
+        "forkbench gym.make (checker wrappers)": lambda: single(
+            gym.make("forkbench/PalletPick-v0"), a.steps
+        ),
         "pure-Python kinematic forklift": lambda: single(KinematicForkliftEnv(), a.steps),
         "Gymnasium Pendulum-v1 (raw)": lambda: single(gym.make("Pendulum-v1").unwrapped, a.steps),
     }
     for n in (16, 64, 256):
-        cases[f"forkbench PalletPickVectorEnv × {n}, 2 threads"] = (
-            lambda n=n: vectorised(PalletPickVectorEnv(n, threads=2), a.steps * 5))
-        cases[f"forkbench PalletPickVectorEnv × {n}, 1 thread"] = (
-            lambda n=n: vectorised(PalletPickVectorEnv(n, threads=1), a.steps * 5))
+        for threads in (2, 1):
+            label = f"{threads} thread{'s' if threads > 1 else ''}"
+            cases[f"forkbench PalletPickVectorEnv × {n}, {label}"] = functools.partial(
+                vectorised_rust, n, threads, a.steps * 5
+            )
     cases["pure-Python forklift, SyncVectorEnv × 16"] = lambda: vectorised(
-        gym.vector.SyncVectorEnv([KinematicForkliftEnv for _ in range(16)]), a.steps)
+        gym.vector.SyncVectorEnv([KinematicForkliftEnv for _ in range(16)]), a.steps
+    )
     runs: dict[str, list[float]] = {k: [] for k in cases}
     for _ in range(a.repeats):  # interleaved: every case once per round
         for name, run in cases.items():
             runs[name].append(run())
-    result = {k: {"steps_per_s_median": statistics.median(v), "runs": v,
-                  "us_per_step": 1e6 / statistics.median(v)} for k, v in runs.items()}
+    result = {
+        k: {
+            "steps_per_s_median": statistics.median(v),
+            "runs": v,
+            "us_per_step": 1e6 / statistics.median(v),
+        }
+        for k, v in runs.items()
+    }
     if a.json:
         print(json.dumps(result, indent=1))
         return

@@ -7,12 +7,13 @@ criteria. Units are SI (m, rad, s) throughout.
 
 from __future__ import annotations
 
-from typing import Any, Iterable, Union
 import os
+from collections.abc import Iterable
+from typing import Any
 
 from ._forkbench import (
-    BatchError,
     OBSERVATION_FIELDS,
+    BatchError,
     PickEnv,
     PickVecEnv,
     RecordingError,
@@ -25,8 +26,8 @@ from ._forkbench import (
 )
 
 __all__ = [
-    "BatchError",
     "OBSERVATION_FIELDS",
+    "BatchError",
     "PickEnv",
     "PickVecEnv",
     "RecordingError",
@@ -41,7 +42,7 @@ __all__ = [
 ]
 
 
-def load(scenario: Union[Scenario, str, "os.PathLike[str]"]) -> Scenario:
+def load(scenario: Scenario | str | os.PathLike[str]) -> Scenario:
     """A scenario from a `Scenario`, an embedded default's name, or a file path."""
     if isinstance(scenario, Scenario):
         return scenario
@@ -68,7 +69,7 @@ def _flat(record: dict[str, Any]) -> dict[str, Any]:
     return row
 
 
-def to_dataframe(records: Iterable[dict[str, Any]]) -> "Any":
+def to_dataframe(records: Iterable[dict[str, Any]]) -> Any:
     """Trial outcomes (from `run_trial` or `run_batch`) as a pandas DataFrame, one row per
     trial, columns in SI units as the outcome names them. Needs pandas."""
     import pandas as pd

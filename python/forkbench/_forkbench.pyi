@@ -1,24 +1,24 @@
 """Typed stubs of forkbench's Rust extension (see the functions' docstrings)."""
 
-from __future__ import annotations
-
 import os
-from typing import Any, Optional, Sequence, Union
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import TypeAlias
 
 __version__: str
 OBSERVATION_FIELDS: list[str]
 
-Outcome = dict[str, Any]
+Outcome: TypeAlias = dict[str, Any]
 """A judged trial: the CLI's `trial --json` record (a batch's also has `trial`, `replan`)."""
 
 class ScenarioError(ValueError):
     """A scenario, world or option that cannot be used."""
 
     file: str
-    field: Optional[str]
+    field: str | None
     reason: str
 
 class BatchError(RuntimeError):
@@ -31,7 +31,7 @@ class Scenario:
     """A loaded and checked scenario."""
 
     @staticmethod
-    def load(path: Union[str, os.PathLike[str]]) -> Scenario: ...
+    def load(path: str | os.PathLike[str]) -> Scenario: ...
     @staticmethod
     def embedded(name: str) -> Scenario: ...
     def with_pallet_sensing(self, kind: str) -> Scenario: ...
@@ -59,42 +59,42 @@ class Scenario:
 def default_scenarios() -> list[Scenario]: ...
 def run_trial(
     scenario: Scenario,
-    case: Optional[str] = None,
+    case: str | None = None,
     *,
-    seed: Optional[int] = None,
-    planner: Optional[str] = None,
-    tracker: Optional[str] = None,
+    seed: int | None = None,
+    planner: str | None = None,
+    tracker: str | None = None,
     noise: bool = True,
-    pallet_noise_scale: Optional[float] = None,
-    replan: Optional[bool] = None,
-    mcap: Optional[Union[str, os.PathLike[str]]] = None,
+    pallet_noise_scale: float | None = None,
+    replan: bool | None = None,
+    mcap: str | os.PathLike[str] | None = None,
 ) -> Outcome: ...
 def run_batch(
-    scenarios: Optional[Sequence[Scenario]] = None,
+    scenarios: Sequence[Scenario] | None = None,
     *,
     trials: int = 20,
     seed: int = 1,
-    planners: Optional[Sequence[str]] = None,
-    trackers: Optional[Sequence[str]] = None,
-    modes: Optional[str] = None,
-    pallet_noise_scale: Optional[float] = None,
-    jobs: Optional[int] = None,
-    out: Optional[Union[str, os.PathLike[str]]] = None,
+    planners: Sequence[str] | None = None,
+    trackers: Sequence[str] | None = None,
+    modes: str | None = None,
+    pallet_noise_scale: float | None = None,
+    jobs: int | None = None,
+    out: str | os.PathLike[str] | None = None,
 ) -> list[Outcome]: ...
 
-Reward = tuple[float, float, float, float]
-Step = tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]
+Reward: TypeAlias = tuple[float, float, float, float]
+Step: TypeAlias = tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]
 
 class PickEnv:
     def __init__(
         self,
         scenario: Scenario,
         *,
-        case: Optional[str] = None,
-        planner: Optional[str] = None,
-        tracker: Optional[str] = None,
+        case: str | None = None,
+        planner: str | None = None,
+        tracker: str | None = None,
         noise: bool = True,
-        replan: Optional[bool] = None,
+        replan: bool | None = None,
         ticks_per_step: int = 1,
         path_points: int = 0,
         path_spacing_m: float = 0.5,
@@ -103,7 +103,7 @@ class PickEnv:
     @property
     def observation_size(self) -> int: ...
     def reset(
-        self, seed: int, case: Optional[str] = None
+        self, seed: int, case: str | None = None
     ) -> tuple[npt.NDArray[np.float32], dict[str, Any]]: ...
     def step(self, speed_mps: float, steer_rad: float) -> Step: ...
     def expert_step(self) -> Step: ...
@@ -114,16 +114,16 @@ class PickVecEnv:
         scenario: Scenario,
         num_envs: int,
         *,
-        case: Optional[str] = None,
-        planner: Optional[str] = None,
-        tracker: Optional[str] = None,
+        case: str | None = None,
+        planner: str | None = None,
+        tracker: str | None = None,
         noise: bool = True,
-        replan: Optional[bool] = None,
+        replan: bool | None = None,
         ticks_per_step: int = 1,
         path_points: int = 0,
         path_spacing_m: float = 0.5,
         reward: Reward = (10.0, 10.0, 0.1, 1.0),
-        threads: Optional[int] = None,
+        threads: int | None = None,
     ) -> None: ...
     @property
     def num_envs(self) -> int: ...
@@ -137,5 +137,5 @@ class PickVecEnv:
         npt.NDArray[np.float64],
         npt.NDArray[np.bool_],
         npt.NDArray[np.bool_],
-        list[Optional[dict[str, Any]]],
+        list[dict[str, Any] | None],
     ]: ...

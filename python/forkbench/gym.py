@@ -31,8 +31,9 @@ weights.
 
 from __future__ import annotations
 
-from typing import Any, Optional, Sequence, Union
 import os
+from collections.abc import Sequence
+from typing import Any
 
 import gymnasium
 import numpy as np
@@ -48,7 +49,7 @@ DEFAULT_SCENARIO = "field-test"
 Reward = tuple[float, float, float, float]
 
 
-def _scenario(scenario: Union[Scenario, str, "os.PathLike[str]"]) -> Scenario:
+def _scenario(scenario: Scenario | str | os.PathLike[str]) -> Scenario:
     from . import load
 
     return load(scenario)
@@ -58,7 +59,9 @@ def _reward(reward: Sequence[float]) -> Reward:
     """The reward weights as the four floats the core takes."""
     r = [float(x) for x in reward]
     if len(r) != 4:
-        raise ValueError(f"reward {reward!r}: expected (success, failure, time_per_s, heading_m_per_rad)")
+        raise ValueError(
+            f"reward {reward!r}: expected (success, failure, time_per_s, heading_m_per_rad)"
+        )
     return (r[0], r[1], r[2], r[3])
 
 
@@ -81,17 +84,18 @@ class PalletPickEnv(gymnasium.Env):
     ``noise``, ``replan``: as for `run_trial` (the tracker only drives `expert_step`).
     """
 
-    metadata = {"render_modes": []}
+    # Gymnasium declares metadata per instance; a class attribute is its convention.
+    metadata = {"render_modes": []}  # noqa: RUF012
 
     def __init__(
         self,
-        scenario: Union[Scenario, str, "os.PathLike[str]"] = DEFAULT_SCENARIO,
+        scenario: Scenario | str | os.PathLike[str] = DEFAULT_SCENARIO,
         *,
-        case: Optional[str] = None,
-        planner: Optional[str] = None,
-        tracker: Optional[str] = None,
+        case: str | None = None,
+        planner: str | None = None,
+        tracker: str | None = None,
         noise: bool = True,
-        replan: Optional[bool] = None,
+        replan: bool | None = None,
         ticks_per_step: int = 1,
         path_points: int = 0,
         path_spacing_m: float = 0.5,
@@ -100,16 +104,23 @@ class PalletPickEnv(gymnasium.Env):
         self.scenario = _scenario(scenario)
         self._case = case
         self._core = _forkbench.PickEnv(
-            self.scenario, case=case, planner=planner, tracker=tracker, noise=noise,
-            replan=replan, ticks_per_step=ticks_per_step, path_points=path_points,
-            path_spacing_m=path_spacing_m, reward=_reward(reward),
+            self.scenario,
+            case=case,
+            planner=planner,
+            tracker=tracker,
+            noise=noise,
+            replan=replan,
+            ticks_per_step=ticks_per_step,
+            path_points=path_points,
+            path_spacing_m=path_spacing_m,
+            reward=_reward(reward),
         )
         self.observation_space, self.action_space = _spaces(
             self.scenario, self._core.observation_size
         )
 
     def reset(
-        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         """Starts an episode; ``options={"case": name}`` chooses its case."""
         super().reset(seed=seed)
@@ -120,9 +131,7 @@ class PalletPickEnv(gymnasium.Env):
         trial_seed = int(self.np_random.integers(0, 2**63 - 1))
         return self._core.reset(trial_seed, case)
 
-    def step(
-        self, action: Any
-    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         a = np.asarray(action, dtype=np.float64).reshape(2)
         return self._core.step(float(a[0]), float(a[1]))
 
@@ -138,19 +147,20 @@ class PalletPickVectorEnv(VectorEnv):
     episodes' cases and trial seeds from a stream seeded by ``reset(seed)`` and i, so
     results do not depend on the thread count."""
 
-    metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
+    # Gymnasium declares metadata per instance; a class attribute is its convention.
+    metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}  # noqa: RUF012
 
     def __init__(
         self,
         num_envs: int = 8,
-        scenario: Union[Scenario, str, "os.PathLike[str]"] = DEFAULT_SCENARIO,
+        scenario: Scenario | str | os.PathLike[str] = DEFAULT_SCENARIO,
         *,
-        threads: Optional[int] = None,
-        case: Optional[str] = None,
-        planner: Optional[str] = None,
-        tracker: Optional[str] = None,
+        threads: int | None = None,
+        case: str | None = None,
+        planner: str | None = None,
+        tracker: str | None = None,
         noise: bool = True,
-        replan: Optional[bool] = None,
+        replan: bool | None = None,
         ticks_per_step: int = 1,
         path_points: int = 0,
         path_spacing_m: float = 0.5,
@@ -158,10 +168,18 @@ class PalletPickVectorEnv(VectorEnv):
     ) -> None:
         self.scenario = _scenario(scenario)
         self._core = _forkbench.PickVecEnv(
-            self.scenario, num_envs, case=case, planner=planner, tracker=tracker,
-            noise=noise, replan=replan, ticks_per_step=ticks_per_step,
-            path_points=path_points, path_spacing_m=path_spacing_m,
-            reward=_reward(reward), threads=threads,
+            self.scenario,
+            num_envs,
+            case=case,
+            planner=planner,
+            tracker=tracker,
+            noise=noise,
+            replan=replan,
+            ticks_per_step=ticks_per_step,
+            path_points=path_points,
+            path_spacing_m=path_spacing_m,
+            reward=_reward(reward),
+            threads=threads,
         )
         self.num_envs = num_envs
         self.single_observation_space, self.single_action_space = _spaces(
@@ -173,8 +191,8 @@ class PalletPickVectorEnv(VectorEnv):
     def reset(
         self,
         *,
-        seed: Optional[Union[int, Sequence[int]]] = None,
-        options: Optional[dict[str, Any]] = None,
+        seed: int | Sequence[int] | None = None,
+        options: dict[str, Any] | None = None,
     ) -> tuple[np.ndarray, dict[str, Any]]:
         if seed is None:
             seed = int(np.random.SeedSequence().generate_state(1, np.uint64)[0])
@@ -191,7 +209,7 @@ class PalletPickVectorEnv(VectorEnv):
         obs, rewards, terminated, truncated, ended = self._core.step(a)
         return obs, rewards, terminated, truncated, self._batch_infos(ended)
 
-    def _batch_infos(self, infos: Sequence[Optional[dict[str, Any]]]) -> dict[str, Any]:
+    def _batch_infos(self, infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
         """Per-environment dicts as Gymnasium's vector info: a key's values in an array,
         ``_key`` marking the environments that have it."""
         out: dict[str, Any] = {}

@@ -89,6 +89,9 @@ impl Scenario {
     }
 }
 
+/// Most trial records a batch returns to Python (each is a dict of about 40 fields).
+const MAX_RECORDS: u64 = 2_000_000;
+
 /// Runs a batch as the CLI's `batch` does (the same trial seeds from `seed` and each
 /// trial's identity, so the same outcomes), in parallel on `jobs` threads, and returns
 /// its records (dicts: the lines of `trials.jsonl`) in the batch's job order. Without
@@ -142,7 +145,24 @@ pub fn run_batch<'py>(
         compare_replanning,
         force_new: false,
     };
-    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let per_trial: u64 = BatchSpec {
+        trials: 1,
+        ..spec.clone()
+    }
+    .row_sizes()
+    .iter()
+    .map(|(_, n)| n)
+    .sum();
+    let total = per_trial.saturating_mul(trials);
+    if total > MAX_RECORDS {
+        return Err(BatchError::new_err(format!(
+            "{total} trials: at most {MAX_RECORDS} are returned to Python at once; run the \
+             CLI's batch (sharded if need be) and read its trials.jsonl"
+        )));
+    }
+    let jobs = jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .max(1);
     let records = py
         .detach(|| run(&spec, jobs, out.as_deref()))
         .map_err(|e| BatchError::new_err(e.to_string()))?;

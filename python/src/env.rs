@@ -13,6 +13,9 @@ use crate::convert::{scenario_error, serde_to_py};
 use crate::obs::{self, ObsConfig, RewardConfig};
 use crate::scenario::Scenario;
 
+/// Most path points an observation carries (it is allocated per step).
+const MAX_PATH_POINTS: usize = 1000;
+
 /// What every episode of an environment shares.
 #[derive(Debug, Clone)]
 pub(crate) struct Setup {
@@ -139,6 +142,11 @@ pub(crate) fn setup(
         return Err(PyValueError::new_err(
             "ticks_per_step must be at least 1 and path_spacing_m a positive length",
         ));
+    }
+    if path_points > MAX_PATH_POINTS {
+        return Err(PyValueError::new_err(format!(
+            "path_points {path_points}: at most {MAX_PATH_POINTS}"
+        )));
     }
     let (success, failure, time_per_s, heading_m_per_rad) = reward;
     if ![success, failure, time_per_s, heading_m_per_rad]

@@ -42,17 +42,21 @@ impl Slot {
     }
 
     fn step(&mut self, s: &Setup, control: Control, obs: &mut [f32]) -> StepOut {
+        // A new episode's first step is never its last: one that ended before driving
+        // (no plan) terminates on the step after.
+        // An episode that ended before driving (no plan) terminates on the step after its
+        // reset, as in the single environment.
         let out = if self.pending_reset {
             self.restart(s);
             StepOut::default()
+        } else if let Some(core) = self.core.as_mut() {
+            let out = core.step(s, control);
+            self.pending_reset = core.ended();
+            out
         } else {
-            match self.core.as_mut() {
-                Some(core) => core.step(s, control),
-                None => StepOut::default(),
-            }
+            StepOut::default()
         };
         if let Some(core) = &self.core {
-            self.pending_reset = core.ended();
             core.write_obs(s, obs);
         }
         out

@@ -5,11 +5,11 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+from conftest import without_clock
 from gymnasium.utils.env_checker import check_env
 
 import forkbench
 from forkbench.gym import PalletPickEnv, PalletPickVectorEnv
-from conftest import without_clock
 
 
 @pytest.mark.filterwarnings("ignore::UserWarning")
@@ -25,7 +25,7 @@ def rollout(env, seed, steps=400):
     rng = np.random.default_rng(seed)
     seen = [obs]
     for _ in range(steps):
-        obs, reward, term, trunc, info = env.step(rng.uniform(-1, 1, 2) * [0.8, 1.0])
+        obs, reward, term, trunc, _info = env.step(rng.uniform(-1, 1, 2) * [0.8, 1.0])
         seen.append(np.append(obs, [reward, term, trunc]))
         if term or trunc:
             break
@@ -60,7 +60,7 @@ def test_episodes_end_as_the_bench_judges():
     env.reset(seed=1)
     steps = 0
     while True:  # standing still: truncated at the scenario's time limit
-        _, reward, term, trunc, info = env.step([0.0, 0.0])
+        _, _reward, term, trunc, info = env.step([0.0, 0.0])
         steps += 1
         if term or trunc:
             break
@@ -91,8 +91,33 @@ def test_the_vector_env_is_independent_of_its_thread_count_and_autoresets():
 
 
 def test_make_vec_uses_the_rust_vector():
-    env = gym.make_vec("forkbench/PalletPick-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    env = gym.make_vec(
+        "forkbench/PalletPick-v0", num_envs=3, vectorization_mode="vector_entry_point"
+    )
     obs, _ = env.reset(seed=0)
     assert obs.shape == (3, 13) and obs.dtype == np.float32
-    obs, rewards, term, trunc, _ = env.step(env.action_space.sample())
+    obs, rewards, term, _trunc, _ = env.step(env.action_space.sample())
     assert rewards.shape == (3,) and term.dtype == np.bool_
+
+
+def test_an_episode_that_ends_before_driving_terminates_on_its_first_step():
+    # spiral-table2's sensing finds no pallet from some start poses: the trial ends at reset.
+    env = PalletPickEnv("spiral-table2")
+    for seed in range(200):
+        _, info = env.reset(seed=seed)
+        if "outcome" in info:
+            break
+    else:
+        pytest.fail("no episode ended before driving in 200 seeds")
+    assert info["failure"] == "pallet_not_found"
+    _, reward, term, trunc, end = env.step([0.5, 0.0])
+    assert term and not trunc and reward == -10.0 and end["failure"] == "pallet_not_found"
+    vec = PalletPickVectorEnv(8, "spiral-table2", ticks_per_step=50)
+    vec.reset(seed=3)
+    ended = 0
+    for _ in range(60):  # every reported outcome comes with its episode's last step
+        _, _, term, trunc, info = vec.step(np.tile([0.6, 0.0], (8, 1)))
+        mask = info.get("_outcome", np.zeros(8, bool))
+        assert np.array_equal(mask, term | trunc), (mask, term, trunc)
+        ended += int(mask.sum())
+    assert ended > 8

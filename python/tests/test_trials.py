@@ -5,9 +5,9 @@ from __future__ import annotations
 import json
 
 import pytest
+from conftest import ROOT, read_jsonl, without_clock
 
 import forkbench
-from conftest import ROOT, read_jsonl, without_clock
 
 
 def test_a_trial_equals_the_clis_at_the_same_seed(cli):
@@ -22,11 +22,24 @@ def test_a_trial_equals_the_clis_at_the_same_seed(cli):
 
 def test_a_batch_equals_the_clis_and_becomes_a_dataframe(cli, tmp_path):
     out = tmp_path / "cli"
-    cli("batch", "scenarios/field-test.toml", "scenarios/rack-pick.toml", "--trials", "3",
-        "--seed", "7", "--out", str(out))
-    want = sorted(read_jsonl(out / "trials.jsonl"), key=lambda r: (r["scenario"], r["case"], r["trial"]))
-    scenarios = [forkbench.load(ROOT / "scenarios/field-test.toml"),
-                 forkbench.load(ROOT / "scenarios/rack-pick.toml")]
+    cli(
+        "batch",
+        "scenarios/field-test.toml",
+        "scenarios/rack-pick.toml",
+        "--trials",
+        "3",
+        "--seed",
+        "7",
+        "--out",
+        str(out),
+    )
+    want = sorted(
+        read_jsonl(out / "trials.jsonl"), key=lambda r: (r["scenario"], r["case"], r["trial"])
+    )
+    scenarios = [
+        forkbench.load(ROOT / "scenarios/field-test.toml"),
+        forkbench.load(ROOT / "scenarios/rack-pick.toml"),
+    ]
     for jobs in (1, 2):
         got = forkbench.run_batch(scenarios, trials=3, seed=7, jobs=jobs)
         got = sorted(got, key=lambda r: (r["scenario"], r["case"], r["trial"]))
@@ -60,11 +73,17 @@ def test_a_trial_records_to_mcap(tmp_path):
 def test_bad_input_names_file_field_and_reason(tmp_path):
     bad = tmp_path / "bad.toml"
     text = (ROOT / "scenarios/field-test.toml").read_text()
-    bad.write_text(text.replace("[tolerances]", "[tolerances]\nlateral_m = -1.0", 1)
-                   if "[tolerances]" in text else text + "\n[tolerances]\nlateral_m = -1.0\n")
+    bad.write_text(
+        text.replace("[tolerances]", "[tolerances]\nlateral_m = -1.0", 1)
+        if "[tolerances]" in text
+        else text + "\n[tolerances]\nlateral_m = -1.0\n"
+    )
     with pytest.raises(forkbench.ScenarioError) as e:
         forkbench.Scenario.load(bad)
-    assert e.value.file.endswith("bad.toml") and "lateral_m" in e.value.field, (e.value.file, e.value.field)
+    assert e.value.file.endswith("bad.toml") and "lateral_m" in e.value.field, (
+        e.value.file,
+        e.value.field,
+    )
     assert e.value.reason
     with pytest.raises(forkbench.ScenarioError) as e:
         forkbench.Scenario.embedded("no-such-scenario")
@@ -79,3 +98,7 @@ def test_bad_input_names_file_field_and_reason(tmp_path):
         forkbench.run_batch([forkbench.load("field-test")], trials=1, modes="sometimes")
     with pytest.raises(forkbench.BatchError, match="trials"):
         forkbench.run_batch([forkbench.load("field-test")], trials=0)
+    with pytest.raises(forkbench.BatchError, match="at most"):
+        forkbench.run_batch([forkbench.load("field-test")], trials=10**12)
+    with pytest.raises(ValueError, match="path_points"):
+        forkbench.PickEnv(forkbench.load("field-test"), path_points=10**9)
