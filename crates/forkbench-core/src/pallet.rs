@@ -14,7 +14,16 @@ pub struct PalletSpec {
     pub width_m: f64,
     /// Width of each fork pocket.
     pub pocket_width_m: f64,
+    /// The empty pallet's own mass.
     pub mass_kg: f64,
+    /// The goods stacked on it: they ride with it when it is lifted, load the truck's
+    /// axles, and press it on the floor.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub payload_kg: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl PalletSpec {
@@ -25,6 +34,7 @@ impl PalletSpec {
             width_m: 1.2,
             pocket_width_m: 0.405,
             mass_kg: 25.0,
+            payload_kg: 0.0,
         }
     }
 
@@ -35,7 +45,19 @@ impl PalletSpec {
             width_m: 1.0,
             pocket_width_m: 0.35,
             mass_kg: 20.0,
+            payload_kg: 0.0,
         }
+    }
+
+    /// The pallet's mass with its payload: what the floor, the forks and the truck carry.
+    pub fn loaded_mass_kg(&self) -> f64 {
+        self.mass_kg + self.payload_kg
+    }
+
+    /// The same pallet carrying `payload_kg` of goods.
+    pub fn with_payload(mut self, payload_kg: f64) -> Self {
+        self.payload_kg = payload_kg;
+        self
     }
 
     pub fn stringer_width_m(&self) -> f64 {
@@ -73,6 +95,12 @@ impl PalletSpec {
                     format!("must be a positive finite number (got {v})"),
                 ));
             }
+        }
+        if !(self.payload_kg.is_finite() && self.payload_kg >= 0.0) {
+            return Err(crate::SettingsError::field(
+                "payload_kg",
+                format!("must be a finite mass ≥ 0 (got {})", self.payload_kg),
+            ));
         }
         if self.stringer_width_m() <= 0.01 {
             return Err(crate::SettingsError::field(

@@ -29,6 +29,18 @@ pub struct ForkliftSpec {
     pub max_speed_mps: f64,
     /// Rate limit of the steering actuator.
     pub max_steer_rate_radps: f64,
+    /// Heaviest load (pallet with its payload) the truck is rated to lift.
+    #[serde(skip_serializing_if = "is_default_capacity")]
+    pub rated_capacity_kg: f64,
+}
+
+/// The A30's rating: 3 t.
+const DEFAULT_RATED_CAPACITY_KG: f64 = 3000.0;
+
+// Left out of serialised specs at its default, so settings written before it existed keep
+// their hashes.
+fn is_default_capacity(v: &f64) -> bool {
+    *v == DEFAULT_RATED_CAPACITY_KG
 }
 
 impl Default for ForkliftSpec {
@@ -47,6 +59,7 @@ impl Default for ForkliftSpec {
             fork_root_ahead_of_front_axle_m: 0.45,
             max_speed_mps: 0.8,
             max_steer_rate_radps: 0.8,
+            rated_capacity_kg: DEFAULT_RATED_CAPACITY_KG,
         }
     }
 }
@@ -87,6 +100,21 @@ impl ForkliftSpec {
             .map(|y| root.to_world(&crate::Pose2::new(along_m, y, 0.0)))
     }
 
+    /// Depth of the shallower fork tip past the face of a pallet whose face centre is at
+    /// `pallet`, at most the fork length, for forks rooted at `root`. A fork root that is
+    /// itself past the face plane (a truck that drove past or away behind the pallet)
+    /// inserted nothing: 0.
+    pub fn insertion_depth_m(&self, pallet: &crate::Pose2, root: &crate::Pose2) -> f64 {
+        if pallet.to_local(root).x_m > 0.0 {
+            return 0.0;
+        }
+        self.fork_points(root, self.fork_length_m)
+            .iter()
+            .map(|tip| pallet.to_local(tip).x_m)
+            .fold(f64::INFINITY, f64::min)
+            .min(self.fork_length_m)
+    }
+
     /// Equivalent steering angle that yields the given path curvature: arctan(L κ).
     pub fn steer_for_curvature(&self, curvature_per_m: f64) -> f64 {
         (self.wheelbase_m * curvature_per_m).atan()
@@ -104,6 +132,7 @@ impl ForkliftSpec {
             ("fork_spacing_m", self.fork_spacing_m),
             ("max_speed_mps", self.max_speed_mps),
             ("max_steer_rate_radps", self.max_steer_rate_radps),
+            ("rated_capacity_kg", self.rated_capacity_kg),
         ];
         for (field, value) in positive {
             if !(value.is_finite() && value > 0.0) {
@@ -145,6 +174,26 @@ mod tests {
         assert!((spec.max_curvature_per_m() - 1.063).abs() < 1e-3);
         assert!((spec.min_turn_radius_m() - 0.9407).abs() < 1e-3);
         assert!(spec.validate().is_ok());
+    }
+
+    /// Issue 21, defect 10: a truck that drove away behind the pallet reported an
+    /// insertion depth of 106 m; depth counts only from the front and is at most the forks.
+    #[test]
+    fn insertion_depth_is_bounded_by_the_forks_and_counted_from_the_front() {
+        let truck = ForkliftSpec::default();
+        let pallet = crate::Pose2::new(0.0, 0.0, 0.0);
+        let at = |x: f64| truck.insertion_depth_m(&pallet, &crate::Pose2::new(x, 0.0, 0.0));
+        assert!(
+            (at(-truck.fork_length_m - 0.5) + 0.5).abs() < 1e-12,
+            "short of the face"
+        );
+        assert!(
+            (at(-truck.fork_length_m + 0.8) - 0.8).abs() < 1e-12,
+            "0.8 m in"
+        );
+        assert!(at(-0.01) <= truck.fork_length_m);
+        assert_eq!(at(0.5), 0.0, "root past the face");
+        assert_eq!(at(105.0), 0.0, "drove away behind the pallet");
     }
 
     #[test]

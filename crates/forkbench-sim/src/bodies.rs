@@ -75,7 +75,7 @@ pub(crate) fn insert_pallet(
             world.insert_collider(
                 ColliderBuilder::cuboid((pallet_spec.depth_m / 2.0) as Real, (sw / 2.0) as Real)
                     .translation(v2(pallet_spec.depth_m / 2.0, y))
-                    .mass((pallet_spec.mass_kg / 3.0) as Real)
+                    .mass((pallet_spec.loaded_mass_kg() / 3.0) as Real)
                     .friction(cfg.fork_friction as Real),
                 Some(pallet),
             ),

@@ -1,6 +1,7 @@
-//! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers, fixed racks.
+//! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers it can lift and carry, fixed racks.
 
 mod bodies;
+mod load;
 mod view;
 use bodies::{insert_obstacles, insert_pallet, insert_truck};
 
@@ -10,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 pub use forkbench_core::PalletSpec;
 pub use forkbench_core::geometry::Obstacle;
+pub use load::LiftError;
 
 /// Standard gravity, for tyre and floor normal loads (the plane itself has no gravity).
 const G_MPS2: f64 = 9.81;
@@ -20,7 +22,8 @@ const G_MPS2: f64 = 9.81;
 pub struct SimConfig {
     /// Fixed physics step (100 Hz by default).
     pub dt_s: f64,
-    /// Tyre–floor friction coefficient: caps the lateral tyre impulse at μ N dt.
+    /// Tyre–floor friction coefficient: caps each axle's lateral tyre impulse, and the
+    /// drive axle's traction and braking, at μ N dt.
     pub tyre_friction: f64,
     /// Pallet–floor friction coefficient.
     pub pallet_floor_friction: f64,
@@ -78,6 +81,10 @@ pub struct Sim {
     pallet_inertia: f64,
     last_fork_force_n: f64,
     last_obstacle_contact: bool,
+    /// The pallet on the forks, once lifted.
+    carried: Option<load::Carried>,
+    load_shifted: bool,
+    peak_load_accel_mps2: f64,
     /// The bodies' state as of the last step: read many times per control tick, and
     /// each read would otherwise redo the same trigonometry on unchanged bodies.
     now: Kinematics,
@@ -177,10 +184,11 @@ impl Sim {
 
         let (truck, chassis, forks, chassis_centre) = insert_truck(&mut world, spec, start, cfg);
         let truck_mass_kg = spec.mass_kg;
+        // The pallet stands on the floor with its payload.
         let truck_inertia =
             spec.mass_kg * (spec.body_length_m.powi(2) + spec.body_width_m.powi(2)) / 12.0;
         let (pallet, stringers) = insert_pallet(&mut world, pallet_spec, pallet_pose, cfg);
-        let pallet_inertia = pallet_spec.mass_kg
+        let pallet_inertia = pallet_spec.loaded_mass_kg()
             * (pallet_spec.depth_m.powi(2) + pallet_spec.width_m.powi(2))
             / 12.0;
         let obstacles = insert_obstacles(&mut world, obstacles);
@@ -207,6 +215,9 @@ impl Sim {
             pallet_inertia,
             last_fork_force_n: 0.0,
             last_obstacle_contact: false,
+            carried: None,
+            load_shifted: false,
+            peak_load_accel_mps2: 0.0,
             // Filled from the bodies just below.
             now: Kinematics {
                 axle: *start,
@@ -231,10 +242,14 @@ impl Sim {
         let b = &self.world.bodies[self.truck];
         let v = b.velocity_at_point(b.translation());
         let (vx, vy) = (v.x as f64, v.y as f64);
+        let pallet = match &self.carried {
+            Some(c) => c.pallet_pose(&axle),
+            None => self.body_pose(self.pallet),
+        };
         Kinematics {
             axle,
             fork_root,
-            pallet: self.body_pose(self.pallet),
+            pallet,
             speed_mps: vx * axle.heading_rad.cos() + vy * axle.heading_rad.sin(),
             lateral_speed_mps: -vx * axle.heading_rad.sin() + vy * axle.heading_rad.cos(),
         }
@@ -328,15 +343,18 @@ impl Sim {
         self.steps += 1;
         self.read_contacts(dt);
         self.now = self.kinematics();
+        self.check_load(dt);
     }
 
-    /// Drive/brake force at the front axle from a proportional speed controller.
+    /// Drive/brake force at the front axle from a proportional speed controller, at most
+    /// what the drive tyres' grip on the floor can pass (μ times the front axle load).
     fn apply_drive(&mut self, speed_cmd: f64, dt: f64) {
         let a = self.front_axle_pose();
         let v = self.speed_mps();
         let accel = (self.cfg.speed_gain_per_s * (speed_cmd - v))
             .clamp(-self.cfg.max_accel_mps2, self.cfg.max_accel_mps2);
-        let j = self.truck_mass_kg * accel * dt;
+        let grip_n = self.cfg.tyre_friction * self.axle_loads_n()[0];
+        let j = (self.truck_mass_kg * accel).clamp(-grip_n, grip_n) * dt;
         let (s, c) = a.heading_rad.sin_cos();
         let b = &mut self.world.bodies[self.truck];
         let p = b.translation();
@@ -382,9 +400,7 @@ impl Sim {
             -(kk[1][1] * u[0] - kk[0][1] * u[1]) / det,
             -(kk[0][0] * u[1] - kk[1][0] * u[0]) / det,
         ];
-        // Static axle loads from where the centre of mass sits between the axles.
-        let rear_share = (-self.com_ahead_m / l).clamp(0.0, 1.0);
-        let loads = [m * G_MPS2 * (1.0 - rear_share), m * G_MPS2 * rear_share];
+        let loads = self.axle_loads_n();
         let b = &mut self.world.bodies[self.truck];
         for (idx, ((p, n), lam)) in pts.iter().zip(lam).enumerate() {
             let cap = self.cfg.tyre_friction * loads[idx] * dt;
@@ -395,8 +411,11 @@ impl Sim {
 
     /// Coulomb floor friction on the pallet, as impulses that never reverse its motion.
     fn apply_pallet_floor_friction(&mut self, dt: f64) {
+        if self.carried.is_some() {
+            return;
+        }
         let mu_g_dt = self.cfg.pallet_floor_friction * G_MPS2 * dt;
-        let m = self.pallet_spec.mass_kg;
+        let m = self.pallet_spec.loaded_mass_kg();
         let i = self.pallet_inertia;
         let b = &mut self.world.bodies[self.pallet];
         let v = b.linvel();
@@ -428,9 +447,14 @@ impl Sim {
             }
         }
         self.last_fork_force_n = fork_force;
+        // A carried pallet is part of the truck: its stringers can hit a rack too.
+        let load: &[ColliderHandle] = match self.carried {
+            Some(_) => &self.stringers,
+            None => &[],
+        };
         let truck_colliders = [self.chassis, self.forks[0], self.forks[1]];
         // The truck's own pairs, not every (truck, obstacle) pair: a warehouse has many racks.
-        self.last_obstacle_contact = truck_colliders.iter().any(|&t| {
+        self.last_obstacle_contact = truck_colliders.iter().chain(load).any(|&t| {
             np.contact_pairs_with(t).any(|p| {
                 let other = if p.collider1 == t {
                     p.collider2

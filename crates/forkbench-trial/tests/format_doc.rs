@@ -17,13 +17,27 @@ fn value<T: serde::Serialize>(v: &T) -> toml::Value {
     toml::Value::try_from(v).expect("serialises to TOML")
 }
 
+/// The truck's defaults, with the keys its serialisation leaves out at their default (so
+/// settings hashes made before they existed still match) put back.
+fn truck_defaults() -> toml::Value {
+    let spec = forkbench_core::ForkliftSpec::default();
+    let mut v = value(&spec);
+    if let toml::Value::Table(t) = &mut v {
+        t.insert(
+            "rated_capacity_kg".to_owned(),
+            toml::Value::Float(spec.rated_capacity_kg),
+        );
+    }
+    v
+}
+
 /// Each table with defaults, by the heading it has in the document.
 fn defaulted() -> Vec<(&'static str, toml::Value)> {
     let noise = NoiseFile::default();
     let scanner =
         |m: &str| value(&forkbench_sensors::scan::ScannerConfig::preset(m).expect("preset"));
     vec![
-        ("[truck]", value(&forkbench_core::ForkliftSpec::default())),
+        ("[truck]", truck_defaults()),
         ("[sim]", value(&forkbench_sim::SimConfig::default())),
         ("[noise.nav350]", value(&noise.nav350)),
         ("[noise.pallet_estimate]", value(&noise.pallet_estimate)),

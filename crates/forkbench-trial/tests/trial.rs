@@ -196,6 +196,18 @@ fn bad_scenarios_are_rejected_with_file_line_and_field() {
     assert!(e.contains("rrt") && e.contains("bad.toml:2:"), "{e}");
     let e = parse_err(&format!("{base}[tolerances]\ninsertion_depth_m = 1.5\n"));
     assert!(e.contains("tolerances.insertion_depth_m"), "{e}");
+    // A load the truck may not lift, and a payload that is no mass.
+    let e = parse_err(&format!(
+        "payload_kg = 1000.0\n{base}[truck]\nrated_capacity_kg = 800.0\n"
+    ));
+    assert!(
+        e.contains("payload_kg") && e.contains("1025 kg") && e.contains("rated_capacity_kg"),
+        "{e}"
+    );
+    let e = parse_err(&format!("payload_kg = nan\n{base}"));
+    assert!(e.contains("payload_kg") && e.contains("≥ 0"), "{e}");
+    let e = parse_err(&format!("{base}[truck]\nrated_capacity_kg = 0.0\n"));
+    assert!(e.contains("truck.rated_capacity_kg"), "{e}");
 }
 
 #[test]

@@ -134,6 +134,34 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
     Ok(())
 }
 
+/// The pallet's payload: a mass, and with the pallet no more than the truck may lift.
+pub(super) fn check_payload(
+    truck: &ForkliftSpec,
+    pallet: &PalletSpec,
+    file: &str,
+) -> Result<(), TrialError> {
+    if !(pallet.payload_kg.is_finite() && pallet.payload_kg >= 0.0) {
+        return Err(invalid(
+            file,
+            "payload_kg",
+            &format!("must be a finite mass ≥ 0 kg (got {})", pallet.payload_kg),
+        ));
+    }
+    if pallet.loaded_mass_kg() > truck.rated_capacity_kg {
+        return Err(invalid(
+            file,
+            "payload_kg",
+            &format!(
+                "the pallet with its payload weighs {} kg, more than the truck's rated capacity \
+                 (truck.rated_capacity_kg = {} kg)",
+                pallet.loaded_mass_kg(),
+                truck.rated_capacity_kg
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Value ranges of the truck, sensors, run settings, estimate bias and pallet jitter.
 pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
     f.truck

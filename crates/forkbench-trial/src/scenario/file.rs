@@ -127,6 +127,10 @@ pub(super) struct ScenarioFile {
     pub(super) seed: u64,
     #[serde(default = "default_pallet_kind")]
     pub(super) pallet_kind: PalletKind,
+    /// Goods on the pallet: they press it on the floor (a pushed pallet resists more)
+    /// and, once lifted, load the truck.
+    #[serde(default)]
+    pub(super) payload_kg: f64,
     #[serde(default = "default_timeout")]
     pub(super) timeout_s: f64,
     /// Refuse plans (and replans) whose swept truck body hits a rack or wall; off lets a

@@ -236,7 +236,9 @@ impl Scenario {
         let pallet = match f.pallet_kind {
             PalletKind::Field1200 => PalletSpec::field_1200(),
             PalletKind::Sim1000 => PalletSpec::sim_1000(),
-        };
+        }
+        .with_payload(f.payload_kg);
+        checks::check_payload(&f.truck, &pallet, file)?;
         checks::check_geometry(&f, &pallet, file)?;
         let cases = resolve_cases(&f, &world, &pallet, file)?;
         let mission = match &f.mission {

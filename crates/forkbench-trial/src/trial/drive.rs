@@ -5,7 +5,7 @@ use forkbench_core::units::wrap_angle;
 use forkbench_track::{Command, TrackerInput};
 
 use super::error::StageError;
-use super::judge::{in_pallet_frame, insertion_depth};
+use super::judge::in_pallet_frame;
 use super::setup::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
 use forkbench_core::{Signal, Style};
@@ -199,7 +199,7 @@ impl<'a> Trial<'a> {
     fn check_entry<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
         let root = self.sim.fork_root_pose();
         let pallet_now = self.sim.pallet_pose();
-        let depth = insertion_depth(&pallet_now, &root, &self.scn.truck);
+        let depth = self.scn.truck.insertion_depth_m(&pallet_now, &root);
         if depth < self.insertion_m - 0.01 {
             self.out.max_contact_force_n = self
                 .out

@@ -1,7 +1,7 @@
 //! Judge stage: final errors, pallet displacement, and the first failed criterion in check order.
 
 use forkbench_core::units::wrap_angle;
-use forkbench_core::{ForkliftSpec, Pose2};
+use forkbench_core::Pose2;
 use rand_chacha::ChaCha8Rng;
 
 use super::setup::Trial;
@@ -26,21 +26,6 @@ pub(super) fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
     pallet.to_local(root)
 }
 
-/// Depth of the shallower fork tip past the pallet face, at most the fork length. A fork
-/// root that is itself past the face plane (a truck that drove past or away behind the
-/// pallet) inserted nothing: 0.
-pub(super) fn insertion_depth(pallet: &Pose2, root: &Pose2, truck: &ForkliftSpec) -> f64 {
-    if pallet.to_local(root).x_m > 0.0 {
-        return 0.0;
-    }
-    let depth = truck
-        .fork_points(root, truck.fork_length_m)
-        .iter()
-        .map(|tip| pallet.to_local(tip).x_m)
-        .fold(f64::INFINITY, f64::min);
-    depth.min(truck.fork_length_m)
-}
-
 impl Trial<'_> {
     /// Final measurements and the verdict.
     pub(super) fn judge(mut self) -> TrialOutcome {
@@ -60,7 +45,7 @@ impl Trial<'_> {
         let local = in_pallet_frame(&pallet_now, &root);
         out.final_lateral_error_m = local.y_m;
         out.final_heading_error_rad = local.heading_rad;
-        out.insertion_depth_m = insertion_depth(&pallet_now, &root, truck);
+        out.insertion_depth_m = truck.insertion_depth_m(&pallet_now, &root);
         out.pallet_displacement_m = pallet_now.distance_to(&self.pallet0);
         out.pallet_rotation_rad = wrap_angle(pallet_now.heading_rad - self.pallet0.heading_rad);
         let pockets = self.scn.pallet.pocket_offsets_m();
@@ -186,29 +171,4 @@ fn violations(t: &Trial<'_>, worst_pocket_miss: f64) -> Vec<(Failure, String)> {
         ));
     }
     v
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Issue 21, defect 10: a truck that drove away behind the pallet reported an
-    /// insertion depth of 106 m; depth counts only from the front and is at most the forks.
-    #[test]
-    fn insertion_depth_is_bounded_by_the_forks_and_counted_from_the_front() {
-        let truck = ForkliftSpec::default();
-        let pallet = Pose2::new(0.0, 0.0, 0.0);
-        let at = |x: f64| insertion_depth(&pallet, &Pose2::new(x, 0.0, 0.0), &truck);
-        assert!(
-            (at(-truck.fork_length_m - 0.5) + 0.5).abs() < 1e-12,
-            "short of the face"
-        );
-        assert!(
-            (at(-truck.fork_length_m + 0.8) - 0.8).abs() < 1e-12,
-            "0.8 m in"
-        );
-        assert!(at(-0.01) <= truck.fork_length_m);
-        assert_eq!(at(0.5), 0.0, "root past the face");
-        assert_eq!(at(105.0), 0.0, "drove away behind the pallet");
-    }
 }

@@ -8,7 +8,6 @@ use forkbench_track::Command;
 
 use super::drive::DriveState;
 use super::error::StageError;
-use super::judge::insertion_depth;
 use super::setup::Trial;
 use super::{Resolved, TrialOptions, goal_for, prepare};
 use crate::TrialError;
@@ -211,7 +210,7 @@ impl Session {
         self.truth = Truth {
             fork_root: root,
             goal: goal_for(&pallet, truck, t.insertion_m),
-            insertion_depth_m: insertion_depth(&pallet, &root, truck),
+            insertion_depth_m: truck.insertion_depth_m(&pallet, &root),
         };
     }
 }
@@ -288,7 +287,10 @@ impl Trial<'_> {
             || out
                 .heading_error_rad
                 .is_some_and(|e| e.abs() > tol.heading_rad);
-        let depth = insertion_depth(&pallet, &self.sim.fork_root_pose(), &self.scn.truck);
+        let depth = self
+            .scn
+            .truck
+            .insertion_depth_m(&pallet, &self.sim.fork_root_pose());
         self.collision
             || out.max_contact_force_n > tol.contact_force_n
             || moved
