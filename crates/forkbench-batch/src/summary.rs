@@ -39,9 +39,13 @@ pub struct SummaryRow {
     /// Missions: success per leg, over the trials that reached the leg.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub legs: Vec<LegSummary>,
+    /// Handling cycles: success per phase (the pick, lift, …), over the trials that
+    /// reached the phase.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<LegSummary>,
 }
 
-/// Success of one mission leg across a row's trials.
+/// Success of one mission leg (or cycle phase) across a row's trials.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LegSummary {
     pub name: String,
@@ -53,14 +57,17 @@ pub struct LegSummary {
     pub ci95_high: f64,
 }
 
-/// Per-leg counts: (name, attempted, done) by leg index.
-fn count_legs(acc: &mut Vec<(String, u64, u64)>, legs: &[forkbench_trial::outcome::LegOutcome]) {
-    for (i, l) in legs.iter().enumerate() {
+/// Per-stage counts (legs or phases): (name, attempted, done) by index.
+fn count_stages<'a>(
+    acc: &mut Vec<(String, u64, u64)>,
+    stages: impl Iterator<Item = (&'a str, bool)>,
+) {
+    for (i, (name, success)) in stages.enumerate() {
         if acc.len() <= i {
-            acc.push((l.name.clone(), 0, 0));
+            acc.push((name.to_owned(), 0, 0));
         }
         acc[i].1 += 1;
-        acc[i].2 += u64::from(l.success);
+        acc[i].2 += u64::from(success);
     }
 }
 
@@ -91,44 +98,60 @@ pub struct Summary {
     pub provenance: Option<super::Provenance>,
 }
 
+/// One summary row's tallies while records are read.
+#[derive(Default)]
+struct Acc {
+    n: u64,
+    k: u64,
+    failures: BTreeMap<String, u64>,
+    lat: Vec<f64>,
+    head: Vec<f64>,
+    wall: Vec<f64>,
+    legs: Vec<(String, u64, u64)>,
+    phases: Vec<(String, u64, u64)>,
+}
+
+impl Acc {
+    fn add(&mut self, o: &forkbench_trial::TrialOutcome) {
+        self.n += 1;
+        if o.success {
+            self.k += 1;
+        } else {
+            let name = o.failure.map_or("unknown", Failure::name).to_owned();
+            *self.failures.entry(name).or_default() += 1;
+        }
+        if let Some(v) = o.lateral_error_m.filter(|v| v.is_finite()) {
+            self.lat.push(v.abs());
+        }
+        if let Some(v) = o.heading_error_rad.filter(|v| v.is_finite()) {
+            self.head.push(v.abs());
+        }
+        self.wall.push(o.wall_time_ms);
+        count_stages(
+            &mut self.legs,
+            o.legs.iter().map(|l| (l.name.as_str(), l.success)),
+        );
+        count_stages(
+            &mut self.phases,
+            o.phases.iter().map(|p| (p.name.as_str(), p.success)),
+        );
+    }
+}
+
 /// Summarises records; order-independent (values are sorted before any sum).
 pub fn summarize(records: &[TrialRecord]) -> Summary {
-    #[derive(Default)]
-    struct Acc {
-        n: u64,
-        k: u64,
-        failures: BTreeMap<String, u64>,
-        lat: Vec<f64>,
-        head: Vec<f64>,
-        wall: Vec<f64>,
-        legs: Vec<(String, u64, u64)>,
-    }
     let mut groups: BTreeMap<(String, String, String, bool), Acc> = BTreeMap::new();
     for r in records {
         let o = &r.outcome;
-        let a = groups
+        groups
             .entry((
                 o.scenario.clone(),
                 o.planner.clone(),
                 o.tracker.clone(),
                 r.replan.unwrap_or(false),
             ))
-            .or_default();
-        a.n += 1;
-        if o.success {
-            a.k += 1;
-        } else {
-            let name = o.failure.map_or("unknown", Failure::name).to_owned();
-            *a.failures.entry(name).or_default() += 1;
-        }
-        if let Some(v) = o.lateral_error_m.filter(|v| v.is_finite()) {
-            a.lat.push(v.abs());
-        }
-        if let Some(v) = o.heading_error_rad.filter(|v| v.is_finite()) {
-            a.head.push(v.abs());
-        }
-        a.wall.push(o.wall_time_ms);
-        count_legs(&mut a.legs, &o.legs);
+            .or_default()
+            .add(o);
     }
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     let rows: Vec<SummaryRow> = groups
@@ -155,6 +178,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 heading_error_p95_rad: percentile_sorted(&a.head, 0.95),
                 wall_time_total_s: a.wall.iter().sum::<f64>() / 1e3,
                 legs: leg_summaries(a.legs),
+                phases: leg_summaries(a.phases),
             }
         })
         .collect();
@@ -228,6 +252,7 @@ impl Summary {
             }
         }
         s.push_str(&self.legs_markdown());
+        s.push_str(&self.phases_markdown());
         s
     }
 }
@@ -235,15 +260,38 @@ impl Summary {
 impl Summary {
     /// The mission legs' success table (empty without missions).
     fn legs_markdown(&self) -> String {
-        let rows: Vec<_> = self.rows.iter().filter(|r| !r.legs.is_empty()).collect();
+        self.stages_markdown(
+            "Mission legs (a trial counts for a leg once the legs before it are done)",
+            "leg",
+            |r| &r.legs,
+        )
+    }
+
+    /// The cycle phases' success table (empty without phases after the pick).
+    fn phases_markdown(&self) -> String {
+        self.stages_markdown(
+            "Phases (a trial counts for a phase once the phases before it succeeded)",
+            "phase",
+            |r| &r.phases,
+        )
+    }
+
+    /// A success table of stages (legs or phases) per row, under `title`.
+    fn stages_markdown(
+        &self,
+        title: &str,
+        column: &str,
+        stages: fn(&SummaryRow) -> &[LegSummary],
+    ) -> String {
+        let rows: Vec<_> = self.rows.iter().filter(|r| !stages(r).is_empty()).collect();
         if rows.is_empty() {
             return String::new();
         }
-        let mut s = String::from(
-            "\nMission legs (a trial counts for a leg once the legs before it are done):\n\n| scenario | planner | tracker | mode | leg | attempted | done | success rate | 95 % CI (Wilson) |\n|---|---|---|---|---|---|---|---|---|\n",
+        let mut s = format!(
+            "\n{title}:\n\n| scenario | planner | tracker | mode | {column} | attempted | done | success rate | 95 % CI (Wilson) |\n|---|---|---|---|---|---|---|---|---|\n",
         );
         for r in rows {
-            for l in &r.legs {
+            for l in stages(r) {
                 s.push_str(&format!(
                     "| {} | {} | {} | {} | {} | {} | {} | {:.1} % | {:.1}–{:.1} % |\n",
                     md_cell(&r.scenario),

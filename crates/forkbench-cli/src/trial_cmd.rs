@@ -158,10 +158,37 @@ fn text_report(out: &TrialOutcome) -> String {
             out.pallet_rotation_rad.to_degrees()
         ),
         format!("replans              {}", out.replans),
+    ]);
+    lines.extend(phase_lines(out));
+    lines.extend([
         format!("sim time             {:.2} s", out.sim_time_s),
         format!("wall time            {:.1} ms", out.wall_time_ms),
     ]);
     lines.join("\n") + "\n"
+}
+
+/// One line per phase of a handling cycle: its verdict, time, distance and load.
+fn phase_lines(out: &TrialOutcome) -> Vec<String> {
+    out.phases
+        .iter()
+        .map(|p| {
+            let verdict = match (p.success, p.failure) {
+                (true, _) => "done".to_owned(),
+                (false, f) => format!(
+                    "FAILED: {}: {}",
+                    f.map_or("unknown", |f| f.name()),
+                    one_line(p.failure_detail.as_deref().unwrap_or(""))
+                ),
+            };
+            format!(
+                "{:<20} {verdict}; {:.2} s, {:.2} m{}",
+                format!("phase {}", p.name),
+                p.time_s,
+                p.distance_m,
+                if p.loaded { ", loaded" } else { "" }
+            )
+        })
+        .collect()
 }
 
 /// Trial options from the CLI: seed, (planner, tracker) names, noise and replanning.

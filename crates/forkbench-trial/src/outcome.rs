@@ -31,6 +31,11 @@ pub enum Failure {
     Error,
     /// The pallet sensing never found the pallet, so there was nothing to plan to.
     PalletNotFound,
+    /// The lift phase could not lift the pallet (forks not under it, over the truck's
+    /// rating, or it would tip the truck).
+    LiftFailed,
+    /// The carried load was accelerated harder than its friction on the forks holds.
+    LoadShifted,
 }
 
 impl Failure {
@@ -48,6 +53,8 @@ impl Failure {
             Failure::ForkOutsidePocket => "fork_outside_pocket",
             Failure::Error => "error",
             Failure::PalletNotFound => "pallet_not_found",
+            Failure::LiftFailed => "lift_failed",
+            Failure::LoadShifted => "load_shifted",
         }
     }
 }
@@ -129,6 +136,26 @@ pub struct TrialOutcome {
     /// A mission's legs before the pick, in order (empty for a pick trial).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub legs: Vec<LegOutcome>,
+    /// The pick and the phases after it, in order, up to the first that failed (empty
+    /// when the scenario lists no phase after the pick).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<PhaseOutcome>,
+}
+
+/// One phase of the handling cycle: the pick, or one after it (lift, reverse out).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseOutcome {
+    pub name: String,
+    pub success: bool,
+    /// Its first failed criterion, with the value and limit.
+    pub failure: Option<Failure>,
+    pub failure_detail: Option<String>,
+    /// Simulated time the phase took.
+    pub time_s: f64,
+    /// Distance the fork root travelled in it.
+    pub distance_m: f64,
+    /// Whether the truck carried the pallet through it.
+    pub loaded: bool,
 }
 
 /// One mission leg: backing out of the station it starts at (if any), then the global
@@ -254,6 +281,7 @@ impl TrialOutcome {
             sim_time_s: 0.0,
             wall_time_ms: 0.0,
             legs: Vec::new(),
+            phases: Vec::new(),
             also_failed: Vec::new(),
             likely_cause: None,
         }

@@ -32,7 +32,18 @@ fn truck_defaults() -> toml::Value {
 }
 
 /// Each table with defaults, by the heading it has in the document.
-fn defaulted() -> Vec<(&'static str, toml::Value)> {
+fn defaulted() -> Vec<(String, toml::Value)> {
+    let phases = forkbench_trial::trial::phase_defaults()
+        .into_iter()
+        .map(|(name, v)| (format!("[phase.{name}]"), v));
+    defaulted_tables()
+        .into_iter()
+        .map(|(s, v)| (s.to_owned(), v))
+        .chain(phases)
+        .collect()
+}
+
+fn defaulted_tables() -> Vec<(&'static str, toml::Value)> {
     let noise = NoiseFile::default();
     let scanner =
         |m: &str| value(&forkbench_sensors::scan::ScannerConfig::preset(m).expect("preset"));
@@ -151,7 +162,7 @@ fn every_defaulted_key_is_documented_with_its_default() {
             }
             println!();
         }
-        let Some(doc_keys) = tables.get(section) else {
+        let Some(doc_keys) = tables.get(&section) else {
             problems.push(format!("{section}: no table"));
             continue;
         };

@@ -49,6 +49,29 @@ fn legs_table(o: &TrialOutcome) -> String {
     s + "\n"
 }
 
+/// The handling cycle's phases: each one's verdict, time, distance and load.
+fn phases_table(o: &TrialOutcome) -> String {
+    if o.phases.is_empty() {
+        return String::new();
+    }
+    let mut s =
+        String::from("| phase | verdict | time | distance | load |\n|---|---|---|---|---|\n");
+    for p in &o.phases {
+        let verdict = match (p.success, p.failure) {
+            (true, _) => "✅ done".to_owned(),
+            (false, f) => format!("❌ **{}**", f.map_or("unknown", |f| f.name())),
+        };
+        s += &format!(
+            "| {} | {verdict} | {:.1} s | {:.2} m | {} |\n",
+            p.name,
+            p.time_s,
+            p.distance_m,
+            if p.loaded { "on the forks" } else { "—" }
+        );
+    }
+    s + "\n"
+}
+
 impl RerunRecorder {
     /// Fixed styles and series names, sent with each entity's first columns.
     fn styles(&mut self) {
@@ -158,7 +181,7 @@ impl RerunRecorder {
         let [lat_limit, head_limit, _] = self.limits;
         let num = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map_or("—".to_owned(), f);
         format!(
-            "{head}\n\n{detail}\n\n\
+            "{head}\n\n{detail}\n\n{}\
              | at entry | value | limit |\n|---|---|---|\n\
              | lateral offset | {} | {lat_limit} m |\n\
              | heading | {} | {head_limit}° |\n\
@@ -175,6 +198,7 @@ impl RerunRecorder {
              out (the PRM roadmap is hidden: add map/nav/roadmap in the blueprint panel)\n\n\
              **Events**\n\n```text\n{}\n```\n\n\
              **Outcome**\n\n```json\n{}\n```\n",
+            phases_table(o),
             num(o.lateral_error_m, &|v| format!("{v:.3} m")),
             num(o.heading_error_rad, &|v| format!("{:.2}°", v.to_degrees())),
             o.insertion_depth_m,

@@ -134,6 +134,29 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
     Ok(())
 }
 
+/// The phases after the pick from `phases` and `[phase.NAME]`; errors name the line.
+pub(super) fn resolve_phases(
+    f: &ScenarioFile,
+    text: &str,
+    file: &str,
+) -> Result<Vec<crate::trial::PhaseSpec>, TrialError> {
+    let names = f.phases.as_ref();
+    let list = names.map_or_else(
+        || vec![crate::trial::PICK.to_owned()],
+        |n| n.get_ref().clone(),
+    );
+    crate::trial::phases_resolve(&list, &f.phase).map_err(|(field, reason)| {
+        let at = names.map_or(0, |n| n.span().start);
+        let line = text[..at.min(text.len())].matches('\n').count() + 1;
+        let file = if names.is_some() {
+            format!("{file}:{line}")
+        } else {
+            file.to_owned()
+        };
+        invalid(&file, &field, &reason)
+    })
+}
+
 /// The pallet's payload: a mass, and with the pallet no more than the truck may lift.
 pub(super) fn check_payload(
     truck: &ForkliftSpec,

@@ -159,6 +159,12 @@ pub(super) struct ScenarioFile {
     pub(super) pallet: Option<PalletPlacement>,
     #[serde(default)]
     pub(super) case: Vec<CaseFile>,
+    /// The handling cycle: `"pick"`, then the phases after it (`"lift"`,
+    /// `"reverse_out"`), in order; none is the pick alone.
+    pub(super) phases: Option<toml::Spanned<Vec<String>>>,
+    /// Settings of listed phases, `[phase.NAME]`.
+    #[serde(default)]
+    pub(super) phase: toml::Table,
     /// A warehouse mission that ends where the pick starts.
     pub(super) mission: Option<super::mission::MissionFile>,
     /// Sensors beyond the defaults (`[sensors.pallet]`).

@@ -134,6 +134,9 @@ pub struct Scenario {
     /// Legs driven before the pick: the truck starts at the mission's start and each
     /// case's start is the staging pose the last leg ends at.
     pub mission: Option<mission::MissionSpec>,
+    /// The phases after the pick, in order (none: the trial is the pick).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phases: Vec<crate::trial::PhaseSpec>,
 }
 
 /// One start/pallet geometry of a scenario.
@@ -247,6 +250,7 @@ impl Scenario {
         };
         let zero = Pose2::new(0.0, 0.0, 0.0);
         let pallet_sensing = sensors::resolve(f.sensors.as_ref(), &f.truck, file)?;
+        let phases = checks::resolve_phases(&f, text, file)?;
         Ok(Scenario {
             file: file.to_owned(),
             name: f.name,
@@ -270,6 +274,7 @@ impl Scenario {
             world,
             cases,
             mission,
+            phases,
         })
     }
 

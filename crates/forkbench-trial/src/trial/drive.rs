@@ -22,7 +22,7 @@ pub(crate) struct DriveState {
 }
 
 /// The trial's own scalar signals go out every this many control steps.
-const SIGNAL_EVERY_STEPS: u64 = 10;
+pub(super) const SIGNAL_EVERY_STEPS: u64 = 10;
 
 impl<'a> Trial<'a> {
     /// Drives until the tracker reports the goal reached and the truck stands, or the
@@ -130,7 +130,9 @@ impl<'a> Trial<'a> {
         rec: &mut R,
     ) {
         let truck = &self.scn.truck;
+        let before = self.sim.fork_root_pose();
         self.sim.step(cmd.speed_mps, cmd.steer_rad);
+        self.travelled_m += before.distance_to(&self.sim.fork_root_pose());
         let (scale, offset) = self.odometry_error;
         let (v, steer) = (
             self.sim.speed_mps() * (1.0 + scale),

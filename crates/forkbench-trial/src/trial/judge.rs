@@ -1,11 +1,11 @@
 //! Judge stage: final errors, pallet displacement, and the first failed criterion in check order.
 
-use forkbench_core::units::wrap_angle;
 use forkbench_core::Pose2;
+use forkbench_core::units::wrap_angle;
 use rand_chacha::ChaCha8Rng;
 
 use super::setup::Trial;
-use crate::outcome::{Failure, TrialOutcome};
+use crate::outcome::Failure;
 use crate::text::compact_numbers;
 
 /// The pallet pose moved by a draw of N(0, σ) per axis in its own frame, truncated at 3σ.
@@ -27,12 +27,6 @@ pub(super) fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
 }
 
 impl Trial<'_> {
-    /// Final measurements and the verdict.
-    pub(super) fn judge(mut self) -> TrialOutcome {
-        self.conclude();
-        self.out
-    }
-
     /// Writes the final measurements and the verdict into the outcome.
     pub(super) fn conclude(&mut self) {
         let truck = &self.scn.truck;

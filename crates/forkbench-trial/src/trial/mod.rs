@@ -7,6 +7,7 @@ mod judge;
 mod localize;
 mod look;
 mod mission;
+mod phases;
 mod plan;
 mod sense;
 mod session;
@@ -23,6 +24,7 @@ use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
 pub use look::{ScanReport, scan_once};
+pub use phases::{PICK, PhaseSpec, phase_defaults, resolve as phases_resolve};
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use setup::Trial;
 
@@ -171,7 +173,9 @@ fn run_stages<R: Recorder + ?Sized>(
         trial.out.fail(Failure::Error, why);
         return trial.out;
     }
-    trial.judge()
+    trial.conclude();
+    trial.run_phases(rec);
+    trial.out
 }
 
 /// A trial up to its drive: the world and components, the mission's legs, the first fix
@@ -219,5 +223,6 @@ pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
     };
     trial.tracker.reset(&path, &scn.truck);
     trial.path = path;
+    trial.pick_started = (trial.sim.time_s(), trial.travelled_m);
     Ok(trial)
 }

@@ -68,6 +68,10 @@ pub struct Trial<'a> {
     pub(super) leg_loc: LocStats,
     /// The last reading gave no pose (the log says so once, and again when one returns).
     pub(super) fix_lost: bool,
+    /// Distance the fork root has travelled, over every physics step.
+    pub(super) travelled_m: f64,
+    /// Simulated time and distance travelled when the pick's drive began.
+    pub(super) pick_started: (f64, f64),
 }
 
 impl std::fmt::Debug for Trial<'_> {
@@ -272,6 +276,8 @@ impl<'a> Trial<'a> {
             loc: LocStats::new(0.0),
             leg_loc: LocStats::new(0.0),
             fix_lost: false,
+            travelled_m: 0.0,
+            pick_started: (0.0, 0.0),
         };
         if scn.mission.is_none()
             && let Err(e) = trial.first_fix_and_estimate(&true_pallet, rec)

@@ -1,0 +1,59 @@
+//! The criteria of the phases after the pick, each once: what it measures and its limit.
+
+use forkbench_core::Pose2;
+use forkbench_core::units::wrap_angle;
+
+use super::Failed;
+use crate::outcome::Failure;
+use crate::trial::setup::Trial;
+
+/// What every phase holds at every step: no rack or wall touched, the load still on the
+/// forks.
+pub(super) fn every_step(t: &Trial<'_>) -> Result<(), Failed> {
+    if t.collision {
+        return Err((
+            Failure::Collision,
+            "truck touched a rack or wall".to_owned(),
+        ));
+    }
+    load_held(t)
+}
+
+/// The carried load stayed on the forks: the truck never accelerated it harder than its
+/// friction on them holds (μ g).
+pub(super) fn load_held(t: &Trial<'_>) -> Result<(), Failed> {
+    if t.sim.load_shifted() {
+        let limit = t.scn.sim.fork_friction * 9.81;
+        return Err((
+            Failure::LoadShifted,
+            format!(
+                "the load was accelerated at {:.2} m/s² (its friction on the forks holds {limit:.2} m/s²)",
+                t.sim.peak_load_accel_mps2()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A pallet left standing stayed where it stood (the forks did not drag it) within the
+/// pick's displacement and rotation limits.
+pub(super) fn pallet_stayed(t: &Trial<'_>, from: &Pose2) -> Result<(), Failed> {
+    let now = t.sim.pallet_pose();
+    let (moved, turned) = (
+        now.distance_to(from),
+        wrap_angle(now.heading_rad - from.heading_rad),
+    );
+    let tol = &t.scn.tolerances;
+    if moved > tol.pallet_displacement_m || turned.abs() > tol.pallet_rotation_rad {
+        return Err((
+            Failure::PalletDisplaced,
+            format!(
+                "the forks dragged the pallet {moved:.3} m and turned it {:.2}° (limits {} m, {}°)",
+                turned.to_degrees(),
+                tol.pallet_displacement_m,
+                tol.pallet_rotation_deg()
+            ),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,83 @@
+//! The reverse-out phase: the truck backs straight out along its own axis for a set distance, with or without the pallet.
+
+use forkbench_core::Pose2;
+use serde::{Deserialize, Serialize};
+
+use super::{Failed, Phase, criteria, settings};
+use crate::outcome::Failure;
+use crate::recorder::Recorder;
+use crate::trial::setup::Trial;
+
+/// `[phase.reverse_out]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct ReverseOut {
+    /// How far the fork root backs out (by the controller's pose).
+    distance_m: f64,
+    speed_mps: f64,
+    /// Time allowed to back out and stand.
+    timeout_s: f64,
+}
+
+impl Default for ReverseOut {
+    fn default() -> Self {
+        Self {
+            distance_m: 2.0,
+            speed_mps: 0.5,
+            timeout_s: 30.0,
+        }
+    }
+}
+
+pub(super) fn defaults() -> toml::Value {
+    toml::Value::try_from(ReverseOut::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
+}
+
+pub(super) fn build(table: &toml::Table) -> Result<Box<dyn Phase>, String> {
+    let r: ReverseOut = settings(table)?;
+    for (name, v, max) in [
+        ("distance_m", r.distance_m, 50.0),
+        ("speed_mps", r.speed_mps, 3.0),
+        ("timeout_s", r.timeout_s, 600.0),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v <= max) {
+            return Err(format!(
+                "{name} must be positive and at most {max} (got {v})"
+            ));
+        }
+    }
+    Ok(Box::new(r))
+}
+
+impl Phase for ReverseOut {
+    fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
+        let (pallet0, carrying) = (t.sim.pallet_pose(), t.sim.carrying());
+        let mut from: Option<Pose2> = None;
+        let mut backed_m = 0.0;
+        let finished = t.drive_by(self.timeout_s, rec, |t, pose| {
+            let start = *from.get_or_insert(pose);
+            backed_m = start.distance_to(&pose);
+            let left_m = self.distance_m - backed_m;
+            if left_m > 0.0 {
+                // Slows over the last metres so the truck stands near the distance.
+                Some((-self.speed_mps.min(0.05 + 1.5 * left_m), 0.0))
+            } else {
+                (t.sim.speed_mps().abs() >= 0.01).then_some((0.0, 0.0))
+            }
+        })?;
+        if !finished {
+            return Err((
+                Failure::Timeout,
+                format!(
+                    "backed out {backed_m:.2} of {} m in {} s",
+                    self.distance_m, self.timeout_s
+                ),
+            ));
+        }
+        if carrying {
+            criteria::load_held(t)
+        } else {
+            criteria::pallet_stayed(t, &pallet0)
+        }
+    }
+}
