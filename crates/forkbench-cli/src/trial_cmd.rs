@@ -167,7 +167,8 @@ fn text_report(out: &TrialOutcome) -> String {
     lines.join("\n") + "\n"
 }
 
-/// One line per phase of a handling cycle: its verdict, time, distance and load.
+/// One line per phase of a handling cycle (its verdict, time, distance and load), then
+/// the cycle's totals.
 fn phase_lines(out: &TrialOutcome) -> Vec<String> {
     out.phases
         .iter()
@@ -188,6 +189,12 @@ fn phase_lines(out: &TrialOutcome) -> Vec<String> {
                 if p.loaded { ", loaded" } else { "" }
             )
         })
+        .chain(out.cycle.iter().map(|c| {
+            format!(
+                "cycle                {:.2} s; {:.2} m driven loaded, {:.2} m empty",
+                c.time_s, c.distance_loaded_m, c.distance_unloaded_m
+            )
+        }))
         .collect()
 }
 

@@ -241,3 +241,35 @@ fn pushing_a_loaded_pallet_takes_its_floor_friction() {
         );
     }
 }
+
+/// The carried pallet is part of the truck: driving it into a wall is a contact, and
+/// it comes when the pallet's far edge (ahead of the fork tips, 1.15 m in) reaches it.
+#[test]
+fn a_carried_pallet_touches_what_it_is_driven_into() {
+    let face_x = ForkliftSpec::default().fork_length_m - 1.15;
+    let wall_face_x = face_x + 1.2 + 0.5;
+    let wall = forkbench_sim::Obstacle {
+        centre: Pose2::new(wall_face_x + 0.1, 0.0, 0.0),
+        length_m: 0.2,
+        width_m: 4.0,
+    };
+    let mut sim = Sim::new(
+        &ForkliftSpec::default(),
+        &Pose2::new(0.0, 0.0, 0.0),
+        &PalletSpec::field_1200().with_payload(300.0),
+        &Pose2::new(face_x, 0.0, 0.0),
+        &[wall],
+        &SimConfig::default(),
+    )
+    .expect("valid world");
+    sim.lift().expect("forks under the pallet");
+    while !sim.obstacle_contact() && sim.time_s() < 10.0 {
+        sim.step(0.3, 0.0);
+    }
+    assert!(sim.obstacle_contact(), "never touched the wall");
+    let front_x = sim.pallet_pose().x_m + 1.2;
+    assert!(
+        (front_x - wall_face_x).abs() < 0.03,
+        "pallet front at {front_x} m, wall at {wall_face_x} m"
+    );
+}

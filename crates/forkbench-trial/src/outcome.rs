@@ -36,6 +36,9 @@ pub enum Failure {
     LiftFailed,
     /// The carried load was accelerated harder than its friction on the forks holds.
     LoadShifted,
+    /// The placed pallet stands farther from its slot, or turned more, than the place
+    /// tolerances allow.
+    PlacementError,
 }
 
 impl Failure {
@@ -55,6 +58,7 @@ impl Failure {
             Failure::PalletNotFound => "pallet_not_found",
             Failure::LiftFailed => "lift_failed",
             Failure::LoadShifted => "load_shifted",
+            Failure::PlacementError => "placement_error",
         }
     }
 }
@@ -140,6 +144,18 @@ pub struct TrialOutcome {
     /// when the scenario lists no phase after the pick).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub phases: Vec<PhaseOutcome>,
+    /// The handling cycle's totals (with phases after the pick).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle: Option<CycleTotals>,
+}
+
+/// A handling cycle's time and the distance the fork root travelled with and without the
+/// pallet on the forks (mission legs included).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CycleTotals {
+    pub time_s: f64,
+    pub distance_loaded_m: f64,
+    pub distance_unloaded_m: f64,
 }
 
 /// One phase of the handling cycle: the pick, or one after it (lift, reverse out).
@@ -156,6 +172,10 @@ pub struct PhaseOutcome {
     pub distance_m: f64,
     /// Whether the truck carried the pallet through it.
     pub loaded: bool,
+    /// What the phase measured, by name with its unit (a place's `position_error_m`,
+    /// `heading_error_rad`, `clearance_m`).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub measures: std::collections::BTreeMap<String, f64>,
 }
 
 /// One mission leg: backing out of the station it starts at (if any), then the global
@@ -282,6 +302,7 @@ impl TrialOutcome {
             wall_time_ms: 0.0,
             legs: Vec::new(),
             phases: Vec::new(),
+            cycle: None,
             also_failed: Vec::new(),
             likely_cause: None,
         }

@@ -124,9 +124,9 @@ fn phase_lists_that_cannot_run_are_refused_at_load() {
             "cannot follow \"reverse_out\"",
         ),
         (
-            line(r#"phases = ["pick", "place"]"#),
+            line(r#"phases = ["pick", "dance"]"#),
             "phases[1]",
-            "no phase \"place\"",
+            "no phase \"dance\"",
         ),
         (
             line("phases = [\"pick\", \"lift\"]\n[phase.lift]\ntime_s = -1.0\n"),
@@ -149,10 +149,119 @@ fn phase_lists_that_cannot_run_are_refused_at_load() {
         let e = with_phases(&phases).expect_err(&phases);
         assert!(e.contains(field) && e.contains(reason), "{phases}: {e}");
     }
+    let e = cycle(|t| t.replace(r#""reverse_out"]"#, r#""reverse_out", "return"]"#))
+        .expect_err("a return without a mission");
+    assert!(e.contains("phase.return") && e.contains("[mission]"), "{e}");
     let heavy = cycle(|t| t.replace("payload_kg = 800.0", "payload_kg = 3500.0"));
     let e = heavy.expect_err("over the rating");
     assert!(
         e.contains("payload_kg") && e.contains("rated_capacity_kg"),
+        "{e}"
+    );
+}
+
+/// scenarios/warehouse-cycle.toml with `edit` applied to its text.
+fn warehouse_cycle(edit: impl Fn(String) -> String) -> Result<Scenario, String> {
+    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios"));
+    let text = std::fs::read_to_string(dir.join("warehouse-cycle.toml")).expect("the scenario");
+    Scenario::parse(&edit(text), "wc.toml", |w| World::load(&dir.join(w)))
+        .map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_carried_pallet_is_placed_in_its_slot_and_the_truck_returns() {
+    let scn = warehouse_cycle(|t| t).expect("valid");
+    let out = run_trial(&scn, &scn.cases[0], &seed(5));
+    assert!(out.success, "{}", out.verdict_line());
+    let names: Vec<_> = out.phases.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["pick", "lift", "reverse_out", "place", "return"]);
+    let place = &out.phases[3];
+    assert!(place.loaded && place.success);
+    let m = &place.measures;
+    assert!(m["position_error_m"] < 0.05 && m["heading_error_rad"].abs() < 2f64.to_radians());
+    assert!(m["clearance_m"] > 0.0 && m["clearance_m"] < 0.1, "{m:?}");
+    let back = &out.phases[4];
+    assert!(
+        !back.loaded && back.measures["final_position_error_m"] < 0.3,
+        "{back:?}"
+    );
+    // Loaded: backing out of bay 1 and driving to bay 2 (not the retract).
+    let cycle = out.cycle.expect("cycle totals");
+    let carried = out.phases[2].distance_m + out.phases[3].distance_m;
+    assert!(
+        cycle.distance_loaded_m > out.phases[2].distance_m && cycle.distance_loaded_m < carried
+    );
+    assert!((cycle.time_s - out.sim_time_s).abs() < 1e-9);
+    assert!(cycle.distance_unloaded_m > back.distance_m + out.phases[0].distance_m);
+}
+
+/// Bay 2 moved 2 m north of where the truck backs out to (a slot offset no path within
+/// the truck's curvature reaches): the place fails planning, naming the slot.
+#[test]
+fn a_slot_the_planner_cannot_reach_fails_the_place() {
+    let scn =
+        warehouse_cycle(|t| t.replace("distance_m = 5.0", "distance_m = 2.5")).expect("valid");
+    let out = run_trial(&scn, &scn.cases[0], &seed(5));
+    assert_eq!(
+        out.failure,
+        Some(Failure::PlanFailed),
+        "{}",
+        out.verdict_line()
+    );
+    let detail = out.failure_detail.as_deref().unwrap_or("");
+    assert!(
+        detail.starts_with("place: to slot \"shelf-bay2\""),
+        "{detail}"
+    );
+    assert_eq!(out.phases.len(), 4);
+}
+
+#[test]
+fn places_that_cannot_be_are_refused_at_load() {
+    let cases = [
+        ("slot = \"shelf-bay2\"", "slot = \"bay9\"", "no such slot"),
+        ("slot = \"shelf-bay2\"", "", "slot: name"),
+        (
+            "\"lift\", \"reverse_out\", \"place\"",
+            "\"place\"",
+            "cannot follow \"pick\"",
+        ),
+        (
+            "\"lift\", \"reverse_out\"",
+            "\"reverse_out\"",
+            "needs the pallet on the forks",
+        ),
+    ];
+    for (from, to, reason) in cases {
+        // Without a lift, the list's reverse_out settings stay and are refused first.
+        let e = warehouse_cycle(|t| {
+            t.replace(from, to)
+                .replace("[phase.reverse_out]\ndistance_m = 5.0\n", "")
+        })
+        .expect_err(to);
+        assert!(e.contains(reason), "{to}: {e}");
+    }
+    // A slot whose pallet would stand in a rack: the shelf's middle frame.
+    let world = forkbench_trial::World::load(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../worlds/warehouse.toml"
+    )))
+    .expect("world");
+    let mut inside = world.clone();
+    let mut bay = inside.pallet_slot[1].clone();
+    bay.name = "in-frame".into();
+    bay.y_m = 10.1;
+    inside.pallet_slot.push(bay);
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/warehouse-cycle.toml"
+    ))
+    .expect("scenario")
+    .replace("slot = \"shelf-bay2\"", "slot = \"in-frame\"");
+    let e = Scenario::parse(&text, "wc.toml", |_| Ok(inside.clone())).expect_err("in a rack");
+    let e = e.to_string();
+    assert!(
+        e.contains("phase.place") && e.contains("overlaps rack \"shelf-frame1\""),
         "{e}"
     );
 }

@@ -30,7 +30,8 @@ pub fn pallet_footprint(pallet: &PalletSpec) -> Footprint {
 /// footprints are shrunk by this on every side before the overlap test.
 const LAYOUT_TOLERANCE_M: f64 = 1e-3;
 
-fn shrunk(fp: Footprint) -> Footprint {
+/// `fp` shrunk by the layout tolerance on every side, for overlap tests that let shapes touch.
+pub(crate) fn shrunk(fp: Footprint) -> Footprint {
     Footprint {
         length_m: fp.length_m - 2.0 * LAYOUT_TOLERANCE_M,
         width_m: fp.width_m - 2.0 * LAYOUT_TOLERANCE_M,
@@ -137,6 +138,7 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
 /// The phases after the pick from `phases` and `[phase.NAME]`; errors name the line.
 pub(super) fn resolve_phases(
     f: &ScenarioFile,
+    (world, pallet, mission): (&World, &PalletSpec, Option<&super::mission::MissionSpec>),
     text: &str,
     file: &str,
 ) -> Result<Vec<crate::trial::PhaseSpec>, TrialError> {
@@ -145,7 +147,12 @@ pub(super) fn resolve_phases(
         || vec![crate::trial::PICK.to_owned()],
         |n| n.get_ref().clone(),
     );
-    crate::trial::phases_resolve(&list, &f.phase).map_err(|(field, reason)| {
+    let cx = crate::trial::PhaseContext {
+        world,
+        pallet,
+        mission,
+    };
+    crate::trial::phases_resolve(&list, &f.phase, &cx).map_err(|(field, reason)| {
         let at = names.map_or(0, |n| n.span().start);
         let line = text[..at.min(text.len())].matches('\n').count() + 1;
         let file = if names.is_some() {

@@ -17,6 +17,7 @@ use serde::Serialize;
 use crate::TrialError;
 use crate::components::{ComponentSpec, Registry, Role};
 
+pub(crate) use checks::shrunk;
 pub use checks::{ForkFit, fork_fit, pallet_footprint, truck_footprint};
 pub use file::{NoiseFile, PalletKind, PalletPlacement, ReplanFile, Tolerances};
 pub use limits::{Limits, Replan};
@@ -250,7 +251,7 @@ impl Scenario {
         };
         let zero = Pose2::new(0.0, 0.0, 0.0);
         let pallet_sensing = sensors::resolve(f.sensors.as_ref(), &f.truck, file)?;
-        let phases = checks::resolve_phases(&f, text, file)?;
+        let phases = checks::resolve_phases(&f, (&world, &pallet, mission.as_ref()), text, file)?;
         Ok(Scenario {
             file: file.to_owned(),
             name: f.name,

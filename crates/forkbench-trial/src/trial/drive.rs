@@ -22,7 +22,7 @@ pub(crate) struct DriveState {
 }
 
 /// The trial's own scalar signals go out every this many control steps.
-pub(super) const SIGNAL_EVERY_STEPS: u64 = 10;
+pub(in crate::trial) const SIGNAL_EVERY_STEPS: u64 = 10;
 
 impl<'a> Trial<'a> {
     /// Drives until the tracker reports the goal reached and the truck stands, or the
@@ -132,7 +132,11 @@ impl<'a> Trial<'a> {
         let truck = &self.scn.truck;
         let before = self.sim.fork_root_pose();
         self.sim.step(cmd.speed_mps, cmd.steer_rad);
-        self.travelled_m += before.distance_to(&self.sim.fork_root_pose());
+        let moved_m = before.distance_to(&self.sim.fork_root_pose());
+        self.travelled_m += moved_m;
+        if self.sim.carrying() {
+            self.travelled_loaded_m += moved_m;
+        }
         let (scale, offset) = self.odometry_error;
         let (v, steer) = (
             self.sim.speed_mps() * (1.0 + scale),

@@ -121,7 +121,7 @@ impl Trial<'_> {
 
     /// One leg: back out of the place it starts at (all but the first), plan from where
     /// the truck stands, drive, and measure the arrival.
-    fn leg<R: Recorder + ?Sized>(
+    pub(super) fn leg<R: Recorder + ?Sized>(
         &mut self,
         map: &NavMap,
         m: &MissionSpec,

@@ -24,7 +24,9 @@ use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
 pub use look::{ScanReport, scan_once};
-pub use phases::{PICK, PhaseSpec, phase_defaults, resolve as phases_resolve};
+pub use phases::{
+    Context as PhaseContext, PICK, PhaseSpec, phase_defaults, resolve as phases_resolve,
+};
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use setup::Trial;
 

@@ -68,10 +68,14 @@ pub struct Trial<'a> {
     pub(super) leg_loc: LocStats,
     /// The last reading gave no pose (the log says so once, and again when one returns).
     pub(super) fix_lost: bool,
-    /// Distance the fork root has travelled, over every physics step.
+    /// Distance the fork root has travelled, over every physics step, and of that with
+    /// the pallet on the forks.
     pub(super) travelled_m: f64,
+    pub(super) travelled_loaded_m: f64,
     /// Simulated time and distance travelled when the pick's drive began.
     pub(super) pick_started: (f64, f64),
+    /// What the running phase measured, by name (see `PhaseOutcome::measures`).
+    pub(super) phase_measures: std::collections::BTreeMap<String, f64>,
 }
 
 impl std::fmt::Debug for Trial<'_> {
@@ -277,7 +281,9 @@ impl<'a> Trial<'a> {
             leg_loc: LocStats::new(0.0),
             fix_lost: false,
             travelled_m: 0.0,
+            travelled_loaded_m: 0.0,
             pick_started: (0.0, 0.0),
+            phase_measures: std::collections::BTreeMap::new(),
         };
         if scn.mission.is_none()
             && let Err(e) = trial.first_fix_and_estimate(&true_pallet, rec)

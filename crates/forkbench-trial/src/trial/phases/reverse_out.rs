@@ -3,7 +3,8 @@
 use forkbench_core::Pose2;
 use serde::{Deserialize, Serialize};
 
-use super::{Failed, Phase, criteria, settings};
+use super::run::open_loop;
+use super::{Context, Failed, Phase, criteria, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 use crate::trial::setup::Trial;
@@ -33,7 +34,7 @@ pub(super) fn defaults() -> toml::Value {
     toml::Value::try_from(ReverseOut::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
 }
 
-pub(super) fn build(table: &toml::Table) -> Result<Box<dyn Phase>, String> {
+pub(super) fn build(table: &toml::Table, _cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
     let r: ReverseOut = settings(table)?;
     for (name, v, max) in [
         ("distance_m", r.distance_m, 50.0),
@@ -52,32 +53,42 @@ pub(super) fn build(table: &toml::Table) -> Result<Box<dyn Phase>, String> {
 impl Phase for ReverseOut {
     fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
         let (pallet0, carrying) = (t.sim.pallet_pose(), t.sim.carrying());
-        let mut from: Option<Pose2> = None;
-        let mut backed_m = 0.0;
-        let finished = t.drive_by(self.timeout_s, rec, |t, pose| {
-            let start = *from.get_or_insert(pose);
-            backed_m = start.distance_to(&pose);
-            let left_m = self.distance_m - backed_m;
-            if left_m > 0.0 {
-                // Slows over the last metres so the truck stands near the distance.
-                Some((-self.speed_mps.min(0.05 + 1.5 * left_m), 0.0))
-            } else {
-                (t.sim.speed_mps().abs() >= 0.01).then_some((0.0, 0.0))
-            }
-        })?;
-        if !finished {
-            return Err((
-                Failure::Timeout,
-                format!(
-                    "backed out {backed_m:.2} of {} m in {} s",
-                    self.distance_m, self.timeout_s
-                ),
-            ));
-        }
+        back_straight(t, (self.distance_m, self.speed_mps, self.timeout_s), rec)?;
         if carrying {
             criteria::load_held(t)
         } else {
             criteria::pallet_stayed(t, &pallet0)
         }
+    }
+}
+
+/// Backs the truck straight out (steering centred) until the fork root, by the
+/// controller's pose, is `distance_m` back and the truck stands; `timeout` if it is not
+/// within `timeout_s`.
+pub(super) fn back_straight(
+    t: &mut Trial<'_>,
+    (distance_m, speed_mps, timeout_s): (f64, f64, f64),
+    rec: &mut dyn Recorder,
+) -> Result<(), Failed> {
+    let mut from: Option<Pose2> = None;
+    let mut backed_m = 0.0;
+    let finished = t.drive_by(timeout_s, rec, |t, pose| {
+        let start = *from.get_or_insert(pose);
+        backed_m = start.distance_to(&pose);
+        let left_m = distance_m - backed_m;
+        Ok(if left_m > 0.0 {
+            // Slows over the last metres so the truck stands near the distance.
+            Some(open_loop(-speed_mps.min(0.05 + 1.5 * left_m), 0.0, &pose))
+        } else {
+            (t.sim.speed_mps().abs() >= 0.01).then(|| open_loop(0.0, 0.0, &pose))
+        })
+    })?;
+    if finished {
+        Ok(())
+    } else {
+        Err((
+            Failure::Timeout,
+            format!("backed out {backed_m:.2} of {distance_m} m in {timeout_s} s"),
+        ))
     }
 }

@@ -1,0 +1,225 @@
+//! The place phase: the truck carries the pallet into a drop slot along a pick planner's path, lowers it, and backs the forks out; judged on where the pallet stands against the slot.
+
+use forkbench_core::Pose2;
+use forkbench_core::units::wrap_angle;
+use serde::{Deserialize, Serialize};
+
+use super::reverse_out::back_straight;
+use super::run::open_loop;
+use super::{Context, Failed, Phase, criteria, settings};
+use crate::outcome::Failure;
+use crate::recorder::{Level, Recorder};
+use crate::scenario::{World, pallet_footprint, shrunk};
+use crate::trial::setup::Trial;
+
+/// `[phase.place]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct PlaceFile {
+    /// The world's pallet slot to place at (required).
+    slot: Option<String>,
+    /// How far the placed pallet's face centre may stand from the slot's.
+    position_m: f64,
+    /// How far its heading may differ from the slot's.
+    heading_deg: f64,
+    /// How far short of the slot the truck aims the pallet's face, leaving room behind
+    /// it for the forks' tips and the truck's overshoot.
+    stop_short_m: f64,
+    /// Time the mast takes to set the pallet down; the truck stands.
+    lower_time_s: f64,
+    /// How far the forks back out of the placed pallet.
+    retract_m: f64,
+    /// Time allowed to drive to the slot and stand.
+    timeout_s: f64,
+}
+
+impl Default for PlaceFile {
+    fn default() -> Self {
+        Self {
+            slot: None,
+            position_m: 0.05,
+            heading_deg: 2.0,
+            stop_short_m: 0.0,
+            lower_time_s: 2.0,
+            retract_m: 2.1,
+            timeout_s: 120.0,
+        }
+    }
+}
+
+/// A resolved place: the slot's pose and the settings.
+#[derive(Debug)]
+struct Place {
+    slot: String,
+    at: Pose2,
+    cfg: PlaceFile,
+}
+
+pub(super) fn defaults() -> toml::Value {
+    toml::Value::try_from(PlaceFile::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
+}
+
+pub(super) fn build(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
+    let cfg: PlaceFile = settings(table)?;
+    for (name, v, max) in [
+        ("position_m", cfg.position_m, 10.0),
+        ("heading_deg", cfg.heading_deg, 180.0),
+        ("lower_time_s", cfg.lower_time_s, 60.0),
+        ("retract_m", cfg.retract_m, 50.0),
+        ("timeout_s", cfg.timeout_s, 600.0),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v <= max) {
+            return Err(format!(
+                "{name} must be positive and at most {max} (got {v})"
+            ));
+        }
+    }
+    if !(cfg.stop_short_m.is_finite() && (0.0..=1.0).contains(&cfg.stop_short_m)) {
+        return Err(format!(
+            "stop_short_m must lie in 0–1 m (got {})",
+            cfg.stop_short_m
+        ));
+    }
+    let slot = cfg
+        .slot
+        .clone()
+        .ok_or("slot: name the world's pallet slot to place at")?;
+    let at = slot_pose(cx.world, &slot)?;
+    let (obstacles, labels) = cx.world.footprint_obstacles();
+    if let Some(i) = obstacles.hit(&shrunk(pallet_footprint(cx.pallet)), &at) {
+        return Err(format!(
+            "slot {slot:?}: a pallet there overlaps {}",
+            labels[i]
+        ));
+    }
+    Ok(Box::new(Place { slot, at, cfg }))
+}
+
+/// The pose of the world's slot `name` (its face centre, heading into the rack).
+fn slot_pose(world: &World, name: &str) -> Result<Pose2, String> {
+    world
+        .pallet_slot
+        .iter()
+        .find(|s| s.name == name)
+        .map(|s| Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()))
+        .ok_or_else(|| {
+            let known: Vec<_> = world.pallet_slot.iter().map(|s| s.name.as_str()).collect();
+            format!(
+                "slot {name:?}: the world has no such slot (slots: {})",
+                known.join(", ")
+            )
+        })
+}
+
+impl Phase for Place {
+    fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
+        if !t.sim.carrying() {
+            return Err((Failure::Error, "nothing on the forks to place".into()));
+        }
+        self.approach(t, rec)?;
+        t.sim.lower();
+        let end_s = t.sim.time_s() + self.cfg.lower_time_s;
+        t.drive_by(self.cfg.lower_time_s + 1.0, rec, |t, pose| {
+            Ok((t.sim.time_s() < end_s).then(|| open_loop(0.0, t.sim.steer_rad(), &pose)))
+        })?;
+        let placed = t.sim.pallet_pose();
+        self.measure(t, &placed);
+        back_straight(t, (self.cfg.retract_m, 0.5, 30.0), rec)?;
+        self.placement(t)?;
+        criteria::pallet_stayed(t, &placed)
+    }
+}
+
+impl Place {
+    /// Plans to the fork-root pose that sets the carried pallet's face on the slot (as
+    /// if picking a pallet standing there) and drives it with the scenario's tracker.
+    fn approach(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
+        let truck = &t.scn.truck;
+        let root_on_pallet = t.sim.pallet_pose().to_local(&t.sim.fork_root_pose());
+        let aim = self
+            .at
+            .to_world(&Pose2::new(-self.cfg.stop_short_m, 0.0, 0.0));
+        let root_goal = aim.to_world(&root_on_pallet);
+        // The face a pick would aim at to end with the fork root at `root_goal`.
+        let face = root_goal.to_world(&Pose2::new(truck.fork_length_m - t.insertion_m, 0.0, 0.0));
+        let pose = t.sense(rec).map_err(|e| (Failure::Error, e.to_string()))?.1;
+        let k0 = t.sim.steer_rad().tan() / truck.wheelbase_m;
+        let time = t.sim.time_s();
+        let refused = |why: String| {
+            (
+                Failure::PlanFailed,
+                format!("to slot {:?}: {why}", self.slot),
+            )
+        };
+        let plan = t
+            .plan_from(pose, k0, &face)
+            .map_err(|e| refused(e.to_string()))?;
+        if let Some(why) = t.clash(&plan.path) {
+            return Err(refused(why.to_string()));
+        }
+        rec.plan(
+            time,
+            t.out.replans + 1,
+            &plan.path,
+            plan.control_polygon_m.as_deref(),
+        );
+        rec.event(
+            time,
+            Level::Info,
+            &format!(
+                "place plan: {:.3} m to slot {}",
+                plan.path.length_m(),
+                self.slot
+            ),
+        );
+        t.tracker.reset(&plan.path, truck);
+        t.path = plan.path;
+        let timeout_s = self.cfg.timeout_s;
+        let arrived = t.drive_by(timeout_s, rec, |t, pose| {
+            let cmd = t
+                .tracker_command(pose)
+                .map_err(|e| (Failure::Error, e.to_string()))?;
+            Ok((!(cmd.done && t.stands())).then_some(cmd))
+        })?;
+        if arrived {
+            Ok(())
+        } else {
+            Err((
+                Failure::Timeout,
+                format!("not stopped at slot {:?} after {timeout_s} s", self.slot),
+            ))
+        }
+    }
+
+    /// The placed pallet against the slot, and the room left around it.
+    fn measure(&self, t: &mut Trial<'_>, placed: &Pose2) {
+        let (obstacles, _) = &t.footprints;
+        let clearance = obstacles.clearance(&pallet_footprint(&t.scn.pallet), placed, 1.0);
+        let m = &mut t.phase_measures;
+        m.insert("position_error_m".into(), placed.distance_to(&self.at));
+        m.insert(
+            "heading_error_rad".into(),
+            wrap_angle(placed.heading_rad - self.at.heading_rad),
+        );
+        m.insert("clearance_m".into(), clearance);
+    }
+
+    /// The pallet set down within the place tolerances of its slot.
+    fn placement(&self, t: &Trial<'_>) -> Result<(), Failed> {
+        let m = &t.phase_measures;
+        let (d, h) = (m["position_error_m"], m["heading_error_rad"]);
+        if d > self.cfg.position_m || h.abs() > self.cfg.heading_deg.to_radians() {
+            return Err((
+                Failure::PlacementError,
+                format!(
+                    "placed {d:.3} m and {:.2}° off slot {:?} (limits {} m, {}°)",
+                    h.to_degrees(),
+                    self.slot,
+                    self.cfg.position_m,
+                    self.cfg.heading_deg
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
