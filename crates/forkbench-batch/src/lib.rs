@@ -42,7 +42,7 @@ pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};
 pub use seed::{SEED_SCHEME, trial_seed};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_batch, load_results, merge, read_numbered, read_records};
-pub use summary::{Summary, SummaryRow, mode_name, summarize};
+pub use summary::{LegSummary, Summary, SummaryRow, mode_name, summarize};
 pub use sweep::{
     RecordChoice, RecordJob, SweepPoint, SweepResult, read_sweep, sweep_markdown, sweep_points,
     trials_to_record, write_sweep,

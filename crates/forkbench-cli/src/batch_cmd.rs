@@ -48,7 +48,7 @@ impl From<Modes> for batch::ReplanModes {
 /// `forkbench batch`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BatchArgs {
-    /// Scenario files (default: the embedded field-test, rack-pick and Table 2 sets).
+    /// Scenario files (default: the embedded field-test, rack-pick, Table 2, warehouse mission and handling-cycle sets).
     pub scenarios: Vec<PathBuf>,
     /// Trials per scenario × case × planner × tracker.
     #[arg(long, default_value_t = 20)]

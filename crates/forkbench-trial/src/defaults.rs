@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::TrialError;
 use crate::scenario::{Scenario, World};
 
-const SCENARIOS: [(&str, &str); 5] = [
+const SCENARIOS: [(&str, &str); 6] = [
     (
         "scenarios/field-test.toml",
         include_str!("../data/scenarios/field-test.toml"),
@@ -25,6 +25,10 @@ const SCENARIOS: [(&str, &str); 5] = [
     (
         "scenarios/warehouse-mission.toml",
         include_str!("../data/scenarios/warehouse-mission.toml"),
+    ),
+    (
+        "scenarios/warehouse-cycle.toml",
+        include_str!("../data/scenarios/warehouse-cycle.toml"),
     ),
 ];
 

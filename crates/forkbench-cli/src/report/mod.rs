@@ -64,12 +64,19 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
     }
     h.push_str("<h2>Success per scenario × planner × tracker</h2>");
     h.push_str(&sections::success_table(&summary));
-    let legs = sections::mission_legs(&summary);
+    let legs = sections::stage_table(&summary, "leg", |r| &r.legs);
     if !legs.is_empty() {
         h.push_str(
             "<h2>Mission legs (a trial counts for a leg once the legs before it are done)</h2>",
         );
         h.push_str(&legs);
+    }
+    let phases = sections::stage_table(&summary, "phase", |r| &r.phases);
+    if !phases.is_empty() {
+        h.push_str(
+            "<h2>Phases (a trial counts for a phase once the phases before it succeeded)</h2>",
+        );
+        h.push_str(&phases);
     }
     h.push_str("<h2>Failures by first failed criterion</h2>");
     h.push_str(&sections::failure_breakdown(&summary));

@@ -54,14 +54,19 @@ pub fn success_table(s: &Summary) -> String {
     h + "</table>"
 }
 
-/// Mission legs: success per leg over the trials that reached it (empty without missions).
-pub fn mission_legs(s: &Summary) -> String {
-    let mut h = String::from(
-        "<table><tr><th>scenario</th><th>planner</th><th>tracker</th><th>mode</th><th>leg</th><th>attempted</th><th>done</th><th>success rate</th><th>95 % CI (Wilson)</th></tr>",
+/// Success per stage (mission leg or cycle phase, as `stages` picks) over the trials that
+/// reached it, the stage named in the `column` column (empty when no row has any).
+pub fn stage_table(
+    s: &Summary,
+    column: &str,
+    stages: fn(&batch::SummaryRow) -> &[batch::LegSummary],
+) -> String {
+    let mut h = format!(
+        "<table><tr><th>scenario</th><th>planner</th><th>tracker</th><th>mode</th><th>{column}</th><th>attempted</th><th>done</th><th>success rate</th><th>95 % CI (Wilson)</th></tr>",
     );
     let mut any = false;
     for r in &s.rows {
-        for l in &r.legs {
+        for l in stages(r) {
             any = true;
             let _ = write!(
                 h,
