@@ -36,6 +36,12 @@ struct Row<'a> {
     path_length_m: f64,
     sim_time_s: f64,
     wall_time_ms: f64,
+    /// Handling cycles: the phases that succeeded, the first that failed, the totals.
+    phases_done: Option<usize>,
+    failed_phase: &'a str,
+    cycle_time_s: Option<f64>,
+    distance_loaded_m: Option<f64>,
+    distance_unloaded_m: Option<f64>,
 }
 
 /// Writes `records` to `path` as CSV (sorted by trial key), atomically; a value not
@@ -75,6 +81,16 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
             path_length_m: o.path_length_m,
             sim_time_s: o.sim_time_s,
             wall_time_ms: o.wall_time_ms,
+            phases_done: (!o.phases.is_empty())
+                .then(|| o.phases.iter().filter(|p| p.success).count()),
+            failed_phase: o
+                .phases
+                .iter()
+                .find(|p| !p.success)
+                .map_or("", |p| p.name.as_str()),
+            cycle_time_s: o.cycle.map(|c| c.time_s),
+            distance_loaded_m: o.cycle.map(|c| c.distance_loaded_m),
+            distance_unloaded_m: o.cycle.map(|c| c.distance_unloaded_m),
         })
         .map_err(|e| csv_error(path, e))?;
     }

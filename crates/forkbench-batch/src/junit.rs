@@ -128,33 +128,53 @@ pub fn regress_cases(report: &GateReport, fail_on_new: bool) -> Vec<Case> {
         .collect()
 }
 
-/// A batch as JUnit: a case per row, failing when its success rate is below `floor`
-/// (every case passes without a floor, and reports its rate).
+/// A batch as JUnit: a case per row, and per phase of a row's handling cycle, failing
+/// when its success rate is below `floor` (every case passes without a floor, and
+/// reports its rate).
 pub fn batch_cases(summary: &Summary, floor: Option<f64>) -> Vec<Case> {
-    summary
-        .rows
-        .iter()
-        .map(|r| {
-            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker, Some(r.replan));
-            let numbers = format!(
-                "success {:.1} % ({} of {}, 95 % CI {:.1}–{:.1} %)",
-                100.0 * r.success_rate,
-                r.successes,
-                r.trials,
-                100.0 * r.ci95_low,
-                100.0 * r.ci95_high
-            );
-            let failure = floor.filter(|f| r.success_rate < *f).map(|f| {
-                (
-                    format!("{numbers} is below the floor {:.1} %", 100.0 * f),
-                    numbers.clone(),
-                )
-            });
-            Case {
-                name,
-                classname,
-                failure,
-            }
-        })
-        .collect()
+    let mut cases = Vec::new();
+    for r in &summary.rows {
+        let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker, Some(r.replan));
+        let rate = (
+            r.success_rate,
+            r.successes,
+            r.trials,
+            r.ci95_low,
+            r.ci95_high,
+        );
+        cases.push(rate_case(name.clone(), classname.clone(), rate, floor));
+        for p in &r.phases {
+            let rate = (p.success_rate, p.done, p.attempted, p.ci95_low, p.ci95_high);
+            let name = format!("{name} / phase {}", p.name);
+            cases.push(rate_case(name, classname.clone(), rate, floor));
+        }
+    }
+    cases
+}
+
+/// A case reporting a success rate (rate, successes, trials, CI low, CI high), failing
+/// below `floor`.
+fn rate_case(
+    name: String,
+    classname: String,
+    (rate, k, n, lo, hi): (f64, u64, u64, f64, f64),
+    floor: Option<f64>,
+) -> Case {
+    let numbers = format!(
+        "success {:.1} % ({k} of {n}, 95 % CI {:.1}–{:.1} %)",
+        100.0 * rate,
+        100.0 * lo,
+        100.0 * hi
+    );
+    let failure = floor.filter(|f| rate < *f).map(|f| {
+        (
+            format!("{numbers} is below the floor {:.1} %", 100.0 * f),
+            numbers.clone(),
+        )
+    });
+    Case {
+        name,
+        classname,
+        failure,
+    }
 }

@@ -390,3 +390,50 @@ fn provenance_keeps_the_first_run_and_lists_each_resume() {
     assert_eq!(p.started_at, p.runs[0].started_at);
     assert!(p.runs.iter().all(|r| r.finished_at.is_some()));
 }
+
+/// A handling cycle counts per phase in the summary, in JUnit (a case per phase, held to
+/// the floor like its row) and in the CSV (phases done, the failed phase, the totals).
+#[test]
+fn cycles_count_per_phase_in_summaries_junit_and_csv() {
+    let d = tmp("cycle");
+    let s = spec(vec![scenario("rack-pick-cycle.toml")], 30, 1);
+    let summary = batch::run_batch(&s, &d, 2, &|_| {}).expect("runs");
+    let row = &summary.rows[0];
+    let names: Vec<_> = row.phases.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["pick", "lift", "reverse_out"]);
+    let (pick, lift) = (&row.phases[0], &row.phases[1]);
+    assert_eq!((pick.attempted, pick.done), (30, row.successes));
+    assert_eq!((lift.attempted, lift.done), (row.successes, row.successes));
+    assert!(
+        row.successes < 30,
+        "some picks fail: the floor test needs one"
+    );
+    let cases = batch::junit::batch_cases(&summary, Some(0.99));
+    let failing: Vec<_> = cases
+        .iter()
+        .filter(|c| c.failure.is_some())
+        .map(|c| c.name.as_str())
+        .collect();
+    assert_eq!(cases.len(), 4);
+    assert_eq!(failing.len(), 2, "{failing:?}");
+    assert!(failing[1].ends_with("/ phase pick"), "{failing:?}");
+    let csv = d.join("trials.csv");
+    batch::write_csv(
+        &batch::read_records(&d.join("trials.jsonl")).expect("read"),
+        &csv,
+    )
+    .expect("csv");
+    let mut reader = csv::Reader::from_path(&csv).expect("csv written");
+    let header = reader.headers().expect("header").clone();
+    let col = |n: &str| header.iter().position(|h| h == n).expect(n);
+    let (done, failed) = (col("phases_done"), col("failed_phase"));
+    let (ok_col, loaded) = (col("success"), col("distance_loaded_m"));
+    for row in reader.records() {
+        let row = row.expect("a row");
+        let ok = &row[ok_col] == "true";
+        assert_eq!(&row[done], if ok { "3" } else { "0" }, "{row:?}");
+        assert_eq!(&row[failed], if ok { "" } else { "pick" }, "{row:?}");
+        let carried = row[loaded].parse::<f64>().expect("number") > 2.0;
+        assert_eq!(carried, ok, "{row:?}");
+    }
+}

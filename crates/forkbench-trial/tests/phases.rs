@@ -174,33 +174,31 @@ fn a_carried_pallet_is_placed_in_its_slot_and_the_truck_returns() {
     let out = run_trial(&scn, &scn.cases[0], &seed(5));
     assert!(out.success, "{}", out.verdict_line());
     let names: Vec<_> = out.phases.iter().map(|p| p.name.as_str()).collect();
-    assert_eq!(names, ["pick", "lift", "reverse_out", "place", "return"]);
-    let place = &out.phases[3];
-    assert!(place.loaded && place.success);
+    assert_eq!(
+        names,
+        ["pick", "lift", "reverse_out", "carry", "place", "return"]
+    );
+    let (carry, place, back) = (&out.phases[3], &out.phases[4], &out.phases[5]);
+    assert!(carry.loaded && place.loaded && !back.loaded);
     let m = &place.measures;
     assert!(m["position_error_m"] < 0.05 && m["heading_error_rad"].abs() < 2f64.to_radians());
-    assert!(m["clearance_m"] > 0.0 && m["clearance_m"] < 0.1, "{m:?}");
-    let back = &out.phases[4];
-    assert!(
-        !back.loaded && back.measures["final_position_error_m"] < 0.3,
-        "{back:?}"
-    );
-    // Loaded: backing out of bay 1 and driving to bay 2 (not the retract).
+    // The drop slot's pallet ends 0.3 m short of the north wall.
+    assert!(m["clearance_m"] > 0.2 && m["clearance_m"] < 0.4, "{m:?}");
+    assert!(back.measures["final_position_error_m"] < 0.3, "{back:?}");
+    // Loaded: the carry and the drive to the slot (not the retract).
     let cycle = out.cycle.expect("cycle totals");
-    let carried = out.phases[2].distance_m + out.phases[3].distance_m;
-    assert!(
-        cycle.distance_loaded_m > out.phases[2].distance_m && cycle.distance_loaded_m < carried
-    );
+    let carried = out.phases[2].distance_m + carry.distance_m + place.distance_m;
+    assert!(cycle.distance_loaded_m > carry.distance_m && cycle.distance_loaded_m < carried);
     assert!((cycle.time_s - out.sim_time_s).abs() < 1e-9);
     assert!(cycle.distance_unloaded_m > back.distance_m + out.phases[0].distance_m);
 }
 
-/// Bay 2 moved 2 m north of where the truck backs out to (a slot offset no path within
-/// the truck's curvature reaches): the place fails planning, naming the slot.
+/// The carry ends 2 m beside the drop slot's axis and 2.5 m before it: no path within
+/// the truck's curvature reaches the slot, and the place fails planning, naming it.
 #[test]
 fn a_slot_the_planner_cannot_reach_fails_the_place() {
-    let scn =
-        warehouse_cycle(|t| t.replace("distance_m = 5.0", "distance_m = 2.5")).expect("valid");
+    let scn = warehouse_cycle(|t| t.replace("x_m = 6.5, y_m = 19.0", "x_m = 8.5, y_m = 21.5"))
+        .expect("valid");
     let out = run_trial(&scn, &scn.cases[0], &seed(5));
     assert_eq!(
         out.failure,
@@ -210,33 +208,51 @@ fn a_slot_the_planner_cannot_reach_fails_the_place() {
     );
     let detail = out.failure_detail.as_deref().unwrap_or("");
     assert!(
-        detail.starts_with("place: to slot \"shelf-bay2\""),
+        detail.starts_with("place: to slot \"sorting-drop\""),
         "{detail}"
     );
-    assert_eq!(out.phases.len(), 4);
+    assert_eq!(out.phases.len(), 5);
 }
 
 #[test]
 fn places_that_cannot_be_are_refused_at_load() {
-    let cases = [
-        ("slot = \"shelf-bay2\"", "slot = \"bay9\"", "no such slot"),
-        ("slot = \"shelf-bay2\"", "", "slot: name"),
+    let without_carry = |t: String| {
+        let t = t.replace("[phase.reverse_out]\ndistance_m = 2.5\n", "");
+        let from = t.find("# The carry backs out").expect("carry settings");
+        let to = t.find("[phase.place]").expect("place settings");
+        format!("{}{}", &t[..from], &t[to..])
+    };
+    let cases: [(&str, &str, &str, bool); 5] = [
         (
-            "\"lift\", \"reverse_out\", \"place\"",
+            "slot = \"sorting-drop\"",
+            "slot = \"bay9\"",
+            "no such slot",
+            false,
+        ),
+        ("slot = \"sorting-drop\"", "", "slot: name", false),
+        (
+            "\"lift\", \"reverse_out\", \"carry\", \"place\"",
             "\"place\"",
             "cannot follow \"pick\"",
+            true,
         ),
         (
-            "\"lift\", \"reverse_out\"",
-            "\"reverse_out\"",
+            "\"lift\", \"reverse_out\", \"carry\"",
+            "\"reverse_out\", \"carry\"",
             "needs the pallet on the forks",
+            false,
+        ),
+        (
+            "pose = { x_m = 6.5",
+            "to = \"sorting\"\npose = { x_m = 6.5",
+            "not both",
+            false,
         ),
     ];
-    for (from, to, reason) in cases {
-        // Without a lift, the list's reverse_out settings stay and are refused first.
+    for (from, to, reason, drop_carry) in cases {
         let e = warehouse_cycle(|t| {
-            t.replace(from, to)
-                .replace("[phase.reverse_out]\ndistance_m = 5.0\n", "")
+            let t = t.replace(from, to);
+            if drop_carry { without_carry(t) } else { t }
         })
         .expect_err(to);
         assert!(e.contains(reason), "{to}: {e}");
@@ -257,7 +273,7 @@ fn places_that_cannot_be_are_refused_at_load() {
         "/../../scenarios/warehouse-cycle.toml"
     ))
     .expect("scenario")
-    .replace("slot = \"shelf-bay2\"", "slot = \"in-frame\"");
+    .replace("slot = \"sorting-drop\"", "slot = \"in-frame\"");
     let e = Scenario::parse(&text, "wc.toml", |_| Ok(inside.clone())).expect_err("in a rack");
     let e = e.to_string();
     assert!(

@@ -76,8 +76,16 @@ const KINDS: &[Kind] = &[
         defaults: reverse_out::defaults,
     },
     Kind {
-        name: "place",
+        name: "carry",
         after: &["lift", "reverse_out"],
+        needs_loaded: Some(true),
+        leaves_loaded: None,
+        build: return_leg::build_carry,
+        defaults: return_leg::defaults,
+    },
+    Kind {
+        name: "place",
+        after: &["lift", "reverse_out", "carry"],
         needs_loaded: Some(true),
         leaves_loaded: Some(false),
         build: place::build,
@@ -88,7 +96,7 @@ const KINDS: &[Kind] = &[
         after: &["place", "reverse_out"],
         needs_loaded: None,
         leaves_loaded: None,
-        build: return_leg::build,
+        build: return_leg::build_return,
         defaults: return_leg::defaults,
     },
 ];

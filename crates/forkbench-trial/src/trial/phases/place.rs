@@ -1,7 +1,7 @@
 //! The place phase: the truck carries the pallet into a drop slot along a pick planner's path, lowers it, and backs the forks out; judged on where the pallet stands against the slot.
 
-use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
+use forkbench_core::{Pose2, Signal, Style};
 use serde::{Deserialize, Serialize};
 
 use super::reverse_out::back_straight;
@@ -11,6 +11,12 @@ use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{World, pallet_footprint, shrunk};
 use crate::trial::setup::Trial;
+
+/// The slot's outline in recordings: cyan, so the placed (orange) pallet reads against it.
+const SLOT: Style = Style {
+    rgba: Some([0, 210, 230, 255]),
+    width_m: Some(0.03),
+};
 
 /// `[phase.place]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -163,6 +169,9 @@ impl Place {
             &plan.path,
             plan.control_polygon_m.as_deref(),
         );
+        let corners = pallet_footprint(&t.scn.pallet).corners(&self.at);
+        let outline: Vec<[f64; 2]> = corners.iter().chain(&corners[..1]).copied().collect();
+        rec.signal(time, "place/slot", &Signal::Path(&outline), SLOT);
         rec.event(
             time,
             Level::Info,

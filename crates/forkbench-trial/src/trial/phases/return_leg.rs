@@ -1,57 +1,79 @@
-//! The return phase: the last leg of the cycle, from where the truck stands back to a station (the charging station), planned and driven as a mission leg.
+//! Mission legs inside the cycle: `carry` (the load on the forks, to where a place begins) and `return` (back to a station, the charging station by default), planned and driven as mission legs.
 
+use forkbench_core::Pose2;
 use forkbench_nav::NavMap;
 use serde::{Deserialize, Serialize};
 
 use super::{Context, Failed, Phase, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
+use crate::scenario::PoseDeg;
 use crate::scenario::mission::Waypoint;
 use crate::trial::setup::Trial;
 
-/// `[phase.return]`.
+/// `[phase.carry]` and `[phase.return]`: where the leg goes.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-struct ReturnFile {
-    /// The world's station to drive to (default: the mission's start).
+struct LegFile {
+    /// The world's station to drive to (a return's default: the mission's start).
     to: Option<String>,
-    /// The heading to arrive with (default: the station's): a station whose own heading
-    /// only a reverse could reach is driven into forward from the other side.
+    /// Or a pose of the fork root to drive to.
+    pose: Option<PoseDeg>,
+    /// The heading to arrive with (default: the station's or the pose's): a station
+    /// whose own heading only a reverse could reach is driven into forward from the
+    /// other side.
     heading_deg: Option<f64>,
 }
 
-/// A resolved return: the station to drive to.
+/// A resolved leg phase: where it goes.
 #[derive(Debug)]
-struct Return {
+struct Leg {
     to: Waypoint,
 }
 
 pub(super) fn defaults() -> toml::Value {
-    toml::Value::try_from(ReturnFile::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
+    toml::Value::try_from(LegFile::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
 }
 
-pub(super) fn build(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
-    let cfg: ReturnFile = settings(table)?;
-    let mission = cx
-        .mission
+/// A `carry`: the destination is required.
+pub(super) fn build_carry(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
+    build(table, cx, None)
+}
+
+/// A `return`: by default to the mission's start (the charging station).
+pub(super) fn build_return(
+    table: &toml::Table,
+    cx: &Context<'_>,
+) -> Result<Box<dyn Phase>, String> {
+    let start = cx.mission.map(|m| m.start.clone());
+    build(table, cx, start)
+}
+
+fn build(
+    table: &toml::Table,
+    cx: &Context<'_>,
+    default: Option<Waypoint>,
+) -> Result<Box<dyn Phase>, String> {
+    let cfg: LegFile = settings(table)?;
+    cx.mission
         .ok_or("needs a [mission] table: its global planner and tracker drive the leg")?;
-    let mut to = match cfg.to {
-        None => mission.start.clone(),
-        Some(name) => {
-            let s = cx
-                .world
-                .station
+    let mut to = match (&cfg.to, &cfg.pose) {
+        (Some(_), Some(_)) => return Err("give `to` (a station) or `pose`, not both".into()),
+        (Some(name), None) => station(cx, name)?,
+        (None, Some(p)) => {
+            let pose = p.to_pose();
+            if ![pose.x_m, pose.y_m, pose.heading_rad]
                 .iter()
-                .find(|s| s.name == name)
-                .ok_or_else(|| {
-                    let known: Vec<_> = cx.world.station.iter().map(|s| s.name.as_str()).collect();
-                    format!("to: no station {name:?} in the world (it has {known:?})")
-                })?;
+                .all(|v| v.is_finite())
+            {
+                return Err("pose must be finite".into());
+            }
             Waypoint {
-                name,
-                pose: forkbench_core::Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()),
+                name: format!("({:.1}, {:.1})", p.x_m, p.y_m),
+                pose,
             }
         }
+        (None, None) => default.ok_or("name where to drive: `to` (a station) or `pose`")?,
     };
     if let Some(h) = cfg.heading_deg {
         if !(h.is_finite() && h.abs() <= 360.0) {
@@ -59,10 +81,27 @@ pub(super) fn build(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Pha
         }
         to.pose.heading_rad = h.to_radians();
     }
-    Ok(Box::new(Return { to }))
+    Ok(Box::new(Leg { to }))
 }
 
-impl Phase for Return {
+/// The world's station `name` as a waypoint.
+fn station(cx: &Context<'_>, name: &str) -> Result<Waypoint, String> {
+    let s = cx
+        .world
+        .station
+        .iter()
+        .find(|s| s.name == name)
+        .ok_or_else(|| {
+            let known: Vec<_> = cx.world.station.iter().map(|s| s.name.as_str()).collect();
+            format!("to: no station {name:?} in the world (it has {known:?})")
+        })?;
+    Ok(Waypoint {
+        name: name.to_owned(),
+        pose: Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()),
+    })
+}
+
+impl Phase for Leg {
     fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
         let scn = t.scn;
         let m = scn
@@ -72,12 +111,14 @@ impl Phase for Return {
         let map = NavMap::shared_from_world(&t.obstacles, m.global.resolution_m)
             .map_err(|e| (Failure::Error, e.to_string()))?;
         let here = Waypoint {
-            name: "the drop".to_owned(),
+            name: "here".to_owned(),
             pose: t.sim.fork_root_pose(),
         };
-        // Numbered after the mission's legs (its seed and recorded route are its own); a
-        // leg after the first backs out of where it starts, as from a station.
-        let leg = t.leg(&map, m, (m.via.len() + 1, &here, &self.to), rec);
+        // Numbered after the mission's legs and the cycle's earlier ones (its seed and
+        // recorded route are its own); a leg after the first backs out of where it
+        // starts, as from a station.
+        let number = m.via.len() + 1 + t.out.phases.len();
+        let leg = t.leg(&map, m, (number, &here, &self.to), rec);
         let measures = [
             ("planned_length_m", leg.planned_length_m),
             ("final_position_error_m", leg.final_position_error_m),
