@@ -4,8 +4,8 @@ use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 use rand_chacha::ChaCha8Rng;
 
+use super::criteria::Judged;
 use super::setup::Trial;
-use crate::outcome::Failure;
 use crate::text::compact_numbers;
 
 /// The pallet pose moved by a draw of N(0, σ) per axis in its own frame, truncated at 3σ.
@@ -50,7 +50,17 @@ impl Trial<'_> {
             // Lateral position of the fork's middle in the pallet frame, against its pocket.
             .map(|(mid, py)| (pallet_now.to_local(mid).y_m - py).abs())
             .fold(0.0, f64::max);
-        let mut broken = violations(self, worst_pocket_miss).into_iter();
+        let judged = Judged {
+            out: &self.out,
+            tol: &self.scn.tolerances,
+            truck,
+            pallet: &self.scn.pallet,
+            collision: self.collision,
+            timed_out: self.timed_out,
+            timeout_s: self.scn.timeout_s,
+            worst_pocket_miss_m: worst_pocket_miss,
+        };
+        let mut broken = super::criteria::broken(&judged).into_iter();
         match broken.next() {
             Some((f, why)) => {
                 self.out.also_failed = broken
@@ -85,84 +95,4 @@ fn likely_cause(t: &Trial<'_>) -> Option<String> {
             truck.max_steer_rad.to_degrees()
         )
     })
-}
-
-/// Every failed criterion, in check order (the first is the verdict), each with its value
-/// and limit.
-fn violations(t: &Trial<'_>, worst_pocket_miss: f64) -> Vec<(Failure, String)> {
-    let mut v = Vec::new();
-    let (out, tol, truck) = (&t.out, &t.scn.tolerances, &t.scn.truck);
-    let clearance = (t.scn.pallet.pocket_width_m - truck.fork_width_m) / 2.0;
-    if t.collision {
-        v.push((
-            Failure::Collision,
-            "truck touched a rack or wall".to_owned(),
-        ));
-    }
-    if out.max_contact_force_n > tol.contact_force_n {
-        v.push((
-            Failure::ContactForce,
-            format!(
-                "fork–pallet contact {:.0} N > {:.0} N before full depth",
-                out.max_contact_force_n, tol.contact_force_n
-            ),
-        ));
-    }
-    if out.pallet_displacement_m > tol.pallet_displacement_m
-        || out.pallet_rotation_rad.abs() > tol.pallet_rotation_rad
-    {
-        v.push((
-            Failure::PalletDisplaced,
-            format!(
-                "pallet moved {:.3} m and turned {:.2}° (limits {} m, {}°)",
-                out.pallet_displacement_m,
-                out.pallet_rotation_rad.to_degrees(),
-                tol.pallet_displacement_m,
-                tol.pallet_rotation_deg()
-            ),
-        ));
-    }
-    if let Some(e) = out.lateral_error_m.filter(|e| e.abs() > tol.lateral_m) {
-        v.push((
-            Failure::LateralError,
-            format!(
-                "{e:.3} m off the pocket centre line at entry (limit {} m)",
-                tol.lateral_m
-            ),
-        ));
-    }
-    if let Some(e) = out.heading_error_rad.filter(|e| e.abs() > tol.heading_rad) {
-        v.push((
-            Failure::HeadingError,
-            format!(
-                "{:.2}° off the pallet axis at entry (limit {}°)",
-                e.to_degrees(),
-                tol.heading_deg()
-            ),
-        ));
-    }
-    if t.timed_out {
-        v.push((
-            Failure::Timeout,
-            format!("not stopped at the goal after {} s", t.scn.timeout_s),
-        ));
-    }
-    if out.insertion_depth_m < tol.insertion_depth_m {
-        v.push((
-            Failure::InsertionDepth,
-            format!(
-                "forks {:.3} m deep (required {} m)",
-                out.insertion_depth_m, tol.insertion_depth_m
-            ),
-        ));
-    }
-    if worst_pocket_miss > clearance {
-        v.push((
-            Failure::ForkOutsidePocket,
-            format!(
-                "a fork is {worst_pocket_miss:.3} m from its pocket centre (clearance {clearance:.4} m)"
-            ),
-        ));
-    }
-    v
 }

@@ -1,6 +1,7 @@
 //! One pick trial as named stages: setup, plan, drive (with replans), judge.
 
 pub mod accuracy;
+mod criteria;
 mod drive;
 mod error;
 mod judge;
@@ -23,6 +24,7 @@ use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
+pub use criteria::{Criterion, PICK_CRITERIA};
 pub use look::{ScanReport, scan_once};
 pub use phases::{
     Context as PhaseContext, PICK, PhaseSpec, phase_defaults, resolve as phases_resolve,
