@@ -130,7 +130,7 @@ fn phase_lists_that_cannot_run_are_refused_at_load() {
         ),
         (
             line("phases = [\"pick\", \"lift\"]\n[phase.lift]\ntime_s = -1.0\n"),
-            "phase.lift",
+            "cycle.toml:15: field `phase.lift`",
             "time_s",
         ),
         (
@@ -155,7 +155,7 @@ fn phase_lists_that_cannot_run_are_refused_at_load() {
     let heavy = cycle(|t| t.replace("payload_kg = 800.0", "payload_kg = 3500.0"));
     let e = heavy.expect_err("over the rating");
     assert!(
-        e.contains("payload_kg") && e.contains("rated_capacity_kg"),
+        e.contains("cycle.toml:11:") && e.contains("payload_kg") && e.contains("rated_capacity_kg"),
         "{e}"
     );
 }

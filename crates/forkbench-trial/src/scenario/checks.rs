@@ -153,23 +153,41 @@ pub(super) fn resolve_phases(
         mission,
     };
     crate::trial::phases_resolve(&list, &f.phase, &cx).map_err(|(field, reason)| {
-        let at = names.map_or(0, |n| n.span().start);
-        let line = text[..at.min(text.len())].matches('\n').count() + 1;
-        let file = if names.is_some() {
-            format!("{file}:{line}")
-        } else {
-            file.to_owned()
+        // A phase's settings are at their table's header; the list's errors at the list.
+        let at = match field.split_once('.') {
+            Some(("phase", name)) => at_line(file, text, &format!("[phase.{name}]")),
+            _ => names.map_or_else(
+                || file.to_owned(),
+                |n| {
+                    let line = text[..n.span().start.min(text.len())].matches('\n').count();
+                    format!("{file}:{}", line + 1)
+                },
+            ),
         };
-        invalid(&file, &field, &reason)
+        invalid(&at, &field, &reason)
     })
+}
+
+/// `file:line` of the first line that writes `key` (a key before its `=`, or a table
+/// header), else `file` alone.
+fn at_line(file: &str, text: &str, key: &str) -> String {
+    text.lines()
+        .position(|l| {
+            l.trim_start().strip_prefix(key).is_some_and(|rest| {
+                let rest = rest.trim_start();
+                rest.is_empty() || rest.starts_with(['=', '#'])
+            })
+        })
+        .map_or_else(|| file.to_owned(), |i| format!("{file}:{}", i + 1))
 }
 
 /// The pallet's payload: a mass, and with the pallet no more than the truck may lift.
 pub(super) fn check_payload(
     truck: &ForkliftSpec,
     pallet: &PalletSpec,
-    file: &str,
+    (file, text): (&str, &str),
 ) -> Result<(), TrialError> {
+    let file = &at_line(file, text, "payload_kg");
     if !(pallet.payload_kg.is_finite() && pallet.payload_kg >= 0.0) {
         return Err(invalid(
             file,

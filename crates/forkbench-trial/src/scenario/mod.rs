@@ -242,7 +242,7 @@ impl Scenario {
             PalletKind::Sim1000 => PalletSpec::sim_1000(),
         }
         .with_payload(f.payload_kg);
-        checks::check_payload(&f.truck, &pallet, file)?;
+        checks::check_payload(&f.truck, &pallet, (file, text))?;
         checks::check_geometry(&f, &pallet, file)?;
         let cases = resolve_cases(&f, &world, &pallet, file)?;
         let mission = match &f.mission {
