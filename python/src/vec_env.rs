@@ -42,8 +42,6 @@ impl Slot {
     }
 
     fn step(&mut self, s: &Setup, control: Control, obs: &mut [f32]) -> StepOut {
-        // A new episode's first step is never its last: one that ended before driving
-        // (no plan) terminates on the step after.
         // An episode that ended before driving (no plan) terminates on the step after its
         // reset, as in the single environment.
         let out = if self.pending_reset {

@@ -184,10 +184,10 @@ impl Sim {
 
         let (truck, chassis, forks, chassis_centre) = insert_truck(&mut world, spec, start, cfg);
         let truck_mass_kg = spec.mass_kg;
-        // The pallet stands on the floor with its payload.
         let truck_inertia =
             spec.mass_kg * (spec.body_length_m.powi(2) + spec.body_width_m.powi(2)) / 12.0;
         let (pallet, stringers) = insert_pallet(&mut world, pallet_spec, pallet_pose, cfg);
+        // The pallet stands on the floor with its payload.
         let pallet_inertia = pallet_spec.loaded_mass_kg()
             * (pallet_spec.depth_m.powi(2) + pallet_spec.width_m.powi(2))
             / 12.0;

@@ -68,6 +68,11 @@ impl Sim {
         self.peak_load_accel_mps2
     }
 
+    /// The largest acceleration a carried load's friction on the forks holds (μ g).
+    pub fn load_grip_mps2(&self) -> f64 {
+        self.cfg.fork_friction * G_MPS2
+    }
+
     /// Static normal loads on the front (drive) and rear (steer) axles, from where the
     /// centre of mass of the truck and whatever it carries sits between them.
     pub fn axle_loads_n(&self) -> [f64; 2] {
@@ -99,9 +104,7 @@ impl Sim {
             });
         }
         let on_forks = axle.to_local(&pallet);
-        let load_centre_ahead_m = on_forks
-            .to_world(&Pose2::new(self.pallet_spec.depth_m / 2.0, 0.0, 0.0))
-            .x_m;
+        let load_centre_ahead_m = self.load_centre(&on_forks).x_m;
         let m = self.truck_mass_kg;
         let ahead_m = (m * self.com_ahead_m + load_kg * load_centre_ahead_m) / (m + load_kg);
         if ahead_m >= 0.0 {
@@ -152,10 +155,7 @@ impl Sim {
 
     /// Re-parents the stringers to `body`, placing the pallet face at `face` in its frame.
     fn move_stringers(&mut self, body: RigidBodyHandle, face: &Pose2) {
-        let ps = &self.pallet_spec;
-        let centres = ps
-            .stringer_offsets_m()
-            .map(|y| face.to_world(&Pose2::new(ps.depth_m / 2.0, y, 0.0)));
+        let centres = self.pallet_spec.stringer_centres(face);
         for (&s, centre) in self.stringers.iter().zip(centres) {
             let colliders = &mut self.world.colliders;
             colliders.set_parent(s, Some(body), &mut self.world.bodies);
@@ -174,13 +174,14 @@ impl Sim {
         self.com_ahead_m = f64::from(props.local_com.x);
     }
 
+    /// The centre of a pallet (where its load sits) whose face is at `face`.
+    fn load_centre(&self, face: &Pose2) -> Pose2 {
+        face.to_world(&Pose2::new(self.pallet_spec.depth_m / 2.0, 0.0, 0.0))
+    }
+
     /// World velocity of the carried load's centre.
     fn load_velocity(&self, c: &Carried) -> [f64; 2] {
-        let centre = c.pallet_pose(&self.front_axle_pose()).to_world(&Pose2::new(
-            self.pallet_spec.depth_m / 2.0,
-            0.0,
-            0.0,
-        ));
+        let centre = self.load_centre(&c.pallet_pose(&self.front_axle_pose()));
         let v = self.world.bodies[self.truck].velocity_at_point(v2(centre.x_m, centre.y_m));
         [f64::from(v.x), f64::from(v.y)]
     }
@@ -196,7 +197,7 @@ impl Sim {
         self.peak_load_accel_mps2 = self.peak_load_accel_mps2.max(accel);
         c.last_velocity_mps = v;
         self.carried = Some(c);
-        if accel > self.cfg.fork_friction * G_MPS2 {
+        if accel > self.load_grip_mps2() {
             self.load_shifted = true;
             self.lower();
         }

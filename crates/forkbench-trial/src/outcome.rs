@@ -158,7 +158,8 @@ pub struct CycleTotals {
     pub distance_unloaded_m: f64,
 }
 
-/// One phase of the handling cycle: the pick, or one after it (lift, reverse out).
+/// One phase of the handling cycle: the pick, or one after it (lift, reverse out, carry,
+/// place, return).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PhaseOutcome {
     pub name: String,

@@ -188,11 +188,12 @@ pub(super) fn check_payload(
     (file, text): (&str, &str),
 ) -> Result<(), TrialError> {
     let file = &at_line(file, text, "payload_kg");
-    if !(pallet.payload_kg.is_finite() && pallet.payload_kg >= 0.0) {
+    // The pallet kinds are fixed and valid: only the payload can fail here.
+    if let Err(e) = pallet.validate() {
         return Err(invalid(
             file,
-            "payload_kg",
-            &format!("must be a finite mass ≥ 0 kg (got {})", pallet.payload_kg),
+            e.field.as_deref().unwrap_or("payload_kg"),
+            &e.reason,
         ));
     }
     if pallet.loaded_mass_kg() > truck.rated_capacity_kg {
@@ -254,18 +255,13 @@ fn place(p: &PalletPlacement, world: &World, file: &str, field: &str) -> Result<
             pd.check(file, field)?;
             Ok(pd.to_pose())
         }
-        PalletPlacement::Slot { slot } => world
-            .pallet_slot
-            .iter()
-            .find(|s| &s.name == slot)
-            .map(|s| Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()))
-            .ok_or_else(|| {
-                invalid(
-                    file,
-                    &format!("{field}.slot"),
-                    &format!("world has no pallet slot {slot:?}"),
-                )
-            }),
+        PalletPlacement::Slot { slot } => world.slot_pose(slot).ok_or_else(|| {
+            invalid(
+                file,
+                &format!("{field}.slot"),
+                &format!("world has no pallet slot {slot:?}"),
+            )
+        }),
     }
 }
 

@@ -160,7 +160,7 @@ pub(super) struct ScenarioFile {
     #[serde(default)]
     pub(super) case: Vec<CaseFile>,
     /// The handling cycle: `"pick"`, then the phases after it (`"lift"`,
-    /// `"reverse_out"`), in order; none is the pick alone.
+    /// `"reverse_out"`, `"carry"`, `"place"`, `"return"`), in order; none is the pick alone.
     pub(super) phases: Option<toml::Spanned<Vec<String>>>,
     /// Settings of listed phases, `[phase.NAME]`.
     #[serde(default)]

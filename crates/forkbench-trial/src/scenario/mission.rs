@@ -149,12 +149,10 @@ impl MissionFile {
                     })
                 }
                 Place::Station(name) => world
-                    .station
-                    .iter()
-                    .find(|s| &s.name == name)
-                    .map(|s| Waypoint {
+                    .station_pose(name)
+                    .map(|pose| Waypoint {
                         name: name.clone(),
-                        pose: Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()),
+                        pose,
                     })
                     .ok_or_else(|| {
                         let known: Vec<_> = world.station.iter().map(|s| s.name.as_str()).collect();

@@ -85,6 +85,12 @@ pub struct PalletSlot {
     pub heading_deg: f64,
 }
 
+impl PalletSlot {
+    pub fn pose(&self) -> Pose2 {
+        Pose2::new(self.x_m, self.y_m, self.heading_deg.to_radians())
+    }
+}
+
 /// A warehouse layout.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -288,6 +294,22 @@ impl World {
             }
         }
         (obstacles, labels)
+    }
+
+    /// The pose of the pallet slot `name`.
+    pub fn slot_pose(&self, name: &str) -> Option<Pose2> {
+        self.pallet_slot
+            .iter()
+            .find(|s| s.name == name)
+            .map(PalletSlot::pose)
+    }
+
+    /// The pose of the station `name`.
+    pub fn station_pose(&self, name: &str) -> Option<Pose2> {
+        self.station
+            .iter()
+            .find(|s| s.name == name)
+            .map(PalletSlot::pose)
     }
 
     /// Racks and walls as simulator obstacles.

@@ -23,7 +23,7 @@ pub(super) fn every_step(t: &Trial<'_>) -> Result<(), Failed> {
 /// friction on them holds (μ g).
 pub(super) fn load_held(t: &Trial<'_>) -> Result<(), Failed> {
     if t.sim.load_shifted() {
-        let limit = t.scn.sim.fork_friction * 9.81;
+        let limit = t.sim.load_grip_mps2();
         return Err((
             Failure::LoadShifted,
             format!(

@@ -2,7 +2,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::run::open_loop;
 use super::{Context, Failed, Phase, criteria, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
@@ -11,7 +10,7 @@ use crate::trial::setup::Trial;
 /// `[phase.lift]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-struct Lift {
+pub(super) struct Lift {
     /// Time the mast takes to raise the pallet clear of the floor.
     time_s: f64,
 }
@@ -20,10 +19,6 @@ impl Default for Lift {
     fn default() -> Self {
         Self { time_s: 2.0 }
     }
-}
-
-pub(super) fn defaults() -> toml::Value {
-    toml::Value::try_from(Lift::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
 }
 
 pub(super) fn build(table: &toml::Table, _cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
@@ -39,10 +34,7 @@ impl Phase for Lift {
         t.sim
             .lift()
             .map_err(|e| (Failure::LiftFailed, e.to_string()))?;
-        let end_s = t.sim.time_s() + self.time_s;
-        t.drive_by(self.time_s + 1.0, rec, |t, pose| {
-            Ok((t.sim.time_s() < end_s).then(|| open_loop(0.0, t.sim.steer_rad(), &pose)))
-        })?;
+        t.stand_for(self.time_s, rec)?;
         criteria::load_held(t)
     }
 }

@@ -1,4 +1,4 @@
-//! The phases after the pick (lift, reverse out): each a unit with its own settings and criteria, built by name from a scenario's `phases` list.
+//! The phases after the pick (lift, reverse out, carry, place, return): each a unit with its own settings and criteria, built by name from a scenario's `phases` list.
 
 mod criteria;
 mod lift;
@@ -65,7 +65,7 @@ const KINDS: &[Kind] = &[
         needs_loaded: Some(false),
         leaves_loaded: Some(true),
         build: lift::build,
-        defaults: lift::defaults,
+        defaults: defaults_of::<lift::Lift>,
     },
     Kind {
         name: "reverse_out",
@@ -73,7 +73,7 @@ const KINDS: &[Kind] = &[
         needs_loaded: None,
         leaves_loaded: None,
         build: reverse_out::build,
-        defaults: reverse_out::defaults,
+        defaults: defaults_of::<reverse_out::ReverseOut>,
     },
     Kind {
         name: "carry",
@@ -81,7 +81,7 @@ const KINDS: &[Kind] = &[
         needs_loaded: Some(true),
         leaves_loaded: None,
         build: return_leg::build_carry,
-        defaults: return_leg::defaults,
+        defaults: defaults_of::<return_leg::LegFile>,
     },
     Kind {
         name: "place",
@@ -89,7 +89,7 @@ const KINDS: &[Kind] = &[
         needs_loaded: Some(true),
         leaves_loaded: Some(false),
         build: place::build,
-        defaults: place::defaults,
+        defaults: defaults_of::<place::PlaceFile>,
     },
     Kind {
         name: "return",
@@ -97,7 +97,7 @@ const KINDS: &[Kind] = &[
         needs_loaded: None,
         leaves_loaded: None,
         build: return_leg::build_return,
-        defaults: return_leg::defaults,
+        defaults: defaults_of::<return_leg::LegFile>,
     },
 ];
 
@@ -173,6 +173,23 @@ fn runnable(prev: &str, name: &str, loaded: bool) -> Result<&'static Kind, Strin
         Some(false) if loaded => Err(format!("{name:?} needs empty forks")),
         _ => Ok(kind),
     }
+}
+
+/// A settings struct at its defaults as a TOML table (for the format document).
+fn defaults_of<T: Serialize + Default>() -> toml::Value {
+    toml::Value::try_from(T::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
+}
+
+/// Each `(name, value, max)` a positive finite number of at most `max`.
+pub(crate) fn positive_at_most(fields: &[(&str, f64, f64)]) -> Result<(), String> {
+    for &(name, v, max) in fields {
+        if !(v.is_finite() && v > 0.0 && v <= max) {
+            return Err(format!(
+                "{name} must be positive and at most {max} (got {v})"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A phase's settings from its table, refusing unknown keys; `check` then the values.

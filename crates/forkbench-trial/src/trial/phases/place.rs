@@ -5,8 +5,7 @@ use forkbench_core::{Pose2, Signal, Style};
 use serde::{Deserialize, Serialize};
 
 use super::reverse_out::back_straight;
-use super::run::open_loop;
-use super::{Context, Failed, Phase, criteria, settings};
+use super::{Context, Failed, Phase, criteria, positive_at_most, settings};
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{World, pallet_footprint, shrunk};
@@ -21,7 +20,7 @@ const SLOT: Style = Style {
 /// `[phase.place]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-struct PlaceFile {
+pub(super) struct PlaceFile {
     /// The world's pallet slot to place at (required).
     slot: Option<String>,
     /// How far the placed pallet's face centre may stand from the slot's.
@@ -61,25 +60,15 @@ struct Place {
     cfg: PlaceFile,
 }
 
-pub(super) fn defaults() -> toml::Value {
-    toml::Value::try_from(PlaceFile::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
-}
-
 pub(super) fn build(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
     let cfg: PlaceFile = settings(table)?;
-    for (name, v, max) in [
+    positive_at_most(&[
         ("position_m", cfg.position_m, 10.0),
         ("heading_deg", cfg.heading_deg, 180.0),
         ("lower_time_s", cfg.lower_time_s, 60.0),
         ("retract_m", cfg.retract_m, 50.0),
         ("timeout_s", cfg.timeout_s, 600.0),
-    ] {
-        if !(v.is_finite() && v > 0.0 && v <= max) {
-            return Err(format!(
-                "{name} must be positive and at most {max} (got {v})"
-            ));
-        }
-    }
+    ])?;
     if !(cfg.stop_short_m.is_finite() && (0.0..=1.0).contains(&cfg.stop_short_m)) {
         return Err(format!(
             "stop_short_m must lie in 0–1 m (got {})",
@@ -103,18 +92,13 @@ pub(super) fn build(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Pha
 
 /// The pose of the world's slot `name` (its face centre, heading into the rack).
 fn slot_pose(world: &World, name: &str) -> Result<Pose2, String> {
-    world
-        .pallet_slot
-        .iter()
-        .find(|s| s.name == name)
-        .map(|s| Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()))
-        .ok_or_else(|| {
-            let known: Vec<_> = world.pallet_slot.iter().map(|s| s.name.as_str()).collect();
-            format!(
-                "slot {name:?}: the world has no such slot (slots: {})",
-                known.join(", ")
-            )
-        })
+    world.slot_pose(name).ok_or_else(|| {
+        let known: Vec<_> = world.pallet_slot.iter().map(|s| s.name.as_str()).collect();
+        format!(
+            "slot {name:?}: the world has no such slot (slots: {})",
+            known.join(", ")
+        )
+    })
 }
 
 impl Phase for Place {
@@ -124,10 +108,7 @@ impl Phase for Place {
         }
         self.approach(t, rec)?;
         t.sim.lower();
-        let end_s = t.sim.time_s() + self.cfg.lower_time_s;
-        t.drive_by(self.cfg.lower_time_s + 1.0, rec, |t, pose| {
-            Ok((t.sim.time_s() < end_s).then(|| open_loop(0.0, t.sim.steer_rad(), &pose)))
-        })?;
+        t.stand_for(self.cfg.lower_time_s, rec)?;
         let placed = t.sim.pallet_pose();
         self.measure(t, &placed);
         back_straight(t, (self.cfg.retract_m, 0.5, 30.0), rec)?;

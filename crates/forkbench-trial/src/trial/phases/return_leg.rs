@@ -1,6 +1,5 @@
 //! Mission legs inside the cycle: `carry` (the load on the forks, to where a place begins) and `return` (back to a station, the charging station by default), planned and driven as mission legs.
 
-use forkbench_core::Pose2;
 use forkbench_nav::NavMap;
 use serde::{Deserialize, Serialize};
 
@@ -14,7 +13,7 @@ use crate::trial::setup::Trial;
 /// `[phase.carry]` and `[phase.return]`: where the leg goes.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-struct LegFile {
+pub(super) struct LegFile {
     /// The world's station to drive to (a return's default: the mission's start).
     to: Option<String>,
     /// Or a pose of the fork root to drive to.
@@ -29,10 +28,6 @@ struct LegFile {
 #[derive(Debug)]
 struct Leg {
     to: Waypoint,
-}
-
-pub(super) fn defaults() -> toml::Value {
-    toml::Value::try_from(LegFile::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
 }
 
 /// A `carry`: the destination is required.
@@ -86,18 +81,13 @@ fn build(
 
 /// The world's station `name` as a waypoint.
 fn station(cx: &Context<'_>, name: &str) -> Result<Waypoint, String> {
-    let s = cx
-        .world
-        .station
-        .iter()
-        .find(|s| s.name == name)
-        .ok_or_else(|| {
-            let known: Vec<_> = cx.world.station.iter().map(|s| s.name.as_str()).collect();
-            format!("to: no station {name:?} in the world (it has {known:?})")
-        })?;
+    let pose = cx.world.station_pose(name).ok_or_else(|| {
+        let known: Vec<_> = cx.world.station.iter().map(|s| s.name.as_str()).collect();
+        format!("to: no station {name:?} in the world (it has {known:?})")
+    })?;
     Ok(Waypoint {
         name: name.to_owned(),
-        pose: Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians()),
+        pose,
     })
 }
 

@@ -4,7 +4,7 @@ use forkbench_core::Pose2;
 use serde::{Deserialize, Serialize};
 
 use super::run::open_loop;
-use super::{Context, Failed, Phase, criteria, settings};
+use super::{Context, Failed, Phase, criteria, positive_at_most, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 use crate::trial::setup::Trial;
@@ -12,7 +12,7 @@ use crate::trial::setup::Trial;
 /// `[phase.reverse_out]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-struct ReverseOut {
+pub(super) struct ReverseOut {
     /// How far the fork root backs out (by the controller's pose).
     distance_m: f64,
     speed_mps: f64,
@@ -30,23 +30,13 @@ impl Default for ReverseOut {
     }
 }
 
-pub(super) fn defaults() -> toml::Value {
-    toml::Value::try_from(ReverseOut::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
-}
-
 pub(super) fn build(table: &toml::Table, _cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
     let r: ReverseOut = settings(table)?;
-    for (name, v, max) in [
+    positive_at_most(&[
         ("distance_m", r.distance_m, 50.0),
         ("speed_mps", r.speed_mps, 3.0),
         ("timeout_s", r.timeout_s, 600.0),
-    ] {
-        if !(v.is_finite() && v > 0.0 && v <= max) {
-            return Err(format!(
-                "{name} must be positive and at most {max} (got {v})"
-            ));
-        }
-    }
+    ])?;
     Ok(Box::new(r))
 }
 
@@ -80,7 +70,7 @@ pub(super) fn back_straight(
             // Slows over the last metres so the truck stands near the distance.
             Some(open_loop(-speed_mps.min(0.05 + 1.5 * left_m), 0.0, &pose))
         } else {
-            (t.sim.speed_mps().abs() >= 0.01).then(|| open_loop(0.0, 0.0, &pose))
+            (!t.stands()).then(|| open_loop(0.0, 0.0, &pose))
         })
     })?;
     if finished {

@@ -127,6 +127,16 @@ impl Trial<'_> {
         self.out.phases.push(done);
     }
 
+    /// Holds the truck standing (steering where it is) for `time_s`, as while the mast
+    /// lifts or lowers; the every-step criteria still hold.
+    pub(crate) fn stand_for(&mut self, time_s: f64, rec: &mut dyn Recorder) -> Result<(), Failed> {
+        let end_s = self.sim.time_s() + time_s;
+        self.drive_by(time_s + 1.0, rec, |t, pose| {
+            Ok((t.sim.time_s() < end_s).then(|| open_loop(0.0, t.sim.steer_rad(), &pose)))
+        })?;
+        Ok(())
+    }
+
     /// Steps the truck under `command` (from the controller's pose) until it returns
     /// `None` (Ok(true)), `limit_s` passes (Ok(false)), it fails, or a criterion every
     /// phase holds at every step breaks (Err).
