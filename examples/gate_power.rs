@@ -53,7 +53,7 @@ fn run(s: Scenario, trials: u64, seed: u64) -> (Summary, Vec<TrialRecord>) {
         trials,
         seed,
         shard: (0, 1),
-        pallet_noise_scale: None,
+        overrides: Default::default(),
         replan: None,
         compare_replanning: false,
         force_new: false,

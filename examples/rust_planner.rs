@@ -151,7 +151,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         trials: 50,
         seed: 1,
         shard: (0, 1),
-        pallet_noise_scale: None,
+        overrides: Default::default(),
         replan: None,
         compare_replanning: false,
         force_new: true,

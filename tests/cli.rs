@@ -508,7 +508,7 @@ fn batch_input_errors_are_clear() {
         (&["--sweep", "pallet_noise=1,x"], "\"x\" is not a number"),
         (
             &["--pallet-noise-scale", "-1"],
-            "must be a finite number ≥ 0",
+            "pallet_noise_scale`: -1 must be a number from 0 to 100",
         ),
     ];
     for (extra, message) in cases {

@@ -4,7 +4,7 @@
 It validates every line forkbench sends against docs/schemas/detector-request.schema.json
 and every answer of the example RANSAC detector against detector-response.schema.json,
 and exits with a message on the first violation (the trial then ends as an error, which
-`.ci/run` sees). Needs `pip install jsonschema numpy`. Run by tools/schema-check-detector.toml.
+`.ci/run` sees). Needs `pip install jsonschema`. Run by tools/schema-check-detector.toml.
 """
 import sys
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """A pallet detector for forkbench in Python: RANSAC line fit on the scan points near
 where the pallet should be, stringer faces clustered along that line, face centre chosen
-to match the pallet's stringer spacing.
+to match the pallet's stringer spacing. Standard library only, so it runs wherever
+python3 does.
 
 Protocol (docs/external-detector.md): JSON lines on stdin/stdout. First line each way is a
 hello; then one answer per "detect" request: {"type": "pallet", "id", "face": pose} or
@@ -12,9 +13,8 @@ the answer is a function of the request alone (whichever process or thread serve
 """
 import json
 import math
+import random
 import sys
-
-import numpy as np
 
 PROTOCOL, VERSION = "forkbench-detector", 1
 ROI_M = 1.0          # points further than this from the prior face are not this pallet
@@ -25,39 +25,52 @@ SPACING_TOL_M = 0.08
 
 
 def points_of(scan):
-    """The scan's returns as map points (a numpy array of shape (n, 2))."""
+    """The scan's returns as map points, a list of (x, y)."""
     p = scan["pose"]
-    r = np.array([np.nan if v is None else v for v in scan["ranges_m"]], dtype=float)
-    a = p["heading_rad"] + scan["angle_min_rad"] + scan["angle_step_rad"] * np.arange(len(r))
-    ok = np.isfinite(r)
-    return np.stack([p["x_m"] + r[ok] * np.cos(a[ok]), p["y_m"] + r[ok] * np.sin(a[ok])], axis=1)
+    out = []
+    for i, r in enumerate(scan["ranges_m"]):
+        if r is None or not math.isfinite(r):
+            continue
+        a = p["heading_rad"] + scan["angle_min_rad"] + scan["angle_step_rad"] * i
+        out.append((p["x_m"] + r * math.cos(a), p["y_m"] + r * math.sin(a)))
+    return out
+
+
+def principal_axis(q):
+    """Centroid and unit direction of largest spread of points q (a 2 x 2 eigenproblem)."""
+    n = len(q)
+    cx = sum(x for x, _ in q) / n
+    cy = sum(y for _, y in q) / n
+    sxx = sum((x - cx) ** 2 for x, _ in q)
+    syy = sum((y - cy) ** 2 for _, y in q)
+    sxy = sum((x - cx) * (y - cy) for x, y in q)
+    angle = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
+    return (cx, cy), (math.cos(angle), math.sin(angle))
 
 
 def ransac_line(pts, rng):
     """The line (point, unit direction) with the most inliers, refit by least squares."""
     best = None
     for _ in range(ITERATIONS):
-        i, j = rng.choice(len(pts), size=2, replace=False)
-        d = pts[j] - pts[i]
-        n = np.linalg.norm(d)
+        i, j = rng.sample(range(len(pts)), 2)
+        dx, dy = pts[j][0] - pts[i][0], pts[j][1] - pts[i][1]
+        n = math.hypot(dx, dy)
         if n < 0.05:
             continue
-        d = d / n
-        dist = np.abs((pts - pts[i]) @ np.array([-d[1], d[0]]))
-        inliers = dist < INLIER_M
-        if best is None or inliers.sum() > best.sum():
+        nx, ny = -dy / n, dx / n
+        xi, yi = pts[i]
+        inliers = [p for p in pts if abs((p[0] - xi) * nx + (p[1] - yi) * ny) < INLIER_M]
+        if best is None or len(inliers) > len(best):
             best = inliers
-    if best is None or best.sum() < 6:
+    if best is None or len(best) < 6:
         return None
-    q = pts[best]
-    c = q.mean(axis=0)
-    _, _, vt = np.linalg.svd(q - c)
-    return c, vt[0], q
+    c, d = principal_axis(best)
+    return c, d, best
 
 
 def clusters(q, c, d):
     """Centres (positions along the line) of the runs of inlier points: stringer faces."""
-    t = np.sort((q - c) @ d)
+    t = sorted((x - c[0]) * d[0] + (y - c[1]) * d[1] for x, y in q)
     groups, start = [], 0
     for k in range(1, len(t) + 1):
         if k == len(t) or t[k] - t[k - 1] > GAP_M:
@@ -85,28 +98,26 @@ def detect(req):
     spacing = req["pallet"]["stringer_offsets_m"][2]
     for k, scan in enumerate(req["scans"]):
         pts = points_of(scan)
-        if prior is not None and len(pts):
-            near = np.hypot(pts[:, 0] - prior["x_m"], pts[:, 1] - prior["y_m"]) < ROI_M
-            pts = pts[near]
+        if prior is not None:
+            pts = [p for p in pts if math.hypot(p[0] - prior["x_m"], p[1] - prior["y_m"]) < ROI_M]
         if len(pts) < 6:
             continue
-        fit = ransac_line(pts, np.random.default_rng(0))
+        fit = ransac_line(pts, random.Random(0))
         if fit is None:
             continue
         c, d, q = fit
         centres = face_centres(clusters(q, c, d), spacing)
         if not centres:
             continue
-        cands = [c + t * d for t in centres]
-        ref = np.array([prior["x_m"], prior["y_m"]]) if prior else c
-        centre = min(cands, key=lambda p: np.hypot(*(p - ref)))
+        cands = [(c[0] + t * d[0], c[1] + t * d[1]) for t in centres]
+        ref = (prior["x_m"], prior["y_m"]) if prior else c
+        centre = min(cands, key=lambda p: math.hypot(p[0] - ref[0], p[1] - ref[1]))
         # Into the pallet: the face normal pointing away from the sensor.
-        n = np.array([-d[1], d[0]])
-        s = np.array([scan["pose"]["x_m"], scan["pose"]["y_m"]])
-        if (centre - s) @ n < 0:
-            n = -n
-        face = {"x_m": float(centre[0]), "y_m": float(centre[1]),
-                "heading_rad": math.atan2(n[1], n[0])}
+        n = (-d[1], d[0])
+        s = (scan["pose"]["x_m"], scan["pose"]["y_m"])
+        if (centre[0] - s[0]) * n[0] + (centre[1] - s[1]) * n[1] < 0:
+            n = (-n[0], -n[1])
+        face = {"x_m": centre[0], "y_m": centre[1], "heading_rad": math.atan2(n[1], n[0])}
         return {"type": "pallet", "id": req["id"], "face": face, "sensor": k}
     return {"type": "none", "id": req["id"]}
 

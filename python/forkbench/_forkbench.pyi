@@ -66,6 +66,11 @@ def run_trial(
     tracker: str | None = None,
     noise: bool = True,
     pallet_noise_scale: float | None = None,
+    localization_noise_scale: float | None = None,
+    odometry_noise_scale: float | None = None,
+    pallet_sensing: str | None = None,
+    localizer: str | None = None,
+    missing_reflectors: Sequence[str] | None = None,
     replan: bool | None = None,
     mcap: str | os.PathLike[str] | None = None,
 ) -> Outcome: ...
@@ -78,6 +83,8 @@ def run_batch(
     trackers: Sequence[str] | None = None,
     modes: str | None = None,
     pallet_noise_scale: float | None = None,
+    localization_noise_scale: float | None = None,
+    odometry_noise_scale: float | None = None,
     jobs: int | None = None,
     out: str | os.PathLike[str] | None = None,
 ) -> list[Outcome]: ...

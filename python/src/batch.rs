@@ -4,6 +4,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 
 use forkbench_batch::{BatchSpec, ReplanModes, TrialRecord};
+use forkbench_trial::trial::Overrides;
 use forkbench_trial::{Recorder, TrialOptions, run_trial_recorded};
 use pyo3::prelude::*;
 use rayon::prelude::*;
@@ -16,7 +17,9 @@ use crate::scenario::Scenario;
 /// that file (Foxglove schemas; .rrd recordings come from the CLI).
 #[pyfunction]
 #[pyo3(signature = (scenario, case=None, *, seed=None, planner=None, tracker=None,
-                    noise=true, pallet_noise_scale=None, replan=None, mcap=None))]
+                    noise=true, pallet_noise_scale=None, localization_noise_scale=None,
+                    odometry_noise_scale=None, pallet_sensing=None, localizer=None,
+                    missing_reflectors=None, replan=None, mcap=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_trial<'py>(
     py: Python<'py>,
@@ -27,6 +30,11 @@ pub fn run_trial<'py>(
     tracker: Option<String>,
     noise: bool,
     pallet_noise_scale: Option<f64>,
+    localization_noise_scale: Option<f64>,
+    odometry_noise_scale: Option<f64>,
+    pallet_sensing: Option<String>,
+    localizer: Option<String>,
+    missing_reflectors: Option<Vec<String>>,
     replan: Option<bool>,
     mcap: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -52,10 +60,18 @@ pub fn run_trial<'py>(
         planner,
         tracker,
         no_noise: !noise,
-        pallet_noise_scale,
         replan,
+        overrides: Overrides {
+            pallet_noise_scale,
+            localization_noise_scale,
+            odometry_noise_scale,
+            localizer,
+            pallet_sensing,
+            missing_reflectors,
+        },
     };
-    let run = scn.resolve(&opts).map_err(|e| scenario_error(py, &e))?;
+    // The CLI's own check: values in range, and every override acting on this scenario.
+    let run = scn.check_options(&opts).map_err(|e| scenario_error(py, &e))?;
     let out = match mcap {
         None => py.detach(|| forkbench_trial::run_trial(scn, case, &opts)),
         Some(path) => {
@@ -99,7 +115,8 @@ const MAX_RECORDS: u64 = 2_000_000;
 /// With `out`, also writes (or resumes) the CLI's batch directory there.
 #[pyfunction]
 #[pyo3(signature = (scenarios=None, *, trials=20, seed=1, planners=None, trackers=None,
-                    modes=None, pallet_noise_scale=None, jobs=None, out=None))]
+                    modes=None, pallet_noise_scale=None, localization_noise_scale=None,
+                    odometry_noise_scale=None, jobs=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_batch<'py>(
     py: Python<'py>,
@@ -110,6 +127,8 @@ pub fn run_batch<'py>(
     trackers: Option<Vec<String>>,
     modes: Option<&str>,
     pallet_noise_scale: Option<f64>,
+    localization_noise_scale: Option<f64>,
+    odometry_noise_scale: Option<f64>,
     jobs: Option<usize>,
     out: Option<PathBuf>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
@@ -140,7 +159,12 @@ pub fn run_batch<'py>(
         trials,
         seed,
         shard: (0, 1),
-        pallet_noise_scale,
+        overrides: Overrides {
+            pallet_noise_scale,
+            localization_noise_scale,
+            odometry_noise_scale,
+            ..Overrides::default()
+        },
         replan,
         compare_replanning,
         force_new: false,

@@ -102,3 +102,33 @@ def test_bad_input_names_file_field_and_reason(tmp_path):
         forkbench.run_batch([forkbench.load("field-test")], trials=10**12)
     with pytest.raises(ValueError, match="path_points"):
         forkbench.PickEnv(forkbench.load("field-test"), path_points=10**9)
+
+
+def test_python_validates_options_as_the_cli_does(cli):
+    scn = forkbench.load("field-test")
+    with pytest.raises(forkbench.ScenarioError) as e:
+        forkbench.run_trial(scn, pallet_noise_scale=-1)
+    assert e.value.field == "pallet_noise_scale" and "from 0 to" in e.value.reason
+    with pytest.raises(forkbench.ScenarioError) as e:
+        forkbench.run_trial(scn, noise=False, localization_noise_scale=2)
+    assert e.value.field == "localization_noise_scale"
+    # The same trial with every override, from Python and from the CLI.
+    want = json.loads(
+        cli(
+            "trial",
+            "field-test",
+            "--seed",
+            "5",
+            "--json",
+            "--pallet-noise-scale",
+            "2",
+            "--localizer",
+            "gaussian",
+            "--odometry-noise-scale",
+            "0.5",
+        )
+    )
+    got = forkbench.run_trial(
+        scn, seed=5, pallet_noise_scale=2, localizer="gaussian", odometry_noise_scale=0.5
+    )
+    assert without_clock(got) == without_clock(want)

@@ -8,13 +8,9 @@ impl BatchSpec {
         if self.trials == 0 {
             return Err(BatchError::Invalid("trials: must be at least 1".into()));
         }
-        if let Some(v) = self.pallet_noise_scale
-            && !(v.is_finite() && v >= 0.0)
-        {
-            return Err(BatchError::Invalid(format!(
-                "pallet_noise_scale {v}: must be a finite number ≥ 0"
-            )));
-        }
+        self.overrides
+            .validate()
+            .map_err(|e| BatchError::Invalid(e.to_string()))?;
         if self.shard.1 == 0 || self.shard.0 >= self.shard.1 {
             return Err(BatchError::Invalid(format!(
                 "shard {}/{}: the index must be below the shard count",
@@ -62,9 +58,16 @@ impl BatchSpec {
         )))
     }
 
-    /// Every planner and tracker name must resolve in every scenario, before any trial runs.
+    /// Every planner and tracker name must resolve in every scenario, and every override
+    /// act on it, before any trial runs.
     fn check_components(&self) -> Result<(), BatchError> {
         for s in &self.scenarios {
+            let opts = forkbench_trial::TrialOptions {
+                overrides: self.overrides.clone(),
+                ..Default::default()
+            };
+            s.check_options(&opts)
+                .map_err(|e| BatchError::Invalid(e.to_string()))?;
             let (planners, trackers) = self.components_of(s);
             for p in &planners {
                 s.component(forkbench_trial::Role::Planner, Some(p))

@@ -183,10 +183,11 @@ fn unpaired_reason(
             now.seed_scheme, then.seed_scheme
         ));
     }
-    if then.pallet_noise_scale != now.pallet_noise_scale {
+    if then.overrides() != now.overrides() {
         why.push(format!(
-            "pallet noise scale {:?} ≠ the baseline's {:?}",
-            now.pallet_noise_scale, then.pallet_noise_scale
+            "noise scales or sensing overrides {} ≠ the baseline's {}",
+            overrides_text(&now.overrides()),
+            overrides_text(&then.overrides())
         ));
     }
     if !differences.is_empty() {
@@ -404,4 +405,9 @@ pub fn regress(
         setting_differences: differences,
         rows,
     }
+}
+
+/// Overrides as compact JSON (`{}` for none), for the gate's reasons.
+fn overrides_text(o: &forkbench_trial::trial::Overrides) -> String {
+    serde_json::to_string(o).unwrap_or_default()
 }

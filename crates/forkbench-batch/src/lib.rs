@@ -44,8 +44,8 @@ pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_batch, load_results, merge, read_numbered, read_records};
 pub use summary::{LegSummary, Summary, SummaryRow, mode_name, summarize};
 pub use sweep::{
-    RecordChoice, RecordJob, SweepPoint, SweepResult, read_sweep, sweep_markdown, sweep_points,
-    trials_to_record, write_sweep,
+    RecordChoice, RecordJob, Sweep, SweepPoint, SweepResult, read_sweep, sweep_markdown,
+    sweep_points, trials_to_record, write_sweep,
 };
 
 use store::{check_unique, read_records_torn, remove_if_present, rewrite_records};
@@ -53,7 +53,7 @@ use summary::write_summary;
 
 use forkbench_trial::outcome::TrialOutcome;
 use forkbench_trial::scenario::Scenario;
-use forkbench_trial::trial::{TrialOptions, run_trial};
+use forkbench_trial::trial::{Overrides, TrialOptions, run_trial};
 
 /// Largest `trials.jsonl` read whole (by `replay`).
 pub const MAX_RECORDS_BYTES: u64 = 1 << 30;
@@ -74,7 +74,8 @@ pub struct BatchSpec {
     pub seed: u64,
     /// This shard's index and the shard count (0/1 = everything).
     pub shard: (u64, u64),
-    pub pallet_noise_scale: Option<f64>,
+    /// Noise scales and sensing models every trial runs with (recorded with each trial).
+    pub overrides: Overrides,
     pub replan: Option<bool>,
     /// Run every trial both planning once (the papers' mode) and replanning on new
     /// estimates, with the same seeds; `replan` is then ignored.
@@ -145,8 +146,8 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> BatchError + '_ {
 pub struct TrialRecord {
     pub trial: u64,
     /// Batch-wide overrides this trial ran with, so `forkbench replay` can repeat it.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pallet_noise_scale: Option<f64>,
+    #[serde(flatten)]
+    pub overrides: Overrides,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub replan: Option<bool>,
     #[serde(flatten)]
@@ -161,8 +162,8 @@ impl TrialRecord {
             planner: Some(self.outcome.planner.clone()),
             tracker: Some(self.outcome.tracker.clone()),
             no_noise: !self.outcome.noise,
-            pallet_noise_scale: self.pallet_noise_scale,
             replan: self.replan,
+            overrides: self.overrides.clone(),
         }
     }
 }
@@ -295,14 +296,14 @@ impl BatchSpec {
             planner: Some(j.planner.clone()),
             tracker: Some(j.tracker.clone()),
             no_noise: false,
-            pallet_noise_scale: self.pallet_noise_scale,
             replan: j.replan,
+            overrides: self.overrides.clone(),
         };
         let names = (j.planner.as_str(), j.tracker.as_str());
         let outcome = guarded(s, &case.name, names, seed, || run_trial(s, case, &opts));
         TrialRecord {
             trial: j.trial,
-            pallet_noise_scale: self.pallet_noise_scale,
+            overrides: self.overrides.clone(),
             // The mode the trial ran in, always written: rows are keyed by it.
             replan: Some(j.replan.unwrap_or(s.replan.enabled)),
             outcome,

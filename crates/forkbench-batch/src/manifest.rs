@@ -29,6 +29,17 @@ pub struct Manifest {
     #[serde(default)]
     pub trackers: Vec<String>,
     pub pallet_noise_scale: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub localization_noise_scale: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub odometry_noise_scale: Option<f64>,
+    /// Sensing models every scenario ran with instead of its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub localizer: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pallet_sensing: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub missing_reflectors: Option<Vec<String>>,
     pub replan: Option<bool>,
     /// Every trial run planning once and replanning.
     #[serde(default)]
@@ -83,11 +94,28 @@ impl Manifest {
             shard: [spec.shard.0, spec.shard.1],
             planners: spec.planners.clone(),
             trackers: spec.trackers.clone(),
-            pallet_noise_scale: spec.pallet_noise_scale,
+            pallet_noise_scale: spec.overrides.pallet_noise_scale,
+            localization_noise_scale: spec.overrides.localization_noise_scale,
+            odometry_noise_scale: spec.overrides.odometry_noise_scale,
+            localizer: spec.overrides.localizer.clone(),
+            pallet_sensing: spec.overrides.pallet_sensing.clone(),
+            missing_reflectors: spec.overrides.missing_reflectors.clone(),
             replan: spec.replan,
             compare_replanning: spec.compare_replanning,
             scenarios,
         })
+    }
+
+    /// The overrides its trials ran with.
+    pub fn overrides(&self) -> forkbench_trial::trial::Overrides {
+        forkbench_trial::trial::Overrides {
+            pallet_noise_scale: self.pallet_noise_scale,
+            localization_noise_scale: self.localization_noise_scale,
+            odometry_noise_scale: self.odometry_noise_scale,
+            localizer: self.localizer.clone(),
+            pallet_sensing: self.pallet_sensing.clone(),
+            missing_reflectors: self.missing_reflectors.clone(),
+        }
     }
 
     /// The manifest in `dir`, if there is one.

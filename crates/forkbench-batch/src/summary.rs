@@ -34,6 +34,14 @@ pub struct SummaryRow {
     pub lateral_error_p95_m: Option<f64>,
     pub heading_error_mean_rad: Option<f64>,
     pub heading_error_p95_rad: Option<f64>,
+    /// Median |lateral error| of the estimate the truck last aimed at, over trials that
+    /// had one: what a pallet-noise scale moves.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimate_error_median_m: Option<f64>,
+    /// Median of the trials' mean localisation error: what a localisation-noise scale
+    /// moves.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub localization_error_median_m: Option<f64>,
     /// Sum of trial wall times (CPU-side cost, not elapsed time).
     pub wall_time_total_s: f64,
     /// Missions: success per leg, over the trials that reached the leg.
@@ -109,6 +117,8 @@ struct Acc {
     wall: Vec<f64>,
     legs: Vec<(String, u64, u64)>,
     phases: Vec<(String, u64, u64)>,
+    est: Vec<f64>,
+    loc: Vec<f64>,
 }
 
 impl Acc {
@@ -125,6 +135,12 @@ impl Acc {
         }
         if let Some(v) = o.heading_error_rad.filter(|v| v.is_finite()) {
             self.head.push(v.abs());
+        }
+        if let Some(v) = o.estimate_lateral_error_m.filter(|v| v.is_finite()) {
+            self.est.push(v.abs());
+        }
+        if o.fixes > 0 && o.localization_error_mean_m.is_finite() {
+            self.loc.push(o.localization_error_mean_m);
         }
         self.wall.push(o.wall_time_ms);
         count_stages(
@@ -160,6 +176,8 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
             a.lat.sort_by(f64::total_cmp);
             a.head.sort_by(f64::total_cmp);
             a.wall.sort_by(f64::total_cmp);
+            a.est.sort_by(f64::total_cmp);
+            a.loc.sort_by(f64::total_cmp);
             let (lo, hi) = wilson(a.k, a.n, Z95);
             SummaryRow {
                 scenario,
@@ -176,6 +194,8 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 lateral_error_p95_m: percentile_sorted(&a.lat, 0.95),
                 heading_error_mean_rad: mean(&a.head),
                 heading_error_p95_rad: percentile_sorted(&a.head, 0.95),
+                estimate_error_median_m: percentile_sorted(&a.est, 0.5),
+                localization_error_median_m: percentile_sorted(&a.loc, 0.5),
                 wall_time_total_s: a.wall.iter().sum::<f64>() / 1e3,
                 legs: leg_summaries(a.legs),
                 phases: leg_summaries(a.phases),

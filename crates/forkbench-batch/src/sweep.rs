@@ -1,31 +1,90 @@
-//! Noise sweeps (one batch per pallet-noise scale) and the choice of a batch's trials to record.
+//! Noise sweeps (one batch per scale of a noise knob) and the choice of a batch's trials to record.
 
 use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 
 use super::{BatchSpec, Summary, TrialRecord};
 use forkbench_trial::scenario::{Case, Scenario};
-use forkbench_trial::trial::TrialOptions;
+use forkbench_trial::text::md_cell;
+use forkbench_trial::trial::{MAX_NOISE_SCALE, NOISE_KNOBS, TrialOptions};
 
 /// One point of a finished sweep as `sweep.json` holds it.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct SweepResult {
-    pub pallet_noise: f64,
+    /// The knob swept ([`forkbench_trial::trial::NOISE_KNOBS`]); sweeps written before
+    /// there were several swept the pallet noise.
+    #[serde(default = "pallet_noise")]
+    pub knob: String,
+    /// Its scale at this point.
+    #[serde(alias = "pallet_noise")]
+    pub value: f64,
     pub summary: Summary,
+}
+
+fn pallet_noise() -> String {
+    "pallet_noise".into()
 }
 
 /// Largest `sweep.json` read.
 const MAX_SWEEP_BYTES: u64 = 256 << 20;
 
+/// A noise sweep: the knob ([`NOISE_KNOBS`]) and the scales it takes, in order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sweep {
+    pub knob: String,
+    pub values: Vec<f64>,
+}
+
+impl Sweep {
+    /// `knob=v1,v2,…` as `--sweep` takes it, every value a valid scale.
+    pub fn parse(text: &str) -> Result<Self, super::BatchError> {
+        let bad = |why: String| super::BatchError::Invalid(format!("--sweep {text:?}: {why}"));
+        let (knob, values) = text
+            .split_once('=')
+            .ok_or_else(|| bad("expected KNOB=V1,V2,…".into()))?;
+        let knob = knob.trim();
+        if !NOISE_KNOBS.contains(&knob) {
+            return Err(bad(format!(
+                "unknown knob {knob:?} (known: {})",
+                NOISE_KNOBS.join(", ")
+            )));
+        }
+        let values = values
+            .split(',')
+            .map(|v| {
+                let x: f64 = v
+                    .trim()
+                    .parse()
+                    .map_err(|_| bad(format!("{v:?} is not a number")))?;
+                if !(x.is_finite() && (0.0..=MAX_NOISE_SCALE).contains(&x)) {
+                    return Err(bad(format!(
+                        "{x} must be a scale from 0 to {MAX_NOISE_SCALE}"
+                    )));
+                }
+                Ok(x)
+            })
+            .collect::<Result<Vec<f64>, _>>()?;
+        Ok(Self {
+            knob: knob.to_owned(),
+            values,
+        })
+    }
+}
+
 /// Writes a finished sweep: `sweep.md` (the table) and `sweep.json` (every point's
 /// summary), each atomically; returns the table.
-pub fn write_sweep(out: &Path, points: &[(f64, Summary)]) -> Result<String, super::BatchError> {
-    let text = sweep_markdown(points);
+pub fn write_sweep(
+    out: &Path,
+    knob: &str,
+    points: &[(f64, Summary)],
+) -> Result<String, super::BatchError> {
+    let text = sweep_markdown(knob, points);
     super::write_atomic(&out.join("sweep.md"), text.as_bytes())?;
     let results: Vec<SweepResult> = points
         .iter()
         .map(|(v, s)| SweepResult {
-            pallet_noise: *v,
+            knob: knob.to_owned(),
+            value: *v,
             summary: s.clone(),
         })
         .collect();
@@ -35,74 +94,84 @@ pub fn write_sweep(out: &Path, points: &[(f64, Summary)]) -> Result<String, supe
     Ok(text)
 }
 
-/// Reads the points of the sweep in `dir` (its `sweep.json`).
-pub fn read_sweep(dir: &Path) -> Result<Vec<(f64, Summary)>, super::BatchError> {
+/// Reads the knob and points of the sweep in `dir` (its `sweep.json`).
+pub fn read_sweep(dir: &Path) -> Result<(String, Vec<(f64, Summary)>), super::BatchError> {
     let path = dir.join("sweep.json");
     let text = super::read_regular(&path, MAX_SWEEP_BYTES)?;
     let results: Vec<SweepResult> = serde_json::from_str(&text)
         .map_err(|e| super::BatchError::Invalid(format!("{}: not a sweep: {e}", path.display())))?;
-    Ok(results
-        .into_iter()
-        .map(|r| (r.pallet_noise, r.summary))
-        .collect())
+    let knob = results
+        .first()
+        .map_or_else(pallet_noise, |r| r.knob.clone());
+    Ok((
+        knob,
+        results.into_iter().map(|r| (r.value, r.summary)).collect(),
+    ))
 }
 
-/// One point of a pallet-noise sweep: the batch to run and where its results go.
+/// One point of a noise sweep: the batch to run and where its results go.
 #[derive(Debug, Clone)]
 pub struct SweepPoint {
-    pub pallet_noise: f64,
+    pub value: f64,
     pub spec: BatchSpec,
     pub dir: PathBuf,
 }
 
-/// The batches of a sweep over pallet-estimate σ scales: `spec` at each scale, each in
-/// `out/pallet_noise-<scale>/`.
-pub fn sweep_points(spec: &BatchSpec, out: &Path, scales: &[f64]) -> Vec<SweepPoint> {
-    scales
+/// The batches of a sweep: `spec` with the knob at each scale, each in
+/// `out/<knob>-<scale>/`. The trial seeds do not depend on the scale, so the points are
+/// paired trial by trial.
+pub fn sweep_points(spec: &BatchSpec, out: &Path, sweep: &Sweep) -> Vec<SweepPoint> {
+    sweep
+        .values
         .iter()
         .map(|&v| {
             let mut s = spec.clone();
-            s.pallet_noise_scale = Some(v);
+            s.overrides.set_scale(&sweep.knob, v);
             SweepPoint {
-                pallet_noise: v,
+                value: v,
                 spec: s,
-                dir: out.join(format!("pallet_noise-{v}")),
+                dir: out.join(format!("{}-{v}", sweep.knob)),
             }
         })
         .collect()
 }
 
-/// A sweep's success rates as markdown: one line per scenario × planner × tracker × scale.
-pub fn sweep_markdown(points: &[(f64, Summary)]) -> String {
-    let mut s = String::from(
-        "| scenario | planner | tracker | pallet noise scale | trials | success rate | 95 % CI |\n|---|---|---|---|---|---|---|\n",
+/// A sweep's success rates and the errors the knob moves, as markdown: one line per
+/// scenario × planner × tracker × mode × scale.
+pub fn sweep_markdown(knob: &str, points: &[(f64, Summary)]) -> String {
+    let mut s = format!(
+        "| scenario | planner | tracker | mode | {} scale | trials | success rate | 95 % CI | estimate error, median (mm) | localisation error, median (mm) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        knob.replace('_', " ")
     );
-    let mut rows: Vec<(&str, &str, &str, f64, &super::SummaryRow)> = points
+    let mut rows: Vec<(f64, &super::SummaryRow)> = points
         .iter()
-        .flat_map(|(v, sum)| {
-            sum.rows.iter().map(move |r| {
-                (
-                    r.scenario.as_str(),
-                    r.planner.as_str(),
-                    r.tracker.as_str(),
-                    *v,
-                    r,
-                )
-            })
-        })
+        .flat_map(|(v, sum)| sum.rows.iter().map(move |r| (*v, r)))
         .collect();
     rows.sort_by(|a, b| {
-        (a.0, a.1, a.2)
-            .cmp(&(b.0, b.1, b.2))
-            .then(a.3.total_cmp(&b.3))
+        let key = |r: &super::SummaryRow| {
+            (
+                r.scenario.clone(),
+                r.planner.clone(),
+                r.tracker.clone(),
+                r.replan,
+            )
+        };
+        key(a.1).cmp(&key(b.1)).then(a.0.total_cmp(&b.0))
     });
-    for (sc, p, t, v, r) in rows {
+    let mm = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{:.1}", v * 1e3));
+    for (v, r) in rows {
         s.push_str(&format!(
-            "| {sc} | {p} | {t} | {v} | {} | {:.1} % | {:.1}–{:.1} % |\n",
+            "| {} | {} | {} | {} | {v} | {} | {:.1} % | {:.1}–{:.1} % | {} | {} |\n",
+            md_cell(&r.scenario),
+            md_cell(&r.planner),
+            md_cell(&r.tracker),
+            super::mode_name(r.replan),
             r.trials,
             100.0 * r.success_rate,
             100.0 * r.ci95_low,
-            100.0 * r.ci95_high
+            100.0 * r.ci95_high,
+            mm(r.estimate_error_median_m),
+            mm(r.localization_error_median_m),
         ));
     }
     s

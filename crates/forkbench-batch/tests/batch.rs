@@ -24,7 +24,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, seed: u64) -> BatchSpec {
         trials,
         seed,
         shard: (0, 1),
-        pallet_noise_scale: None,
+        overrides: Default::default(),
         replan: Some(true),
         compare_replanning: false,
         force_new: false,
@@ -173,7 +173,7 @@ fn resume_refuses_other_settings_and_force_new_starts_over() {
     let base = spec(vec![scenario("field-test.toml")], 6, 3);
     batch::run_batch(&base, &d, 2, &|_| {}).expect("runs");
     let mut quiet = base.clone();
-    quiet.pallet_noise_scale = Some(0.0);
+    quiet.overrides.pallet_noise_scale = Some(0.0);
     let e = err(batch::run_batch(&quiet, &d, 2, &|_| {}));
     assert!(
         e.contains("pallet_noise_scale: null → 0.0") && e.contains("force_new"),

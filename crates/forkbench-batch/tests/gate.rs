@@ -39,7 +39,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, seed: u64) -> BatchSpec {
         trials,
         seed,
         shard: (0, 1),
-        pallet_noise_scale: None,
+        overrides: Default::default(),
         replan: Some(true),
         compare_replanning: false,
         force_new: false,

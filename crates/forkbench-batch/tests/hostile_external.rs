@@ -58,7 +58,10 @@ fn spec(s: Scenario, trials: u64) -> BatchSpec {
         trials,
         seed: 5,
         shard: (0, 1),
-        pallet_noise_scale: Some(0.0),
+        overrides: forkbench_trial::trial::Overrides {
+            pallet_noise_scale: Some(0.0),
+            ..Default::default()
+        },
         replan: None,
         compare_replanning: false,
         force_new: false,

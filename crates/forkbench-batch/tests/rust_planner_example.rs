@@ -35,7 +35,7 @@ fn the_example_planner_runs_in_a_trial_and_a_batch() {
         trials: 3,
         seed: 2,
         shard: (0, 1),
-        pallet_noise_scale: None,
+        overrides: Default::default(),
         replan: None,
         compare_replanning: false,
         force_new: true,

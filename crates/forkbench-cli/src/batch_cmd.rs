@@ -63,6 +63,10 @@ pub struct BatchArgs {
     /// own [sensors.localizer]).
     #[arg(long, value_name = "KIND")]
     pub localizer: Option<String>,
+    /// Reflectors (comma-separated names) missing from every scenario's world while the
+    /// NAV350's map keeps them.
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    pub missing_reflectors: Option<Vec<String>>,
     /// Batch seed; each trial's seed derives from it and the trial's identity.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -90,9 +94,17 @@ pub struct BatchArgs {
     pub out: PathBuf,
     #[arg(long)]
     pub json: bool,
-    /// Scale of the pallet-estimate σ for every trial.
+    /// Scale of every pallet-sensing error (Gaussian estimate σ, scanner range noise and
+    /// bias) for every trial; 0 = exact returns.
     #[arg(long, allow_hyphen_values = true)]
     pub pallet_noise_scale: Option<f64>,
+    /// Scale of the localiser's noise (Gaussian σ, or the NAV350's reflector range and
+    /// bearing σ); 0 = exact fixes.
+    #[arg(long, allow_hyphen_values = true)]
+    pub localization_noise_scale: Option<f64>,
+    /// Scale of the odometry's speed-scale and steering-offset σ; 0 = exact odometry.
+    #[arg(long, allow_hyphen_values = true)]
+    pub odometry_noise_scale: Option<f64>,
     /// Re-estimate the pallet and replan on the way in (short for --modes replan).
     #[arg(long, conflicts_with = "modes")]
     pub replan: bool,
@@ -100,7 +112,8 @@ pub struct BatchArgs {
     /// with the same seeds (default: both for the embedded scenarios, else scenario).
     #[arg(long, value_enum)]
     pub modes: Option<Modes>,
-    /// Sweep a noise knob, e.g. pallet_noise=0,0.5,1,1.5,2 (table and plot per planner).
+    /// Sweep a noise knob on the same trial seeds: pallet_noise, localization_noise or
+    /// odometry_noise, e.g. pallet_noise=0,1,3 (table and plot per planner).
     #[arg(long)]
     pub sweep: Option<String>,
     /// Which trials to record as .rrd and .mcap under OUT/recordings/.
@@ -131,29 +144,6 @@ pub struct BatchArgs {
     /// run when a row has fewer trials than a paired gate needs for it.
     #[arg(long)]
     pub min_detectable_drop: Option<f64>,
-}
-
-/// `--sweep pallet_noise=0,0.5,1`: the knob and its values.
-fn parse_sweep(text: &str) -> anyhow::Result<Vec<f64>> {
-    let (knob, values) = text
-        .split_once('=')
-        .with_context(|| format!("--sweep {text:?}: expected pallet_noise=V1,V2,…"))?;
-    if knob.trim() != "pallet_noise" {
-        bail!("--sweep {text:?}: unknown knob {knob:?} (supported: pallet_noise)");
-    }
-    values
-        .split(',')
-        .map(|v| {
-            let x: f64 = v
-                .trim()
-                .parse()
-                .with_context(|| format!("--sweep: {v:?} is not a number"))?;
-            if !(x.is_finite() && x >= 0.0) {
-                bail!("--sweep: {x} must be a finite number ≥ 0");
-            }
-            Ok(x)
-        })
-        .collect()
 }
 
 fn progress(total: u64) -> ProgressBar {
@@ -194,23 +184,10 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     } else {
         a.scenarios
             .iter()
-            .map(|p| Scenario::load(p))
+            .map(|p| defaults::load_scenario(p))
             .collect::<Result<_, _>>()?
     };
-    let scenarios = match &a.pallet_sensing {
-        Some(kind) => scenarios
-            .into_iter()
-            .map(|s| s.with_pallet_sensing(kind))
-            .collect::<Result<_, _>>()?,
-        None => scenarios,
-    };
-    let scenarios = match &a.localizer {
-        Some(kind) => scenarios
-            .into_iter()
-            .map(|s| s.with_localizer(kind))
-            .collect::<Result<_, _>>()?,
-        None => scenarios,
-    };
+    scenarios.iter().for_each(crate::warn_slips);
     let shard = match a.shard.as_deref() {
         Some(text) => {
             let arg = batch::parse_shard(text, a.shard_count)?;
@@ -232,7 +209,14 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         trials: a.trials,
         seed: a.seed,
         shard,
-        pallet_noise_scale: a.pallet_noise_scale,
+        overrides: forkbench_trial::trial::Overrides {
+            pallet_noise_scale: a.pallet_noise_scale,
+            localization_noise_scale: a.localization_noise_scale,
+            odometry_noise_scale: a.odometry_noise_scale,
+            localizer: a.localizer.clone(),
+            pallet_sensing: a.pallet_sensing.clone(),
+            missing_reflectors: a.missing_reflectors.clone(),
+        },
         replan,
         compare_replanning,
         force_new: a.force_new,
@@ -285,8 +269,53 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
         );
     }
     shown?;
-    let below = |f: f64| summary.rows.iter().any(|r| r.success_rate < f);
-    Ok(!a.floor.is_some_and(below))
+    warn_dead_rows(&summary);
+    let below: Vec<String> = a.floor.map_or_else(Vec::new, |f| {
+        summary
+            .rows
+            .iter()
+            .filter(|r| r.success_rate < f)
+            .map(|r| format!("{} ({:.1} %)", row_name(r), 100.0 * r.success_rate))
+            .collect()
+    });
+    if !below.is_empty() {
+        eprintln!(
+            "below the floor of {:.1} %: {}",
+            100.0 * a.floor.unwrap_or(0.0),
+            below.join(", ")
+        );
+    }
+    Ok(below.is_empty())
+}
+
+fn row_name(r: &batch::SummaryRow) -> String {
+    forkbench_trial::text::one_line(&format!(
+        "{} / {} / {} / {}",
+        r.scenario,
+        r.planner,
+        r.tracker,
+        batch::mode_name(r.replan)
+    ))
+}
+
+/// A row none of whose trials succeeded, all for one reason, is more often a broken setup
+/// (an external planner's traceback, a missing interpreter) than a result: say so.
+fn warn_dead_rows(summary: &Summary) {
+    for r in &summary.rows {
+        if r.successes == 0 && r.failures.len() == 1 {
+            let (failure, n) = r
+                .failures
+                .iter()
+                .next()
+                .map_or(("?", 0), |(f, n)| (f.as_str(), *n));
+            eprintln!(
+                "warning: every trial of {} failed with {failure} ({n} of {}); see a trial's \
+                 failure_detail in trials.jsonl or replay one",
+                row_name(r),
+                r.trials
+            );
+        }
+    }
 }
 
 /// The outputs asked for beside the results (CSV, JUnit, HTML report), each attempted,
@@ -319,12 +348,25 @@ fn write_extras(summary: &Summary, a: &BatchArgs, failed: &mut Vec<String>) -> S
 }
 
 fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()> {
-    let values = parse_sweep(sweep)?;
-    let mut points: Vec<(f64, Summary)> = Vec::new();
-    for p in batch::sweep_points(spec, &a.out, &values) {
-        points.push((p.pallet_noise, run_one(&p.spec, &p.dir, a.jobs)?));
+    let sweep = batch::Sweep::parse(sweep)?;
+    if spec.overrides.scale(&sweep.knob).is_some() {
+        bail!(
+            "--sweep {}: the knob is also set with --{}-scale; give it one way",
+            sweep.knob,
+            sweep.knob.replace('_', "-")
+        );
     }
-    let text = batch::write_sweep(&a.out, &points)?;
+    let planned = batch::sweep_points(spec, &a.out, &sweep);
+    // Every point is checked before the first runs: a scale the scenarios refuse is one
+    // error, not a half-finished sweep.
+    for p in &planned {
+        p.spec.check(a.jobs)?;
+    }
+    let mut points: Vec<(f64, Summary)> = Vec::new();
+    for p in planned {
+        points.push((p.value, run_one(&p.spec, &p.dir, a.jobs)?));
+    }
+    let text = batch::write_sweep(&a.out, &sweep.knob, &points)?;
     let mut planners: Vec<String> = points
         .iter()
         .flat_map(|(_, s)| s.rows.iter().map(|r| r.planner.clone()))
@@ -333,7 +375,7 @@ fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()>
     planners.dedup();
     for p in &planners {
         let file = a.out.join(format!("sweep-{p}.png"));
-        crate::plot::draw_sweep(&file, p, &points)?;
+        crate::plot::draw_sweep(&file, (p, &sweep.knob), &points)?;
     }
     if a.report {
         crate::report::write(&a.out, None)?;
@@ -341,8 +383,9 @@ fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()>
     if a.json {
         let results: Vec<batch::SweepResult> = points
             .into_iter()
-            .map(|(pallet_noise, summary)| batch::SweepResult {
-                pallet_noise,
+            .map(|(value, summary)| batch::SweepResult {
+                knob: sweep.knob.clone(),
+                value,
                 summary,
             })
             .collect();
@@ -380,73 +423,4 @@ fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
         crate::record::record_trial(j.scenario, j.case, &j.options, &dir)?;
     }
     Ok(jobs.len())
-}
-
-/// `forkbench replay`: re-runs one trial from its JSON line, records it, and checks that
-/// the outcome is the recorded one.
-pub fn replay(
-    file: &Path,
-    line: usize,
-    scenario: Option<&Path>,
-    rec: &crate::record::RecordArgs,
-) -> anyhow::Result<bool> {
-    let text = batch::read_regular(file, batch::MAX_RECORDS_BYTES)?;
-    if line == 0 {
-        bail!("--line 0: lines are numbered from 1");
-    }
-    let Some(raw) = text.lines().nth(line - 1) else {
-        bail!("{}: has no line {line}", file.display());
-    };
-    let record: TrialRecord = serde_json::from_str(raw)
-        .map_err(|e| anyhow::anyhow!("{}:{line}: not a trial record: {e}", file.display()))?;
-    let scenarios = match scenario {
-        Some(p) => vec![Scenario::load(p)?],
-        None => defaults::default_scenarios()?,
-    };
-    let scn = scenarios
-        .iter()
-        .find(|s| s.name == record.outcome.scenario)
-        .with_context(|| {
-            format!(
-                "no scenario named {:?}; pass its file with --scenario",
-                record.outcome.scenario
-            )
-        })?;
-    let case = scn.case(&record.outcome.case)?;
-    let opts = record.options();
-    let run = scn.resolve(&opts)?;
-    let mut sinks =
-        crate::record::Sinks::open(rec, crate::record::metadata(&scn.name, &case.name, &run))?;
-    let (out, written) = sinks.record(|r| forkbench_trial::run_trial_recorded(scn, case, &opts, r));
-    let viewer_error = sinks.viewer_error.take();
-    if let Some(e) = &viewer_error {
-        eprintln!("error: {e} (the trial ran without the viewer)");
-    }
-    // Wall-clock times (the trial's and each leg's planning) are all a rerun may change.
-    let same = serde_json::to_value(out.without_wall_times())?
-        == serde_json::to_value(record.outcome.without_wall_times())?;
-    crate::emit(&format!(
-        "replayed {} / case {} / {} / {} / seed {}: {} ({})\n",
-        out.scenario,
-        out.case,
-        out.planner,
-        out.tracker,
-        out.seed,
-        out.verdict_word(),
-        if same {
-            "identical to the recorded outcome"
-        } else {
-            "DIFFERS from the recorded outcome"
-        }
-    ))?;
-    // As for `trial`: the outcome is printed first, then a recording or viewer error
-    // makes the exit status 1.
-    written.context("writing the recording")?;
-    if viewer_error.is_some() {
-        bail!("the requested rerun viewer could not be reached");
-    }
-    if !same {
-        bail!("the replay did not reproduce the recorded outcome");
-    }
-    Ok(out.success)
 }

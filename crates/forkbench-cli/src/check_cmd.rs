@@ -15,7 +15,8 @@ pub struct CheckArgs {
 }
 
 pub fn run(a: &CheckArgs) -> anyhow::Result<()> {
-    let scn = Scenario::load(&a.scenario)?;
+    let scn = forkbench_trial::defaults::load_scenario(&a.scenario)?;
+    crate::warn_slips(&scn);
     let fit = scn.fork_fit();
     if a.json {
         let v = serde_json::json!({"scenario": scn, "fork_fit": fit});

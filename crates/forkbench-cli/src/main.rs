@@ -13,6 +13,7 @@ mod plan_cmd;
 mod plot;
 mod prm_plot;
 mod record;
+mod replay_cmd;
 mod report;
 mod reproduce_cmd;
 mod route_cmd;
@@ -99,12 +100,24 @@ struct TrialCli {
     /// Tracker by name: the scenario's own or a registered kind (default: the scenario's).
     #[arg(long)]
     tracker: Option<String>,
-    /// Turn off NAV350 and pallet-estimate noise.
+    /// Ideal sensors everywhere: no localisation, pallet-sensing or odometry error.
     #[arg(long)]
     no_noise: bool,
-    /// Scale of the pallet-estimate σ (0: perfect estimate, NAV350 noise kept).
+    /// Scale of every pallet-sensing error (Gaussian estimate σ, scanner range noise and
+    /// bias); 0 = exact returns, the other noise kept.
     #[arg(long, allow_hyphen_values = true)]
     pallet_noise_scale: Option<f64>,
+    /// Scale of the localiser's noise (Gaussian σ, or the NAV350's reflector range and
+    /// bearing σ); 0 = exact fixes.
+    #[arg(long, allow_hyphen_values = true)]
+    localization_noise_scale: Option<f64>,
+    /// Scale of the odometry's speed-scale and steering-offset σ; 0 = exact odometry.
+    #[arg(long, allow_hyphen_values = true)]
+    odometry_noise_scale: Option<f64>,
+    /// Estimate the pallet with this sensing at its default settings (gaussian, tim561,
+    /// kinect2, tim561+kinect2) instead of the scenario's [sensors.pallet].
+    #[arg(long, value_name = "KIND")]
+    pallet_sensing: Option<String>,
     /// Re-estimate the pallet at the configured ranges and replan when it moved.
     #[arg(long)]
     replan: bool,
@@ -114,8 +127,8 @@ struct TrialCli {
     localizer: Option<String>,
     /// Reflectors (comma-separated names) missing from the world while the NAV350's map
     /// keeps them: which legs suffer if they go.
-    #[arg(long, value_delimiter = ',')]
-    missing_reflectors: Vec<String>,
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    missing_reflectors: Option<Vec<String>>,
     #[arg(long)]
     json: bool,
     #[command(flatten)]
@@ -124,16 +137,23 @@ struct TrialCli {
 
 impl TrialCli {
     fn run(self, mission: bool) -> anyhow::Result<Done> {
+        let overrides = forkbench_trial::trial::Overrides {
+            pallet_noise_scale: self.pallet_noise_scale,
+            localization_noise_scale: self.localization_noise_scale,
+            odometry_noise_scale: self.odometry_noise_scale,
+            localizer: self.localizer,
+            pallet_sensing: self.pallet_sensing,
+            missing_reflectors: self.missing_reflectors,
+        };
         let opts = trial_cmd::options(
             self.seed,
             (self.planner, self.tracker),
             self.no_noise,
-            self.pallet_noise_scale,
             self.replan,
+            overrides,
         )?;
         let ok = trial_cmd::run(
             &self.scenario,
-            (self.localizer.as_deref(), &self.missing_reflectors),
             self.case.as_deref(),
             &opts,
             (self.json, mission),
@@ -304,7 +324,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             scenario,
             record,
         } => {
-            let ok = batch_cmd::replay(&file, line, scenario.as_deref(), &record.args())?;
+            let ok = replay_cmd::replay(&file, line, scenario.as_deref(), &record.args())?;
             Ok(if ok { Done::Ok } else { Done::PickFailed })
         }
         Command::Plan(args) => match args.route()? {
@@ -370,5 +390,12 @@ fn main() -> ExitCode {
             );
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Prints a scenario's likely slips (radians in a degrees key) as warnings.
+pub(crate) fn warn_slips(scn: &forkbench_trial::Scenario) {
+    for w in &scn.warnings {
+        eprintln!("warning: {}", forkbench_trial::text::one_line(w));
     }
 }

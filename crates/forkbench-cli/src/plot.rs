@@ -277,20 +277,31 @@ where
 /// Success rate against the pallet-noise scale, one line per scenario, Wilson 95 % bars.
 pub fn draw_sweep(
     file: &FsPath,
-    planner: &str,
+    (planner, knob): (&str, &str),
     points: &[(f64, forkbench_batch::Summary)],
 ) -> anyhow::Result<()> {
     to_file(
         file,
         (900, 600),
-        |a| draw_sweep_on(a, planner, points),
-        |a| draw_sweep_on(a, planner, points),
+        |a| draw_sweep_on(a, (planner, knob), points),
+        |a| draw_sweep_on(a, (planner, knob), points),
     )
+}
+
+/// What a knob's scale of 1 means, for the sweep's axis.
+pub fn knob_axis(knob: &str) -> String {
+    let what = match knob {
+        "pallet_noise" => "pallet-sensing error (estimate σ, scanner noise and bias)",
+        "localization_noise" => "localisation error (NAV350 or Gaussian σ)",
+        "odometry_noise" => "odometry error (speed scale and steering σ)",
+        other => other,
+    };
+    format!("scale of the {what}; 1 = the scenario's own")
 }
 
 fn draw_sweep_on<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
-    planner: &str,
+    (planner, knob): (&str, &str),
     points: &[(f64, forkbench_batch::Summary)],
 ) -> anyhow::Result<()>
 where
@@ -303,14 +314,17 @@ where
         .x_label_area_size(40)
         .y_label_area_size(55)
         .caption(
-            format!("{planner}: fork-entry success vs pallet-estimate noise"),
+            format!(
+                "{planner}: fork-entry success vs {}",
+                knob.replace('_', " ")
+            ),
             ("sans-serif", 20),
         )
         .build_cartesian_2d(-0.05 * x_max..1.05 * x_max, 0.0..100.0)
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc("pallet-estimate σ scale (1 = ±60 mm, ±6° at 6.5 m as 2σ)")
+        .x_desc(knob_axis(knob))
         .y_desc("success rate (%)")
         .draw()
         .map_err(err)?;

@@ -37,7 +37,7 @@ pub struct ScanArgs {
 }
 
 pub fn run(a: &ScanArgs) -> anyhow::Result<()> {
-    let scn = forkbench_trial::Scenario::load(&a.scenario)?;
+    let scn = forkbench_trial::defaults::load_scenario(&a.scenario)?;
     // The scenario's own scanner of that model (with its settings), else the model's.
     let cfg = scn
         .pallet_sensing

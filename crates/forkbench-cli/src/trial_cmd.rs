@@ -10,19 +10,13 @@ use forkbench_trial::{Scenario, TrialOptions, TrialOutcome};
 /// requires one and prints each leg): runs, records, prints; Ok(success).
 pub fn run(
     file: &Path,
-    (localizer, missing): (Option<&str>, &[String]),
     case: Option<&str>,
     opts: &TrialOptions,
     (json, mission): (bool, bool),
     rec: &crate::record::RecordArgs,
 ) -> anyhow::Result<bool> {
-    let mut scn = Scenario::load(file)?;
-    if let Some(kind) = localizer {
-        scn = scn.with_localizer(kind)?;
-    }
-    if !missing.is_empty() {
-        scn = scn.with_missing_reflectors(missing)?;
-    }
+    let scn = forkbench_trial::defaults::load_scenario(file)?;
+    crate::warn_slips(&scn);
     if mission && scn.mission.is_none() {
         anyhow::bail!(
             "{}: has no [mission] table; `forkbench trial` runs its pick",
@@ -30,8 +24,9 @@ pub fn run(
         );
     }
     let case = pick_case(&scn, file, case)?;
-    // Unknown planner or tracker names stop here, before any recording file is made.
-    let run = scn.resolve(opts)?;
+    // Unknown planner or tracker names, and overrides that cannot act, stop here, before
+    // any recording file is made.
+    let run = scn.check_options(opts)?;
     // File targets are checked before the run; a viewer that cannot be reached is
     // reported and the trial runs anyway.
     let mut sinks =
@@ -198,25 +193,23 @@ fn phase_lines(out: &TrialOutcome) -> Vec<String> {
         .collect()
 }
 
-/// Trial options from the CLI: seed, (planner, tracker) names, noise and replanning.
+/// Trial options from the CLI: seed, (planner, tracker) names, noise off, replanning
+/// and the overrides, checked by the library's one validation.
 pub fn options(
     seed: Option<u64>,
     (planner, tracker): (Option<String>, Option<String>),
     no_noise: bool,
-    pallet_noise_scale: Option<f64>,
     replan: bool,
+    overrides: forkbench_trial::trial::Overrides,
 ) -> anyhow::Result<TrialOptions> {
-    if let Some(s) = pallet_noise_scale
-        && !(s.is_finite() && s >= 0.0)
-    {
-        anyhow::bail!("--pallet-noise-scale {s}: must be a finite number ≥ 0");
-    }
-    Ok(TrialOptions {
+    let opts = TrialOptions {
         seed,
         planner,
         tracker,
         no_noise,
-        pallet_noise_scale,
         replan: replan.then_some(true),
-    })
+        overrides,
+    };
+    opts.validate()?;
+    Ok(opts)
 }

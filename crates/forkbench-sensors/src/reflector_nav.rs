@@ -126,19 +126,18 @@ impl Trail {
 
 impl ReflectorNav {
     /// A device with `map`, in a world whose surfaces are `surfaces`, sampling at
-    /// `rate_hz` and delivering `latency_s` later.
+    /// `rate_hz` and delivering `latency_s` later, its measurement σ scaled by
+    /// `noise_scale` (0: exact).
     pub fn new(
         settings: ReflectorNavSettings,
         map: &[Reflector],
         surfaces: &[Surface],
         (rate_hz, latency_s): (f64, f64),
-        noise: bool,
+        noise_scale: f64,
     ) -> Self {
         let mut measured = settings.measurement.clone();
-        if !noise {
-            measured.range_sigma_m = 0.0;
-            measured.bearing_sigma_rad = 0.0;
-        }
+        measured.range_sigma_m *= noise_scale;
+        measured.bearing_sigma_rad *= noise_scale;
         let present = map
             .iter()
             .filter(|r| !settings.missing_reflectors.contains(&r.name))

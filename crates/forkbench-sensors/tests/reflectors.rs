@@ -225,7 +225,7 @@ mod localiser {
             mount: Pose2::new(-0.8, 0.2, 0.1),
             ..ReflectorNavSettings::default()
         };
-        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), false);
+        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), 0.0);
         let truth = Pose2::new(4.0, 3.0, 0.7);
         let r = sweep_at(&mut nav, truth);
         let pose = r.pose.expect("four reflectors in sight");
@@ -245,7 +245,7 @@ mod localiser {
             &room(),
             &wall,
             (8.0, 0.0),
-            false,
+            0.0,
         );
         let r = sweep_at(&mut nav, Pose2::new(4.0, 3.0, 0.0));
         assert_eq!((r.pose, r.detected), (None, 2));
@@ -258,7 +258,7 @@ mod localiser {
             ..ReflectorNavSettings::default()
         };
         settings.validate(&room()).expect("names exist");
-        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), false);
+        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), 0.0);
         let r = sweep_at(&mut nav, Pose2::new(4.0, 3.0, 0.0));
         assert_eq!((r.pose, r.detected), (None, 2));
         let bad = ReflectorNavSettings {
@@ -276,7 +276,7 @@ mod localiser {
             speed_input,
             ..ReflectorNavSettings::default()
         };
-        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), false);
+        let mut nav = ReflectorNav::new(settings, &room(), &[], (8.0, 0.0), 0.0);
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let pose_at = |t: f64| Pose2::new(2.0 + t, 2.0 + 0.3 * t * t, 0.6 * t);
         let mut worst = 0.0f64;

@@ -50,7 +50,7 @@ fn bench(c: &mut Criterion) {
     // carried by the speed input, associated from a pose 5 cm off, and the solve.
     let fixed = world.fixed_surfaces();
     let settings = ReflectorNavSettings::default();
-    let mut nav = ReflectorNav::new(settings, &world.reflector, &fixed, (8.0, 0.0), true);
+    let mut nav = ReflectorNav::new(settings, &world.reflector, &fixed, (8.0, 0.0), 1.0);
     let mut k = 0u64;
     g.bench_function("nav350_fix/warehouse", |b| {
         b.iter(|| {

@@ -87,3 +87,31 @@ pub fn default_scenarios() -> Result<Vec<Scenario>, TrialError> {
         })
         .collect()
 }
+
+/// An embedded default scenario by its name (`field-test`).
+pub fn embedded_scenario(name: &str) -> Result<Scenario, TrialError> {
+    let all = default_scenarios()?;
+    let known: Vec<String> = all.iter().map(|s| s.name.clone()).collect();
+    all.into_iter()
+        .find(|s| s.name == name)
+        .ok_or_else(|| TrialError::Invalid {
+            file: name.to_owned(),
+            field: "scenario".into(),
+            reason: format!(
+                "no such file, and no embedded scenario of that name (embedded: {})",
+                known.join(", ")
+            ),
+        })
+}
+
+/// A scenario as a user names it: a file when one exists at `arg` (or the name ends in
+/// `.toml`), else an embedded default by name. The CLI and Python share this rule.
+pub fn load_scenario(arg: &Path) -> Result<Scenario, TrialError> {
+    let is_file = arg.exists() || arg.extension().is_some_and(|e| e == "toml");
+    match arg.to_str() {
+        Some(name) if !is_file && !name.contains(std::path::MAIN_SEPARATOR) => {
+            embedded_scenario(name)
+        }
+        _ => Scenario::load(arg),
+    }
+}

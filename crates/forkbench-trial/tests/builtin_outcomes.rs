@@ -40,7 +40,7 @@ fn rerun(want: &Value) -> Value {
         planner: Some(common::text(want, "planner")),
         tracker: None,
         no_noise: false,
-        pallet_noise_scale: None,
+        overrides: Default::default(),
         // The records of plan-once came from the scenario's own setting.
         replan: replan.then_some(true),
     };

@@ -37,7 +37,7 @@ fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario]) -> Value {
         planner: Some(common::text(want, "planner")),
         tracker: Some(common::text(want, "tracker")),
         no_noise: false,
-        pallet_noise_scale: None,
+        overrides: Default::default(),
         replan: Some(replan),
     };
     let mut v = serde_json::to_value(run_trial(scn, case, &opts)).expect("serialises");

@@ -95,11 +95,12 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
 }
 
 fn sweep_body(dir: &Path) -> anyhow::Result<String> {
-    let points = batch::read_sweep(dir)?;
-    let mut h = String::from("<h2>Success vs pallet-estimate noise</h2>");
-    h.push_str(&sections::sweep(&points));
+    let (knob, points) = batch::read_sweep(dir)?;
+    let words = knob.replace('_', " ");
+    let mut h = format!("<h2>Success vs {}</h2>", svg::esc(&words));
+    h.push_str(&sections::sweep(&knob, &points));
     for (v, s) in &points {
-        h.push_str(&format!("<h2>Pallet noise scale {v}</h2>"));
+        h.push_str(&format!("<h2>{} scale {v}</h2>", svg::esc(&words)));
         h.push_str(&sections::success_table(s));
     }
     h.push_str("<h2>Provenance (first point)</h2>");

@@ -428,11 +428,27 @@ fn batch_in_words(m: &Manifest) -> String {
             v.join(", ")
         }
     };
-    let noise = m
-        .pallet_noise_scale
-        .map_or("as each scenario sets it".to_owned(), |x| {
-            format!("scaled × {x}")
-        });
+    let o = m.overrides();
+    let mut noise: Vec<String> = forkbench_trial::trial::NOISE_KNOBS
+        .iter()
+        .filter_map(|k| o.scale(k).map(|x| format!("{} × {x}", k.replace('_', " "))))
+        .collect();
+    for (what, v) in [
+        ("localiser", &o.localizer),
+        ("pallet sensing", &o.pallet_sensing),
+    ] {
+        if let Some(v) = v {
+            noise.push(format!("{what} {v}"));
+        }
+    }
+    if let Some(m) = &o.missing_reflectors {
+        noise.push(format!("reflectors missing: {}", m.join(", ")));
+    }
+    let noise = if noise.is_empty() {
+        "as each scenario sets it".to_owned()
+    } else {
+        noise.join(", ")
+    };
     let modes = match (m.compare_replanning, m.replan) {
         (true, _) => "both (plan once and replan, same seeds)",
         (false, Some(true)) => "replan always",
@@ -440,7 +456,7 @@ fn batch_in_words(m: &Manifest) -> String {
         (false, None) => "each scenario's own",
     };
     format!(
-        "seed {}, {} trials per row and case, shard {} of {}; planners: {}; trackers: {}; pallet-estimate noise {noise}; replanning: {modes}",
+        "seed {}, {} trials per row and case, shard {} of {}; planners: {}; trackers: {}; noise and sensing: {noise}; replanning: {modes}",
         m.seed,
         m.trials,
         m.shard[0] + 1,
@@ -450,8 +466,8 @@ fn batch_in_words(m: &Manifest) -> String {
     )
 }
 
-/// Success against the pallet-estimate σ scale, a line per scenario × planner × tracker.
-pub fn sweep(points: &[(f64, Summary)]) -> String {
+/// Success against a noise knob's scale, a line per scenario × planner × tracker.
+pub fn sweep(knob: &str, points: &[(f64, Summary)]) -> String {
     let mut series: BTreeMap<String, Vec<(f64, f64, f64, f64)>> = BTreeMap::new();
     for (v, s) in points {
         for r in &s.rows {
@@ -474,8 +490,8 @@ pub fn sweep(points: &[(f64, Summary)]) -> String {
     let series: Vec<_> = series.into_iter().collect();
     svg::lines(
         "sweep",
-        "fork-entry success vs pallet-estimate noise",
+        &format!("fork-entry success vs {}", knob.replace('_', " ")),
         &series,
-        "pallet-estimate σ scale (1 = the papers' sensor)",
+        &crate::plot::knob_axis(knob),
     )
 }

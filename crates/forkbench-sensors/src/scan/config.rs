@@ -139,6 +139,32 @@ impl ScannerConfig {
             .max(0.0)
     }
 
+    /// Whether this scanner has any range error a noise scale could act on.
+    pub fn has_noise(&self) -> bool {
+        [
+            self.range_sigma_m,
+            self.range_sigma_per_m,
+            self.range_sigma_per_m2,
+            self.incidence_sigma,
+            self.range_bias_max_m,
+        ]
+        .iter()
+        .any(|v| *v != 0.0)
+    }
+
+    /// The same scanner with its random range error and systematic bias scaled by `s`
+    /// (≥ 0): the spot and echo geometry are the device's optics, not noise, and stay.
+    pub fn scaled_errors(&self, s: f64) -> Self {
+        Self {
+            range_sigma_m: self.range_sigma_m * s,
+            range_sigma_per_m: self.range_sigma_per_m * s,
+            range_sigma_per_m2: self.range_sigma_per_m2 * s,
+            incidence_sigma: self.incidence_sigma * s,
+            range_bias_max_m: self.range_bias_max_m * s,
+            ..self.clone()
+        }
+    }
+
     /// Every value in its range, naming the field.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let bad = |f: &str, why: &str| Err(SettingsError::field(f, why));

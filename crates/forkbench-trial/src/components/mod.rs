@@ -53,6 +53,9 @@ pub struct LocalizerContext<'a> {
     pub nav350: &'a Nav350Config,
     /// Sensor noise on (off: exact measurements).
     pub noise: bool,
+    /// The run's localisation noise scale (1 unless a run overrides it); only kinds
+    /// registered with [`Registry::with_scaled_localizer`] are handed another value.
+    pub noise_scale: f64,
     /// The world's reflectors (the device's map).
     pub reflectors: &'a [Reflector],
     /// The world's surfaces (racks and walls hide reflectors).
@@ -70,6 +73,8 @@ pub struct Registry {
     trackers: BTreeMap<String, TrackerCtor>,
     detectors: BTreeMap<String, DetectorCtor>,
     localizers: BTreeMap<String, LocalizerCtor>,
+    /// Localiser kinds that apply `LocalizerContext::noise_scale`.
+    scaled_localizers: std::collections::BTreeSet<String>,
     estimator: EstimatorCtor,
 }
 
@@ -128,13 +133,19 @@ impl Registry {
             trackers: BTreeMap::new(),
             detectors: BTreeMap::new(),
             localizers: BTreeMap::new(),
+            scaled_localizers: std::collections::BTreeSet::new(),
             estimator: Arc::new(|cfg| Box::new(cfg.clone())),
         }
-        .with_localizer("gaussian", |s, cx| {
+        .with_scaled_localizer("gaussian", |s, cx| {
             forkbench_core::settings::parse::<Empty>(s)?;
-            Ok(Box::new(Nav350::new(cx.nav350.clone(), cx.noise)))
+            let cfg = Nav350Config {
+                position_sigma_m: cx.nav350.position_sigma_m * cx.noise_scale,
+                heading_sigma_rad: cx.nav350.heading_sigma_rad * cx.noise_scale,
+                ..cx.nav350.clone()
+            };
+            Ok(Box::new(Nav350::new(cfg, cx.noise)))
         })
-        .with_localizer("nav350", |s, cx| {
+        .with_scaled_localizer("nav350", |s, cx| {
             let settings: ReflectorNavSettings = forkbench_core::settings::parse(s)?;
             settings.validate(cx.reflectors)?;
             check_mount(&settings.mount, cx.truck)?;
@@ -144,7 +155,7 @@ impl Registry {
                 cx.reflectors,
                 cx.surfaces,
                 timing,
-                cx.noise,
+                if cx.noise { cx.noise_scale } else { 0.0 },
             )))
         })
         .with_detector("pockets", |s, _| {
@@ -210,7 +221,29 @@ impl Registry {
         + 'static,
     ) -> Self {
         self.localizers.insert(kind.to_owned(), Arc::new(ctor));
+        self.scaled_localizers.remove(kind);
         self
+    }
+
+    /// Adds (or replaces) a localiser kind that applies the run's localisation noise
+    /// scale (`LocalizerContext::noise_scale`); a kind added with `with_localizer` is
+    /// never handed one, and a run that asks for one is refused.
+    pub fn with_scaled_localizer(
+        mut self,
+        kind: &str,
+        ctor: impl Fn(&Settings, &LocalizerContext<'_>) -> Result<Box<dyn Localizer>, SettingsError>
+        + Send
+        + Sync
+        + 'static,
+    ) -> Self {
+        self = self.with_localizer(kind, ctor);
+        self.scaled_localizers.insert(kind.to_owned());
+        self
+    }
+
+    /// Whether a localiser kind applies a localisation noise scale.
+    pub fn localizer_takes_noise_scale(&self, kind: &str) -> bool {
+        self.scaled_localizers.contains(kind)
     }
 
     /// Replaces the pallet-estimate model.
@@ -276,6 +309,7 @@ impl Registry {
                 let cx = LocalizerContext {
                     nav350: &nav350,
                     noise: true,
+                    noise_scale: 1.0,
                     reflectors: &[],
                     surfaces: &[],
                     truck: &truck,

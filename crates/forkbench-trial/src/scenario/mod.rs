@@ -2,6 +2,7 @@
 
 mod checks;
 mod file;
+mod hints;
 mod limits;
 pub mod mission;
 pub mod sensors;
@@ -87,8 +88,12 @@ pub(crate) fn parse<T: serde::de::DeserializeOwned>(
 ) -> Result<T, TrialError> {
     toml::from_str(text).map_err(|e| {
         let mut message = crate::text::compact_numbers(e.to_string().trim_end());
+        let hint = hints::misplaced_key(text, &message);
         if message.chars().count() > MAX_MESSAGE_CHARS {
             message = message.chars().take(MAX_MESSAGE_CHARS).collect::<String>() + " …";
+        }
+        if let Some(hint) = hint {
+            message = format!("{message}\n{hint}");
         }
         TrialError::Parse {
             file: file.to_owned(),
@@ -138,6 +143,10 @@ pub struct Scenario {
     /// The phases after the pick, in order (none: the trial is the pick).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub phases: Vec<crate::trial::PhaseSpec>,
+    /// Likely slips the file is still valid with (radians in a degrees key), as
+    /// `file:line: …`; front ends print them.
+    #[serde(skip)]
+    pub warnings: Vec<String>,
 }
 
 /// One start/pallet geometry of a scenario.
@@ -244,7 +253,22 @@ impl Scenario {
         .with_payload(f.payload_kg);
         checks::check_payload(&f.truck, &pallet, (file, text))?;
         checks::check_geometry(&f, &pallet, file)?;
-        let cases = resolve_cases(&f, &world, &pallet, file)?;
+        let cases = resolve_cases(&f, &world, &pallet, file).map_err(|e| match e {
+            TrialError::Invalid {
+                file,
+                field,
+                reason,
+            } if reason == "missing" => {
+                let key = field.rsplit('.').next().unwrap_or(&field);
+                let hint = hints::misplaced_key(text, &format!("missing field `{key}`"));
+                TrialError::Invalid {
+                    file,
+                    field,
+                    reason: hint.map_or(reason, |h| format!("missing; {h}")),
+                }
+            }
+            e => e,
+        })?;
         let mission = match &f.mission {
             Some(m) => Some(m.resolve(&world, file)?),
             None => None,
@@ -276,6 +300,7 @@ impl Scenario {
             cases,
             mission,
             phases,
+            warnings: hints::unit_warnings(text, file),
         })
     }
 
@@ -326,7 +351,7 @@ impl Scenario {
     }
 
     /// Builds the localiser `spec` names once in this scenario's world, on its truck.
-    fn check_localizer(
+    pub(crate) fn check_localizer(
         &self,
         registry: &Registry,
         spec: &ComponentSpec,
@@ -335,6 +360,7 @@ impl Scenario {
         let cx = crate::components::LocalizerContext {
             nav350: &self.noise.nav350,
             noise: true,
+            noise_scale: 1.0,
             reflectors: &self.world.reflector,
             surfaces: &surfaces,
             truck: &self.truck,

@@ -28,9 +28,10 @@ pub(super) struct SensorsFile {
 #[serde(deny_unknown_fields)]
 struct PalletSensorFile {
     kind: String,
-    scanner: Option<ScannerConfig>,
+    /// Keys over the model's own settings (its preset), not over another model's.
+    scanner: Option<toml::Table>,
     #[serde(default)]
-    scanners: BTreeMap<String, ScannerConfig>,
+    scanners: BTreeMap<String, toml::Table>,
     detector: Option<toml::Table>,
 }
 
@@ -132,16 +133,16 @@ pub(super) fn resolve(
                 &format!("{name:?} is named twice"),
             ));
         }
-        let scanner = p
-            .scanners
-            .get(name)
-            .or(p.scanner.as_ref())
-            .cloned()
-            .unwrap_or(preset);
         let table = if p.scanners.contains_key(name) {
             format!("sensors.pallet.scanners.{name}")
         } else {
             "sensors.pallet.scanner".to_owned()
+        };
+        let scanner = match p.scanners.get(name).or(p.scanner.as_ref()) {
+            Some(keys) => {
+                over_preset(&preset, keys).map_err(|e| invalid_setting(file, &table, &e))?
+            }
+            None => preset,
         };
         check_scanner(&scanner, truck, file, &table)?;
         sensors.push(NamedScanner {
@@ -149,7 +150,10 @@ pub(super) fn resolve(
             scanner,
         });
     }
-    sensors.sort_by(|a, b| a.scanner.range_max_m.total_cmp(&b.scanner.range_max_m));
+    // Shortest reach first, ties by name: the order a file lists them in never matters.
+    sensors.sort_by(|a, b| {
+        (a.scanner.range_max_m.total_cmp(&b.scanner.range_max_m)).then_with(|| a.name.cmp(&b.name))
+    });
     let table = toml::Value::Table(p.detector.clone().unwrap_or_default());
     let detector = ComponentSpec::from_value(Role::Detector, &table, Some("pockets"), ".".into())
         .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))?;
@@ -157,7 +161,7 @@ pub(super) fn resolve(
 }
 
 /// The sensing a kind names with every setting at its default (`--pallet-sensing`).
-pub(super) fn of_kind(
+pub(crate) fn of_kind(
     kind: &str,
     truck: &ForkliftSpec,
     file: &str,
@@ -172,6 +176,19 @@ pub(super) fn of_kind(
         }),
     };
     resolve(Some(&f), truck, file)
+}
+
+/// A model's preset with the keys a file gives laid over it (unknown keys refused).
+fn over_preset(
+    preset: &ScannerConfig,
+    keys: &toml::Table,
+) -> Result<ScannerConfig, forkbench_core::SettingsError> {
+    let mut table = toml::Table::try_from(preset)
+        .map_err(|e| forkbench_core::SettingsError::field("scanner", e.to_string()))?;
+    for (k, v) in keys {
+        table.insert(k.clone(), v.clone());
+    }
+    forkbench_core::settings::parse(&table)
 }
 
 /// A scanner's settings in range, and its mount outside the truck's body.

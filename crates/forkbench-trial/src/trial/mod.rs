@@ -8,6 +8,7 @@ mod judge;
 mod localize;
 mod look;
 mod mission;
+mod options;
 mod phases;
 mod plan;
 mod sense;
@@ -26,27 +27,12 @@ use crate::scenario::{Case, Scenario};
 
 pub use criteria::{Criterion, PICK_CRITERIA};
 pub use look::{ScanReport, scan_once};
+pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
 pub use phases::{
     Context as PhaseContext, PICK, PhaseSpec, phase_defaults, resolve as phases_resolve,
 };
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use setup::Trial;
-
-/// Per-run choices on top of the scenario file.
-#[derive(Debug, Clone, Default)]
-pub struct TrialOptions {
-    pub seed: Option<u64>,
-    /// Planner by name: the scenario's own (by its name) or a registered kind.
-    pub planner: Option<String>,
-    /// Tracker by name, resolved the same way.
-    pub tracker: Option<String>,
-    /// Turn off NAV350 and pallet-estimate noise.
-    pub no_noise: bool,
-    /// Override of the pallet-estimate σ scale (0 = perfect estimate, NAV350 noise kept).
-    pub pallet_noise_scale: Option<f64>,
-    /// Force replanning on new pallet estimates on or off.
-    pub replan: Option<bool>,
-}
 
 /// Gap between the fork tips and the pallet face at the end of the approach curve.
 pub const APPROACH_GAP_M: f64 = 0.3;
@@ -60,17 +46,6 @@ pub fn goal_for(face: &Pose2, truck: &ForkliftSpec, insertion_m: f64) -> Pose2 {
 /// Depth the fork tips reach aimed at: 5 cm short of the pallet back (or the fork length).
 pub fn target_insertion_m(truck: &ForkliftSpec, pallet: &PalletSpec) -> f64 {
     pallet.depth_m.min(truck.fork_length_m) - 0.05
-}
-
-/// Everything a trial runs with, resolved once from the scenario and the options.
-#[derive(Debug, Clone)]
-pub struct Resolved {
-    pub seed: u64,
-    pub planner: ComponentSpec,
-    pub tracker: ComponentSpec,
-    pub noise: bool,
-    pub replan: bool,
-    pub pallet_estimate: forkbench_sensors::PalletEstimateConfig,
 }
 
 impl Scenario {
@@ -111,22 +86,6 @@ impl Scenario {
                 ),
             })?;
         Ok(spec)
-    }
-
-    /// Resolves a run's options against this scenario: the one place defaults meet overrides.
-    pub fn resolve(&self, opts: &TrialOptions) -> Result<Resolved, TrialError> {
-        let mut pallet_estimate = self.noise.pallet_estimate.clone();
-        if let Some(s) = opts.pallet_noise_scale {
-            pallet_estimate.scale = s;
-        }
-        Ok(Resolved {
-            seed: opts.seed.unwrap_or(self.seed),
-            planner: self.component(Role::Planner, opts.planner.as_deref())?,
-            tracker: self.component(Role::Tracker, opts.tracker.as_deref())?,
-            noise: self.noise.enabled && !opts.no_noise,
-            replan: opts.replan.unwrap_or(self.replan.enabled),
-            pallet_estimate,
-        })
     }
 }
 

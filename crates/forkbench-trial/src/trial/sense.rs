@@ -35,7 +35,7 @@ impl Trial<'_> {
         rec: &mut R,
     ) -> Result<Option<Pose2>, StageError> {
         self.out.estimates += 1;
-        let est = match &self.scn.pallet_sensing {
+        let est = match &self.run.pallet_sensing {
             PalletSensing::Gaussian => Some(self.gaussian_estimate(truth, range_m)),
             PalletSensing::Scanner { .. } => self.scanned_estimate(believed, rec)?,
         };
@@ -57,10 +57,10 @@ impl Trial<'_> {
     /// One scan from `sensor` (its true pose), placed at `placed` (its believed pose).
     fn scan_from(&mut self, k: usize, s: &NamedScanner, sensor: Pose2, placed: Pose2) -> Scan {
         let mut out = if self.run.noise {
-            let bias_m = self.scan_bias_m[k];
+            let (bias_m, rng) = &mut self.scanners[k];
             let errors = Errors::Modelled {
-                bias_m,
-                rng: &mut self.est_rng,
+                bias_m: *bias_m,
+                rng,
             };
             scan(&s.scanner, &self.sim, sensor, errors)
         } else {
@@ -75,7 +75,7 @@ impl Trial<'_> {
         believed: &Pose2,
         rec: &mut R,
     ) -> Result<Option<Pose2>, StageError> {
-        let PalletSensing::Scanner { sensors, .. } = &self.scn.pallet_sensing else {
+        let PalletSensing::Scanner { sensors, .. } = &self.run.pallet_sensing else {
             return Ok(None);
         };
         // Where to look: the last estimate, or before the first, where the pallet should

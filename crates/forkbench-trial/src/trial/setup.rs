@@ -55,8 +55,9 @@ pub struct Trial<'a> {
     /// Where the pallet should stand (the case's placement, before any jitter): the
     /// region a detector looks in before its first estimate.
     pub(super) pallet_nominal: Pose2,
-    /// Each scanner's range bias for the whole trial (its systematic error).
-    pub(super) scan_bias_m: Vec<f64>,
+    /// Each scanner's range bias for the whole trial (its systematic error) and the
+    /// stream its per-beam noise draws from, in the sensing's order.
+    pub(super) scanners: Vec<(f64, ChaCha8Rng)>,
     /// The pallet detector, when the sensing scans.
     pub(super) detector: Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
     pub(super) collision: bool,
@@ -110,30 +111,43 @@ pub(super) fn build_world(
     Ok((sim, start, true_pallet, obstacles))
 }
 
-/// The bias stream's salt for a scanner model: 4 for the first model the bench had, the
-/// name's FNV-1a hash for others, so adding a sensor leaves another's draw unchanged
-/// (before/after comparisons stay paired).
-fn bias_salt(name: &str) -> u64 {
-    if name == "tim561" {
-        return 4;
+/// A scanner model's stream salt for `what` (its bias, its per-beam noise): for the first
+/// model the bench had, the salts it always used (bias 4, noise 2, the estimate's stream);
+/// for others the FNV-1a hash of `name/what`. Streams are keyed by what they are for, so
+/// adding a sensor, or listing them in another order, leaves every other draw unchanged.
+fn scanner_salt(name: &str, what: &str) -> u64 {
+    match (name, what) {
+        ("tim561", "bias") => 4,
+        ("tim561", "noise") => 2,
+        // The bias salt predates the keyed noise streams; kept so outcomes stay paired.
+        (_, "bias") => fnv1a(name.bytes()),
+        _ => fnv1a(name.bytes().chain(b"/".iter().copied()).chain(what.bytes())),
     }
-    name.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+}
+
+fn fnv1a(bytes: impl Iterator<Item = u8>) -> u64 {
+    bytes.fold(0xcbf2_9ce4_8422_2325, |h, b| {
         (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     })
 }
 
-/// Each scanner's systematic range error for one trial, each on a stream of its own (none
-/// for the Gaussian model or with noise off, which draw nothing).
-fn scan_bias(scn: &Scenario, run: &Resolved) -> Vec<f64> {
-    match &scn.pallet_sensing {
-        PalletSensing::Scanner { sensors, .. } if run.noise => sensors
+/// Each scanner's systematic range error for one trial and the stream of its per-beam
+/// noise, each keyed by the scanner's name (nothing for the Gaussian model; no bias with
+/// noise off, where scans draw nothing).
+fn scanner_streams(run: &Resolved) -> Vec<(f64, ChaCha8Rng)> {
+    match &run.pallet_sensing {
+        PalletSensing::Scanner { sensors, .. } => sensors
             .iter()
             .map(|s| {
-                s.scanner
-                    .draw_bias(&mut stream(run.seed, bias_salt(&s.name)))
+                let bias = if run.noise {
+                    let salt = scanner_salt(&s.name, "bias");
+                    s.scanner.draw_bias(&mut stream(run.seed, salt))
+                } else {
+                    0.0
+                };
+                (bias, stream(run.seed, scanner_salt(&s.name, "noise")))
             })
             .collect(),
-        PalletSensing::Scanner { sensors, .. } => vec![0.0; sensors.len()],
         PalletSensing::Gaussian => Vec::new(),
     }
 }
@@ -154,12 +168,13 @@ fn build_components(scn: &Scenario, run: &Resolved) -> Result<Built, SettingsErr
     let cx = LocalizerContext {
         nav350: &scn.noise.nav350,
         noise: run.noise,
+        noise_scale: run.localization_noise_scale,
         reflectors: &scn.world.reflector,
         surfaces: &surfaces,
         truck: &scn.truck,
     };
-    let localizer = scn.registry.localizer(&scn.localizer, &cx)?;
-    let detector = match &scn.pallet_sensing {
+    let localizer = scn.registry.localizer(&run.localizer, &cx)?;
+    let detector = match &run.pallet_sensing {
         PalletSensing::Scanner { detector, .. } => Some(scn.registry.detector(detector)?),
         PalletSensing::Gaussian => None,
     };
@@ -175,17 +190,17 @@ fn odometry_from(start: Pose2) -> PosePredictor {
 
 /// The odometry's speed-scale error and steering offset for one trial, on a stream of
 /// their own (none with noise off).
-fn odometry_error(scn: &Scenario, run: &Resolved) -> (f64, f64) {
+fn odometry_error(run: &Resolved) -> (f64, f64) {
     if run.noise {
-        scn.noise.odometry.draw(&mut stream(run.seed, 6))
+        run.odometry.draw(&mut stream(run.seed, 6))
     } else {
         (0.0, 0.0)
     }
 }
 
 /// The reflectors a localiser's settings say are missing from the world.
-fn missing_reflectors(scn: &Scenario) -> Vec<String> {
-    match scn.localizer.settings.get("missing_reflectors") {
+fn missing_reflectors(run: &Resolved) -> Vec<String> {
+    match run.localizer.settings.get("missing_reflectors") {
         Some(toml::Value::Array(a)) => a
             .iter()
             .filter_map(|v| v.as_str().map(str::to_owned))
@@ -217,7 +232,7 @@ fn record_scene<R: Recorder + ?Sized>(
         start,
         tolerances: &scn.tolerances,
     });
-    record_reflectors(rec, &scn.world, &missing_reflectors(scn));
+    record_reflectors(rec, &scn.world, &missing_reflectors(run));
 }
 
 impl<'a> Trial<'a> {
@@ -272,11 +287,11 @@ impl<'a> Trial<'a> {
             footprints: scn.world.footprint_obstacles(),
             pallet0,
             pallet_nominal: case.pallet,
-            scan_bias_m: scan_bias(scn, run),
+            scanners: scanner_streams(run),
             detector,
             collision: false,
             timed_out: true,
-            odometry_error: odometry_error(scn, run),
+            odometry_error: odometry_error(run),
             loc: LocStats::new(0.0),
             leg_loc: LocStats::new(0.0),
             fix_lost: false,

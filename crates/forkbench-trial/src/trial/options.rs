@@ -1,0 +1,323 @@
+//! A run's choices on top of a scenario file (`TrialOptions`, its `Overrides`), checked once, and their resolution into what a trial runs with.
+
+use serde::{Deserialize, Serialize};
+
+use crate::TrialError;
+use crate::components::{ComponentSpec, Role};
+use crate::scenario::sensors::PalletSensing;
+use crate::scenario::{Scenario, invalid};
+
+/// Largest noise scale a run may ask for: far past any sweep's use, and a bound that
+/// keeps scaled σ finite and meaningful.
+pub const MAX_NOISE_SCALE: f64 = 100.0;
+
+/// What a run changes of a scenario besides its seed, components and replanning: the
+/// noise scales and sensing models. A batch records them with every trial, so `replay`
+/// rebuilds the trial exactly.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Overrides {
+    /// Scales every pallet-sensing error: the Gaussian estimate's σ, and each scanner's
+    /// random range error and systematic bias (0 = exact returns; a spot straddling a
+    /// depth edge still mixes ranges, which is geometry, not noise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pallet_noise_scale: Option<f64>,
+    /// Scales the localiser's noise: the Gaussian σ or the NAV350's reflector range and
+    /// bearing σ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub localization_noise_scale: Option<f64>,
+    /// Scales the odometry's speed-scale and steering-offset σ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub odometry_noise_scale: Option<f64>,
+    /// Localise with this kind at its default settings instead of `[sensors.localizer]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub localizer: Option<String>,
+    /// Estimate the pallet with this sensing kind at its default settings instead of
+    /// `[sensors.pallet]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pallet_sensing: Option<String>,
+    /// Reflectors missing from the world while the NAV350's map keeps them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub missing_reflectors: Option<Vec<String>>,
+}
+
+/// The noise knobs by the names sweeps and messages use, with their source.
+pub const NOISE_KNOBS: [&str; 3] = ["pallet_noise", "localization_noise", "odometry_noise"];
+
+impl Overrides {
+    /// The scale of a knob ([`NOISE_KNOBS`]).
+    pub fn scale(&self, knob: &str) -> Option<f64> {
+        match knob {
+            "pallet_noise" => self.pallet_noise_scale,
+            "localization_noise" => self.localization_noise_scale,
+            "odometry_noise" => self.odometry_noise_scale,
+            _ => None,
+        }
+    }
+
+    /// Sets a knob's scale; false for a name that is not a knob.
+    pub fn set_scale(&mut self, knob: &str, v: f64) -> bool {
+        let slot = match knob {
+            "pallet_noise" => &mut self.pallet_noise_scale,
+            "localization_noise" => &mut self.localization_noise_scale,
+            "odometry_noise" => &mut self.odometry_noise_scale,
+            _ => return false,
+        };
+        *slot = Some(v);
+        true
+    }
+
+    /// Every value in range (the scenario aside): what the CLI and Python check alike.
+    pub fn validate(&self) -> Result<(), TrialError> {
+        for knob in NOISE_KNOBS {
+            if let Some(v) = self.scale(knob)
+                && !(v.is_finite() && (0.0..=MAX_NOISE_SCALE).contains(&v))
+            {
+                return Err(bad_option(
+                    &format!("{knob}_scale"),
+                    &format!("{v} must be a number from 0 to {MAX_NOISE_SCALE}"),
+                ));
+            }
+        }
+        if let Some(names) = &self.missing_reflectors
+            && let Some(n) = names.iter().find(|n| n.trim().is_empty())
+        {
+            return Err(bad_option(
+                "missing_reflectors",
+                &format!("{n:?} is not a reflector name"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Per-run choices on top of the scenario file.
+#[derive(Debug, Clone, Default)]
+pub struct TrialOptions {
+    pub seed: Option<u64>,
+    /// Planner by name: the scenario's own (by its name) or a registered kind.
+    pub planner: Option<String>,
+    /// Tracker by name, resolved the same way.
+    pub tracker: Option<String>,
+    /// Ideal sensors everywhere: no localisation, pallet-sensing or odometry error.
+    pub no_noise: bool,
+    /// Force replanning on new pallet estimates on or off.
+    pub replan: Option<bool>,
+    /// Noise scales and sensing models.
+    pub overrides: Overrides,
+}
+
+impl TrialOptions {
+    /// Every value in range, and no knob that contradicts another: the one check the CLI,
+    /// batches and Python share (resolving against a scenario runs it too).
+    pub fn validate(&self) -> Result<(), TrialError> {
+        self.overrides.validate()?;
+        if self.no_noise
+            && let Some(knob) = NOISE_KNOBS
+                .iter()
+                .find(|k| self.overrides.scale(k).is_some())
+        {
+            return Err(bad_option(
+                &format!("{knob}_scale"),
+                "no noise was asked for (--no-noise): a noise scale has nothing to act on",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn bad_option(field: &str, reason: &str) -> TrialError {
+    invalid("options", field, reason)
+}
+
+/// Everything a trial runs with, resolved once from the scenario and the options.
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    pub seed: u64,
+    pub planner: ComponentSpec,
+    pub tracker: ComponentSpec,
+    pub noise: bool,
+    pub replan: bool,
+    pub pallet_estimate: forkbench_sensors::PalletEstimateConfig,
+    /// The pallet sensing, its scanners' errors scaled.
+    pub pallet_sensing: PalletSensing,
+    /// The localiser, with any missing reflectors.
+    pub localizer: ComponentSpec,
+    /// The localiser's noise scale (1 unless overridden).
+    pub localization_noise_scale: f64,
+    /// The odometry's errors, scaled.
+    pub odometry: forkbench_sensors::OdometryConfig,
+    /// The overrides this was resolved with (recordings' metadata).
+    pub overrides: Overrides,
+}
+
+impl Scenario {
+    /// Resolves a run's options against this scenario: the one place defaults meet
+    /// overrides. A scale that cannot act on what is configured is refused, naming the
+    /// component and the knob.
+    pub fn resolve(&self, opts: &TrialOptions) -> Result<Resolved, TrialError> {
+        opts.validate()?;
+        let o = &opts.overrides;
+        let noise = self.noise.enabled && !opts.no_noise;
+        let sensing = self.sensing_for(o.pallet_sensing.as_deref())?;
+        let localizer = self.localizer_for(o)?;
+        if !noise && let Some(knob) = NOISE_KNOBS.iter().find(|k| o.scale(k).is_some()) {
+            return Err(invalid(
+                &self.file,
+                "noise.enabled",
+                &format!("noise is off in this scenario, so {knob}_scale has nothing to act on"),
+            ));
+        }
+        let mut pallet_estimate = self.noise.pallet_estimate.clone();
+        let pallet_sensing = match o.pallet_noise_scale {
+            Some(s) => {
+                pallet_estimate.scale = s;
+                self.scaled_sensing(sensing, s)?
+            }
+            None => sensing,
+        };
+        let localization_noise_scale = match o.localization_noise_scale {
+            Some(s) => {
+                self.check_localizer_scale(&localizer)?;
+                s
+            }
+            None => 1.0,
+        };
+        Ok(Resolved {
+            seed: opts.seed.unwrap_or(self.seed),
+            planner: self.component(Role::Planner, opts.planner.as_deref())?,
+            tracker: self.component(Role::Tracker, opts.tracker.as_deref())?,
+            noise,
+            replan: opts.replan.unwrap_or(self.replan.enabled),
+            pallet_estimate,
+            pallet_sensing,
+            localizer,
+            localization_noise_scale,
+            odometry: self.scaled_odometry(o.odometry_noise_scale)?,
+            overrides: o.clone(),
+        })
+    }
+
+    /// Resolves and also builds the localiser once in this scenario's world: what a run
+    /// checks before its first trial, so a bad override is one error, not an error outcome
+    /// per trial.
+    pub fn check_options(&self, opts: &TrialOptions) -> Result<Resolved, TrialError> {
+        let run = self.resolve(opts)?;
+        let registry = std::sync::Arc::clone(&self.registry);
+        self.check_localizer(&registry, &run.localizer)
+            .map_err(|e| crate::scenario::invalid_setting(&self.file, "sensors.localizer", &e))?;
+        Ok(run)
+    }
+
+    fn sensing_for(&self, kind: Option<&str>) -> Result<PalletSensing, TrialError> {
+        match kind {
+            Some(k) => crate::scenario::sensors::of_kind(k, &self.truck, &self.file),
+            None => Ok(self.pallet_sensing.clone()),
+        }
+    }
+
+    fn localizer_for(&self, o: &Overrides) -> Result<ComponentSpec, TrialError> {
+        let mut spec = match &o.localizer {
+            Some(kind) => ComponentSpec::of_kind(Role::Localizer, kind),
+            None => self.localizer.clone(),
+        };
+        if let Some(names) = &o.missing_reflectors {
+            if spec.kind != "nav350" {
+                return Err(invalid(
+                    &self.file,
+                    "sensors.localizer.missing_reflectors",
+                    &format!(
+                        "only the nav350 localiser measures reflectors; this run's is {:?}",
+                        spec.kind
+                    ),
+                ));
+            }
+            let list = names
+                .iter()
+                .map(|n| toml::Value::from(n.as_str()))
+                .collect();
+            spec.settings
+                .insert("missing_reflectors".into(), toml::Value::Array(list));
+        }
+        Ok(spec)
+    }
+
+    fn scaled_sensing(&self, sensing: PalletSensing, s: f64) -> Result<PalletSensing, TrialError> {
+        match sensing {
+            PalletSensing::Gaussian => Ok(PalletSensing::Gaussian),
+            PalletSensing::Scanner {
+                mut sensors,
+                detector,
+            } => {
+                if sensors.iter().all(|n| !n.scanner.has_noise()) {
+                    return Err(invalid(
+                        &self.file,
+                        "sensors.pallet",
+                        &format!(
+                            "pallet_noise_scale cannot act: the scanners ({}) have no range \
+                             noise or bias to scale",
+                            names_of(&sensors)
+                        ),
+                    ));
+                }
+                for n in &mut sensors {
+                    n.scanner = n.scanner.scaled_errors(s);
+                }
+                Ok(PalletSensing::Scanner { sensors, detector })
+            }
+        }
+    }
+
+    /// Refuses a localisation scale the localiser cannot take.
+    fn check_localizer_scale(&self, spec: &ComponentSpec) -> Result<(), TrialError> {
+        if self.registry.localizer_takes_noise_scale(&spec.kind) {
+            Ok(())
+        } else {
+            Err(invalid(
+                &self.file,
+                "sensors.localizer",
+                &format!(
+                    "localization_noise_scale cannot act: the {:?} localiser has no noise \
+                     model the bench can scale",
+                    spec.kind
+                ),
+            ))
+        }
+    }
+
+    fn scaled_odometry(
+        &self,
+        scale: Option<f64>,
+    ) -> Result<forkbench_sensors::OdometryConfig, TrialError> {
+        let base = &self.noise.odometry;
+        let Some(s) = scale else {
+            return Ok(base.clone());
+        };
+        if base.speed_scale_sigma == 0.0 && base.steer_offset_sigma_rad == 0.0 {
+            return Err(invalid(
+                &self.file,
+                "noise.odometry",
+                "odometry_noise_scale cannot act: both odometry σ are 0",
+            ));
+        }
+        let scaled = forkbench_sensors::OdometryConfig {
+            speed_scale_sigma: base.speed_scale_sigma * s,
+            steer_offset_sigma_rad: base.steer_offset_sigma_rad * s,
+        };
+        scaled.validate().map_err(|e| {
+            invalid(
+                &self.file,
+                "noise.odometry",
+                &format!("odometry_noise_scale {s} makes {e}"),
+            )
+        })?;
+        Ok(scaled)
+    }
+}
+
+fn names_of(sensors: &[crate::scenario::sensors::NamedScanner]) -> String {
+    sensors
+        .iter()
+        .map(|n| n.name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
