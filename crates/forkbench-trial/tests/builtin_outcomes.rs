@@ -26,6 +26,8 @@ fn rerun(want: &Value) -> Value {
                 .with_pallet_sensing("gaussian")
                 .and_then(|s| s.with_localizer("gaussian"))
                 .expect("kind");
+            // …and replanned by a new plan from the truck, before replans deformed the path.
+            s.replan.method = forkbench_trial::scenario::ReplanMethod::Plan;
             s.noise.odometry = forkbench_sensors::OdometryConfig {
                 speed_scale_sigma: 0.0,
                 steer_offset_sigma_rad: 0.0,

@@ -92,6 +92,22 @@ pub struct ReplanFile {
     /// `[noise.pallet_estimate] reestimate_at_m`, where it used to live.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reestimate_at_m: Option<Vec<f64>>,
+    /// How a new estimate changes the path: `deform` the remaining path onto it (the
+    /// default), or `plan` anew from the truck's pose with the scenario's planner.
+    pub method: ReplanMethod,
+}
+
+/// How a replan changes the path the tracker follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReplanMethod {
+    /// The path ahead of the truck moved by the rigid motion that carries the old
+    /// estimate onto the new one, blended in over the approach (falls back to `plan`
+    /// where that would exceed κ_max or touch a rack).
+    #[default]
+    Deform,
+    /// A new plan from the truck's pose and steering to the new estimate.
+    Plan,
 }
 
 impl Default for ReplanFile {
@@ -101,6 +117,7 @@ impl Default for ReplanFile {
             position_threshold_m: 0.02,
             heading_threshold_deg: 1.0,
             reestimate_at_m: None,
+            method: ReplanMethod::Deform,
         }
     }
 }

@@ -88,6 +88,7 @@ pub struct Replan {
     /// Ranges at which a new estimate is taken (the trial's schedule, not the sensor's);
     /// `None`: the pallet-estimate settings' own list.
     pub reestimate_at_m: Option<Vec<f64>>,
+    pub method: super::file::ReplanMethod,
 }
 
 impl Default for Replan {
@@ -104,6 +105,7 @@ impl From<ReplanFile> for Replan {
             heading_threshold_rad: r.heading_threshold_deg.to_radians(),
             written_heading_deg: r.heading_threshold_deg,
             reestimate_at_m: r.reestimate_at_m,
+            method: r.method,
         }
     }
 }
@@ -115,6 +117,7 @@ impl From<Replan> for ReplanFile {
             position_threshold_m: r.position_threshold_m,
             heading_threshold_deg: deg_of(r.heading_threshold_rad, r.written_heading_deg),
             reestimate_at_m: r.reestimate_at_m,
+            method: r.method,
         }
     }
 }

@@ -20,7 +20,7 @@ use crate::components::{ComponentSpec, Registry, Role};
 
 pub(crate) use checks::shrunk;
 pub use checks::{ForkFit, fork_fit, pallet_footprint, truck_footprint};
-pub use file::{NoiseFile, PalletKind, PalletPlacement, ReplanFile, Tolerances};
+pub use file::{NoiseFile, PalletKind, PalletPlacement, ReplanFile, ReplanMethod, Tolerances};
 pub use limits::{Limits, Replan};
 pub use world::{MAX_WORLD_EXTENT_M, PalletSlot, PoseDeg, RectFile, World};
 

@@ -254,21 +254,10 @@ impl<'a> Trial<'a> {
             return Ok(());
         }
         let t = self.sim.time_s();
-        let k0 = self.sim.steer_rad().tan() / self.scn.truck.wheelbase_m;
-        let replan = self
-            .plan_from(*pose, k0, &new_est)
-            .and_then(|p| match self.clash(&p.path) {
-                Some(why) => Err(why),
-                None => Ok(p),
-            });
+        let replan = self.replanned(pose, &new_est);
         match replan {
-            Ok(p) => {
-                rec.plan(
-                    t,
-                    self.out.replans + 1,
-                    &p.path,
-                    p.control_polygon_m.as_deref(),
-                );
+            Ok((path, polygon)) => {
+                rec.plan(t, self.out.replans + 1, &path, polygon.as_deref());
                 rec.event(
                     t,
                     Level::Info,
@@ -277,8 +266,8 @@ impl<'a> Trial<'a> {
                         turned.to_degrees()
                     ),
                 );
-                self.tracker.reset(&p.path, &self.scn.truck);
-                self.path = p.path;
+                self.tracker.reset(&path, &self.scn.truck);
+                self.path = path;
                 self.adopt_estimate(new_est, &truth);
                 self.out.replans += 1;
             }
