@@ -1,4 +1,4 @@
-//! A/B in one batch: two planners (or two trackers) that ran the same trials on shared seeds, compared pair by pair per scenario.
+//! A/B in one batch: two planners, two trackers, or planning once against replanning, on the same trials and seeds, compared pair by pair per scenario.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -53,7 +53,7 @@ pub struct Discordant {
 /// The whole comparison.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CompareReport {
-    /// "planner" or "tracker".
+    /// "planner", "tracker" or "mode".
     pub kind: String,
     pub a: String,
     pub b: String,
@@ -67,32 +67,50 @@ pub struct CompareReport {
 
 type PairKey = (String, String, bool, String, u64);
 
-/// The trials of one component, keyed by everything but that component.
+/// What two sides of a comparison differ in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Axis {
+    Planner,
+    Tracker,
+    /// Planning once against replanning (`plan_once`, `replan`).
+    Mode,
+}
+
+/// The replanning mode a comparison side names, if it names one.
+fn mode_of(name: &str) -> Option<bool> {
+    match name {
+        "plan_once" | "plan-once" | "plan once" | "once" => Some(false),
+        "replan" => Some(true),
+        _ => None,
+    }
+}
+
+/// The trials of one side, keyed by everything but what the sides differ in.
 fn side<'a>(
     records: &'a [(usize, TrialRecord)],
     name: &str,
-    planners: bool,
+    axis: Axis,
 ) -> BTreeMap<PairKey, (usize, &'a TrialRecord)> {
     records
         .iter()
-        .filter(|(_, r)| {
-            let c = if planners {
-                &r.outcome.planner
-            } else {
-                &r.outcome.tracker
-            };
-            c == name
+        .filter(|(_, r)| match axis {
+            Axis::Planner => r.outcome.planner == name,
+            Axis::Tracker => r.outcome.tracker == name,
+            Axis::Mode => mode_of(name) == Some(r.replan.unwrap_or(false)),
         })
         .map(|(line, r)| {
-            let other = if planners {
-                &r.outcome.tracker
-            } else {
-                &r.outcome.planner
+            let (other, mode) = match axis {
+                Axis::Planner => (r.outcome.tracker.clone(), r.replan.unwrap_or(false)),
+                Axis::Tracker => (r.outcome.planner.clone(), r.replan.unwrap_or(false)),
+                Axis::Mode => (
+                    format!("{} / {}", r.outcome.planner, r.outcome.tracker),
+                    false,
+                ),
             };
             let key = (
                 r.outcome.scenario.clone(),
-                other.clone(),
-                r.replan.unwrap_or(false),
+                other,
+                mode,
                 r.outcome.case.clone(),
                 r.trial,
             );
@@ -101,8 +119,8 @@ fn side<'a>(
         .collect()
 }
 
-/// Whether A and B are planners or trackers of this batch.
-fn kind_of(records: &[(usize, TrialRecord)], a: &str, b: &str) -> Result<bool, BatchError> {
+/// What A and B are of this batch: planners, trackers, or the two replanning modes.
+fn kind_of(records: &[(usize, TrialRecord)], a: &str, b: &str) -> Result<Axis, BatchError> {
     let planners: BTreeSet<&str> = records
         .iter()
         .map(|(_, r)| r.outcome.planner.as_str())
@@ -115,14 +133,16 @@ fn kind_of(records: &[(usize, TrialRecord)], a: &str, b: &str) -> Result<bool, B
         return Err(BatchError::Invalid(format!("A and B are both {a:?}")));
     }
     if planners.contains(a) && planners.contains(b) {
-        Ok(true)
+        Ok(Axis::Planner)
     } else if trackers.contains(a) && trackers.contains(b) {
-        Ok(false)
+        Ok(Axis::Tracker)
+    } else if mode_of(a).is_some() && mode_of(b).is_some() && mode_of(a) != mode_of(b) {
+        Ok(Axis::Mode)
     } else {
         let list = |s: &BTreeSet<&str>| s.iter().copied().collect::<Vec<_>>().join(", ");
         Err(BatchError::Invalid(format!(
-            "{a:?} and {b:?} are not two planners or two trackers of this batch (planners: {}; \
-             trackers: {})",
+            "{a:?} and {b:?} are not two planners, two trackers or the two modes (plan_once, \
+             replan) of this batch (planners: {}; trackers: {})",
             list(&planners),
             list(&trackers)
         )))
@@ -192,14 +212,22 @@ pub fn compare(
     o: &CompareOptions,
 ) -> Result<CompareReport, BatchError> {
     crate::check_alpha(o.alpha)?;
-    let planners = kind_of(records, a, b)?;
-    let (sa, sb) = (side(records, a, planners), side(records, b, planners));
+    let axis = kind_of(records, a, b)?;
+    let (sa, sb) = (side(records, a, axis), side(records, b, axis));
     let (counts, discordant, paired) = tally(&sa, &sb, (a, b));
+    let kind = match axis {
+        Axis::Planner => "planner",
+        Axis::Tracker => "tracker",
+        Axis::Mode => "mode",
+    };
     if paired == 0 {
+        let how = match axis {
+            Axis::Mode => "`--modes both`".to_owned(),
+            _ => format!("`--{kind} {a} {b}`"),
+        };
         return Err(BatchError::Invalid(format!(
-            "{a} and {b} share no trial at the same seed: run them in one batch \
-             (`--{} {a} {b}`) by a forkbench whose seeds leave the components out",
-            if planners { "planner" } else { "tracker" }
+            "{a} and {b} share no trial at the same seed: run them in one batch ({how}) by a \
+             forkbench whose seeds leave the components and the mode out"
         )));
     }
     let p: Vec<f64> = counts
@@ -225,7 +253,7 @@ pub fn compare(
         })
         .collect();
     Ok(CompareReport {
-        kind: if planners { "planner" } else { "tracker" }.to_owned(),
+        kind: kind.to_owned(),
         a: a.to_owned(),
         b: b.to_owned(),
         alpha: o.alpha,
@@ -248,19 +276,26 @@ impl CompareReport {
             md_cell(&self.b),
             self.correction.name(),
             self.alpha,
-            if self.kind == "planner" {
-                "tracker"
-            } else {
-                "planner"
+            match self.kind.as_str() {
+                "planner" => "tracker",
+                "tracker" => "planner",
+                _ => "planner / tracker",
             }
         );
+        let mode = |replan: bool| {
+            if self.kind == "mode" {
+                "–"
+            } else {
+                super::mode_name(replan)
+            }
+        };
         for r in &self.rows {
             let pct = |k: u64| format!("{:.1} %", 100.0 * k as f64 / r.pairs.max(1) as f64);
             s.push_str(&format!(
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {} |\n",
                 md_cell(&r.scenario),
                 md_cell(&r.other),
-                super::mode_name(r.replan),
+                mode(r.replan),
                 r.pairs,
                 pct(r.a_successes),
                 pct(r.b_successes),
@@ -283,7 +318,7 @@ impl CompareReport {
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
                 md_cell(&d.scenario),
                 md_cell(&d.case),
-                super::mode_name(d.replan),
+                mode(d.replan),
                 d.trial,
                 d.seed,
                 md_cell(&d.winner),

@@ -18,6 +18,7 @@ mod gate_text;
 mod guard;
 pub mod junit;
 mod manifest;
+mod mode_pairs;
 mod modes;
 mod order;
 mod provenance;
@@ -37,6 +38,7 @@ pub use gate::{
 };
 pub use guard::guarded;
 pub use manifest::{DirLock, Manifest};
+pub use mode_pairs::{ModePairs, mode_pairs, mode_pairs_markdown};
 pub use modes::ReplanModes;
 pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};
 pub use seed::{SEED_SCHEME, trial_seed};

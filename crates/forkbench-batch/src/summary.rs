@@ -101,6 +101,9 @@ pub struct Summary {
     pub trials: u64,
     pub successes: u64,
     pub rows: Vec<SummaryRow>,
+    /// Replanning against planning once, paired, for every row run in both modes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub replanning: Vec<super::ModePairs>,
     /// How, where and with what the batch ran (absent in summaries derived from records alone).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub provenance: Option<super::Provenance>,
@@ -206,6 +209,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
         trials: rows.iter().map(|r| r.trials).sum(),
         successes: rows.iter().map(|r| r.successes).sum(),
         rows,
+        replanning: super::mode_pairs(records),
         provenance: None,
     }
 }
@@ -271,6 +275,7 @@ impl Summary {
                 ));
             }
         }
+        s.push_str(&super::mode_pairs_markdown(&self.replanning));
         s.push_str(&self.legs_markdown());
         s.push_str(&self.phases_markdown());
         s

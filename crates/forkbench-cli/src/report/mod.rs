@@ -64,6 +64,7 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
     }
     h.push_str("<h2>Success per scenario × planner × tracker</h2>");
     h.push_str(&sections::success_table(&summary));
+    h.push_str(&mode_pairs_table(&summary.replanning));
     let legs = sections::stage_table(&summary, "leg", |r| &r.legs);
     if !legs.is_empty() {
         h.push_str(
@@ -108,4 +109,27 @@ fn sweep_body(dir: &Path) -> anyhow::Result<String> {
         points.first().and_then(|p| p.1.provenance.as_ref()),
     ));
     Ok(h)
+}
+
+/// Replanning against planning once, paired, per row run in both modes (empty without).
+fn mode_pairs_table(rows: &[batch::ModePairs]) -> String {
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut h = String::from(
+        "<h2>Replanning against planning once (paired: same trials and seeds)</h2><table data-plot=\"mode-pairs\"><tr><th>scenario</th><th>planner</th><th>tracker</th><th>pairs</th><th>replanning broke</th><th>replanning fixed</th><th>p (McNemar, two-sided)</th></tr>",
+    );
+    for r in rows {
+        h.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.4}</td></tr>",
+            svg::esc(&r.scenario),
+            svg::esc(&r.planner),
+            svg::esc(&r.tracker),
+            r.pairs,
+            r.broke,
+            r.fixed,
+            r.p_value
+        ));
+    }
+    h + "</table>"
 }
