@@ -313,27 +313,61 @@ impl BatchSpec {
     }
 }
 
+/// What a batch writes into its directory (besides `recordings/`).
+const BATCH_FILES: [&str; 5] = [
+    "trials.jsonl",
+    "summary.json",
+    "summary.md",
+    manifest::FILE,
+    provenance::RUNS_FILE,
+];
+
 impl BatchSpec {
+    /// Starts `dir` over for `force_new`, deleting only what a batch wrote: refused where
+    /// no manifest says forkbench wrote the directory, and of `recordings/` only the
+    /// recordings (.rrd, .mcap), the folder itself only when that leaves it empty.
+    fn reset_dir(&self, dir: &Path, want: &Manifest) -> Result<(), BatchError> {
+        let ours = Manifest::read(dir).ok().flatten().is_some();
+        let rec = dir.join("recordings");
+        let present: Vec<&str> = BATCH_FILES
+            .iter()
+            .copied()
+            .filter(|f| dir.join(f).exists())
+            .chain(rec.exists().then_some("recordings/"))
+            .collect();
+        if !ours && !present.is_empty() {
+            return Err(BatchError::Invalid(format!(
+                "{}: force_new starts over only a directory a batch wrote, and this one has no \
+                 manifest.json, yet holds {}; nothing was deleted: move them away or choose \
+                 another output directory",
+                dir.display(),
+                present.join(", ")
+            )));
+        }
+        for f in BATCH_FILES {
+            remove_if_present(&dir.join(f))?;
+        }
+        if rec.is_dir() {
+            for entry in std::fs::read_dir(&rec).map_err(io(&rec))?.flatten() {
+                let path = entry.path();
+                let recording = path.extension().is_some_and(|e| e == "rrd" || e == "mcap");
+                if recording && entry.file_type().is_ok_and(|t| t.is_file()) {
+                    remove_if_present(&path)?;
+                }
+            }
+            // Left in place when anything else is in it.
+            let _ = std::fs::remove_dir(&rec);
+        }
+        want.write(dir)
+    }
+
     /// Makes `dir` hold this batch: a new directory gets the manifest; an existing one
     /// must have been started with the same settings (or is cleared with `force_new`).
     fn prepare_dir(&self, dir: &Path) -> Result<(), BatchError> {
         let want = Manifest::of(self)?;
         let trials = dir.join("trials.jsonl");
         if self.force_new {
-            for f in [
-                "trials.jsonl",
-                "summary.json",
-                "summary.md",
-                manifest::FILE,
-                provenance::RUNS_FILE,
-            ] {
-                remove_if_present(&dir.join(f))?;
-            }
-            let rec = dir.join("recordings");
-            if rec.is_dir() {
-                std::fs::remove_dir_all(&rec).map_err(io(&rec))?;
-            }
-            return want.write(dir);
+            return self.reset_dir(dir, &want);
         }
         match Manifest::read(dir)? {
             Some(have) => {
@@ -351,8 +385,9 @@ impl BatchSpec {
             }
             None if std::fs::metadata(&trials).is_ok_and(|m| m.len() > 0) => {
                 Err(BatchError::Invalid(format!(
-                    "{}: has trials.jsonl but no manifest.json (written by an older forkbench?), \
-                     so its settings are unknown; set force_new to start over",
+                    "{}: has trials.jsonl but no manifest.json (written by an older forkbench, or \
+                     not by forkbench), so its settings are unknown; move it away or choose \
+                     another output directory",
                     dir.display()
                 )))
             }

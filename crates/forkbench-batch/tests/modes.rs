@@ -56,3 +56,51 @@ fn the_summary_and_compare_pair_the_two_modes() {
     assert_eq!(c.discordant.len() as u64, broke + fixed);
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `force_new` never deletes what forkbench did not write: a directory without a
+/// manifest is refused untouched, and in a batch's own directory a user's file under
+/// `recordings/` survives while the batch's recordings go.
+#[test]
+fn force_new_deletes_only_what_a_batch_wrote() {
+    let dir = std::env::temp_dir().join(format!("forkbench-force-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mine = dir.join("recordings/mine");
+    std::fs::create_dir_all(&mine).expect("mkdir");
+    std::fs::write(mine.join("thesis.txt"), "x").expect("write");
+    let spec = BatchSpec {
+        scenarios: vec![defaults::embedded_scenario("field-test").expect("embedded")],
+        planners: vec![],
+        trackers: vec![],
+        trials: 1,
+        seed: 1,
+        shard: (0, 1),
+        overrides: Default::default(),
+        replan: None,
+        compare_replanning: false,
+        force_new: true,
+    };
+    let e = batch::run_batch(&spec, &dir, 1, &|_| {}).expect_err("refused");
+    assert!(e.to_string().contains("no manifest.json"), "{e}");
+    assert!(
+        mine.join("thesis.txt").is_file(),
+        "the user's file was deleted"
+    );
+    // A batch's own directory: its recording goes, the user's file stays.
+    let ours = dir.join("batch");
+    let spec = BatchSpec {
+        force_new: false,
+        ..spec
+    };
+    batch::run_batch(&spec, &ours, 1, &|_| {}).expect("batch");
+    std::fs::create_dir_all(ours.join("recordings")).expect("mkdir");
+    std::fs::write(ours.join("recordings/t.mcap"), "m").expect("write");
+    std::fs::write(ours.join("recordings/notes.txt"), "n").expect("write");
+    let spec = BatchSpec {
+        force_new: true,
+        ..spec
+    };
+    batch::run_batch(&spec, &ours, 1, &|_| {}).expect("starts over");
+    assert!(!ours.join("recordings/t.mcap").exists());
+    assert!(ours.join("recordings/notes.txt").is_file());
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -73,3 +73,19 @@ fn a_partial_scanner_table_lays_its_keys_over_that_models_defaults() {
         "not the TiM561's defaults"
     );
 }
+
+#[test]
+fn a_huge_back_out_is_refused_at_load_naming_its_field() {
+    let text = include_str!("../data/scenarios/warehouse-cycle.toml")
+        .replace("backout_m = 3.0", "backout_m = 1e9");
+    let e = Scenario::parse(&text, "cycle.toml", |p| {
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        forkbench_trial::defaults::embedded_world(name)
+    })
+    .expect_err("refused")
+    .to_string();
+    assert!(
+        e.contains("mission.backout_m") && e.contains("(0, 50]"),
+        "{e}"
+    );
+}

@@ -175,7 +175,7 @@ fn bad_mission_input_names_the_file_and_field() {
             "backout_m = 3.0",
             "backout_m = -1.0",
             "mission.backout_m",
-            "positive",
+            "in (0, 50]",
         ),
         (
             "nodes = 500",

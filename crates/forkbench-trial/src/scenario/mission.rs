@@ -9,6 +9,8 @@ use super::world::World;
 use super::{PoseDeg, invalid};
 use crate::TrialError;
 
+/// Longest back-out, lead-in or approach a mission may ask for (m).
+pub const MAX_MANOEUVRE_M: f64 = 50.0;
 /// The global planner of a mission (Luo's PRM + A* by default).
 pub use forkbench_nav::GlobalPlannerKind;
 
@@ -185,17 +187,31 @@ impl MissionFile {
 
     fn check(&self, file: &str) -> Result<(), TrialError> {
         let g = &self.global;
-        let positive = [
-            ("mission.backout_m", self.backout_m),
-            ("mission.arrive_tolerance_m", self.arrive_tolerance_m),
-            ("mission.arrive_tolerance_deg", self.arrive_tolerance_deg),
-            ("mission.global.lead_m", g.lead_m),
-            ("mission.global.approach_m", g.approach_m),
-            ("mission.global.resolution_m", g.resolution_m),
+        // Upper bounds keep a typo from becoming work: a back-out or approach longer than a
+        // warehouse aisle is a leg of its own, and its path's samples and footprint checks
+        // grow with its length.
+        let bounded = [
+            ("mission.backout_m", self.backout_m, MAX_MANOEUVRE_M),
+            ("mission.arrive_tolerance_m", self.arrive_tolerance_m, 10.0),
+            (
+                "mission.arrive_tolerance_deg",
+                self.arrive_tolerance_deg,
+                180.0,
+            ),
+            ("mission.global.lead_m", g.lead_m, MAX_MANOEUVRE_M),
+            ("mission.global.approach_m", g.approach_m, MAX_MANOEUVRE_M),
+            ("mission.global.resolution_m", g.resolution_m, 5.0),
         ];
-        for (field, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(invalid(file, field, "must be a positive finite number"));
+        for (field, v, max) in bounded {
+            if !(v.is_finite() && v > 0.0 && v <= max) {
+                return Err(invalid(
+                    file,
+                    field,
+                    &format!(
+                        "{} must be a number in (0, {max}]",
+                        crate::text::compact_numbers(&v.to_string())
+                    ),
+                ));
             }
         }
         if !(self.leg_timeout_s.is_finite()
