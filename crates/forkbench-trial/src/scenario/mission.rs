@@ -185,11 +185,11 @@ impl MissionFile {
         })
     }
 
-    fn check(&self, file: &str) -> Result<(), TrialError> {
+    /// Lengths and tolerances in range. Upper bounds keep a typo from becoming work: a
+    /// back-out or approach longer than a warehouse aisle is a leg of its own, and its
+    /// path's samples and footprint checks grow with its length.
+    fn check_bounded(&self, file: &str) -> Result<(), TrialError> {
         let g = &self.global;
-        // Upper bounds keep a typo from becoming work: a back-out or approach longer than a
-        // warehouse aisle is a leg of its own, and its path's samples and footprint checks
-        // grow with its length.
         let bounded = [
             ("mission.backout_m", self.backout_m, MAX_MANOEUVRE_M),
             ("mission.arrive_tolerance_m", self.arrive_tolerance_m, 10.0),
@@ -214,6 +214,12 @@ impl MissionFile {
                 ));
             }
         }
+        Ok(())
+    }
+
+    fn check(&self, file: &str) -> Result<(), TrialError> {
+        let g = &self.global;
+        self.check_bounded(file)?;
         if !(self.leg_timeout_s.is_finite()
             && self.leg_timeout_s > 0.0
             && self.leg_timeout_s <= super::MAX_TIMEOUT_S)
