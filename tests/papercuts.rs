@@ -1,0 +1,104 @@
+//! What costs a new user an hour, checked through the binary: a file scenario's records
+//! replay without naming the file, rows below --floor are named, an embedded scenario by
+//! name, a radians slip and a key swallowed by a table are pointed out.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn forkbench(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_forkbench"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("forkbench-papercuts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+fn text(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr)
+}
+
+#[test]
+fn records_of_a_file_scenario_replay_through_the_manifest_and_floors_name_rows() {
+    let scn = tmp("copy.toml");
+    let original =
+        std::fs::read_to_string(repo_root().join("scenarios/field-test.toml")).expect("field test");
+    std::fs::write(
+        &scn,
+        original.replace("name = \"field-test\"", "name = \"my-copy\""),
+    )
+    .expect("write");
+    let out_dir = tmp("batch");
+    let out = forkbench(&[
+        "batch",
+        scn.to_str().expect("utf-8"),
+        "--trials",
+        "6",
+        "--pallet-noise-scale",
+        "2",
+        "--junit",
+        tmp("j.xml").to_str().expect("utf-8"),
+        "--floor",
+        "0.99",
+        "--record",
+        "none",
+        "--out",
+        out_dir.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    assert!(
+        text(&out).contains("below the floor of 99.0 %: my-copy / bspline / pure_pursuit"),
+        "{}",
+        text(&out)
+    );
+    let records = out_dir.join("trials.jsonl");
+    for line in ["1", "4"] {
+        let out = forkbench(&["replay", records.to_str().expect("utf-8"), "--line", line]);
+        assert!(
+            text(&out).contains("identical to the recorded outcome"),
+            "{}",
+            text(&out)
+        );
+    }
+}
+
+#[test]
+fn embedded_names_slips_and_swallowed_keys() {
+    let out = forkbench(&["trial", "field-test", "--seed", "3", "--json"]);
+    assert!(matches!(out.status.code(), Some(0 | 3)), "{}", text(&out));
+    let slip = tmp("slip.toml");
+    std::fs::write(
+        &slip,
+        "name = \"s\"\nplanner = \"bspline\"\nstart = { x_m = 0, y_m = 0, heading_deg = 1.79 }\n\
+         pallet = { x_m = 8, y_m = 1, heading_deg = 0 }\n",
+    )
+    .expect("write");
+    let out = forkbench(&["check", slip.to_str().expect("utf-8")]);
+    assert!(
+        text(&out).contains("slip.toml:3: heading_deg = 1.79 looks like radians"),
+        "{}",
+        text(&out)
+    );
+    let swallowed = tmp("swallowed.toml");
+    std::fs::write(
+        &swallowed,
+        "name = \"s\"\nplanner = \"bspline\"\n[tracker]\nlookahead_m = 0.7\n\
+         start = { x_m = 0, y_m = 0, heading_deg = 0 }\npallet = { x_m = 8, y_m = 1, heading_deg = 0 }\n",
+    )
+    .expect("write");
+    let out = forkbench(&["check", swallowed.to_str().expect("utf-8")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out).contains("`start` is written at line 5 inside [tracker]"),
+        "{}",
+        text(&out)
+    );
+}
