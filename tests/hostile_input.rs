@@ -325,3 +325,61 @@ fn a_failed_output_skips_none_of_the_others_and_stray_records_are_refused() {
     assert_eq!(o.status.code(), Some(1));
     assert!(text(&o).contains("does not name"), "{}", text(&o));
 }
+
+/// Round three: every user file goes through the one capped reader, so a FIFO or a device
+/// as the scenario, its world, `--truck`, `--config` or `reproduce --table` is refused at
+/// once, naming it, instead of hanging or reading without end.
+#[test]
+fn special_files_anywhere_are_refused_at_once() {
+    let d = tmp("special");
+    let fifo = d.join("fifo");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo")
+            .success()
+    );
+    let f = fifo.to_str().expect("utf-8");
+    let world_fifo = d.join("w.toml");
+    std::fs::write(
+        &world_fifo,
+        format!(
+            "name = \"x\"\nplanner = \"bspline\"\nworld = \"{f}\"\nstart = {{ x_m = 0, y_m = 0, heading_deg = 0 }}\npallet = {{ x_m = 8, y_m = 0, heading_deg = 0 }}\n"
+        ),
+    )
+    .expect("write");
+    let w = world_fifo.to_str().expect("utf-8");
+    let pose = ["--start", "0,0,90", "--goal", "1.5,6.5,105"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["check", f], "a FIFO"),
+        (vec!["check", w], "a FIFO"),
+        (vec!["coverage", f], "a FIFO"),
+        (
+            vec!["map", f, "--out", d.to_str().expect("utf-8")],
+            "a FIFO",
+        ),
+        (
+            [&["plan", "bspline", "--truck", "/dev/zero"][..], &pose].concat(),
+            "a device",
+        ),
+        (
+            [&["plan", "bspline", "--config", f][..], &pose].concat(),
+            "a FIFO",
+        ),
+        (
+            vec!["reproduce", "bspline", "--table", "/dev/zero"],
+            "a device",
+        ),
+    ];
+    for (args, want) in cases {
+        let t0 = Instant::now();
+        let out = forkbench(&args);
+        assert!(
+            t0.elapsed() < Duration::from_secs(10),
+            "{args:?} took too long"
+        );
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", text(&out));
+        assert!(text(&out).contains(want), "{args:?}: {}", text(&out));
+    }
+}

@@ -274,8 +274,7 @@ pub(crate) fn load_truck(path: Option<&PathBuf>) -> anyhow::Result<ForkliftSpec>
     let Some(path) = path else {
         return Ok(ForkliftSpec::default());
     };
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text = read_input(path)?;
     let spec: ForkliftSpec =
         toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     spec.validate()
@@ -398,4 +397,14 @@ pub(crate) fn warn_slips(scn: &forkbench_trial::Scenario) {
     for w in &scn.warnings {
         eprintln!("warning: {}", forkbench_trial::text::one_line(w));
     }
+}
+
+/// Largest settings file (truck spec, planner config, reference table) read: far above
+/// any real one, a bound on what a wrong path can make the binary read.
+const MAX_SETTINGS_BYTES: u64 = 4 << 20;
+
+/// A user's input file through the one capped reader: regular files only (a FIFO or a
+/// device is refused at once, naming it), at most [`MAX_SETTINGS_BYTES`].
+pub(crate) fn read_input(path: &std::path::Path) -> anyhow::Result<String> {
+    Ok(forkbench_core::files::read_text(path, MAX_SETTINGS_BYTES)?)
 }

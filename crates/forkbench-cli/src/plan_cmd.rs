@@ -4,8 +4,6 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::Context as _;
-
 use forkbench_core::Settings;
 use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_plan::{PlanParams, PlanRequest};
@@ -140,8 +138,7 @@ impl PlanCli {
         let truck = crate::load_truck(self.truck.as_ref())?;
         let mut settings = match &self.config {
             Some(p) => {
-                let text = std::fs::read_to_string(p)
-                    .with_context(|| format!("reading {}", p.display()))?;
+                let text = crate::read_input(p)?;
                 toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?
             }
             None => Settings::new(),

@@ -3,7 +3,6 @@
 use std::fmt::Write as _;
 use std::path::Path as FsPath;
 
-use anyhow::Context as _;
 use forkbench_core::ForkliftSpec;
 use forkbench_plan::reproduce::{BsplineTable, SpiralTable, reproduce_bspline, reproduce_spiral};
 use forkbench_plan::{BsplineConfig, Plan, SpiralConfig};
@@ -27,8 +26,7 @@ pub fn run(
     plot_file: Option<&FsPath>,
 ) -> anyhow::Result<()> {
     let truck = ForkliftSpec::default();
-    let read =
-        |p: &FsPath| std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()));
+    let read = |p: &FsPath| crate::read_input(p);
     let planner = if bspline { "bspline" } else { "spiral" };
     let (text, plans) = match bspline {
         true => {

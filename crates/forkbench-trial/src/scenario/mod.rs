@@ -63,23 +63,23 @@ pub const MAX_INPUT_BYTES: u64 = 4 << 20;
 const MAX_MESSAGE_CHARS: usize = 2000;
 
 pub(crate) fn read(path: &FsPath) -> Result<String, TrialError> {
-    use std::io::Read as _;
-    let err = |cause| TrialError::Read {
-        file: path.display().to_string(),
-        cause,
-    };
-    let file = std::fs::File::open(path).map_err(err)?;
-    let mut text = String::new();
-    file.take(MAX_INPUT_BYTES + 1)
-        .read_to_string(&mut text)
-        .map_err(err)?;
-    if text.len() as u64 > MAX_INPUT_BYTES {
-        return Err(TrialError::Parse {
+    // The one capped reader: regular files only, so a FIFO or a device is refused at once
+    // instead of blocking or growing without end.
+    forkbench_core::files::read_text(path, MAX_INPUT_BYTES).map_err(|e| match e {
+        forkbench_core::files::FileError::Io { cause, .. } => TrialError::Read {
             file: path.display().to_string(),
-            message: format!("larger than {MAX_INPUT_BYTES} bytes; not a scenario or world file"),
-        });
-    }
-    Ok(text)
+            cause,
+        },
+        other => {
+            let file = path.display().to_string();
+            let message = other.to_string();
+            let message = message
+                .strip_prefix(&format!("{file}: "))
+                .unwrap_or(&message)
+                .to_owned();
+            TrialError::Parse { file, message }
+        }
+    })
 }
 
 pub(crate) fn parse<T: serde::de::DeserializeOwned>(
