@@ -383,3 +383,36 @@ fn special_files_anywhere_are_refused_at_once() {
         assert!(text(&out).contains(want), "{args:?}: {}", text(&out));
     }
 }
+
+/// A plot that cannot be written is an error naming it (a missing folder, a file-size
+/// limit), and nothing half written is left at its name.
+#[test]
+fn plot_write_failures_are_reported_and_leave_no_truncated_file() {
+    let d = tmp("plots");
+    let world = repo_root().join("worlds/warehouse.toml");
+    let w = world.to_str().expect("utf-8");
+    let out = forkbench(&["coverage", w, "--plot", "/nonexistent-dir/cov.png"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    assert!(
+        text(&out).contains("/nonexistent-dir/cov.png"),
+        "{}",
+        text(&out)
+    );
+    for name in ["cov.png", "cov.svg"] {
+        let target = d.join(name);
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -f 20; exec \"$0\" coverage {w} --plot {}",
+                target.display()
+            ))
+            .arg(env!("CARGO_BIN_EXE_forkbench"))
+            .output()
+            .expect("sh runs");
+        assert_eq!(out.status.code(), Some(1), "{name}: {}", text(&out));
+        assert!(text(&out).contains("File too large"), "{}", text(&out));
+        assert!(!target.exists(), "{name} was left half written");
+    }
+    let leftovers = std::fs::read_dir(&d).expect("dir").count();
+    assert_eq!(leftovers, 0, "temporary files left in {}", d.display());
+}

@@ -374,6 +374,13 @@ fn reproduce(
 }
 
 fn main() -> ExitCode {
+    // A file-size limit (`ulimit -f`) must fail a write with an error the command reports,
+    // naming the file, not kill the process and leave outputs half written: with a
+    // handler installed, the write returns EFBIG instead.
+    let _ = signal_hook::flag::register(
+        signal_hook::consts::SIGXFSZ,
+        std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false)),
+    );
     let cli = Cli::parse();
     let result = run(cli);
     // No external process (or its children) outlives the command.

@@ -43,11 +43,39 @@ pub fn to_file(
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let result = match ext.as_deref() {
-        Some("svg") => svg(SVGBackend::new(file, size).into_drawing_area()),
-        Some("png") => png(BitMapBackend::new(file, size).into_drawing_area()),
-        _ => bail!("{}: plot file must end in .svg or .png", file.display()),
+    if !matches!(ext.as_deref(), Some("svg" | "png")) {
+        bail!("{}: plot file must end in .svg or .png", file.display());
+    }
+    if std::fs::symlink_metadata(file).is_ok_and(|m| !m.is_file()) {
+        bail!(
+            "{}: exists and is not a regular file; give a file's path for the plot",
+            file.display()
+        );
+    }
+    // Drawn to a temporary file beside the target and presented explicitly (plotters
+    // only logs a failed write when a backend is dropped), then renamed over it: a full
+    // disk or a missing folder is an error naming the file, never a truncated plot.
+    // Beside the target, keeping its extension (the backend picks the format by it).
+    let name = file
+        .file_name()
+        .map_or_else(|| "plot".into(), |n| n.to_string_lossy());
+    let tmp = file.with_file_name(format!(".tmp-{}-{name}", std::process::id()));
+    let result = if ext.as_deref() == Some("svg") {
+        let area = SVGBackend::new(&tmp, size).into_drawing_area();
+        svg(area.clone()).and_then(|()| area.present().map_err(|e| anyhow::anyhow!("{e}")))
+    } else {
+        let area = BitMapBackend::new(&tmp, size).into_drawing_area();
+        png(area.clone()).and_then(|()| area.present().map_err(|e| anyhow::anyhow!("{e}")))
     };
+    let result = result.and_then(|()| {
+        std::fs::File::open(&tmp)
+            .and_then(|f| f.sync_all())
+            .and_then(|()| std::fs::rename(&tmp, file))
+            .map_err(anyhow::Error::from)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
     result.with_context(|| format!("drawing {}", file.display()))
 }
 
