@@ -199,6 +199,25 @@ fn unpaired_reason(
     (!why.is_empty()).then(|| why.join("; "))
 }
 
+/// Trials at the same key as a baseline trial but another seed: records edited, or made
+/// by another seed scheme. Pairing would silently drop them, so none is paired.
+fn seed_mismatch(base: &Baseline, now: &HashMap<TrialKey, (u64, bool)>) -> Option<String> {
+    let mut differ = base
+        .trials
+        .iter()
+        .filter(|t| now.get(&t.key()).is_some_and(|(seed, _)| *seed != t.seed));
+    let first = differ.next()?;
+    Some(format!(
+        "{} trials share a key with the baseline but not its seed (first: {} / case {} / trial \
+         {}: seed {} in the baseline); records edited, or made by another seed scheme",
+        1 + differ.count(),
+        first.scenario,
+        first.case,
+        first.trial,
+        first.seed
+    ))
+}
+
 /// Pair counts of one row: baseline trials matched by key and seed in the results.
 fn pair_row(
     base: &Baseline,
@@ -368,11 +387,12 @@ pub fn regress(
     o: &GateOptions,
 ) -> GateReport {
     let differences = manifest.map_or_else(Vec::new, |m| base.setting_differences(m));
-    let reason = unpaired_reason(base, manifest, &differences);
     let index: HashMap<TrialKey, (u64, bool)> = records
         .iter()
         .map(|r| (r.key(), (r.outcome.seed, r.outcome.success)))
         .collect();
+    let reason =
+        unpaired_reason(base, manifest, &differences).or_else(|| seed_mismatch(base, &index));
     let mut rows: Vec<RegressRow> = base
         .rows
         .iter()

@@ -57,7 +57,7 @@ use forkbench_trial::outcome::TrialOutcome;
 use forkbench_trial::scenario::Scenario;
 use forkbench_trial::trial::{Overrides, TrialOptions, run_trial};
 
-/// Largest `trials.jsonl` read whole (by `replay`).
+/// Largest `trials.jsonl` read (by `replay`, `regress`, `baseline`, `merge`, a resume).
 pub const MAX_RECORDS_BYTES: u64 = 1 << 30;
 
 /// Most worker threads a batch starts.

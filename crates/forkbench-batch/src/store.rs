@@ -34,6 +34,17 @@ fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), 
                 path.display()
             )));
         }
+        // Every reader of records (regress, baseline, merge, resume, replay) holds them all
+        // in memory: the file's size bounds that, not its line count.
+        Ok(m) if m.len() > super::MAX_RECORDS_BYTES => {
+            return Err(BatchError::Invalid(format!(
+                "{}: {} bytes, more than the {} bytes of trial records read at once; shard \
+                 the batch (--shard I/N) and gate the shards, or lower --trials",
+                path.display(),
+                m.len(),
+                super::MAX_RECORDS_BYTES
+            )));
+        }
         Ok(_) => File::open(path).map_err(io(path))?,
     };
     let lines = capped_lines(BufReader::new(file), path)?;

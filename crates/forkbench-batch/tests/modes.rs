@@ -104,3 +104,88 @@ fn force_new_deletes_only_what_a_batch_wrote() {
     assert!(ours.join("recordings/notes.txt").is_file());
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Records are read whole, so their file's size is capped: a `trials.jsonl` past
+/// `MAX_RECORDS_BYTES` (here a sparse file) is refused at once, naming it and the cap.
+#[test]
+fn a_records_file_past_the_byte_cap_is_refused_before_reading() {
+    let dir = std::env::temp_dir().join(format!("forkbench-cap-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let spec = BatchSpec {
+        scenarios: vec![defaults::embedded_scenario("field-test").expect("embedded")],
+        planners: vec![],
+        trackers: vec![],
+        trials: 1,
+        seed: 1,
+        shard: (0, 1),
+        overrides: Default::default(),
+        replan: None,
+        compare_replanning: false,
+        force_new: false,
+    };
+    batch::run_batch(&spec, &dir, 1, &|_| {}).expect("batch");
+    let f = std::fs::OpenOptions::new()
+        .write(true)
+        .open(dir.join("trials.jsonl"))
+        .expect("open");
+    f.set_len(batch::MAX_RECORDS_BYTES + 1).expect("sparse");
+    let t0 = std::time::Instant::now();
+    let e = batch::load_results(&dir).expect_err("refused").to_string();
+    assert!(
+        e.contains("trials.jsonl") && e.contains("read at once"),
+        "{e}"
+    );
+    assert!(t0.elapsed().as_secs() < 5);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The gate never pairs silently around trials whose seed differs from the baseline's at
+/// the same key: it says so and compares unpaired.
+#[test]
+fn swapped_seeds_make_the_gate_unpaired_with_the_reason_named() {
+    let dir = std::env::temp_dir().join(format!("forkbench-seeds-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let spec = BatchSpec {
+        scenarios: vec![defaults::embedded_scenario("field-test").expect("embedded")],
+        planners: vec![],
+        trackers: vec![],
+        trials: 4,
+        seed: 1,
+        shard: (0, 1),
+        overrides: Default::default(),
+        replan: None,
+        compare_replanning: false,
+        force_new: false,
+    };
+    let summary = batch::run_batch(&spec, &dir, 1, &|_| {}).expect("batch");
+    let mut records = batch::read_records(&dir.join("trials.jsonl")).expect("records");
+    let manifest = batch::Manifest::read(&dir)
+        .expect("read")
+        .expect("manifest");
+    let summary = batch::Summary {
+        provenance: summary.provenance.clone(),
+        ..batch::summarize(&records)
+    };
+    let base = batch::Baseline::from_results(&summary, &records, "t".into());
+    let o = batch::GateOptions::default();
+    let paired = batch::regress(&base, &summary, &records, Some(&manifest), &o);
+    assert!(
+        matches!(paired.pairing, batch::Pairing::Paired { pairs: 4 }),
+        "{:?}",
+        paired.pairing
+    );
+    let (a, b) = (records[0].outcome.seed, records[1].outcome.seed);
+    records[0].outcome.seed = b;
+    records[1].outcome.seed = a;
+    let report = batch::regress(&base, &summary, &records, Some(&manifest), &o);
+    match &report.pairing {
+        batch::Pairing::Unpaired { reason } => {
+            assert!(
+                reason.contains("2 trials share a key with the baseline but not its seed"),
+                "{reason}"
+            )
+        }
+        p => panic!("paired despite swapped seeds: {p:?}"),
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
