@@ -129,15 +129,30 @@ class PalletPickEnv(gymnasium.Env):
             cases = self.scenario.cases
             case = cases[int(self.np_random.integers(len(cases)))]
         trial_seed = int(self.np_random.integers(0, 2**63 - 1))
+        self._ended = False
         return self._core.reset(trial_seed, case)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        self._refuse_after_end()
         a = np.asarray(action, dtype=np.float64).reshape(2)
-        return self._core.step(float(a[0]), float(a[1]))
+        return self._mark_end(self._core.step(float(a[0]), float(a[1])))
 
     def expert_step(self) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """One step under the scenario's own tracker (a reference to compare against)."""
-        return self._core.expert_step()
+        self._refuse_after_end()
+        return self._mark_end(self._core.expert_step())
+
+    def _refuse_after_end(self) -> None:
+        # A step after the end would repeat the terminal reward: Gymnasium's contract is
+        # that the caller resets first.
+        if getattr(self, "_ended", False):
+            raise RuntimeError("the episode has ended (terminated or truncated); call reset()")
+
+    def _mark_end(
+        self, out: tuple[np.ndarray, float, bool, bool, dict[str, Any]]
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        self._ended = bool(out[2] or out[3])
+        return out
 
 
 class PalletPickVectorEnv(VectorEnv):

@@ -71,7 +71,9 @@ pub fn run_trial<'py>(
         },
     };
     // The CLI's own check: values in range, and every override acting on this scenario.
-    let run = scn.check_options(&opts).map_err(|e| scenario_error(py, &e))?;
+    let run = scn
+        .check_options(&opts)
+        .map_err(|e| scenario_error(py, &e))?;
     let out = match mcap {
         None => py.detach(|| forkbench_trial::run_trial(scn, case, &opts)),
         Some(path) => {

@@ -66,6 +66,10 @@ def test_episodes_end_as_the_bench_judges():
             break
     assert trunc and not term and info["failure"] == "timeout"
     assert steps == round(env.scenario.timeout_s / 0.01)
+    # After the end a step raises instead of repeating the terminal reward.
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step([0.0, 0.0])
+    env.reset(seed=2)
     with pytest.raises(ValueError, match="finite"):
         env.step([float("nan"), 0.0])
 
