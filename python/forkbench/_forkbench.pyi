@@ -73,6 +73,7 @@ def run_trial(
     missing_reflectors: Sequence[str] | None = None,
     replan: bool | None = None,
     mcap: str | os.PathLike[str] | None = None,
+    force: bool = False,
 ) -> Outcome: ...
 def run_batch(
     scenarios: Sequence[Scenario] | None = None,

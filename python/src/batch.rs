@@ -19,7 +19,7 @@ use crate::scenario::Scenario;
 #[pyo3(signature = (scenario, case=None, *, seed=None, planner=None, tracker=None,
                     noise=true, pallet_noise_scale=None, localization_noise_scale=None,
                     odometry_noise_scale=None, pallet_sensing=None, localizer=None,
-                    missing_reflectors=None, replan=None, mcap=None))]
+                    missing_reflectors=None, replan=None, mcap=None, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_trial<'py>(
     py: Python<'py>,
@@ -37,6 +37,7 @@ pub fn run_trial<'py>(
     missing_reflectors: Option<Vec<String>>,
     replan: Option<bool>,
     mcap: Option<PathBuf>,
+    force: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let scn = &scenario.inner;
     let case = match case {
@@ -83,7 +84,8 @@ pub fn run_trial<'py>(
                 env!("CARGO_PKG_VERSION"),
             );
             let fail = |e: forkbench_log::LogError| RecordingError::new_err(e.to_string());
-            forkbench_log::check_writable(&path, true).map_err(fail)?;
+            // As the CLI: an existing file is replaced only when asked (`force=True`).
+            forkbench_log::check_writable(&path, force).map_err(fail)?;
             let mut rec = forkbench_log::McapRecorder::create(&path, meta).map_err(fail)?;
             let out = py.detach(|| {
                 let r: &mut dyn Recorder = &mut rec;
@@ -186,9 +188,15 @@ pub fn run_batch<'py>(
              CLI's batch (sharded if need be) and read its trials.jsonl"
         )));
     }
-    let jobs = jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-        .max(1);
+    if jobs == Some(0) {
+        return Err(BatchError::new_err("jobs 0: at least one worker thread"));
+    }
+    if out.as_ref().is_some_and(|p| p.as_os_str().is_empty()) {
+        return Err(BatchError::new_err(
+            "out \"\": name the batch directory (None keeps the records in memory)",
+        ));
+    }
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let records = py
         .detach(|| run(&spec, jobs, out.as_deref()))
         .map_err(|e| BatchError::new_err(e.to_string()))?;

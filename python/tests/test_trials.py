@@ -68,6 +68,14 @@ def test_a_trial_records_to_mcap(tmp_path):
     out = forkbench.run_trial(forkbench.load("field-test"), seed=1, noise=False, mcap=path)
     data = path.read_bytes()
     assert out["success"] and data[:8] == b"\x89MCAP0\r\n" and len(data) > 10_000
+    # An existing recording is replaced only when asked, as the CLI's --force.
+    with pytest.raises(forkbench.RecordingError, match="exists"):
+        forkbench.run_trial(forkbench.load("field-test"), seed=1, noise=False, mcap=path)
+    forkbench.run_trial(forkbench.load("field-test"), seed=1, noise=False, mcap=path, force=True)
+    with pytest.raises(forkbench.BatchError, match="jobs 0"):
+        forkbench.run_batch([forkbench.load("field-test")], trials=1, jobs=0)
+    with pytest.raises(forkbench.BatchError, match="out"):
+        forkbench.run_batch([forkbench.load("field-test")], trials=1, out="")
 
 
 def test_bad_input_names_file_field_and_reason(tmp_path):
