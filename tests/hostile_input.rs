@@ -416,3 +416,66 @@ fn plot_write_failures_are_reported_and_leave_no_truncated_file() {
     let leftovers = std::fs::read_dir(&d).expect("dir").count();
     assert_eq!(leftovers, 0, "temporary files left in {}", d.display());
 }
+
+/// An interrupt or a termination kills the external children (each in its own process
+/// group, out of a terminal's reach) before forkbench exits with 128 + the signal.
+#[test]
+fn interrupting_forkbench_kills_its_external_detector() {
+    for (signal, code) in [("INT", 130), ("TERM", 143)] {
+        let d = tmp(&format!("interrupt-{signal}"));
+        let marker = format!("forkbench-sleeper-{}-{signal}", std::process::id());
+        std::fs::write(
+            d.join("sleeper.py"),
+            format!(
+                "import json, sys, time\n# {marker}\nprint(json.dumps({{\"type\": \"hello\", \
+                 \"protocol\": \"forkbench-detector\", \"version\": 1, \"name\": \"sleeper\"}}), \
+                 flush=True)\nsys.stdin.readline()\ntime.sleep(600)\n"
+            ),
+        )
+        .expect("write");
+        let scn = d.join("s.toml");
+        std::fs::write(
+            &scn,
+            format!(
+                "name = \"s\"\nplanner = \"bspline\"\nstart = {{ x_m = 0, y_m = 0, heading_deg = 0 }}\n\
+                 pallet = {{ x_m = 6, y_m = 0, heading_deg = 0 }}\n[sensors.pallet]\nkind = \"tim561\"\n\
+                 [sensors.pallet.detector]\nkind = \"external\"\ncommand = [\"python3\", \"sleeper.py\", \"{marker}\"]\n\
+                 timeout_s = 300.0\n"
+            ),
+        )
+        .expect("write");
+        let mut child = Command::new(env!("CARGO_BIN_EXE_forkbench"))
+            .args(["trial", scn.to_str().expect("utf-8")])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("spawns");
+        let running = || {
+            Command::new("pgrep")
+                .args(["-f", &marker])
+                .output()
+                .is_ok_and(|o| o.status.success())
+        };
+        let t0 = Instant::now();
+        while !running() && t0.elapsed() < Duration::from_secs(20) {
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        assert!(running(), "the detector never started");
+        std::thread::sleep(Duration::from_millis(300));
+        let pid = child.id().to_string();
+        assert!(
+            Command::new("kill")
+                .args([&format!("-{signal}"), &pid])
+                .status()
+                .expect("kill")
+                .success()
+        );
+        let status = child.wait().expect("waits");
+        assert_eq!(status.code(), Some(code), "{signal}");
+        std::thread::sleep(Duration::from_millis(200));
+        assert!(
+            !running(),
+            "the detector outlived forkbench after SIG{signal}"
+        );
+    }
+}

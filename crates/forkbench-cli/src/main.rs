@@ -381,6 +381,7 @@ fn main() -> ExitCode {
         signal_hook::consts::SIGXFSZ,
         std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false)),
     );
+    kill_children_on_signals();
     let cli = Cli::parse();
     let result = run(cli);
     // No external process (or its children) outlives the command.
@@ -414,4 +415,21 @@ const MAX_SETTINGS_BYTES: u64 = 4 << 20;
 /// device is refused at once, naming it), at most [`MAX_SETTINGS_BYTES`].
 pub(crate) fn read_input(path: &std::path::Path) -> anyhow::Result<String> {
     Ok(forkbench_core::files::read_text(path, MAX_SETTINGS_BYTES)?)
+}
+
+/// On an interrupt, a termination or a hang-up, every external planner, tracker and
+/// detector (each in a process group of its own, which a terminal's Ctrl-C does not
+/// reach) is killed with its group before forkbench exits with 128 + the signal; records
+/// already written stay (each is flushed as it is written).
+fn kill_children_on_signals() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(sig) = signals.forever().next() {
+            forkbench_ipc::kill_all();
+            std::process::exit(128 + sig);
+        }
+    });
 }
