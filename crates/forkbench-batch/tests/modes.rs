@@ -5,22 +5,27 @@
 use forkbench_batch::{self as batch, BatchSpec, CompareOptions};
 use forkbench_trial::defaults;
 
-#[test]
-fn the_summary_and_compare_pair_the_two_modes() {
-    let dir = std::env::temp_dir().join(format!("forkbench-modes-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let spec = BatchSpec {
-        scenarios: vec![defaults::embedded_scenario("bspline-table2").expect("embedded")],
+/// A batch of `trials` per case of `scenario`, both modes when `both`.
+fn spec(scenario: &str, trials: u64, both: bool, force_new: bool) -> BatchSpec {
+    BatchSpec {
+        scenarios: vec![defaults::embedded_scenario(scenario).expect("embedded")],
         planners: vec![],
         trackers: vec![],
-        trials: 3,
+        trials,
         seed: 1,
         shard: (0, 1),
         overrides: Default::default(),
         replan: None,
-        compare_replanning: true,
-        force_new: true,
-    };
+        compare_replanning: both,
+        force_new,
+    }
+}
+
+#[test]
+fn the_summary_and_compare_pair_the_two_modes() {
+    let dir = std::env::temp_dir().join(format!("forkbench-modes-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let spec = spec("bspline-table2", 3, true, true);
     let summary = batch::run_batch(&spec, &dir, 2, &|_| {}).expect("batch");
     let records = batch::read_records(&dir.join("trials.jsonl")).expect("records");
     let (mut broke, mut fixed) = (0, 0);
@@ -67,18 +72,7 @@ fn force_new_deletes_only_what_a_batch_wrote() {
     let mine = dir.join("recordings/mine");
     std::fs::create_dir_all(&mine).expect("mkdir");
     std::fs::write(mine.join("thesis.txt"), "x").expect("write");
-    let spec = BatchSpec {
-        scenarios: vec![defaults::embedded_scenario("field-test").expect("embedded")],
-        planners: vec![],
-        trackers: vec![],
-        trials: 1,
-        seed: 1,
-        shard: (0, 1),
-        overrides: Default::default(),
-        replan: None,
-        compare_replanning: false,
-        force_new: true,
-    };
+    let spec = spec("field-test", 1, false, true);
     let e = batch::run_batch(&spec, &dir, 1, &|_| {}).expect_err("refused");
     assert!(e.to_string().contains("no manifest.json"), "{e}");
     assert!(
@@ -111,18 +105,7 @@ fn force_new_deletes_only_what_a_batch_wrote() {
 fn a_records_file_past_the_byte_cap_is_refused_before_reading() {
     let dir = std::env::temp_dir().join(format!("forkbench-cap-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let spec = BatchSpec {
-        scenarios: vec![defaults::embedded_scenario("field-test").expect("embedded")],
-        planners: vec![],
-        trackers: vec![],
-        trials: 1,
-        seed: 1,
-        shard: (0, 1),
-        overrides: Default::default(),
-        replan: None,
-        compare_replanning: false,
-        force_new: false,
-    };
+    let spec = spec("field-test", 1, false, false);
     batch::run_batch(&spec, &dir, 1, &|_| {}).expect("batch");
     let f = std::fs::OpenOptions::new()
         .write(true)
@@ -145,18 +128,7 @@ fn a_records_file_past_the_byte_cap_is_refused_before_reading() {
 fn swapped_seeds_make_the_gate_unpaired_with_the_reason_named() {
     let dir = std::env::temp_dir().join(format!("forkbench-seeds-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let spec = BatchSpec {
-        scenarios: vec![defaults::embedded_scenario("field-test").expect("embedded")],
-        planners: vec![],
-        trackers: vec![],
-        trials: 4,
-        seed: 1,
-        shard: (0, 1),
-        overrides: Default::default(),
-        replan: None,
-        compare_replanning: false,
-        force_new: false,
-    };
+    let spec = spec("field-test", 4, false, false);
     let summary = batch::run_batch(&spec, &dir, 1, &|_| {}).expect("batch");
     let mut records = batch::read_records(&dir.join("trials.jsonl")).expect("records");
     let manifest = batch::Manifest::read(&dir)

@@ -326,23 +326,10 @@ impl Scenario {
     /// The same scenario with `names` missing from the NAV350's world (a layout review's
     /// "what if these go"); its map still holds them.
     pub fn with_missing_reflectors(mut self, names: &[String]) -> Result<Self, TrialError> {
-        if self.localizer.kind != "nav350" {
-            return Err(invalid(
-                &self.file,
-                "sensors.localizer.missing_reflectors",
-                &format!(
-                    "only the nav350 localiser measures reflectors; this scenario's is {:?}",
-                    self.localizer.kind
-                ),
-            ));
-        }
-        let mut spec = self.localizer.clone();
-        let list = names
-            .iter()
-            .map(|n| toml::Value::from(n.as_str()))
-            .collect();
-        spec.settings
-            .insert("missing_reflectors".into(), toml::Value::Array(list));
+        let spec = self.localizer_for(&crate::trial::Overrides {
+            missing_reflectors: Some(names.to_vec()),
+            ..Default::default()
+        })?;
         let registry = Arc::clone(&self.registry);
         self.check_localizer(&registry, &spec)
             .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;

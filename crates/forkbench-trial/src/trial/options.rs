@@ -215,7 +215,9 @@ impl Scenario {
         }
     }
 
-    fn localizer_for(&self, o: &Overrides) -> Result<ComponentSpec, TrialError> {
+    /// The localiser a run's overrides name (the scenario's own, or a kind), with any
+    /// missing reflectors.
+    pub(crate) fn localizer_for(&self, o: &Overrides) -> Result<ComponentSpec, TrialError> {
         let mut spec = match &o.localizer {
             Some(kind) => ComponentSpec::of_kind(Role::Localizer, kind),
             None => self.localizer.clone(),
@@ -226,7 +228,7 @@ impl Scenario {
                     &self.file,
                     "sensors.localizer.missing_reflectors",
                     &format!(
-                        "only the nav350 localiser measures reflectors; this run's is {:?}",
+                        "only the nav350 localiser measures reflectors; this scenario's is {:?}",
                         spec.kind
                     ),
                 ));
