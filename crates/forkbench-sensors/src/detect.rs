@@ -45,6 +45,42 @@ impl Default for DetectorConfig {
     }
 }
 
+impl DetectorConfig {
+    /// Every value in its documented range, naming the field (a NaN would make every
+    /// comparison false and every trial `pallet_not_found`).
+    pub fn validate(&self) -> Result<(), forkbench_core::SettingsError> {
+        let lengths = [
+            ("break_m", self.break_m),
+            ("split_m", self.split_m),
+            ("width_tolerance_m", self.width_tolerance_m),
+            ("spacing_tolerance_m", self.spacing_tolerance_m),
+            ("roi_m", self.roi_m),
+            ("line_tolerance_m", self.line_tolerance_m),
+        ];
+        for (f, v) in lengths {
+            if !(v.is_finite() && v > 0.0 && v <= 10.0) {
+                return Err(forkbench_core::SettingsError::field(
+                    f,
+                    "must lie in (0, 10] m",
+                ));
+            }
+        }
+        if !(self.roi_rad > 0.0 && self.roi_rad <= std::f64::consts::PI) {
+            return Err(forkbench_core::SettingsError::field(
+                "roi_rad",
+                "must lie in (0, π]",
+            ));
+        }
+        if !(self.min_coverage > 0.0 && self.min_coverage <= 1.0) {
+            return Err(forkbench_core::SettingsError::field(
+                "min_coverage",
+                "must lie in (0, 1]",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// A pallet found in a scan.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Detection {

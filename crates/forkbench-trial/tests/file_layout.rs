@@ -89,3 +89,18 @@ fn a_huge_back_out_is_refused_at_load_naming_its_field() {
         "{e}"
     );
 }
+
+#[test]
+fn pocket_detector_settings_are_range_checked_at_load() {
+    for (key, value) in [
+        ("roi_m", "nan"),
+        ("min_coverage", "1.5"),
+        ("roi_rad", "-1.0"),
+    ] {
+        let text = format!("{FIELD_TEST}\n[sensors.pallet.detector]\n{key} = {value}\n");
+        let e = Scenario::parse(&text, "d.toml", |_| Ok(World::default()))
+            .expect_err(key)
+            .to_string();
+        assert!(e.contains(&format!("sensors.pallet.detector.{key}")), "{e}");
+    }
+}

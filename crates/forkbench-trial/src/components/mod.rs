@@ -159,9 +159,10 @@ impl Registry {
             )))
         })
         .with_detector("pockets", |s, _| {
-            Ok(Box::new(Pockets {
-                cfg: forkbench_core::settings::parse(s)?,
-            }))
+            let cfg: forkbench_sensors::detect::DetectorConfig =
+                forkbench_core::settings::parse(s)?;
+            cfg.validate()?;
+            Ok(Box::new(Pockets { cfg }))
         })
         .with_detector("external", |s, cx| {
             Ok(Box::new(ExternalDetector::from_settings(
