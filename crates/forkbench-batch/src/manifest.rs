@@ -81,7 +81,10 @@ impl Manifest {
                 Ok(ScenarioEntry {
                     name: s.name.clone(),
                     file: s.file.clone(),
-                    settings_hash: format!("{:016x}", fnv1a(settings.to_string().as_bytes())),
+                    settings_hash: format!(
+                        "{:016x}",
+                        forkbench_core::hash::fnv1a(settings.to_string().bytes())
+                    ),
                     settings,
                 })
             })
@@ -271,15 +274,6 @@ fn short(v: &Value) -> String {
     } else {
         s
     }
-}
-
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h ^= u64::from(*b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
 }
 
 /// An exclusive lock on a batch directory, held while a batch or merge writes it.

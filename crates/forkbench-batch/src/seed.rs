@@ -8,19 +8,13 @@ pub const SEED_SCHEME: u32 = 2;
 /// tracker is part of it: components compared in one batch see the same random draws
 /// (common random numbers), so their trials pair one to one.
 pub fn trial_seed(batch_seed: u64, scenario: &str, case: &str, trial: u64) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut eat = |bytes: &[u8]| {
-        for b in bytes {
-            h ^= u64::from(*b);
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        h ^= 0xff;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    };
-    eat(&batch_seed.to_le_bytes());
-    eat(scenario.as_bytes());
-    eat(case.as_bytes());
-    eat(&trial.to_le_bytes());
+    // Each field followed by 0xff, so no two keys run together into one byte stream.
+    let h = forkbench_core::hash::fnv1a(
+        (batch_seed.to_le_bytes().into_iter().chain([0xff]))
+            .chain(scenario.bytes().chain([0xff]))
+            .chain(case.bytes().chain([0xff]))
+            .chain(trial.to_le_bytes().into_iter().chain([0xff])),
+    );
     let mut z = h.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use super::{BatchSpec, Summary, TrialRecord};
 use forkbench_trial::scenario::{Case, Scenario};
 use forkbench_trial::text::md_cell;
-use forkbench_trial::trial::{MAX_NOISE_SCALE, NOISE_KNOBS, TrialOptions};
+use forkbench_trial::trial::{NOISE_KNOBS, Overrides, TrialOptions};
 
 /// One point of a finished sweep as `sweep.json` holds it.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -56,14 +56,13 @@ impl Sweep {
                     .trim()
                     .parse()
                     .map_err(|_| bad(format!("{v:?} is not a number")))?;
-                if !(x.is_finite() && (0.0..=MAX_NOISE_SCALE).contains(&x)) {
-                    return Err(bad(format!(
-                        "{x} must be a scale from 0 to {MAX_NOISE_SCALE}"
-                    )));
-                }
+                // The same range check as every run's overrides.
+                let mut point = Overrides::default();
+                point.set_scale(knob, x);
+                point.validate().map_err(|e| bad(e.to_string()))?;
                 Ok(x)
             })
-            .collect::<Result<Vec<f64>, _>>()?;
+            .collect::<Result<Vec<f64>, super::BatchError>>()?;
         Ok(Self {
             knob: knob.to_owned(),
             values,

@@ -2,6 +2,7 @@
 
 pub mod files;
 pub mod geometry;
+pub mod hash;
 pub mod pallet;
 pub mod path;
 pub mod pose;

@@ -308,14 +308,17 @@ impl Scenario {
     /// `kinect2`, `tim561+kinect2`) at its default settings and the pocket detector: how
     /// a run compares sensing models on the same seeds.
     pub fn with_pallet_sensing(mut self, kind: &str) -> Result<Self, TrialError> {
-        self.pallet_sensing = sensors::of_kind(kind, &self.truck, &self.file)?;
+        self.pallet_sensing = self.sensing_for(Some(kind))?;
         Ok(self)
     }
 
     /// The same scenario localising with `kind` (`gaussian`, `nav350`) at its default
     /// settings: how a run compares localisation models on the same seeds.
     pub fn with_localizer(mut self, kind: &str) -> Result<Self, TrialError> {
-        let spec = ComponentSpec::of_kind(Role::Localizer, kind);
+        let spec = self.localizer_for(&crate::trial::Overrides {
+            localizer: Some(kind.to_owned()),
+            ..Default::default()
+        })?;
         let registry = Arc::clone(&self.registry);
         self.check_localizer(&registry, &spec)
             .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;

@@ -146,8 +146,6 @@ pub struct Resolved {
     pub localization_noise_scale: f64,
     /// The odometry's errors, scaled.
     pub odometry: forkbench_sensors::OdometryConfig,
-    /// The overrides this was resolved with (recordings' metadata).
-    pub overrides: Overrides,
 }
 
 impl Scenario {
@@ -193,7 +191,6 @@ impl Scenario {
             localizer,
             localization_noise_scale,
             odometry: self.scaled_odometry(o.odometry_noise_scale)?,
-            overrides: o.clone(),
         })
     }
 
@@ -208,7 +205,8 @@ impl Scenario {
         Ok(run)
     }
 
-    fn sensing_for(&self, kind: Option<&str>) -> Result<PalletSensing, TrialError> {
+    /// The pallet sensing a run names by kind (at its defaults), or the scenario's own.
+    pub(crate) fn sensing_for(&self, kind: Option<&str>) -> Result<PalletSensing, TrialError> {
         match kind {
             Some(k) => crate::scenario::sensors::of_kind(k, &self.truck, &self.file),
             None => Ok(self.pallet_sensing.clone()),

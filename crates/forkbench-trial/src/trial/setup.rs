@@ -1,5 +1,6 @@
 //! Setup stage: the simulated world, sensors with their own random streams, the components, the first fix and estimate.
 
+use forkbench_core::hash::fnv1a;
 use forkbench_core::{Pose2, SettingsError};
 use forkbench_plan::Planner;
 use forkbench_sensors::{Localizer, PalletEstimator};
@@ -123,12 +124,6 @@ fn scanner_salt(name: &str, what: &str) -> u64 {
         (_, "bias") => fnv1a(name.bytes()),
         _ => fnv1a(name.bytes().chain(b"/".iter().copied()).chain(what.bytes())),
     }
-}
-
-fn fnv1a(bytes: impl Iterator<Item = u8>) -> u64 {
-    bytes.fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
 }
 
 /// Each scanner's systematic range error for one trial and the stream of its per-beam
