@@ -20,6 +20,10 @@ pub struct MapFigure<'a> {
     /// The smoothed path, and where its swept footprint strikes an obstacle.
     pub smoothed: Option<&'a [[f64; 2]]>,
     pub strike: Option<[f64; 2]>,
+    /// A Hybrid-A* manoeuvre: forward and backward segments, the truck outlined at its
+    /// start, each cusp and its end.
+    pub manoeuvre: Option<&'a forkbench_nav::hybrid::Manoeuvre>,
+    pub truck: &'a forkbench_core::ForkliftSpec,
     pub start: [f64; 2],
     pub goal: [f64; 2],
 }
@@ -77,17 +81,10 @@ fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> an
             draw_line(&mut chart, p, name, colour.stroke_width(width))?;
         }
     }
-    if let Some(at) = fig.strike {
-        chart
-            .draw_series(std::iter::once(Cross::new(
-                (at[0], at[1]),
-                9,
-                BLACK.stroke_width(3),
-            )))
-            .map_err(err)?
-            .label("footprint strikes")
-            .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+    if let Some(m) = fig.manoeuvre {
+        draw_manoeuvre(&mut chart, m, fig.truck)?;
     }
+    draw_strike(&mut chart, fig.strike)?;
     for (at, name, colour) in [
         (fig.start, "start", RGBColor(30, 150, 60)),
         (fig.goal, "goal", RGBColor(230, 130, 20)),
@@ -152,5 +149,83 @@ fn draw_roadmap<DB: DrawingBackend>(
     chart
         .draw_series(map.nodes.iter().map(|n| Circle::new((n[0], n[1]), 2, node)))
         .map_err(err)?;
+    Ok(())
+}
+
+/// Where a smoothed path's footprint strikes an obstacle.
+fn draw_strike<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    strike: Option<[f64; 2]>,
+) -> anyhow::Result<()> {
+    if let Some(at) = strike {
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (at[0], at[1]),
+                9,
+                BLACK.stroke_width(3),
+            )))
+            .map_err(err)?
+            .label("footprint strikes")
+            .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+    }
+    Ok(())
+}
+
+/// Forward segments blue, backward ones purple, and the truck's outline (chassis and
+/// forks) at the start, at each cusp and at the end.
+fn draw_manoeuvre<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    m: &forkbench_nav::hybrid::Manoeuvre,
+    truck: &forkbench_core::ForkliftSpec,
+) -> anyhow::Result<()> {
+    let forward = RGBColor(30, 90, 220).stroke_width(3);
+    let backward = RGBColor(150, 40, 170).stroke_width(3);
+    let (mut fwd_label, mut back_label) = (false, false);
+    for seg in &m.segments {
+        let (style, name, labelled) = if seg.reverse {
+            (backward, "backwards", &mut back_label)
+        } else {
+            (forward, "forwards", &mut fwd_label)
+        };
+        let line = PathElement::new(
+            seg.samples
+                .iter()
+                .map(|p| (p.x_m, p.y_m))
+                .collect::<Vec<_>>(),
+            style,
+        );
+        let drawn = chart.draw_series(std::iter::once(line)).map_err(err)?;
+        if !*labelled {
+            drawn
+                .label(name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            *labelled = true;
+        }
+    }
+    let mut poses: Vec<forkbench_core::Pose2> = m.poses().take(1).collect();
+    poses.extend(m.cusps());
+    poses.extend(m.poses().last());
+    let outline = BLACK.mix(0.7).stroke_width(1);
+    for pose in &poses {
+        for part in forkbench_nav::truck_parts(truck, 0.0) {
+            let mut c: Vec<(f64, f64)> = part.corners(pose).iter().map(|p| (p[0], p[1])).collect();
+            c.push(c[0]);
+            chart
+                .draw_series(std::iter::once(PathElement::new(c, outline)))
+                .map_err(err)?;
+        }
+    }
+    let cusps = m.cusps();
+    if !cusps.is_empty() {
+        chart
+            .draw_series(
+                cusps
+                    .iter()
+                    .map(|c| TriangleMarker::new((c.x_m, c.y_m), 8, RED.filled())),
+            )
+            .map_err(err)?
+            .label("cusp (stop, change direction)")
+            .legend(|(x, y)| TriangleMarker::new((x + 10, y), 5, RED.filled()));
+    }
     Ok(())
 }

@@ -42,8 +42,8 @@ pub struct PlanCli {
     /// Draw path, curvature and steering to FILE (.svg or .png).
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    /// Global planners (prm, rrt, rrt-connect): the map, a world TOML or a ROS map_server
-    /// YAML.
+    /// Global planners (prm, rrt, rrt-connect, hybrid-astar): the map, a world TOML or a
+    /// ROS map_server YAML.
     #[arg(long)]
     pub map: Option<PathBuf>,
     /// PRM: samples drawn over the map (the paper's 500); with --first-solution, the
@@ -71,10 +71,11 @@ pub struct PlanCli {
     /// Global planners: obstacle inflation (default 0.5 × wheelbase, as the paper).
     #[arg(long)]
     pub inflate_m: Option<f64>,
-    /// Global planners: `inflate` (the paper: obstacles grown by 0.5 × wheelbase) or
-    /// `footprint` (the chassis and forks swept along each edge).
-    #[arg(long, default_value = "inflate")]
-    pub collision: forkbench_nav::CollisionModel,
+    /// Global planners: `inflate` (the paper: obstacles grown by 0.5 × wheelbase; the
+    /// default of prm, rrt and rrt-connect) or `footprint` (the chassis and forks swept
+    /// along each edge; hybrid-astar's only model).
+    #[arg(long)]
+    pub collision: Option<forkbench_nav::CollisionModel>,
     /// Global planners: smooth the route into a drivable path (κ ≤ κ_max, clothoid
     /// corners) from the start heading to the goal heading, its swept footprint checked.
     #[arg(long)]
@@ -90,9 +91,35 @@ pub struct PlanCli {
     /// `inflate`, as the paper).
     #[arg(long)]
     pub margin_m: Option<f64>,
+    /// With --smooth: report a route that cannot be smoothed as failed, instead of
+    /// planning a manoeuvre (forwards and backwards) with Hybrid-A*.
+    #[arg(long)]
+    pub no_fallback: bool,
 }
 
 impl PlanCli {
+    /// Flags of point planners that cannot act on Hybrid-A*, refused by name.
+    fn refuse_for_manoeuvres(&self) -> anyhow::Result<()> {
+        let why =
+            |flag: &str, reason: &str| anyhow::anyhow!("plan {}: {flag} {reason}", self.planner);
+        if self.smooth {
+            return Err(why(
+                "--smooth",
+                "is for point routes: hybrid-astar plans drivable manoeuvres",
+            ));
+        }
+        if self.collision == Some(forkbench_nav::CollisionModel::Inflate) {
+            return Err(why(
+                "--collision inflate",
+                "is for point planners: hybrid-astar checks the truck's footprint (--collision footprint)",
+            ));
+        }
+        if self.nodes.is_some() || self.first_solution {
+            return Err(why("--nodes/--first-solution", "are PRM settings"));
+        }
+        Ok(())
+    }
+
     /// A global planner's arguments, when `planner` is one.
     pub fn route(&self) -> anyhow::Result<Option<crate::route_cmd::RouteArgs>> {
         let kind = forkbench_nav::GlobalPlannerKind::from_name(&self.planner);
@@ -102,12 +129,20 @@ impl PlanCli {
         let Some(planner) = kind else {
             return Ok(None);
         };
+        if planner.kinodynamic() {
+            self.refuse_for_manoeuvres()?;
+        }
         let map = self.map.clone().ok_or_else(|| {
             anyhow::anyhow!(
                 "plan {}: --map WORLD.toml|MAP.yaml is required",
                 self.planner
             )
         })?;
+        let collision = self.collision.unwrap_or(if planner.kinodynamic() {
+            forkbench_nav::CollisionModel::Footprint
+        } else {
+            forkbench_nav::CollisionModel::Inflate
+        });
         Ok(Some(crate::route_cmd::RouteArgs {
             planner,
             map,
@@ -122,11 +157,12 @@ impl PlanCli {
             seed: self.seed,
             resolution_m: self.resolution_m,
             inflate_m: self.inflate_m,
-            collision: self.collision,
+            collision,
             smooth: self.smooth,
+            fallback: self.smooth && !self.no_fallback,
             lead_m: self.lead_m,
             approach_m: self.approach_m,
-            margin_m: self.margin_m.unwrap_or(self.collision.default_margin_m()),
+            margin_m: self.margin_m.unwrap_or(collision.default_margin_m()),
             truck: crate::load_truck(self.truck.as_ref())?,
             json: self.json,
             plot: self.plot.clone(),

@@ -33,6 +33,8 @@ pub struct RouteArgs {
     pub inflate_m: Option<f64>,
     pub collision: CollisionModel,
     pub smooth: bool,
+    /// With `smooth`: plan a Hybrid-A* manoeuvre when the route cannot be smoothed.
+    pub fallback: bool,
     pub lead_m: f64,
     pub approach_m: Option<f64>,
     pub margin_m: f64,
@@ -86,6 +88,9 @@ impl RouteArgs {
             approach: Vec::new(),
             margin_m: self.margin_m,
             truck: self.truck.clone(),
+            manoeuvre_fallback: self
+                .fallback
+                .then(forkbench_nav::hybrid::HybridParams::default),
         }
     }
 }
@@ -100,7 +105,7 @@ pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
         if let (Some(file), 0) = (&a.plot, run) {
             plot(&a, &map, &q, &plan, file)?;
         }
-        let simplified = if q.smooth {
+        let simplified = if q.smooth || a.planner.kinodynamic() {
             None
         } else {
             simplify(&map, &q, &plan, a.seed)
@@ -154,6 +159,19 @@ fn plot(
         ),
         _ => format!("{:.1} m A* polyline", route.length_m),
     };
+    let drivable = match &plan.manoeuvre {
+        Some(m) => format!(
+            "{:.1} m manoeuvre, {} cusps{}",
+            m.length_m,
+            m.cusps().len(),
+            if plan.fallback.is_some() {
+                " (Hybrid-A* fallback)"
+            } else {
+                ""
+            }
+        ),
+        None => drivable,
+    };
     let title = match &route.points {
         Some(_) => format!("{} on {}: {drivable}", a.planner.name(), a.map.display()),
         None => format!("{} on {}: no path", a.planner.name(), a.map.display()),
@@ -174,9 +192,13 @@ fn plot(
         grid: &map.grid,
         inflated: &inflated,
         roadmap: plan.roadmap.as_ref(),
-        path: route.points.as_deref(),
+        // A manoeuvre's own route is the manoeuvre: the point route is drawn only when
+        // the manoeuvre replaced it.
+        path: route.points.as_deref().filter(|_| !a.planner.kinodynamic()),
         smoothed: line.as_deref(),
         strike: smoothed.and_then(|s| s.hit).map(|h| [h.x_m, h.y_m]),
+        manoeuvre: plan.manoeuvre.as_ref(),
+        truck: &q.truck,
         start: [a.start.x_m, a.start.y_m],
         goal: [a.goal.x_m, a.goal.y_m],
     };
@@ -240,7 +262,9 @@ fn report(
             "nodes_requested": a.nodes,
             "connect_m": a.connect_m,
             "seed": a.seed,
-            "success": r.found() && (!a.smooth || plan.drivable().is_some()),
+            "success": if a.smooth || a.planner.kinodynamic() { plan.succeeded() } else { r.found() },
+            "manoeuvre": plan.manoeuvre.as_ref().map(manoeuvre_json),
+            "fallback": plan.fallback,
             "polyline_m": r.points,
             "length_m": r.found().then_some(r.length_m),
             "first_solution": a.first_solution,
@@ -260,14 +284,18 @@ fn report(
             q.margin_m
         ),
     };
+    let seed = if a.planner.kinodynamic() {
+        String::new()
+    } else {
+        format!(", seed {}", a.seed)
+    };
     let head = format!(
-        "{} on {} ({} × {} cells at {} m, {model}), seed {}\n",
+        "{} on {} ({} × {} cells at {} m, {model}){seed}\n",
         a.planner.name(),
         a.map.display(),
         grid.width,
         grid.height,
         grid.resolution_m,
-        a.seed
     );
     let timing = format!(
         "time {:.2} ms (sampling {:.2}, connection {:.2}, search {:.2}, smoothing {:.2}); {} nodes\n",
@@ -290,7 +318,55 @@ fn report(
             1e3 * s.time_s
         )
     });
-    head + &body + &short + &smoothing_text(plan) + &timing
+    head + &body + &short + &smoothing_text(plan) + &manoeuvre_text(plan) + &timing
+}
+
+/// A manoeuvre as JSON: its segments (direction, length, samples) and cusps.
+fn manoeuvre_json(m: &forkbench_nav::hybrid::Manoeuvre) -> serde_json::Value {
+    let segments: Vec<_> = m
+        .segments
+        .iter()
+        .map(|p| {
+            json!({
+                "reverse": p.reverse,
+                "length_m": p.length_m(),
+                "samples": p.samples.iter().map(|s| [s.s_m, s.x_m, s.y_m, s.heading_rad, s.curvature_per_m]).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let cusps: Vec<_> = m
+        .cusps()
+        .iter()
+        .map(|c| [c.x_m, c.y_m, c.heading_rad])
+        .collect();
+    json!({
+        "length_m": m.length_m,
+        "reverse_m": m.reverse_m(),
+        "cusps": cusps,
+        "segments": segments,
+        "expansions": m.expansions,
+        "time_s": m.time_s,
+    })
+}
+
+/// The manoeuvre, and why it replaced a smoothed route, in text.
+fn manoeuvre_text(plan: &GlobalPlan) -> String {
+    let mut out = String::new();
+    if let Some(why) = &plan.fallback {
+        out += &format!("fallback: {why}\n");
+    }
+    if let Some(m) = &plan.manoeuvre {
+        out += &format!(
+            "manoeuvre (Hybrid-A*): {} segments, {} cusps, {:.2} m ({:.2} m backwards); {} nodes expanded in {:.2} ms\n",
+            m.segments.len(),
+            m.cusps().len(),
+            m.length_m,
+            m.reverse_m(),
+            m.expansions,
+            1e3 * m.time_s
+        );
+    }
+    out
 }
 
 /// The warehouse leg the reproduction plans: charging station to the aisle in front of a

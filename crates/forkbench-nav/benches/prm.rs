@@ -91,6 +91,7 @@ fn bench(c: &mut Criterion) {
                 approach: Vec::new(),
                 margin_m: 0.15,
                 truck: forkbench_core::ForkliftSpec::default(),
+                manoeuvre_fallback: None,
             };
             plan_global(&map, &q).expect("plans")
         })

@@ -7,6 +7,7 @@ use forkbench_core::geometry::Obstacle;
 use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_geom::Obstacles;
 
+use crate::hybrid::{HybridParams, HybridQuery, Manoeuvre, plan_hybrid};
 use crate::smooth::{SmoothError, SmoothParams, Smoothed, lead_points, shortcut, smooth};
 use crate::space::{CollisionModel, FootprintSpace, FreeSpace, grid_obstacles, truck_parts};
 use crate::{
@@ -110,21 +111,35 @@ pub enum GlobalPlannerKind {
     Prm,
     Rrt,
     RrtConnect,
+    #[serde(alias = "hybrid_astar")]
+    HybridAstar,
 }
 
 impl GlobalPlannerKind {
-    pub const ALL: [Self; 3] = [Self::Prm, Self::Rrt, Self::RrtConnect];
+    pub const ALL: [Self; 4] = [Self::Prm, Self::Rrt, Self::RrtConnect, Self::HybridAstar];
 
     pub fn name(self) -> &'static str {
         match self {
             Self::Prm => "prm",
             Self::Rrt => "rrt",
             Self::RrtConnect => "rrt-connect",
+            Self::HybridAstar => "hybrid-astar",
         }
     }
 
+    /// The kind by name (`hybrid_astar` also names Hybrid-A*).
     pub fn from_name(name: &str) -> Option<Self> {
+        let name = if name == "hybrid_astar" {
+            "hybrid-astar"
+        } else {
+            name
+        };
         Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// Whether it searches the truck's poses itself (no smoothing of a point route).
+    pub fn kinodynamic(self) -> bool {
+        self == Self::HybridAstar
     }
 
     /// The algorithm with its parameters: PRM's node count and connection distance, the
@@ -142,6 +157,7 @@ impl GlobalPlannerKind {
             }),
             Self::Rrt => Algorithm::Rrt(rrt),
             Self::RrtConnect => Algorithm::RrtConnect(rrt),
+            Self::HybridAstar => Algorithm::HybridAstar(HybridParams::default()),
         }
     }
 }
@@ -154,6 +170,9 @@ pub enum Algorithm {
     PrmFirstSolution(PrmParams),
     Rrt(RrtParams),
     RrtConnect(RrtParams),
+    /// Hybrid-A* over the truck's poses, forwards and backwards: a manoeuvre, not a route
+    /// to smooth.
+    HybridAstar(HybridParams),
 }
 
 /// A global planning query.
@@ -177,6 +196,10 @@ pub struct GlobalQuery {
     /// path is checked with the footprint grown by it in both models).
     pub margin_m: f64,
     pub truck: ForkliftSpec,
+    /// With `smooth`: when the point route cannot be smoothed into a drivable path (a start
+    /// facing away from the route, no room for a lead), plan a manoeuvre with Hybrid-A*
+    /// instead (`None`: report the failure).
+    pub manoeuvre_fallback: Option<HybridParams>,
 }
 
 /// A global plan: the planner's route (with the lead points when smoothing), its roadmap
@@ -188,6 +211,10 @@ pub struct GlobalPlan {
     /// `None` without `smooth` or without a route.
     pub smoothed: Option<Result<Smoothed, SmoothError>>,
     pub smoothing_s: f64,
+    /// Hybrid-A*'s manoeuvre: the plan itself, or the fallback when smoothing failed.
+    pub manoeuvre: Option<Manoeuvre>,
+    /// Why the smoothed route gave way to the manoeuvre, or why the fallback failed too.
+    pub fallback: Option<String>,
 }
 
 impl GlobalPlan {
@@ -197,6 +224,11 @@ impl GlobalPlan {
             Some(Ok(s)) if s.clear() => Some(s),
             _ => None,
         }
+    }
+
+    /// Whether the plan can be driven: a clear smoothed path or a manoeuvre.
+    pub fn succeeded(&self) -> bool {
+        self.drivable().is_some() || self.manoeuvre.is_some()
     }
 }
 
@@ -221,8 +253,22 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
             &footprint
         }
     };
+    if let Algorithm::HybridAstar(params) = q.algorithm {
+        return plan_manoeuvre(map, q, params).map(|m| GlobalPlan {
+            route: route_of(&m),
+            roadmap: None,
+            smoothed: None,
+            smoothing_s: 0.0,
+            manoeuvre: Some(m),
+            fallback: None,
+        });
+    }
     let (from, to) = if q.smooth {
-        lead_in_and_out(map, space, q)?
+        match (lead_in_and_out(map, space, q), q.manoeuvre_fallback) {
+            (Ok(ends), _) => ends,
+            (Err(e), Some(params)) => return fallback(map, q, params, e.to_string(), None),
+            (Err(e), None) => return Err(e),
+        }
     } else {
         ([q.start.x_m, q.start.y_m], [q.goal.x_m, q.goal.y_m])
     };
@@ -233,6 +279,8 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
         roadmap,
         smoothed: None,
         smoothing_s: 0.0,
+        manoeuvre: None,
+        fallback: None,
     };
     let Some(points) = route.points.take() else {
         return Ok(plan);
@@ -241,6 +289,82 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
         let t0 = Instant::now();
         plan.smoothed = Some(smooth_route(map, space, q, &points));
         plan.smoothing_s = t0.elapsed().as_secs_f64();
+        if let (None, Some(params)) = (plan.drivable(), q.manoeuvre_fallback) {
+            let why = smoothing_failure(&plan);
+            return fallback(map, q, params, why, Some(plan));
+        }
+    }
+    Ok(plan)
+}
+
+fn plan_manoeuvre(
+    map: &NavMap,
+    q: &GlobalQuery,
+    params: HybridParams,
+) -> Result<Manoeuvre, NavError> {
+    let hq = HybridQuery {
+        start: q.start,
+        goal: q.goal,
+        truck: q.truck.clone(),
+        margin_m: q.margin_m,
+        load: None,
+        params,
+    };
+    plan_hybrid(map, &hq)
+}
+
+/// The manoeuvre's positions as the plan's route.
+fn route_of(m: &Manoeuvre) -> Route {
+    let timing = crate::Timing {
+        search_s: m.time_s,
+        ..Default::default()
+    };
+    Route::new(Some(m.polyline()), timing, m.expansions)
+}
+
+/// Why a smoothed plan is not drivable, in words.
+fn smoothing_failure(plan: &GlobalPlan) -> String {
+    match &plan.smoothed {
+        Some(Err(e)) => format!("smoothing failed: {e}"),
+        Some(Ok(s)) => s.hit.map_or_else(
+            || "smoothing failed".to_owned(),
+            |h| {
+                format!(
+                    "the smoothed path's footprint strikes an obstacle at ({:.2}, {:.2}) m",
+                    h.x_m, h.y_m
+                )
+            },
+        ),
+        None => "no route to smooth".to_owned(),
+    }
+}
+
+/// The smoothed route could not be had (`why`): a Hybrid-A* manoeuvre instead, keeping
+/// the point route and its failed smoothing (when there were any) for the record.
+fn fallback(
+    map: &NavMap,
+    q: &GlobalQuery,
+    params: HybridParams,
+    why: String,
+    point_plan: Option<GlobalPlan>,
+) -> Result<GlobalPlan, NavError> {
+    let t0 = Instant::now();
+    let m = plan_manoeuvre(map, q, params);
+    let mut plan = point_plan.unwrap_or_else(|| GlobalPlan {
+        route: Route::new(None, crate::Timing::default(), 0),
+        roadmap: None,
+        smoothed: None,
+        smoothing_s: 0.0,
+        manoeuvre: None,
+        fallback: None,
+    });
+    plan.smoothing_s += t0.elapsed().as_secs_f64();
+    match m {
+        Ok(m) => {
+            plan.fallback = Some(format!("{why}; planned by Hybrid-A* instead"));
+            plan.manoeuvre = Some(m);
+        }
+        Err(e) => plan.fallback = Some(format!("{why}; Hybrid-A* failed too: {e}")),
     }
     Ok(plan)
 }
@@ -294,6 +418,11 @@ fn run_algorithm(
         }
         Algorithm::Rrt(p) => (plan_rrt(space, from, to, p)?, None),
         Algorithm::RrtConnect(p) => (plan_rrt_connect(space, from, to, p)?, None),
+        Algorithm::HybridAstar(_) => {
+            return Err(NavError::Params(
+                "hybrid-astar plans poses, not a point route".into(),
+            ));
+        }
     })
 }
 

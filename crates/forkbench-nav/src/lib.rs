@@ -2,9 +2,11 @@
 
 pub mod global;
 pub mod grid;
+pub mod hybrid;
 pub mod incremental;
 mod inflate;
 pub mod map_server;
+pub mod reeds_shepp;
 pub mod reproduce;
 pub mod roadmap;
 pub mod rrt;
@@ -35,6 +37,12 @@ pub enum NavError {
     Blocked { which: &'static str, x: f64, y: f64 },
     #[error("{0}")]
     Params(String),
+    #[error("the goal cannot be reached: {0}")]
+    Unreachable(String),
+    #[error(
+        "no path within the search budget ({expansions} nodes expanded in {time_s:.2} s; raise max_expansions or max_time_s)"
+    )]
+    Budget { expansions: usize, time_s: f64 },
 }
 
 /// Wall time of a plan's stages.

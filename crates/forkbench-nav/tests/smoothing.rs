@@ -204,6 +204,7 @@ fn a_footprint_plan_is_drivable_and_clears_the_truck_by_its_margin() {
         approach: Vec::new(),
         margin_m: 0.2,
         truck: truck.clone(),
+        manoeuvre_fallback: None,
     };
     let plan = plan_global(&map, &q).expect("plans");
     let s = plan.drivable().expect("a drivable path");

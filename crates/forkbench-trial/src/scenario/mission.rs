@@ -220,6 +220,14 @@ impl MissionFile {
     fn check(&self, file: &str) -> Result<(), TrialError> {
         let g = &self.global;
         self.check_bounded(file)?;
+        if g.planner.kinodynamic() {
+            return Err(invalid(
+                file,
+                "mission.global.planner",
+                "hybrid-astar plans manoeuvres with cusps, which mission legs do not drive yet \
+                 (use it with `forkbench plan hybrid-astar`); legs use prm, rrt or rrt-connect",
+            ));
+        }
         if !(self.leg_timeout_s.is_finite()
             && self.leg_timeout_s > 0.0
             && self.leg_timeout_s <= super::MAX_TIMEOUT_S)

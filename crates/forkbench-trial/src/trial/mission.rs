@@ -396,6 +396,8 @@ fn plan_leg(
                 approach,
                 margin_m: g.margin_m,
                 truck: truck.clone(),
+                // A leg drives one forward path; manoeuvres with cusps are not driven yet.
+                manoeuvre_fallback: None,
             };
             let plan = plan_global(map, &q).map_err(LegError::from);
             if plan.as_ref().is_ok_and(|p| accepted(p, m).is_some()) {
