@@ -1,4 +1,4 @@
-//! PRM on the warehouse map: roadmap build and A* query, 500 nodes at 10 m (target: median ≤ 5 ms), PRM to the first solution, RRT-Connect (and a simplified RRT-Connect route) beside it, and a footprint-checked, smoothed plan.
+//! PRM on the warehouse map: roadmap build and A* query, 500 nodes at 10 m (target: median ≤ 5 ms), PRM to the first solution, RRT-Connect (and a simplified RRT-Connect route) beside it, a footprint-checked, smoothed plan, and Hybrid-A* out of a station.
 
 use std::path::Path;
 
@@ -95,6 +95,20 @@ fn bench(c: &mut Criterion) {
             };
             plan_global(&map, &q).expect("plans")
         })
+    });
+    // Hybrid-A* on the mission's second leg: out of the sorting station (a K-turn) to the
+    // staging pose before the shelf, ending in the 1.8 m approach; deterministic.
+    g.bench_function("hybrid-astar-sorting-to-staging", |b| {
+        let q = forkbench_nav::hybrid::HybridQuery {
+            start: Pose2::new(6.5, 21.5, std::f64::consts::FRAC_PI_2),
+            goal: Pose2::new(6.0, 9.05, std::f64::consts::PI),
+            truck: forkbench_core::ForkliftSpec::default(),
+            margin_m: 0.15,
+            load: None,
+            params: forkbench_nav::hybrid::HybridParams::default(),
+            approach_m: 1.8,
+        };
+        b.iter(|| forkbench_nav::hybrid::plan_hybrid(&map, &q).expect("plans"))
     });
     g.finish();
 }

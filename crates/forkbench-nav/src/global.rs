@@ -309,6 +309,7 @@ fn plan_manoeuvre(
         margin_m: q.margin_m,
         load: None,
         params,
+        approach_m: 0.0,
     };
     plan_hybrid(map, &hq)
 }

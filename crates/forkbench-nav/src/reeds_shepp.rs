@@ -262,7 +262,7 @@ const FAMILIES: [Family; 10] = [
 ];
 
 /// The 5-piece family (8.11) has its own lengths: two quarter turns around the straight.
-fn ccscc(x: f64, y: f64, phi: f64, best: &mut Option<(f64, usize, Vec<f64>)>) {
+fn ccscc(x: f64, y: f64, phi: f64, c: &Pricing, best: &mut Option<(f64, usize, Vec<f64>)>) {
     for (sx, sy, flip) in [
         (1.0, 1.0, false),
         (-1.0, 1.0, true),
@@ -275,20 +275,70 @@ fn ccscc(x: f64, y: f64, phi: f64, best: &mut Option<(f64, usize, Vec<f64>)>) {
         let word = if sy > 0.0 { 16 } else { 17 };
         let k = if flip { -1.0 } else { 1.0 };
         let lengths = vec![k * t, -k * FRAC_PI_2, k * u, -k * FRAC_PI_2, k * v];
-        consider(best, word, lengths);
+        consider(best, c, word, lengths);
     }
 }
 
-fn consider(best: &mut Option<(f64, usize, Vec<f64>)>, word: usize, lengths: Vec<f64>) {
-    let total: f64 = lengths.iter().map(|l| l.abs()).sum();
+/// What a path costs beyond its length: multipliers on distance driven backwards and
+/// turning, and a price per change of direction (in metres).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Costs {
+    pub reverse: f64,
+    pub turn: f64,
+    pub cusp_m: f64,
+}
+
+impl Costs {
+    /// Length alone: the classic shortest path.
+    pub const LENGTH: Self = Self {
+        reverse: 1.0,
+        turn: 1.0,
+        cusp_m: 0.0,
+    };
+
+    /// The cost of a word's lengths (turning radius 1), the cusp price scaled to it.
+    fn of(&self, word: usize, lengths: &[f64], radius_m: f64) -> f64 {
+        let mut total = 0.0;
+        let mut last = 0.0;
+        for (steer, &l) in WORDS[word].iter().zip(lengths) {
+            if l.abs() <= ZERO {
+                continue;
+            }
+            let mut c = l.abs();
+            if l < 0.0 {
+                c *= self.reverse;
+            }
+            if *steer != Steer::Straight {
+                c *= self.turn;
+            }
+            if last != 0.0 && f64::signum(last) != l.signum() {
+                c += self.cusp_m / radius_m;
+            }
+            total += c;
+            last = l;
+        }
+        total
+    }
+}
+
+/// The costs and the turning radius a word is priced at.
+type Pricing = (Costs, f64);
+
+fn consider(
+    best: &mut Option<(f64, usize, Vec<f64>)>,
+    (c, radius_m): &Pricing,
+    word: usize,
+    lengths: Vec<f64>,
+) {
+    let total = c.of(word, &lengths, *radius_m);
     if best.as_ref().is_none_or(|(b, _, _)| total < *b) {
         *best = Some((total, word, lengths));
     }
 }
 
-/// The shortest word from the origin (heading 0) to (x, y, phi), turning radius 1: its
+/// The cheapest word from the origin (heading 0) to (x, y, phi), turning radius 1: its
 /// index into [`WORDS`] and signed lengths (radians for turns, metres for straights).
-fn shortest(x: f64, y: f64, phi: f64) -> Option<(usize, Vec<f64>)> {
+fn shortest(x: f64, y: f64, phi: f64, c: &Pricing) -> Option<(usize, Vec<f64>)> {
     let mut best = None;
     let (xb, yb) = (x * phi.cos() + y * phi.sin(), x * phi.sin() - y * phi.cos());
     for f in &FAMILIES {
@@ -307,22 +357,27 @@ fn shortest(x: f64, y: f64, phi: f64) -> Option<(usize, Vec<f64>)> {
             if flip {
                 lengths.iter_mut().for_each(|l| *l = -*l);
             }
-            consider(&mut best, word, lengths);
+            consider(&mut best, c, word, lengths);
         }
     }
-    ccscc(x, y, phi, &mut best);
+    ccscc(x, y, phi, c, &mut best);
     best.map(|(_, w, l)| (w, l))
 }
 
 impl RsPath {
     /// The shortest path from `from` to `to` at turning radius `radius_m` (> 0).
     pub fn between(from: &Pose2, to: &Pose2, radius_m: f64) -> Option<Self> {
+        Self::cheapest(from, to, radius_m, Costs::LENGTH)
+    }
+
+    /// Of the 48 candidate paths, the one of least `costs`.
+    pub fn cheapest(from: &Pose2, to: &Pose2, radius_m: f64, costs: Costs) -> Option<Self> {
         let (dx, dy) = (to.x_m - from.x_m, to.y_m - from.y_m);
         let (s, c) = from.heading_rad.sin_cos();
         let x = (c * dx + s * dy) / radius_m;
         let y = (-s * dx + c * dy) / radius_m;
         let phi = to.heading_rad - from.heading_rad;
-        let (word, lengths) = shortest(x, y, phi)?;
+        let (word, lengths) = shortest(x, y, phi, &(costs, radius_m))?;
         let segments = WORDS[word]
             .iter()
             .zip(lengths)

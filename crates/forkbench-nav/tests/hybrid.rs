@@ -47,12 +47,16 @@ fn query(start: Pose2, goal: Pose2) -> HybridQuery {
         margin_m: 0.1,
         load: None,
         params: HybridParams::default(),
+        approach_m: 0.0,
     }
 }
 
-/// Ends at the goal, every pose clear of the map's obstacles, curvature within κ_max.
+/// Ends at the goal, every pose clear of the map's obstacles (the footprint grown by the
+/// margin less the corners' travel between the search's checks), curvature within the
+/// fork root's limit.
 fn check(m: &NavMap, q: &HybridQuery, plan: &Manoeuvre) {
-    let body = Body::of(&q.truck, q.margin_m, q.load);
+    let slack = forkbench_nav::hybrid::CORNER_STEP_M;
+    let body = Body::of(&q.truck, q.margin_m - slack, q.load);
     let end = plan.poses().last().expect("poses");
     assert!(
         (end.x_m - q.goal.x_m).hypot(end.y_m - q.goal.y_m) < 1e-3,
@@ -64,7 +68,7 @@ fn check(m: &NavMap, q: &HybridQuery, plan: &Manoeuvre) {
     for p in plan.poses() {
         assert!(body.free(&m.obstacles, &p), "strikes at {p:?}");
     }
-    let k = q.truck.max_curvature_per_m();
+    let k = forkbench_nav::hybrid::root_max_curvature_per_m(&q.truck) * q.params.curvature_fraction;
     for s in plan.segments.iter().flat_map(|p| &p.samples) {
         assert!(s.curvature_per_m.abs() <= k + 1e-9);
     }

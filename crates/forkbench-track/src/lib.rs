@@ -4,12 +4,14 @@ pub mod external;
 mod predictor;
 mod pursuit;
 mod regulated;
+mod segments;
 mod tracker;
 
 pub use external::ExternalTracker;
 pub use predictor::PosePredictor;
 pub use pursuit::{Command, PurePursuit, TrackerConfig};
 pub use regulated::{RegulatedConfig, RegulatedPurePursuit};
+pub use segments::{SegmentFollower, steer_for_root_curvature};
 pub use tracker::{Tracker, TrackerInput};
 
 use forkbench_core::settings::{self, Settings, SettingsError};

@@ -1,5 +1,6 @@
 //! Hybrid-A* over (x, y, heading), forward and reverse, with Reeds-Shepp shots to the goal (as Nav2's Smac planner): manoeuvres a point planner cannot make.
 
+mod approach;
 mod heuristic;
 mod refine;
 mod search;
@@ -10,7 +11,7 @@ use forkbench_geom::{Footprint, Obstacles};
 
 use crate::{NavError, NavMap, truck_parts};
 
-pub use search::plan_hybrid;
+pub use search::{CORNER_STEP_M, plan_hybrid, plan_hybrid_from_here};
 
 /// Hybrid-A* settings: the search lattice, the costs and the budget.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -36,6 +37,11 @@ pub struct HybridParams {
     pub max_expansions: usize,
     /// Most wall time before giving up.
     pub max_time_s: f64,
+    /// Least distance driven in one direction before changing direction (no shuffles).
+    pub min_segment_m: f64,
+    /// Share of the fork root's tightest curvature the moves use: the rest is the
+    /// tracker's headroom.
+    pub curvature_fraction: f64,
 }
 
 impl Default for HybridParams {
@@ -51,6 +57,8 @@ impl Default for HybridParams {
             forward_only: false,
             max_expansions: 200_000,
             max_time_s: 5.0,
+            curvature_fraction: 0.9,
+            min_segment_m: 1.0,
         }
     }
 }
@@ -58,7 +66,9 @@ impl Default for HybridParams {
 impl HybridParams {
     /// Every setting within its range, named when not.
     pub fn check(&self) -> Result<(), NavError> {
-        let ranges: [(&str, f64, f64, f64); 8] = [
+        let ranges: [(&str, f64, f64, f64); 10] = [
+            ("min_segment_m", self.min_segment_m, 0.0, 10.0),
+            ("curvature_fraction", self.curvature_fraction, 0.1, 1.0),
             ("cell_m", self.cell_m, 0.05, 2.0),
             ("headings", self.headings as f64, 8.0, 360.0),
             ("reverse_penalty", self.reverse_penalty, 1.0, 100.0),
@@ -107,6 +117,16 @@ impl Body {
         Self { parts }
     }
 
+    /// The farthest any corner lies from the fork root.
+    pub fn reach_m(&self) -> f64 {
+        let origin = Pose2::new(0.0, 0.0, 0.0);
+        self.parts
+            .iter()
+            .flat_map(|fp| fp.corners(&origin))
+            .map(|c| c[0].hypot(c[1]))
+            .fold(0.0, f64::max)
+    }
+
     pub fn free(&self, obstacles: &Obstacles, pose: &Pose2) -> bool {
         self.parts.iter().all(|fp| !obstacles.collides(fp, pose))
     }
@@ -127,6 +147,9 @@ pub struct HybridQuery {
     pub margin_m: f64,
     pub load: Option<Footprint>,
     pub params: HybridParams,
+    /// A straight this long, driven forwards, ends the manoeuvre (0: none): the tracker
+    /// settles onto the goal heading on it, as before a rack face.
+    pub approach_m: f64,
 }
 
 /// A manoeuvre: paths driven in turn, each forwards or backwards, with a stop and change
@@ -220,6 +243,15 @@ fn segments_of(samples: &[(Pose2, f64, bool)]) -> Vec<Path> {
     }
     out.retain(|p| p.samples.len() >= 2);
     out
+}
+
+/// The tightest curvature the fork root can drive: the truck turns about a point on its
+/// fixed front axle's line, `1 / κ_max` from the axle, and the fork root sits ahead of the
+/// axle, so it circles wider than the axle does.
+pub fn root_max_curvature_per_m(truck: &ForkliftSpec) -> f64 {
+    1.0 / truck
+        .min_turn_radius_m()
+        .hypot(truck.fork_root_ahead_of_front_axle_m)
 }
 
 /// The radius the truck covers around its fork root in every pose (the heuristic's

@@ -12,6 +12,43 @@ pub(crate) struct Move {
     pub kappa: f64,
 }
 
+/// The run a truck is on: its last move's signed length (0 at the start) and the
+/// distance driven in that direction since the last cusp.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Run {
+    pub ds: f64,
+    pub run_m: f64,
+}
+
+impl Run {
+    /// Whether `moves`, driven on from this run, change direction only after at least
+    /// `min_m` in each direction (the last run, which ends at the goal or continues into
+    /// more moves, excepted).
+    pub fn runs_long_enough(&self, moves: &[Move], min_m: f64) -> bool {
+        let (mut ds, mut run) = (self.ds, self.run_m);
+        for m in moves {
+            if ds != 0.0 && m.ds.signum() != ds.signum() {
+                if run < min_m - 1e-9 {
+                    return false;
+                }
+                run = 0.0;
+            }
+            run += m.ds.abs();
+            ds = m.ds;
+        }
+        true
+    }
+
+    /// The run after driving `m`.
+    pub fn after(self, m: &Move) -> Self {
+        let same = self.ds == 0.0 || self.ds.signum() == m.ds.signum();
+        Self {
+            ds: m.ds,
+            run_m: if same { self.run_m } else { 0.0 } + m.ds.abs(),
+        }
+    }
+}
+
 /// Spacing of the result's samples.
 const SAMPLE_STEP_M: f64 = 0.05;
 /// Most moves one shortcut may replace (bounds the work to moves × this).
@@ -47,25 +84,28 @@ pub(crate) fn refine(cx: &Ctx, moves: Vec<Move>) -> Vec<Move> {
         poses.push(advance(&last, m.ds, m.kappa));
     }
     let mut out: Vec<Move> = Vec::new();
+    let mut run = Run {
+        ds: 0.0,
+        run_m: 0.0,
+    };
     let mut i = 0;
     while i < moves.len() {
-        let prev = out.last().map_or(0.0, |m| m.ds);
+        let prev = run.ds;
         let far = (i + WINDOW).min(moves.len());
         let found = (i + 2..=far).rev().find_map(|j| {
-            let shot = cx.shot(&poses[i], &poses[j])?;
+            let shot = cx.shot(&poses[i], &poses[j], run)?;
             (move_cost(cx, &shot, prev) < move_cost(cx, &moves[i..j], prev) - 1e-9)
                 .then_some((j, shot))
         });
-        match found {
-            Some((j, shot)) => {
-                out.extend(shot);
-                i = j;
-            }
-            None => {
-                out.push(moves[i]);
-                i += 1;
-            }
+        let (taken, next) = match found {
+            Some((j, shot)) => (shot, j),
+            None => (vec![moves[i]], i + 1),
+        };
+        for m in &taken {
+            run = run.after(m);
         }
+        out.extend(taken);
+        i = next;
     }
     out
 }

@@ -8,13 +8,16 @@ use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 
 use super::heuristic::Distances;
-use super::refine::{Move, move_cost, refine, sample};
+use super::refine::{Move, Run, move_cost, refine, sample};
 use super::{Body, HybridQuery, Manoeuvre, relaxed_grid, segments_of};
-use crate::reeds_shepp::{RsPath, Steer, advance};
+use crate::reeds_shepp::{Costs, RsPath, Steer, advance};
 use crate::{NavError, NavMap};
 
-/// Spacing of the footprint checks along a move.
+/// Spacing of the footprint checks along a straight move.
 pub(super) const CHECK_STEP_M: f64 = 0.1;
+/// Most distance any corner of the truck moves between two footprint checks (within the
+/// margin the footprint is grown by).
+pub const CORNER_STEP_M: f64 = 0.05;
 /// Nodes between two Reeds-Shepp shots, per coarse cell of heuristic distance (Smac's
 /// analytic expansion ratio).
 const SHOT_RATIO: f64 = 3.5;
@@ -27,6 +30,8 @@ struct Node {
     /// The move that reached it: signed length and curvature.
     ds: f64,
     kappa: f64,
+    /// Distance driven in this direction since the last cusp (or the start).
+    run_m: f64,
 }
 
 /// One search's fixed inputs.
@@ -41,9 +46,17 @@ pub(super) struct Ctx<'a> {
     near: std::sync::Arc<crate::OccupancyGrid>,
     kappa_max: f64,
     step_m: f64,
+    /// Farthest corner of the body from the fork root.
+    reach_m: f64,
 }
 
 impl Ctx<'_> {
+    /// Check spacing on a move at `kappa`: turning, the far corners sweep faster than the
+    /// fork root.
+    fn check_step_m(&self, kappa: f64) -> f64 {
+        CHECK_STEP_M.min(CORNER_STEP_M / (kappa.abs() * self.reach_m).max(1e-9))
+    }
+
     pub(super) fn free(&self, pose: &Pose2) -> bool {
         self.body.on_map(pose, self.extent) && self.body.free(&self.map.obstacles, pose)
     }
@@ -67,7 +80,7 @@ impl Ctx<'_> {
     /// The cost of a move from `from` (reached by `prev_ds`) of signed length `ds` at
     /// `kappa`, or `None` when the footprint strikes something on the way.
     fn step(&self, from: &Pose2, prev_ds: f64, ds: f64, kappa: f64) -> Option<(Pose2, f64)> {
-        let n = (ds.abs() / CHECK_STEP_M).ceil().max(1.0) as usize;
+        let n = (ds.abs() / self.check_step_m(kappa)).ceil().max(1.0) as usize;
         let mut at = *from;
         for _ in 0..n {
             at = advance(&at, ds / n as f64, kappa);
@@ -95,46 +108,64 @@ impl Ctx<'_> {
     }
 
     /// A Reeds-Shepp path from `from` to `to` whose footprint is clear (forwards only
-    /// when so set), as moves.
-    pub(super) fn shot(&self, from: &Pose2, to: &Pose2) -> Option<Vec<Move>> {
-        let rs = RsPath::between(from, to, 1.0 / self.kappa_max)?;
+    /// when so set) and whose runs between cusps are not too short, as moves. `prev`: the
+    /// run the truck is on when it reaches `from`.
+    pub(super) fn shot(&self, from: &Pose2, to: &Pose2, prev: Run) -> Option<Vec<Move>> {
+        let p = &self.q.params;
+        let costs = Costs {
+            reverse: p.reverse_penalty,
+            turn: p.turn_penalty,
+            cusp_m: p.cusp_penalty_m,
+        };
+        let rs = RsPath::cheapest(from, to, 1.0 / self.kappa_max, costs)?;
         if self.q.params.forward_only && rs.segments.iter().any(|s| s.length_m < 0.0) {
             return None;
         }
-        let samples = rs.sample(from, CHECK_STEP_M);
-        samples.iter().all(|(p, _, _)| self.free(p)).then(|| {
-            rs.segments
-                .iter()
-                .map(|s| Move {
-                    ds: s.length_m,
-                    kappa: match s.steer {
-                        Steer::Left => self.kappa_max,
-                        Steer::Right => -self.kappa_max,
-                        Steer::Straight => 0.0,
-                    },
-                })
-                .collect()
-        })
+        let moves: Vec<Move> = rs
+            .segments
+            .iter()
+            .map(|s| Move {
+                ds: s.length_m,
+                kappa: match s.steer {
+                    Steer::Left => self.kappa_max,
+                    Steer::Right => -self.kappa_max,
+                    Steer::Straight => 0.0,
+                },
+            })
+            .collect();
+        if !prev.runs_long_enough(&moves, self.q.params.min_segment_m) {
+            return None;
+        }
+        let samples = rs.sample(from, self.check_step_m(self.kappa_max));
+        samples
+            .iter()
+            .all(|(p, _, _)| self.free(p))
+            .then_some(moves)
     }
 }
 
 /// Plans `q` on `map`: a manoeuvre from the start pose to the goal pose whose footprint
 /// clears every obstacle, or an error naming why there is none.
 pub fn plan_hybrid(map: &NavMap, q: &HybridQuery) -> Result<Manoeuvre, NavError> {
+    if q.approach_m != 0.0 {
+        return super::approach::plan_with_approach(map, q);
+    }
     q.params.check()?;
     let t0 = Instant::now();
-    let kappa_max = q.truck.max_curvature_per_m();
+    let kappa_max = super::root_max_curvature_per_m(&q.truck) * q.params.curvature_fraction;
     let relaxed = relaxed_grid(map, q);
     let ends = ([q.start.x_m, q.start.y_m], [q.goal.x_m, q.goal.y_m]);
+    let body = Body::of(&q.truck, q.margin_m, q.load);
     let cx = Ctx {
         map,
         q,
-        body: Body::of(&q.truck, q.margin_m, q.load),
+        body: body.clone(),
         extent: map.grid.extent(),
         dist: Distances::to_goal(&relaxed, q.params.cell_m, ends.0, ends.1),
         near: map.inflated(super::covered_radius_m(&q.truck, q.margin_m) + q.params.proximity_m),
         kappa_max,
         step_m: primitive_length_m(q.params.cell_m, kappa_max, q.params.headings),
+        reach_m: body.reach_m(),
     };
     check_ends(&cx)?;
     if !cx.dist.at(ends.0).is_finite() {
@@ -152,6 +183,28 @@ pub fn plan_hybrid(map: &NavMap, q: &HybridQuery) -> Result<Manoeuvre, NavError>
         expansions,
         time_s: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// [`plan_hybrid`] from where a truck stands after driving: when its footprint grown by
+/// the full margin touches something (tracking left it nearer than planned), the margin
+/// is halved, then dropped, so the truck can still leave; the margin used comes back.
+pub fn plan_hybrid_from_here(map: &NavMap, q: &HybridQuery) -> Result<(Manoeuvre, f64), NavError> {
+    let mut last = None;
+    for margin_m in [q.margin_m, q.margin_m / 2.0, 0.0] {
+        let try_q = HybridQuery {
+            margin_m,
+            ..q.clone()
+        };
+        match plan_hybrid(map, &try_q) {
+            Err(e @ NavError::Blocked { which: "start", .. }) => last = Some(e),
+            other => return other.map(|m| (m, margin_m)),
+        }
+    }
+    Err(last.unwrap_or(NavError::Blocked {
+        which: "start",
+        x: q.start.x_m,
+        y: q.start.y_m,
+    }))
 }
 
 /// Start and goal on the map with the truck's footprint clear.
@@ -194,6 +247,7 @@ fn search(cx: &Ctx, t0: Instant) -> Result<(Vec<Move>, usize), NavError> {
         parent: u32::MAX,
         ds: 0.0,
         kappa: 0.0,
+        run_m: 0.0,
     }];
     let mut best: HashMap<u64, u32> = HashMap::from([(cx.key(&cx.q.start), 0)]);
     let mut closed = std::collections::HashSet::new();
@@ -213,13 +267,23 @@ fn search(cx: &Ctx, t0: Instant) -> Result<(Vec<Move>, usize), NavError> {
             });
         }
         if expansions >= next_shot {
-            if let Some(tail) = cx.shot(&node.pose, &cx.q.goal) {
+            let run = Run {
+                ds: node.ds,
+                run_m: node.run_m,
+            };
+            if let Some(tail) = cx.shot(&node.pose, &cx.q.goal, run) {
                 return Ok((assemble(&nodes, i, tail), expansions));
             }
             let cells = cx.dist.at([node.pose.x_m, node.pose.y_m]) / p.cell_m;
             next_shot = expansions + (cells / SHOT_RATIO).clamp(1.0, 50.0) as usize;
         }
         for &dir in dirs {
+            let turning_back = node.ds != 0.0 && node.ds.signum() != dir;
+            // No shuffles: a direction is kept for a least distance before a cusp.
+            if turning_back && node.run_m < p.min_segment_m {
+                continue;
+            }
+            let run_m = if turning_back { 0.0 } else { node.run_m } + cx.step_m;
             for kappa in [cx.kappa_max, 0.0, -cx.kappa_max] {
                 let ds = dir * cx.step_m;
                 let Some((pose, cost)) = cx.step(&node.pose, node.ds, ds, kappa) else {
@@ -240,6 +304,7 @@ fn search(cx: &Ctx, t0: Instant) -> Result<(Vec<Move>, usize), NavError> {
                     parent: i,
                     ds,
                     kappa,
+                    run_m,
                 });
                 best.insert(key, j);
                 open.push(Reverse(((g + cx.heuristic(&pose)).to_bits(), j)));

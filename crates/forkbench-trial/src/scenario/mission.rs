@@ -37,6 +37,8 @@ pub struct GlobalFile {
     /// Refuse a smoothed path whose swept footprint strikes an obstacle. Off, a path is
     /// driven as planned (as the paper's inflation model does, which never checks it).
     pub check_swept: bool,
+    /// `planner = "hybrid-astar"`: its lattice, costs and budget (`[mission.global.hybrid]`).
+    pub hybrid: forkbench_nav::hybrid::HybridParams,
 }
 
 impl Default for GlobalFile {
@@ -53,6 +55,7 @@ impl Default for GlobalFile {
             resolution_m: 0.05,
             attempts: 10,
             check_swept: true,
+            hybrid: forkbench_nav::hybrid::HybridParams::default(),
         }
     }
 }
@@ -220,13 +223,15 @@ impl MissionFile {
     fn check(&self, file: &str) -> Result<(), TrialError> {
         let g = &self.global;
         self.check_bounded(file)?;
-        if g.planner.kinodynamic() {
+        if g.planner.kinodynamic() && g.collision != CollisionModel::Footprint {
             return Err(invalid(
                 file,
-                "mission.global.planner",
-                "hybrid-astar plans manoeuvres with cusps, which mission legs do not drive yet \
-                 (use it with `forkbench plan hybrid-astar`); legs use prm, rrt or rrt-connect",
+                "mission.global.collision",
+                "hybrid-astar checks the truck's footprint: collision must be \"footprint\"",
             ));
+        }
+        if let Err(e) = g.hybrid.check() {
+            return Err(invalid(file, "mission.global.hybrid", &e.to_string()));
         }
         if !(self.leg_timeout_s.is_finite()
             && self.leg_timeout_s > 0.0

@@ -63,4 +63,6 @@ pub enum LegError {
     Struck { x_m: f64, y_m: f64 },
     #[error("not stopped at the end of the path within {timeout_s} s")]
     NotStopped { timeout_s: f64 },
+    #[error("the manoeuvre still had cusps ahead after {plans} plans")]
+    TooManyCusps { plans: u32 },
 }

@@ -19,10 +19,10 @@ use crate::scenario::mission::{GlobalPlannerKind, MissionSpec, Waypoint};
 const OCCUPIED: Style = Style::rgba([150, 150, 150, 110]).width(0.02);
 const ROADMAP: Style = Style::rgba([120, 160, 230, 30]).width(0.012);
 const POLYLINE: Style = Style::rgb(255, 150, 40).width(0.024);
-const SMOOTHED: Style = Style::rgb(40, 110, 240).width(0.06);
-const REVERSE: Style = Style::rgb(170, 90, 230).width(0.06);
+pub(super) const SMOOTHED: Style = Style::rgb(40, 110, 240).width(0.06);
+pub(super) const REVERSE: Style = Style::rgb(170, 90, 230).width(0.06);
 
-fn path_points(p: &Path) -> Vec<[f64; 2]> {
+pub(super) fn path_points(p: &Path) -> Vec<[f64; 2]> {
     p.samples.iter().map(|q| [q.x_m, q.y_m]).collect()
 }
 
@@ -73,7 +73,7 @@ fn record_route<R: Recorder + ?Sized>(
 
 /// Running totals of one leg's drive.
 #[derive(Debug, Default)]
-struct DriveStats {
+pub(super) struct DriveStats {
     cross_track_sum_m: f64,
     cross_track_max_m: f64,
     steps: u64,
@@ -133,6 +133,10 @@ impl Trial<'_> {
         let mut leg = blank_leg(format!("{} → {}", from.name, to.name));
         let mut stats = DriveStats::default();
         let mut run = || -> Result<(), LegError> {
+            if m.global.planner.kinodynamic() {
+                // Hybrid-A* plans the way out of the station itself, reversing as needed.
+                return self.manoeuvre_leg(map, m, (i, to), (&mut leg, &mut stats), rec);
+            }
             if i > 0 {
                 self.back_out(map, m, (i, from, to), (&mut leg, &mut stats), rec)?;
             }
@@ -203,13 +207,29 @@ impl Trial<'_> {
         stats: &mut DriveStats,
         rec: &mut R,
     ) -> Result<(), LegError> {
-        let truck = &self.scn.truck;
         let mut tracker = PurePursuit::with_config(m.tracker.clone());
-        tracker.reset(path, truck);
+        tracker.reset(path, &self.scn.truck);
+        self.drive_with(
+            &mut |input| Tracker::command(&mut tracker, input),
+            m,
+            stats,
+            rec,
+        )
+    }
+
+    /// Drives with `next` giving each tick's command until it reports done with the truck
+    /// standing; a touch of a rack or wall ends the leg.
+    pub(super) fn drive_with<R: Recorder + ?Sized>(
+        &mut self,
+        next: &mut dyn FnMut(&forkbench_track::TrackerInput) -> forkbench_track::Command,
+        m: &MissionSpec,
+        stats: &mut DriveStats,
+        rec: &mut R,
+    ) -> Result<(), LegError> {
         let deadline_s = self.sim.time_s() + m.leg_timeout_s;
         while self.sim.time_s() < deadline_s {
             let (fix, pose) = self.sense(rec)?;
-            let cmd = Tracker::command(&mut tracker, &self.tracker_input(pose));
+            let cmd = next(&self.tracker_input(pose));
             if cmd.done && self.sim.speed_mps().abs() < 0.01 {
                 return Ok(());
             }

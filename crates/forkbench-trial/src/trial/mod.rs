@@ -7,6 +7,7 @@ mod error;
 mod judge;
 mod localize;
 mod look;
+mod manoeuvre_leg;
 mod mission;
 mod options;
 mod phases;
