@@ -356,3 +356,78 @@ fn a_mission_batch_records_a_failed_leg_and_goes_on() {
         "{summary}"
     );
 }
+
+/// `plan hybrid-astar`: a manoeuvre out of the sorting station with its segments and
+/// cusps in JSON, settings from `--config` acting (forwards only cannot turn round in a
+/// dead-end aisle), and the point planners' flags and settings refused by name.
+#[test]
+fn hybrid_astar_plans_manoeuvres_and_refuses_what_cannot_act() {
+    let v = json_of(&forkbench(&[
+        "plan",
+        "hybrid-astar",
+        "--map",
+        &world("warehouse.toml"),
+        "--start",
+        "6.5,21.5,90",
+        "--goal",
+        "6,9.05,180",
+        "--json",
+    ]));
+    assert_eq!(v["success"], true, "{v}");
+    let m = &v["manoeuvre"];
+    let segments = m["segments"].as_array().expect("segments");
+    assert!(segments.len() >= 2, "{m}");
+    assert_eq!(
+        segments[0]["reverse"], true,
+        "backs out of the station first"
+    );
+    assert_eq!(
+        m["cusps"].as_array().expect("cusps").len(),
+        segments.len() - 1
+    );
+    let dir = tmp("hybrid");
+    let turn = [
+        "--map",
+        &world("turnaround.toml"),
+        "--start",
+        "11,4,0",
+        "--goal",
+        "3,4,180",
+    ];
+    let cfg = dir.join("forward.toml");
+    std::fs::write(&cfg, "forward_only = true\nmax_expansions = 5000\n").expect("write");
+    let plain = forkbench(&[&["plan", "hybrid-astar"][..], &turn, &["--json"]].concat());
+    assert_eq!(json_of(&plain)["success"], true);
+    let cfg_arg = cfg.to_str().expect("utf-8");
+    let forward =
+        forkbench(&[&["plan", "hybrid-astar"][..], &turn, &["--config", cfg_arg]].concat());
+    assert_eq!(
+        forward.status.code(),
+        Some(1),
+        "forwards only cannot turn round"
+    );
+    for (args, needle) in [
+        (vec!["plan", "hybrid-astar", "--smooth"], "--smooth"),
+        (
+            vec!["plan", "hybrid-astar", "--collision", "inflate"],
+            "--collision inflate",
+        ),
+        (vec!["plan", "hybrid-astar", "--nodes", "50"], "--nodes"),
+        (vec!["plan", "prm", "--config", cfg_arg], "--config"),
+    ] {
+        let out = forkbench(&[&args[..], &turn].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(needle),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::write(&cfg, "reverse_penalty = 0.5\n").expect("write");
+    let out = forkbench(&[&["plan", "hybrid-astar"][..], &turn, &["--config", cfg_arg]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("reverse_penalty") && err.contains("forward.toml"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -70,6 +70,7 @@ pub fn run_trial<'py>(
             pallet_sensing,
             missing_reflectors,
         },
+        wall_budget_s: None,
     };
     // The CLI's own check: values in range, and every override acting on this scenario.
     let run = scn

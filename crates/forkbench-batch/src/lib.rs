@@ -166,6 +166,7 @@ impl TrialRecord {
             no_noise: !self.outcome.noise,
             replan: self.replan,
             overrides: self.overrides.clone(),
+            wall_budget_s: None,
         }
     }
 }
@@ -300,6 +301,7 @@ impl BatchSpec {
             no_noise: false,
             replan: j.replan,
             overrides: self.overrides.clone(),
+            wall_budget_s: None,
         };
         let names = (j.planner.as_str(), j.tracker.as_str());
         let outcome = guarded(s, &case.name, names, seed, || run_trial(s, case, &opts));

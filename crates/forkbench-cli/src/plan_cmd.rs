@@ -30,7 +30,7 @@ pub struct PlanCli {
     #[arg(long)]
     pub truck: Option<PathBuf>,
     /// Planner settings: a TOML file with the keys of a scenario's [planner] table
-    /// (without `kind`).
+    /// (without `kind`); for hybrid-astar, the keys of `[mission.global.hybrid]`.
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Spiral: search lengths outside the paper's window 1 + θ²/5 ≤ s_f ≤ 2 + θ²/5.
@@ -120,6 +120,31 @@ impl PlanCli {
         Ok(())
     }
 
+    /// Hybrid-A*'s settings: `--config` (keys of `[mission.global.hybrid]`) for
+    /// hybrid-astar, the defaults for the others' fallback; refused for a point planner.
+    fn hybrid_params(
+        &self,
+        planner: forkbench_nav::GlobalPlannerKind,
+    ) -> anyhow::Result<forkbench_nav::hybrid::HybridParams> {
+        let Some(p) = &self.config else {
+            return Ok(Default::default());
+        };
+        if !planner.kinodynamic() {
+            anyhow::bail!(
+                "plan {}: --config is for pick planners and hybrid-astar (its settings); {} has none",
+                self.planner,
+                self.planner
+            );
+        }
+        let text = crate::read_input(p)?;
+        let params: forkbench_nav::hybrid::HybridParams =
+            toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
+        params
+            .check()
+            .map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
+        Ok(params)
+    }
+
     /// A global planner's arguments, when `planner` is one.
     pub fn route(&self) -> anyhow::Result<Option<crate::route_cmd::RouteArgs>> {
         let kind = forkbench_nav::GlobalPlannerKind::from_name(&self.planner);
@@ -132,6 +157,7 @@ impl PlanCli {
         if planner.kinodynamic() {
             self.refuse_for_manoeuvres()?;
         }
+        let hybrid = self.hybrid_params(planner)?;
         let map = self.map.clone().ok_or_else(|| {
             anyhow::anyhow!(
                 "plan {}: --map WORLD.toml|MAP.yaml is required",
@@ -160,6 +186,7 @@ impl PlanCli {
             collision,
             smooth: self.smooth,
             fallback: self.smooth && !self.no_fallback,
+            hybrid,
             lead_m: self.lead_m,
             approach_m: self.approach_m,
             margin_m: self.margin_m.unwrap_or(collision.default_margin_m()),

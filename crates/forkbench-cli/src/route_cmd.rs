@@ -35,6 +35,8 @@ pub struct RouteArgs {
     pub smooth: bool,
     /// With `smooth`: plan a Hybrid-A* manoeuvre when the route cannot be smoothed.
     pub fallback: bool,
+    /// Hybrid-A*'s settings (the planner's own, or the fallback's).
+    pub hybrid: forkbench_nav::hybrid::HybridParams,
     pub lead_m: f64,
     pub approach_m: Option<f64>,
     pub margin_m: f64,
@@ -72,6 +74,9 @@ impl RouteArgs {
         let mut algorithm = self
             .planner
             .algorithm(self.nodes, self.connect_m, self.seed);
+        if let forkbench_nav::Algorithm::HybridAstar(_) = algorithm {
+            algorithm = forkbench_nav::Algorithm::HybridAstar(self.hybrid);
+        }
         if let (true, forkbench_nav::Algorithm::Prm(p)) = (self.first_solution, algorithm) {
             algorithm = forkbench_nav::Algorithm::PrmFirstSolution(p);
         }
@@ -88,9 +93,7 @@ impl RouteArgs {
             approach: Vec::new(),
             margin_m: self.margin_m,
             truck: self.truck.clone(),
-            manoeuvre_fallback: self
-                .fallback
-                .then(forkbench_nav::hybrid::HybridParams::default),
+            manoeuvre_fallback: self.fallback.then_some(self.hybrid),
         }
     }
 }

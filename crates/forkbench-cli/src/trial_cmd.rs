@@ -209,6 +209,7 @@ pub fn options(
         no_noise,
         replan: replan.then_some(true),
         overrides,
+        wall_budget_s: None,
     };
     opts.validate()?;
     Ok(opts)

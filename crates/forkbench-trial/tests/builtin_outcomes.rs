@@ -45,6 +45,7 @@ fn rerun(want: &Value) -> Value {
         overrides: Default::default(),
         // The records of plan-once came from the scenario's own setting.
         replan: replan.then_some(true),
+        wall_budget_s: None,
     };
     let out = run_trial(scn, case, &opts);
     let mut v = serde_json::to_value(&out).expect("serialises");

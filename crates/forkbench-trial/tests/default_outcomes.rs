@@ -39,6 +39,7 @@ fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario]) -> Value {
         no_noise: false,
         overrides: Default::default(),
         replan: Some(replan),
+        wall_budget_s: None,
     };
     let mut v = serde_json::to_value(run_trial(scn, case, &opts)).expect("serialises");
     without_clock_times(&mut v);

@@ -159,3 +159,34 @@ fn tracker_settings_are_checked_at_load() {
         assert!(e.contains(&format!("tracker.{field}")), "{table}: {e}");
     }
 }
+
+/// A tracker that answers every tick slowly, each answer within its own timeout, meets the
+/// trial's wall-time budget: the trial ends as an error naming it, well before the pick.
+#[test]
+fn a_slow_tracker_meets_the_trials_wall_time_budget() {
+    let slow = "    time.sleep(0.05)\n    print(json.dumps({'type': 'command', 'id': req['id'], \
+                'speed_mps': 0.3, 'steer_rad': 0.0, 'done': False}), flush=True)\n";
+    let scn = with_tracker("slow", &script(None, slow), 1.0);
+    let opts = TrialOptions {
+        wall_budget_s: Some(1.0),
+        ..seeded(1)
+    };
+    let t0 = std::time::Instant::now();
+    let out = run_trial(&scn, &scn.cases[0], &opts);
+    assert!(t0.elapsed().as_secs_f64() < 10.0);
+    assert_eq!(out.failure, Some(Failure::Error), "{out:?}");
+    let detail = out.failure_detail.unwrap_or_default();
+    assert!(detail.contains("wall-time budget of 1 s"), "{detail}");
+    // A budget out of range is refused before the trial starts.
+    let bad = TrialOptions {
+        wall_budget_s: Some(f64::NAN),
+        ..seeded(1)
+    };
+    let out = run_trial(&scn, &scn.cases[0], &bad);
+    assert!(
+        out.failure_detail
+            .unwrap_or_default()
+            .contains("wall_budget_s"),
+        "refused"
+    );
+}

@@ -24,6 +24,11 @@ pub enum StageError {
     /// The tracker could not steer (an external one hung, crashed or broke the protocol).
     #[error("tracker {tracker}: {reason}")]
     Tracker { tracker: String, reason: String },
+    /// The trial ran past its wall-time budget (an external component slow on every tick).
+    #[error(
+        "the trial took more than its wall-time budget of {budget_s} s (TrialOptions::wall_budget_s; an external component answering slowly on every tick?)"
+    )]
+    WallBudget { budget_s: f64 },
     /// A mission leg failed; `detail` is the leg's recorded failure.
     #[error("leg {number} {name}: {detail}")]
     Leg {

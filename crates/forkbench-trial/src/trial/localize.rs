@@ -94,6 +94,10 @@ impl Trial<'_> {
         &mut self,
         rec: &mut R,
     ) -> Result<(Option<Pose2>, Pose2), StageError> {
+        let budget_s = self.run.wall_budget_s;
+        if self.wall_start.elapsed().as_secs_f64() > budget_s {
+            return Err(StageError::WallBudget { budget_s });
+        }
         let truth = self.sim.fork_root_pose();
         let t_s = self.sim.time_s();
         let input = LocalizerInput {

@@ -104,13 +104,31 @@ pub struct TrialOptions {
     pub replan: Option<bool>,
     /// Noise scales and sensing models.
     pub overrides: Overrides,
+    /// Most wall time one trial may take, external components' answers included
+    /// (`None`: [`DEFAULT_WALL_BUDGET_S`]); past it the trial ends as an error.
+    pub wall_budget_s: Option<f64>,
 }
+
+/// A trial's wall-time budget unless a run sets one: built-in trials take well under a
+/// second; this bounds a slow external tracker's ticks (each under its own `timeout_s`).
+pub const DEFAULT_WALL_BUDGET_S: f64 = 600.0;
+/// The range a run's budget may be set within.
+pub const WALL_BUDGET_RANGE_S: (f64, f64) = (0.01, 86_400.0);
 
 impl TrialOptions {
     /// Every value in range, and no knob that contradicts another: the one check the CLI,
     /// batches and Python share (resolving against a scenario runs it too).
     pub fn validate(&self) -> Result<(), TrialError> {
         self.overrides.validate()?;
+        let (lo, hi) = WALL_BUDGET_RANGE_S;
+        if let Some(b) = self.wall_budget_s
+            && !(b.is_finite() && (lo..=hi).contains(&b))
+        {
+            return Err(bad_option(
+                "wall_budget_s",
+                &format!("{b} s: must lie within {lo}..{hi} s"),
+            ));
+        }
         if self.no_noise
             && let Some(knob) = NOISE_KNOBS
                 .iter()
@@ -146,6 +164,8 @@ pub struct Resolved {
     pub localization_noise_scale: f64,
     /// The odometry's errors, scaled.
     pub odometry: forkbench_sensors::OdometryConfig,
+    /// Most wall time the trial may take.
+    pub wall_budget_s: f64,
 }
 
 impl Scenario {
@@ -191,6 +211,7 @@ impl Scenario {
             localizer,
             localization_noise_scale,
             odometry: self.scaled_odometry(o.odometry_noise_scale)?,
+            wall_budget_s: opts.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
         })
     }
 

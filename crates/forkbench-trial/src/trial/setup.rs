@@ -27,6 +27,8 @@ pub(super) fn stream(seed: u64, salt: u64) -> ChaCha8Rng {
 
 /// A trial in progress: its world, sensors, components and what it has measured so far.
 pub struct Trial<'a> {
+    /// When the trial began, for its wall-time budget.
+    pub(super) wall_start: std::time::Instant,
     pub(super) scn: &'a Scenario,
     pub(super) run: &'a Resolved,
     pub(super) out: TrialOutcome,
@@ -294,6 +296,7 @@ impl<'a> Trial<'a> {
             travelled_loaded_m: 0.0,
             pick_started: (0.0, 0.0),
             phase_measures: std::collections::BTreeMap::new(),
+            wall_start: std::time::Instant::now(),
         };
         if scn.mission.is_none()
             && let Err(e) = trial.first_fix_and_estimate(&true_pallet, rec)
