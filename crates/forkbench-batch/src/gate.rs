@@ -303,6 +303,9 @@ fn compare_row(b: &BaselineRow, now: Option<&SummaryRow>, pairs: Option<PairCoun
 /// The smallest drop seen with 80 % power, and the trials `want` needs, at `level`.
 fn power_of(row: &RegressRow, level: f64, want: Option<f64>) -> (Option<f64>, Option<u64>) {
     let p0 = row.baseline_rate.unwrap_or(0.0);
+    // A rate cannot drop below zero: a wanted drop larger than the baseline's rate is the
+    // drop to zero, and a row at zero has no drop to see.
+    let want = want.map(|d| d.min(p0)).filter(|d| *d > 0.0);
     match row.paired {
         Some(c) => {
             let psi = (c.broke + c.fixed) as f64 / c.pairs as f64;
@@ -367,7 +370,9 @@ fn judge(rows: &mut [RegressRow], o: &GateOptions) -> f64 {
             Verdict::Drop
         } else if o.floor.is_some_and(|f| r.now_rate.is_some_and(|v| v < f)) {
             Verdict::BelowFloor
-        } else if o.min_detectable_drop.is_some() && need.is_none_or(|n| n > have) {
+        } else if o.min_detectable_drop.is_some()
+            && (mdd.is_none() || need.is_none_or(|n| n > have))
+        {
             Verdict::Underpowered
         } else {
             Verdict::Ok

@@ -56,7 +56,16 @@ fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), 
             continue;
         }
         match serde_json::from_str::<TrialRecord>(line) {
-            Ok(r) => out.push((i + 1, r)),
+            Ok(r) => {
+                if let Some(why) = contradiction(&r) {
+                    return Err(BatchError::Record {
+                        path: path.display().to_string(),
+                        line: i + 1,
+                        message: why,
+                    });
+                }
+                out.push((i + 1, r));
+            }
             Err(_) if Some(i) == last => torn = true, // torn or corrupt final write
             Err(e) => {
                 return Err(BatchError::Record {
@@ -68,6 +77,19 @@ fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), 
         }
     }
     Ok((out, torn))
+}
+
+/// Why a parsed record contradicts itself (an edited or foreign file), if it does: a
+/// success has no failure, a failure names one.
+fn contradiction(r: &TrialRecord) -> Option<String> {
+    match (r.outcome.success, r.outcome.failure) {
+        (true, Some(f)) => Some(format!(
+            "success is true but failure is {:?}: a record is one or the other",
+            f.name()
+        )),
+        (false, None) => Some("success is false but no failure is named".to_owned()),
+        _ => None,
+    }
 }
 
 /// Longest line of `trials.jsonl` read: a record is a few kilobytes.

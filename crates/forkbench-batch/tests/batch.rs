@@ -341,6 +341,30 @@ fn a_corrupt_last_line_is_dropped_before_resuming() {
     batch::load_results(&d).expect("readable");
 }
 
+/// A record that is both a success and a failure (an edited file) is an error naming the
+/// file and line, not a trial counted either way.
+#[test]
+fn a_record_that_contradicts_itself_is_refused() {
+    let d = tmp("contradiction");
+    let s = spec(vec![scenario("field-test.toml")], 3, 9);
+    batch::run_batch(&s, &d, 1, &|_| {}).expect("runs");
+    let path = d.join("trials.jsonl");
+    let text = std::fs::read_to_string(&path).expect("written");
+    let mut lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("json"))
+        .collect();
+    lines[1]["success"] = true.into();
+    lines[1]["failure"] = "collision".into();
+    let edited: Vec<String> = lines.iter().map(|v| v.to_string()).collect();
+    std::fs::write(&path, edited.join("\n") + "\n").expect("write");
+    let err = batch::read_records(&path).expect_err("refused").to_string();
+    assert!(
+        err.contains("trials.jsonl") && err.contains('2') && err.contains("success is true"),
+        "{err}"
+    );
+}
+
 /// Recorded failures are spread over scenario × case × failure × mode, not the first ones
 /// in job order (which were all one case of one scenario).
 #[test]

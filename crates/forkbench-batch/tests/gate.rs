@@ -278,6 +278,31 @@ fn min_detectable_drop_marks_small_rows_underpowered() {
         "{:?}",
         r.trials_needed
     );
+    // A wanted drop larger than the row's rate is no easier to see than the drop to zero,
+    // and a row whose detectable drop is "none" is never called detectable.
+    for drop in [1.0, r.baseline_rate.expect("rate")] {
+        let g = gate(
+            &base,
+            &d,
+            &GateOptions {
+                min_detectable_drop: Some(drop),
+                ..GateOptions::default()
+            },
+        );
+        let r2 = &g.rows[0];
+        if r2.detectable_drop.is_none() {
+            assert_eq!(r2.verdict, Verdict::Underpowered, "{}", g.markdown());
+        }
+    }
+    let at = |drop: f64| {
+        let o = GateOptions {
+            min_detectable_drop: Some(drop),
+            ..GateOptions::default()
+        };
+        let g = gate(&base, &d, &o);
+        (g.rows[0].verdict, g.rows[0].trials_needed)
+    };
+    assert_eq!(at(1.0), at(r.baseline_rate.expect("rate")));
     // The batch side: a 5 pp drop needs more than 10 trials on any gate.
     let need = batch::paired_trials_needed(0.05, 0.05, 1).expect("n");
     assert!(need > 10, "{need}");

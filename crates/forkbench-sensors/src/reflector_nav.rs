@@ -52,6 +52,19 @@ impl ReflectorNavSettings {
         if !self.mount.is_finite() {
             return Err(SettingsError::field("mount", "must be finite"));
         }
+        // A world that cannot give one fix would run every trial on dead reckoning (a
+        // study that takes reflectors away may leave fewer: that is its question).
+        let have = map.len();
+        if have < self.measurement.min_reflectors {
+            return Err(SettingsError::field(
+                "kind",
+                format!(
+                    "nav350 needs at least {} reflectors in the world ([[reflector]]) for a \
+                     fix; it has {have} (use kind = \"gaussian\" on a world without them)",
+                    self.measurement.min_reflectors
+                ),
+            ));
+        }
         for name in &self.missing_reflectors {
             if !map.iter().any(|r| &r.name == name) {
                 return Err(SettingsError::field(

@@ -56,14 +56,19 @@ impl Default for ReflectorNavConfig {
 
 impl ReflectorNavConfig {
     pub fn validate(&self) -> Result<(), SettingsError> {
-        for (f, v) in [
-            ("range_sigma_m", self.range_sigma_m),
-            ("bearing_sigma_rad", self.bearing_sigma_rad),
-            ("association_gate_m", self.association_gate_m),
-            ("range_max_m", self.range_max_m),
+        // Ranges a NAV350 can have: σ from a micrometre (the fix's weights are 1/σ², and
+        // below that they overflow) to a metre or a radian (beyond that nothing is measured).
+        for (f, v, lo, hi) in [
+            ("range_sigma_m", self.range_sigma_m, 1e-6, 1.0),
+            ("bearing_sigma_rad", self.bearing_sigma_rad, 1e-7, 1.0),
+            ("association_gate_m", self.association_gate_m, 1e-3, 10.0),
+            ("range_max_m", self.range_max_m, 0.1, 1000.0),
         ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(SettingsError::field(f, "must be a positive finite number"));
+            if !(v.is_finite() && (lo..=hi).contains(&v)) {
+                return Err(SettingsError::field(
+                    f,
+                    &format!("{v:?}: must lie within {lo:?}..{hi:?}"),
+                ));
             }
         }
         if !(self.range_min_m.is_finite() && (0.0..self.range_max_m).contains(&self.range_min_m)) {

@@ -10,6 +10,8 @@ use crate::scenario::World;
 
 /// Most cells a coverage map may have (bounded work and memory on any world file).
 pub const MAX_CELLS: usize = 4_000_000;
+/// Most cell × (obstacle + reflector) tests a coverage map may take.
+pub const MAX_WORK: f64 = 5e8;
 
 /// One cell centre.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -70,17 +72,29 @@ pub fn coverage(
             reason: "the world has no racks, walls or reflectors to span an area".into(),
         });
     };
-    let (nx, ny) = (
-        ((hi[0] - lo[0]) / resolution_m).ceil() as usize,
-        ((hi[1] - lo[1]) / resolution_m).ceil() as usize,
+    // Counted in floating point first: a tiny resolution must not wrap or saturate.
+    let (fx, fy) = (
+        ((hi[0] - lo[0]) / resolution_m).ceil(),
+        ((hi[1] - lo[1]) / resolution_m).ceil(),
     );
-    if nx.saturating_mul(ny) > MAX_CELLS {
+    if fx * fy > MAX_CELLS as f64 {
         return Err(bad(&format!(
-            "gives {nx} × {ny} cells, more than {MAX_CELLS}; choose a coarser resolution"
+            "gives {fx:.3e} × {fy:.3e} cells, more than {MAX_CELLS}; choose a coarser resolution"
+        )));
+    }
+    let (nx, ny) = (fx as usize, fy as usize);
+    let obstacles = world.obstacles();
+    // Each cell is tested against every rack, wall and reflector: bound that work.
+    let per_cell = obstacles.len() + world.reflector.len() + 1;
+    let work = (nx * ny) as f64 * per_cell as f64;
+    if work > MAX_WORK {
+        return Err(bad(&format!(
+            "{} cells × {per_cell} racks, walls and reflectors = {work:.3e} tests, more than \
+             {MAX_WORK:.0e}; choose a coarser resolution",
+            nx * ny
         )));
     }
     let fixed = Sight::new(&world.fixed_surfaces());
-    let obstacles = world.obstacles();
     // A cell centre on a side counts as inside.
     let free = |p: [f64; 2]| !obstacles.iter().any(|o| o.depth_inside(p) >= 0.0);
     let cells = (0..ny)

@@ -75,3 +75,37 @@ fn bad_reflectors_are_refused_naming_the_field() {
         assert!(e.contains(field) && e.contains("w.toml"), "{extra}: {e}");
     }
 }
+
+/// The work of a coverage map is bounded by cells × (racks, walls and reflectors), and
+/// a tiny resolution is refused with cell counts that do not wrap.
+#[test]
+fn coverage_work_is_bounded() {
+    let mut text = String::from("name = \"checker\"\n");
+    // A 60 × 60 m floor of 2,500 small racks: 4 M cells at 3 cm would take ~1e10 tests.
+    for i in 0..50 {
+        for j in 0..50 {
+            text += &format!(
+                "[[rack]]\nx_m = {}\ny_m = {}\nlength_m = 0.3\nwidth_m = 0.3\n",
+                1.2 * f64::from(i),
+                1.2 * f64::from(j)
+            );
+        }
+    }
+    let world = World::parse(&text, "checker.toml").expect("loads");
+    let cfg = ReflectorNavConfig::default();
+    let t0 = std::time::Instant::now();
+    let err = coverage(&world, 0.03, &cfg)
+        .expect_err("bounded")
+        .to_string();
+    assert!(err.contains("tests, more than"), "{err}");
+    assert!(t0.elapsed().as_secs_f64() < 2.0);
+    let err = coverage(&world, 1e-300, &cfg)
+        .expect_err("tiny")
+        .to_string();
+    assert!(
+        err.contains("e") && !err.contains("18446744073709551615"),
+        "{err}"
+    );
+    // A coarse map of the same world is made.
+    assert!(coverage(&world, 1.0, &cfg).is_ok());
+}

@@ -120,7 +120,17 @@ fn bad_localiser_settings_name_the_file_line_and_field() {
         (
             "kind = \"nav350\"\nmeasurement = { range_sigma_m = -1.0 }",
             "sensors.localizer.measurement.range_sigma_m",
-            "positive",
+            "must lie within",
+        ),
+        (
+            "kind = \"nav350\"\nmeasurement = { range_sigma_m = 1e-100 }",
+            "sensors.localizer.measurement.range_sigma_m",
+            "1e-6",
+        ),
+        (
+            "kind = \"nav350\"\nmeasurement = { bearing_sigma_rad = 100.0 }",
+            "sensors.localizer.measurement.bearing_sigma_rad",
+            "must lie within",
         ),
         (
             "kind = \"nav350\"\nmount = { x_m = nan, y_m = 0.0, heading_rad = 0.0 }",
@@ -142,4 +152,70 @@ fn bad_localiser_settings_name_the_file_line_and_field() {
             "{e} (the table is at line {line})"
         );
     }
+}
+
+/// Reflector lists that would make every NAV350 fix slow are refused at load, with the
+/// work they ask for; 80,000 uniquely named reflectors on an open floor load quickly
+/// (the duplicate-name check is linear); a name with a comma, which the command line
+/// could not name, is refused.
+#[test]
+fn reflector_work_is_bounded_and_names_are_checked_in_linear_time() {
+    let dir = std::env::temp_dir().join(format!("forkbench-refl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let world = |name: &str, racks: usize, reflectors: usize, bad: &str| {
+        let mut t = String::from("name = \"w\"\n");
+        for i in 0..racks {
+            t += &format!(
+                "[[rack]]\nname = \"r{i}\"\nx_m = {}\ny_m = 50.0\nlength_m = 0.5\nwidth_m = 0.5\n",
+                i as f64
+            );
+        }
+        for i in 0..reflectors {
+            t += &format!(
+                "[[reflector]]\nname=\"f{i}{bad}\"\nx_m={}\ny_m=0\n",
+                i as f64 * 0.01
+            );
+        }
+        let p = dir.join(name);
+        std::fs::write(&p, t).expect("write");
+        p
+    };
+    let t0 = std::time::Instant::now();
+    let err = forkbench_trial::World::load(&world("heavy.toml", 100, 30_000, ""))
+        .expect_err("too much work per fix")
+        .to_string();
+    assert!(
+        err.contains("heavy.toml") && err.contains("3000000"),
+        "{err}"
+    );
+    assert!(t0.elapsed().as_secs_f64() < 5.0);
+    let t0 = std::time::Instant::now();
+    forkbench_trial::World::load(&world("many.toml", 0, 80_000, "")).expect("loads");
+    assert!(t0.elapsed().as_secs_f64() < 5.0, "{:?}", t0.elapsed());
+    let err = forkbench_trial::World::load(&world("comma.toml", 0, 2, ",x"))
+        .expect_err("comma")
+        .to_string();
+    assert!(
+        err.contains("reflector[0].name") && err.contains("comma"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The NAV350 on a world without enough reflectors for one fix is refused, naming why,
+/// instead of running every trial on dead reckoning with zero fixes.
+#[test]
+fn nav350_without_reflectors_is_refused() {
+    let scn = Scenario::load(&data("../../scenarios/field-test.toml")).expect("loads");
+    let err = scn
+        .with_localizer("nav350")
+        .expect_err("no reflectors")
+        .to_string();
+    assert!(
+        err.contains("sensors.localizer") && err.contains("at least 3 reflectors"),
+        "{err}"
+    );
+    // The warehouse mission's world has them.
+    let mission = Scenario::load(&data("../../scenarios/warehouse-mission.toml")).expect("loads");
+    assert!(mission.with_localizer("nav350").is_ok());
 }

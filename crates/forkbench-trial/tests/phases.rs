@@ -222,7 +222,19 @@ fn places_that_cannot_be_are_refused_at_load() {
         let to = t.find("[phase.place]").expect("place settings");
         format!("{}{}", &t[..from], &t[to..])
     };
-    let cases: [(&str, &str, &str, bool); 5] = [
+    let cases: [(&str, &str, &str, bool); 7] = [
+        (
+            "pose = { x_m = 6.5",
+            "pose = { x_m = 1e300",
+            "within ±10000 m",
+            false,
+        ),
+        (
+            "pose = { x_m = 6.5, y_m = 19.0, heading_deg = 90.0 }",
+            "pose = { x_m = 6.5, y_m = 19.0, heading_deg = 1e9 }",
+            "±360°",
+            false,
+        ),
         (
             "slot = \"sorting-drop\"",
             "slot = \"bay9\"",

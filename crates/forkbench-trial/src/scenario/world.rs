@@ -60,6 +60,8 @@ impl PoseDeg {
 
 /// Largest |x| or |y| anywhere in a world or scenario file.
 pub const MAX_WORLD_EXTENT_M: f64 = 1e4;
+/// Most reflector × obstacle pairs a world may have (the NAV350's work per fix).
+pub const MAX_REFLECTOR_WORK: usize = 2_000_000;
 
 /// A fixed rectangle in a world file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -189,6 +191,7 @@ impl World {
             }
         }
         for (kind, list) in [("pallet_slot", &w.pallet_slot), ("station", &w.station)] {
+            let mut seen = std::collections::HashMap::new();
             for (i, s) in list.iter().enumerate() {
                 PoseDeg {
                     x_m: s.x_m,
@@ -196,7 +199,7 @@ impl World {
                     heading_deg: s.heading_deg,
                 }
                 .check(file, &format!("{kind}[{i}]"))?;
-                if let Some(j) = list[..i].iter().position(|o| o.name == s.name) {
+                if let Some(j) = seen.insert(s.name.as_str(), i) {
                     return Err(invalid(
                         file,
                         &format!("{kind}[{i}].name"),
@@ -215,6 +218,22 @@ impl World {
     /// rack or wall (mount them on a face, a few centimetres proud of it).
     fn check_reflectors(&self, file: &str) -> Result<(), TrialError> {
         let obstacles = self.obstacles();
+        // Each NAV350 fix tests reflectors against the racks and walls: a bound on that
+        // work, not on either count alone.
+        let work = self.reflector.len().saturating_mul(obstacles.len().max(1));
+        if work > MAX_REFLECTOR_WORK {
+            return Err(invalid(
+                file,
+                "reflector",
+                &format!(
+                    "{} reflectors × {} racks and walls = {work} sight-line tests per fix, more \
+                     than {MAX_REFLECTOR_WORK}: fewer reflectors, or split the site into worlds",
+                    self.reflector.len(),
+                    obstacles.len()
+                ),
+            ));
+        }
+        let mut seen = std::collections::HashMap::new();
         for (i, r) in self.reflector.iter().enumerate() {
             let f = format!("reflector[{i}]");
             PoseDeg {
@@ -223,11 +242,23 @@ impl World {
                 heading_deg: 0.0,
             }
             .check(file, &f)?;
-            if let Some(j) = self.reflector[..i].iter().position(|o| o.name == r.name) {
+            if let Some(j) = seen.insert(r.name.as_str(), i) {
                 return Err(invalid(
                     file,
                     &format!("{f}.name"),
                     &format!("{:?} is also reflector[{j}]'s name", r.name),
+                ));
+            }
+            // `--missing-reflectors` lists names separated by commas.
+            if r.name.is_empty() || r.name.contains(',') {
+                return Err(invalid(
+                    file,
+                    &format!("{f}.name"),
+                    &format!(
+                        "{:?}: a name is not empty and has no comma (the command line lists \
+                         names separated by commas)",
+                        r.name
+                    ),
                 ));
             }
             // On a face is allowed: that is where a reflector hangs.

@@ -57,11 +57,13 @@ fn build(
         (Some(name), None) => station(cx, name)?,
         (None, Some(p)) => {
             let pose = p.to_pose();
-            if ![pose.x_m, pose.y_m, pose.heading_rad]
-                .iter()
-                .all(|v| v.is_finite())
-            {
-                return Err("pose must be finite".into());
+            let limit = crate::scenario::MAX_WORLD_EXTENT_M;
+            let within = |v: f64, lim: f64| v.is_finite() && v.abs() <= lim;
+            if !(within(p.x_m, limit) && within(p.y_m, limit) && within(p.heading_deg, 360.0)) {
+                return Err(format!(
+                    "pose must lie within ±{limit} m and ±360° (got x_m {}, y_m {}, heading_deg {})",
+                    p.x_m, p.y_m, p.heading_deg
+                ));
             }
             Waypoint {
                 name: format!("({:.1}, {:.1})", p.x_m, p.y_m),
