@@ -67,7 +67,7 @@ impl ReflectorNavConfig {
             if !(v.is_finite() && (lo..=hi).contains(&v)) {
                 return Err(SettingsError::field(
                     f,
-                    &format!("{v:?}: must lie within {lo:?}..{hi:?}"),
+                    format!("{v:?}: must lie within {lo:?}..{hi:?}"),
                 ));
             }
         }
