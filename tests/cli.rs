@@ -1153,6 +1153,21 @@ fn scan_reports_beams_truth_and_estimate() {
             .any(|b| b["range_m"].as_f64().is_some_and(|r| r > 8.0))
     );
     assert_eq!(v["sensor"], "tim561");
+    assert_eq!(v["detector"], "pockets");
+    // The scenario's own detector looks: the RANSAC example's external one.
+    let ransac = repo_root().join("examples/detectors/ransac-near-pick.toml");
+    let r = stdout_json(&forkbench(&[
+        "scan",
+        ransac.to_str().expect("utf8"),
+        "--no-noise",
+        "--json",
+    ]));
+    assert_ne!(r["detector"], "pockets", "{}", r["detector"]);
+    assert!(
+        r["estimate"].is_object(),
+        "the RANSAC detector found it: {}",
+        r["estimate"]
+    );
     let (t, e) = (&v["truth"], &v["estimate"]);
     let d = (e["x_m"].as_f64().expect("x") - t["x_m"].as_f64().expect("x"))
         .hypot(e["y_m"].as_f64().expect("y") - t["y_m"].as_f64().expect("y"));

@@ -384,6 +384,33 @@ fn special_files_anywhere_are_refused_at_once() {
     }
 }
 
+/// A world's name with terminal escapes and XML's special characters reaches neither the
+/// terminal nor the coverage SVG raw.
+#[test]
+fn a_world_name_cannot_drive_the_terminal_or_break_the_svg() {
+    let d = tmp("coverage-name");
+    let world = d.join("w.toml");
+    std::fs::write(
+        &world,
+        "name = \"evil\\u001b[2J<b>&\"\n[[wall]]\nx_m = 0.0\ny_m = 0.0\nlength_m = 4.0\nwidth_m = 0.2\n\
+         [[reflector]]\nname = \"a\"\nx_m = 0.0\ny_m = 1.0\n",
+    )
+    .expect("write");
+    let svg = d.join("cov.svg");
+    let out = forkbench(&[
+        "coverage",
+        world.to_str().expect("utf-8"),
+        "--plot",
+        svg.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    assert!(!out.stdout.contains(&0x1b), "{}", text(&out));
+    let drawn = std::fs::read_to_string(&svg).expect("svg");
+    assert!(!drawn.contains('\u{1b}'), "raw escape in the SVG");
+    assert!(!drawn.contains("<b>"), "raw markup in the SVG");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// A plot that cannot be written is an error naming it (a missing folder, a file-size
 /// limit), and nothing half written is left at its name.
 #[test]

@@ -194,6 +194,14 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
     let records = read_records(&path)?;
     check_unique(&records, &path)?;
     let expected = m.expected_trials();
+    if records.len() as u64 > expected {
+        return Err(BatchError::Invalid(format!(
+            "{}: holds {} trials, more than the {expected} its manifest names: records were \
+             added or the manifest edited; rerun the batch into a new directory",
+            dir.display(),
+            records.len()
+        )));
+    }
     if records.len() as u64 != expected || expected == 0 {
         return Err(BatchError::Invalid(format!(
             "{}: holds {} of the {expected} trials its manifest names (interrupted?); \

@@ -295,8 +295,18 @@ fn results_come_from_a_complete_trials_file_and_baselines_have_rows() {
     let mut expected = summary.clone();
     expected.provenance = None;
     assert_eq!(loaded, expected);
-    // An interrupted directory is refused.
+    // One with more trials than its manifest names is refused as edited, not "resume it".
     let text = std::fs::read_to_string(d.join("trials.jsonl")).expect("written");
+    let mut extra: serde_json::Value =
+        serde_json::from_str(text.lines().next().expect("a line")).expect("json");
+    extra["trial"] = 99.into();
+    std::fs::write(d.join("trials.jsonl"), format!("{text}{extra}\n")).expect("write");
+    let e = err(batch::load_results(&d));
+    assert!(
+        e.contains("5 trials, more than the 4") && !e.contains("resume"),
+        "{e}"
+    );
+    // An interrupted directory is refused.
     let kept: Vec<&str> = text.lines().take(2).collect();
     std::fs::write(d.join("trials.jsonl"), kept.join("\n") + "\n").expect("write");
     assert!(err(batch::load_results(&d)).contains("holds 2 of the 4 trials"));

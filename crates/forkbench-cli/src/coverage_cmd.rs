@@ -55,7 +55,7 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
         };
         let title = format!(
             "{}: NAV350 fix 1σ with {} reflectors{gone} (grey: fewer than 3 in sight)",
-            world.name,
+            forkbench_trial::text::one_line(&world.name),
             world.reflector.len()
         );
         let obstacles: Vec<[[f64; 2]; 4]> = world
@@ -83,7 +83,12 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
                 "cells": cov.cells})
         ));
     }
-    crate::emit(&summary(&world.name, &cov, elapsed_s))
+    // A world's name is the user's text: no control characters reach a terminal or SVG.
+    crate::emit(&summary(
+        &forkbench_trial::text::one_line(&world.name),
+        &cov,
+        elapsed_s,
+    ))
 }
 
 fn summary(name: &str, cov: &Coverage, elapsed_s: f64) -> String {

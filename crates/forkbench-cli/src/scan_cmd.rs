@@ -82,6 +82,7 @@ fn to_json(r: &ScanReport) -> serde_json::Value {
         .map(|d| json!({"stringers": d.stringers, "points": d.points, "rms_m": d.rms_m}));
     json!({
         "sensor": r.sensor,
+        "detector": r.detector,
         "sensor_pose": pose_json(&s.sensor),
         "fork_root": pose_json(&r.fork_root),
         "beams": beams,
@@ -103,11 +104,12 @@ fn text(r: &ScanReport) -> String {
         )
     };
     let mut out = format!(
-        "{} from {}: {} beams, {} returns\npallet face (truth) {}\n",
+        "{} from {}: {} beams, {} returns (detector {})\npallet face (truth) {}\n",
         r.sensor,
         deg(&s.sensor),
         s.ranges_m.len(),
         returns,
+        forkbench_trial::text::one_line(&r.detector),
         deg(&r.truth)
     );
     match &r.estimate {
@@ -125,7 +127,7 @@ fn text(r: &ScanReport) -> String {
                 forkbench_core::units::wrap_angle(e.heading_rad).to_degrees()
             );
         }
-        None => out += "estimate            not found (no stringers spaced like this pallet's)\n",
+        None => out += "estimate            not found\n",
     }
     out
 }

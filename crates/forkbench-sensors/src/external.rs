@@ -160,6 +160,13 @@ fn implausible(face: &Pose2, sensor: usize, req: &DetectRequest<'_>) -> Option<S
     if !face.is_finite() {
         return Some(format!("the face pose is not finite: {face:?}"));
     }
+    // A heading is an angle: a detector answering 1e300 rad has lost its units.
+    if face.heading_rad.abs() > 4.0 * std::f64::consts::PI {
+        return Some(format!(
+            "the face heading {:e} rad is not an angle within ±4π",
+            face.heading_rad
+        ));
+    }
     let Some(s) = req.scans.get(sensor) else {
         return Some(format!(
             "sensor {sensor} does not exist ({} scans were sent)",
@@ -198,6 +205,11 @@ impl PalletDetector for ExternalDetector {
             } => {
                 if let Some(why) = implausible(&face, sensor, req) {
                     return Err(fail(why));
+                }
+                if let Some(r) = rms_m.filter(|r| !(r.is_finite() && *r >= 0.0)) {
+                    return Err(fail(format!(
+                        "rms_m {r:e}: a residual is a finite distance ≥ 0"
+                    )));
                 }
                 Ok(Some(Found {
                     detection: Detection {

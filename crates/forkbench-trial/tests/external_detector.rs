@@ -82,6 +82,22 @@ fn a_misbehaving_detector_fails_only_its_trial_with_the_reason() {
             "beyond the sensor's reach",
         ),
         (
+            "spin",
+            script(
+                "    print(json.dumps({'type': 'pallet', 'id': req['id'], 'face': \
+                 {'x_m': 3.0, 'y_m': 0.0, 'heading_rad': 1e300}}), flush=True)\n",
+            ),
+            "not an angle",
+        ),
+        (
+            "residual",
+            script(
+                "    print(json.dumps({'type': 'pallet', 'id': req['id'], 'face': \
+                 {'x_m': 3.0, 'y_m': 0.0, 'heading_rad': 0.0}, 'rms_m': -1e308}), flush=True)\n",
+            ),
+            "rms_m",
+        ),
+        (
             "reported",
             script(
                 "    print(json.dumps({'type': 'error', 'id': req['id'], 'message': 'no model'}), \

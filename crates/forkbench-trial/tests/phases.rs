@@ -152,6 +152,12 @@ fn phase_lists_that_cannot_run_are_refused_at_load() {
     let e = cycle(|t| t.replace(r#""reverse_out"]"#, r#""reverse_out", "return"]"#))
         .expect_err("a return without a mission");
     assert!(e.contains("phase.return") && e.contains("[mission]"), "{e}");
+    // Named at the phase list's line, as the return has no table of its own.
+    assert!(
+        e.split_once("cycle.toml:")
+            .is_some_and(|(_, rest)| rest.starts_with(|c: char| c.is_ascii_digit())),
+        "no line: {e}"
+    );
     let heavy = cycle(|t| t.replace("payload_kg = 800.0", "payload_kg = 3500.0"));
     let e = heavy.expect_err("over the rating");
     assert!(

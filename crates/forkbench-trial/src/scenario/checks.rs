@@ -153,16 +153,23 @@ pub(super) fn resolve_phases(
         mission,
     };
     crate::trial::phases_resolve(&list, &f.phase, &cx).map_err(|(field, reason)| {
-        // A phase's settings are at their table's header; the list's errors at the list.
-        let at = match field.split_once('.') {
-            Some(("phase", name)) => at_line(file, text, &format!("[phase.{name}]")),
-            _ => names.map_or_else(
+        // A phase's settings are at their table's header; the list's errors, and those of
+        // a phase without a table, at the list.
+        let list_at = || {
+            names.map_or_else(
                 || file.to_owned(),
                 |n| {
                     let line = text[..n.span().start.min(text.len())].matches('\n').count();
                     format!("{file}:{}", line + 1)
                 },
-            ),
+            )
+        };
+        let at = match field.split_once('.') {
+            Some(("phase", name)) => {
+                let at = at_line(file, text, &format!("[phase.{name}]"));
+                if at == file { list_at() } else { at }
+            }
+            _ => list_at(),
         };
         invalid(&at, &field, &reason)
     })

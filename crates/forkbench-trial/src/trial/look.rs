@@ -3,6 +3,7 @@
 use forkbench_core::Pose2;
 use forkbench_core::signal::Scan;
 use forkbench_sensors::detect::{Detection, detect};
+use forkbench_sensors::detector::{DetectorError, detect_in};
 use forkbench_sensors::scan::{Errors, ScannerConfig, scan};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -10,11 +11,14 @@ use serde::Serialize;
 
 use super::error::StageError;
 use super::setup::build_world;
+use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Case, Scenario};
 
 /// One scan and what the detector made of it.
 #[derive(Debug, Clone, Serialize)]
 pub struct ScanReport {
+    /// The detector that looked: the scenario's.
+    pub detector: String,
     pub sensor: String,
     /// The fork-root pose the truck scanned from.
     pub fork_root: Pose2,
@@ -52,14 +56,31 @@ pub fn scan_once(
             },
         )
     };
-    // Where the pallet should stand is where the detector looks (as in a trial).
-    let estimate = detect(
-        &scn.pallet_sensing.pocket_settings(),
-        &s,
-        &scn.pallet,
-        Some(&case.pallet),
-    );
+    // Where the pallet should stand is where the detector looks (as in a trial), and the
+    // detector is the scenario's own (an external one too); the built-in pocket detector
+    // where the scenario senses without scans.
+    let (detector, estimate) = match &scn.pallet_sensing {
+        PalletSensing::Scanner { detector, .. } => {
+            let fail = |reason: String| DetectorError {
+                detector: detector.name.clone(),
+                reason,
+            };
+            let mut d = scn
+                .registry
+                .detector(detector)
+                .map_err(|e| fail(e.to_string()))?;
+            let scans = [(sensor, s.clone())];
+            let found = detect_in(&mut *d, &scans, &scn.pallet, Some(case.pallet))?;
+            (detector.name.clone(), found.map(|f| f.detection))
+        }
+        PalletSensing::Gaussian => {
+            let cfg = scn.pallet_sensing.pocket_settings();
+            let found = detect(&cfg, &s, &scn.pallet, Some(&case.pallet));
+            ("pockets".to_owned(), found)
+        }
+    };
     Ok(ScanReport {
+        detector,
         sensor: sensor.to_owned(),
         fork_root: root,
         scan: s,
