@@ -1154,6 +1154,15 @@ fn scan_reports_beams_truth_and_estimate() {
     );
     assert_eq!(v["sensor"], "tim561");
     assert_eq!(v["detector"], "pockets");
+    // --at is bounded, and the truck may not stand in the pallet.
+    for (at, want) in [
+        ("1e300,0,0", "within ±10000 m"),
+        ("1.7,15.4,102.8", "in the pallet"),
+    ] {
+        let out = forkbench(&["scan", scn, "--at", at]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(want), "{at}: {err}");
+    }
     // The scenario's own detector looks: the RANSAC example's external one.
     let ransac = repo_root().join("examples/detectors/ransac-near-pick.toml");
     let r = stdout_json(&forkbench(&[

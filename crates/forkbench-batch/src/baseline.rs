@@ -147,9 +147,22 @@ impl Baseline {
         Ok(text + "\n")
     }
 
-    /// Writes the baseline atomically.
+    /// Writes the baseline atomically; refuses one larger than [`Baseline::load`] reads.
     pub fn write(&self, path: &Path) -> Result<(), BatchError> {
-        super::write_atomic(path, self.to_text()?.as_bytes())
+        self.write_capped(path, MAX_BASELINE_BYTES)
+    }
+
+    fn write_capped(&self, path: &Path, max_bytes: u64) -> Result<(), BatchError> {
+        let text = self.to_text()?;
+        if text.len() as u64 > max_bytes {
+            return Err(BatchError::Invalid(format!(
+                "{}: the baseline would be {} bytes, more than the {max_bytes} that regress \
+                 reads; make it from fewer trials (or shards, one baseline each)",
+                path.display(),
+                text.len()
+            )));
+        }
+        super::write_atomic(path, text.as_bytes())
     }
 
     pub fn load(path: &Path) -> Result<Self, BatchError> {
@@ -255,5 +268,31 @@ impl BaselineRow {
         let mut same = rows.iter().filter(|r| self.matches(r));
         let first = same.next()?;
         (self.replan.is_some() || same.next().is_none()).then_some(first)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_baseline_regress_could_not_read_is_not_written() {
+        let dir = std::env::temp_dir().join(format!("forkbench-base-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let path = dir.join("b.json");
+        let b: Baseline =
+            serde_json::from_str(r#"{"description": "x", "rows": []}"#).expect("a baseline");
+        let err = b
+            .write_capped(&path, 10)
+            .expect_err("too large")
+            .to_string();
+        assert!(
+            err.contains("more than the 10") && err.contains("b.json"),
+            "{err}"
+        );
+        assert!(!path.exists(), "nothing written");
+        b.write_capped(&path, MAX_BASELINE_BYTES).expect("fits");
+        assert!(path.exists());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -52,6 +52,9 @@ pub fn run(a: &ScanArgs) -> anyhow::Result<()> {
             )
         })?;
     let case = crate::trial_cmd::pick_case(&scn, &a.scenario, a.case.as_deref())?;
+    if let Some(at) = &a.at {
+        check_at(at, &scn, case)?;
+    }
     let report = scan_once(&scn, case, (&a.sensor, &cfg), a.at, a.seed, a.no_noise)?;
     if let Some(file) = &a.plot {
         draw(file, &report, &scn.pallet)?;
@@ -60,6 +63,32 @@ pub fn run(a: &ScanArgs) -> anyhow::Result<()> {
         return crate::emit(&format!("{}\n", to_json(&report)));
     }
     crate::emit(&text(&report))
+}
+
+/// `--at` within the world's extent and with the truck outside the pallet.
+fn check_at(
+    at: &Pose2,
+    scn: &forkbench_trial::Scenario,
+    case: &forkbench_trial::scenario::Case,
+) -> anyhow::Result<()> {
+    let lim = forkbench_trial::scenario::MAX_WORLD_EXTENT_M;
+    if !(at.x_m.abs() <= lim && at.y_m.abs() <= lim && at.heading_rad.is_finite()) {
+        anyhow::bail!("--at ({}, {}) m: must lie within ±{lim} m", at.x_m, at.y_m);
+    }
+    let fp = forkbench_trial::scenario::pallet_footprint(&scn.pallet);
+    let mut pallet = forkbench_geom::Obstacles::new();
+    pallet.add_rect(&fp.centre(&case.pallet), fp.length_m, fp.width_m);
+    if forkbench_nav::truck_parts(&scn.truck, 0.0)
+        .iter()
+        .any(|part| pallet.collides(part, at))
+    {
+        anyhow::bail!(
+            "--at ({:.2}, {:.2}) m: the truck would stand in the pallet; scan from outside it",
+            at.x_m,
+            at.y_m
+        );
+    }
+    Ok(())
 }
 
 fn pose_json(p: &Pose2) -> serde_json::Value {
