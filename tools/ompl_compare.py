@@ -46,9 +46,10 @@ def ensure_ompl():
                    env=env, stdout=subprocess.DEVNULL)
 
 
-def build_bench(out_dir):
-    exe = os.path.join(out_dir, "ompl_bench")
-    src = os.path.join(ROOT, "tools", "ompl_bench.cpp")
+def build_bench(out_dir, name="ompl_bench"):
+    """tools/NAME.cpp built with g++ against OMPL into OUT_DIR/NAME."""
+    exe = os.path.join(out_dir, name)
+    src = os.path.join(ROOT, "tools", name + ".cpp")
     subprocess.run(["g++", "-O2", "-std=c++17", src, f"-I{OMPL_INCLUDE}", "-I/usr/include/eigen3",
                     "-lompl", "-o", exe], check=True)
     return exe

@@ -27,7 +27,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import ompl_compare  # noqa: E402  (the toolchain check and the percentile)
+import ompl_compare  # noqa: E402  (the toolchain check, the build and the percentile)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RADIUS_M = 1.0 / 1.0632  # the default truck: tan(1.0471) / 1.629
@@ -162,9 +162,7 @@ def main():
     a = ap.parse_args()
     ompl_compare.ensure_ompl()
     tmp = tempfile.mkdtemp(prefix="ompl-rs-compare-")
-    bench = os.path.join(tmp, "ompl_rs_bench")
-    subprocess.run(["g++", "-O2", "-std=c++17", os.path.join(ROOT, "tools", "ompl_rs_bench.cpp"),
-                    f"-I{ompl_compare.OMPL_INCLUDE}", "-I/usr/include/eigen3", "-lompl", "-o", bench], check=True)
+    bench = ompl_compare.build_bench(tmp, "ompl_rs_bench")
     rows, short = [], []
     for world in ["warehouse", "warehouse-narrow"]:
         subprocess.run([a.forkbench, "map", os.path.join(ROOT, "worlds", world + ".toml"), "--out", tmp],
