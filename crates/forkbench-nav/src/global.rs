@@ -218,6 +218,18 @@ pub struct GlobalPlan {
 }
 
 impl GlobalPlan {
+    /// A route and its roadmap, nothing smoothed or manoeuvred yet.
+    fn of_route(route: Route, roadmap: Option<Roadmap>) -> Self {
+        Self {
+            route,
+            roadmap,
+            smoothed: None,
+            smoothing_s: 0.0,
+            manoeuvre: None,
+            fallback: None,
+        }
+    }
+
     /// A drivable path whose swept footprint clears every obstacle.
     pub fn drivable(&self) -> Option<&Smoothed> {
         match &self.smoothed {
@@ -254,13 +266,12 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
         }
     };
     if let Algorithm::HybridAstar(params) = q.algorithm {
-        return plan_manoeuvre(map, q, params).map(|m| GlobalPlan {
-            route: route_of(&m),
-            roadmap: None,
-            smoothed: None,
-            smoothing_s: 0.0,
-            manoeuvre: Some(m),
-            fallback: None,
+        return plan_manoeuvre(map, q, params).map(|m| {
+            let route = route_of(&m);
+            GlobalPlan {
+                manoeuvre: Some(m),
+                ..GlobalPlan::of_route(route, None)
+            }
         });
     }
     let (from, to) = if q.smooth {
@@ -274,14 +285,7 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
     };
     crate::check_endpoints(space, from, to)?;
     let (mut route, roadmap) = run_algorithm(space, from, to, &q.algorithm)?;
-    let mut plan = GlobalPlan {
-        route: route.clone(),
-        roadmap,
-        smoothed: None,
-        smoothing_s: 0.0,
-        manoeuvre: None,
-        fallback: None,
-    };
+    let mut plan = GlobalPlan::of_route(route.clone(), roadmap);
     let Some(points) = route.points.take() else {
         return Ok(plan);
     };
@@ -351,13 +355,8 @@ fn fallback(
 ) -> Result<GlobalPlan, NavError> {
     let t0 = Instant::now();
     let m = plan_manoeuvre(map, q, params);
-    let mut plan = point_plan.unwrap_or_else(|| GlobalPlan {
-        route: Route::new(None, crate::Timing::default(), 0),
-        roadmap: None,
-        smoothed: None,
-        smoothing_s: 0.0,
-        manoeuvre: None,
-        fallback: None,
+    let mut plan = point_plan.unwrap_or_else(|| {
+        GlobalPlan::of_route(Route::new(None, crate::Timing::default(), 0), None)
     });
     plan.smoothing_s += t0.elapsed().as_secs_f64();
     match m {
