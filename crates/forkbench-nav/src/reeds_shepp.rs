@@ -198,7 +198,7 @@ struct Family {
     backwards: bool,
 }
 
-const FAMILIES: [Family; 10] = [
+const FAMILIES: [Family; 11] = [
     Family {
         formula: lp_sp_lp,
         word: 14,
@@ -259,25 +259,14 @@ const FAMILIES: [Family; 10] = [
         lengths: |[t, u, v]| vec![v, u, -FRAC_PI_2, t],
         backwards: true,
     },
+    // Formula 8.11: two quarter turns around the straight.
+    Family {
+        formula: lp_rm_s_lm_rp,
+        word: 16,
+        lengths: |[t, u, v]| vec![t, -FRAC_PI_2, u, -FRAC_PI_2, v],
+        backwards: false,
+    },
 ];
-
-/// The 5-piece family (8.11) has its own lengths: two quarter turns around the straight.
-fn ccscc(x: f64, y: f64, phi: f64, c: &Pricing, best: &mut Option<(f64, usize, Vec<f64>)>) {
-    for (sx, sy, flip) in [
-        (1.0, 1.0, false),
-        (-1.0, 1.0, true),
-        (1.0, -1.0, false),
-        (-1.0, -1.0, true),
-    ] {
-        let Some([t, u, v]) = lp_rm_s_lm_rp(sx * x, sy * y, sx * sy * phi) else {
-            continue;
-        };
-        let word = if sy > 0.0 { 16 } else { 17 };
-        let k = if flip { -1.0 } else { 1.0 };
-        let lengths = vec![k * t, -k * FRAC_PI_2, k * u, -k * FRAC_PI_2, k * v];
-        consider(best, c, word, lengths);
-    }
-}
 
 /// What a path costs beyond its length: multipliers on distance driven backwards and
 /// turning, and a price per change of direction (in metres).
@@ -360,7 +349,6 @@ fn shortest(x: f64, y: f64, phi: f64, c: &Pricing) -> Option<(usize, Vec<f64>)> 
             consider(&mut best, c, word, lengths);
         }
     }
-    ccscc(x, y, phi, c, &mut best);
     best.map(|(_, w, l)| (w, l))
 }
 
