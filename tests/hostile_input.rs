@@ -351,6 +351,10 @@ fn special_files_anywhere_are_refused_at_once() {
     .expect("write");
     let w = world_fifo.to_str().expect("utf-8");
     let pose = ["--start", "0,0,90", "--goal", "1.5,6.5,105"];
+    let field = repo_root()
+        .join("scenarios/field-test.toml")
+        .display()
+        .to_string();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec!["check", f], "a FIFO"),
         (vec!["check", w], "a FIFO"),
@@ -371,6 +375,8 @@ fn special_files_anywhere_are_refused_at_once() {
             vec!["reproduce", "bspline", "--table", "/dev/zero"],
             "a device",
         ),
+        (vec!["trial", &field, "--mcap", f], "not a regular file"),
+        (vec!["trial", &field, "--rrd", f], "not a regular file"),
     ];
     for (args, want) in cases {
         let t0 = Instant::now();
@@ -505,4 +511,55 @@ fn interrupting_forkbench_kills_its_external_detector() {
             "the detector outlived forkbench after SIG{signal}"
         );
     }
+}
+
+/// A detector that leaves a child in a session of its own (setsid) and a daemon
+/// (double fork, its parent gone) does not leave either behind when a normal trial ends.
+#[test]
+fn a_detectors_setsid_child_and_daemon_do_not_outlive_the_trial() {
+    let d = tmp("setsid");
+    let marker = format!("{}", 700_000 + std::process::id() % 90_000);
+    std::fs::write(
+        d.join("leaver.py"),
+        format!(
+            "import json, os, subprocess, sys\n\
+             subprocess.Popen(['sleep', '{marker}'], start_new_session=True)\n\
+             if os.fork() == 0:\n    os.setsid()\n    if os.fork() == 0:\n        os.execvp('sleep', ['sleep', '{marker}.5'])\n    os._exit(0)\n\
+             for line in sys.stdin:\n    m = json.loads(line)\n    \
+             r = {{\"type\": \"hello\", \"protocol\": \"forkbench-detector\", \"version\": 1, \
+             \"name\": \"leaver\"}} if m.get(\"type\") == \"hello\" else {{\"type\": \"none\", \
+             \"id\": m[\"id\"]}}\n    print(json.dumps(r), flush=True)\n"
+        ),
+    )
+    .expect("write");
+    let scn = d.join("s.toml");
+    std::fs::write(
+        &scn,
+        "name = \"s\"\nplanner = \"bspline\"\nstart = { x_m = 0, y_m = 0, heading_deg = 0 }\n\
+         pallet = { x_m = 6, y_m = 0, heading_deg = 0 }\n[sensors.pallet]\nkind = \"tim561\"\n\
+         [sensors.pallet.detector]\nkind = \"external\"\ncommand = [\"python3\", \"leaver.py\"]\n",
+    )
+    .expect("write");
+    let out = forkbench(&["trial", scn.to_str().expect("utf-8"), "--json"]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("\"pallet_not_found\""),
+        "{}",
+        text(&out)
+    );
+    let left = |needle: &str| {
+        Command::new("pgrep")
+            .args(["-f", needle])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    std::thread::sleep(Duration::from_millis(200));
+    assert!(
+        !left(&format!("sleep {marker}$")),
+        "the setsid child outlived the trial"
+    );
+    assert!(
+        !left(&format!("sleep {marker}.5")),
+        "the daemon outlived the trial"
+    );
 }

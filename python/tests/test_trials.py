@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 
 import pytest
 from conftest import ROOT, read_jsonl, without_clock
@@ -72,6 +73,11 @@ def test_a_trial_records_to_mcap(tmp_path):
     with pytest.raises(forkbench.RecordingError, match="exists"):
         forkbench.run_trial(forkbench.load("field-test"), seed=1, noise=False, mcap=path)
     forkbench.run_trial(forkbench.load("field-test"), seed=1, noise=False, mcap=path, force=True)
+    # A FIFO (opening it to write would wait for a reader) is refused at once, even forced.
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    with pytest.raises(forkbench.RecordingError, match="not a regular file"):
+        forkbench.run_trial(forkbench.load("field-test"), seed=1, mcap=fifo, force=True)
     with pytest.raises(forkbench.BatchError, match="jobs 0"):
         forkbench.run_batch([forkbench.load("field-test")], trials=1, jobs=0)
     with pytest.raises(forkbench.BatchError, match="out"):

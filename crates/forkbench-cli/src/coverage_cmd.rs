@@ -6,7 +6,6 @@ use forkbench_sensors::reflectors::ReflectorNavConfig;
 use forkbench_trial::coverage::{Coverage, coverage};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use serde_json::json;
 
 use crate::plot::{err, to_file};
 
@@ -77,11 +76,22 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
         to_file(file, (width, height), |d| draw(d, &fig), |d| draw(d, &fig))?;
     }
     if a.json {
-        return crate::emit(&format!(
-            "{}\n",
-            json!({"world": world.name, "resolution_m": cov.resolution_m, "reflectors": world.reflector,
-                "cells": cov.cells})
-        ));
+        // Streamed, not built as a JSON tree: a map of millions of cells would hold
+        // gigabytes as one.
+        #[derive(serde::Serialize)]
+        struct Out<'a> {
+            world: &'a str,
+            resolution_m: f64,
+            reflectors: &'a [forkbench_sensors::reflectors::Reflector],
+            cells: &'a [forkbench_trial::coverage::CoverageCell],
+        }
+        let out = Out {
+            world: &world.name,
+            resolution_m: cov.resolution_m,
+            reflectors: &world.reflector,
+            cells: &cov.cells,
+        };
+        return crate::emit_json_line(&out);
     }
     // A world's name is the user's text: no control characters reach a terminal or SVG.
     crate::emit(&summary(

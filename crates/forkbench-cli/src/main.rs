@@ -265,6 +265,21 @@ pub(crate) fn emit(text: &str) -> anyhow::Result<()> {
     }
 }
 
+/// Writes `value` as one JSON line to stdout, serialised as it is written (no copy of the
+/// whole text in memory); a closed pipe is not an error.
+pub(crate) fn emit_json_line<T: serde::Serialize>(value: &T) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let written = serde_json::to_writer(&mut out, value)
+        .map_err(std::io::Error::from)
+        .and_then(|()| out.write_all(b"\n"))
+        .and_then(|()| out.flush());
+    match written {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other.context("writing to stdout"),
+    }
+}
+
 pub(crate) fn parse_pose(text: &str) -> Result<Pose2, String> {
     Pose2::parse_ui(text).map_err(|e| e.to_string())
 }
@@ -382,6 +397,8 @@ fn main() -> ExitCode {
         std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false)),
     );
     kill_children_on_signals();
+    // A detector's daemonised grandchild is reparented here, where the exit kills it.
+    forkbench_ipc::adopt_orphans();
     let cli = Cli::parse();
     let result = run(cli);
     // No external process (or its children) outlives the command.

@@ -22,6 +22,20 @@ impl SettingsError {
     }
 }
 
+/// Checks every `(field, value, lo, hi)`: each value finite and within `[lo, hi]`; the
+/// error names the first field outside its range, the range and the value.
+pub fn in_ranges(fields: &[(&str, f64, f64, f64)]) -> Result<(), SettingsError> {
+    for &(field, value, lo, hi) in fields {
+        if !(value.is_finite() && value >= lo && value <= hi) {
+            return Err(SettingsError::field(
+                field,
+                format!("must lie in [{lo}, {hi}] (got {value})"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads `settings` into a component's typed config (which should deny unknown fields);
 /// the error names the offending field where serde does.
 pub fn parse<T: DeserializeOwned>(settings: &Settings) -> Result<T, SettingsError> {

@@ -153,6 +153,26 @@ impl ForkliftSpec {
                 "must be finite",
             ));
         }
+        // Upper bounds: beyond them no forklift exists, and the geometry and the physics
+        // would only be asked for absurd work.
+        crate::settings::in_ranges(&[
+            ("wheelbase_m", self.wheelbase_m, 0.0, 10.0),
+            ("body_length_m", self.body_length_m, 0.0, 20.0),
+            ("body_width_m", self.body_width_m, 0.0, 10.0),
+            ("mass_kg", self.mass_kg, 0.0, 100_000.0),
+            ("fork_length_m", self.fork_length_m, 0.0, 5.0),
+            ("fork_width_m", self.fork_width_m, 0.0, 1.0),
+            ("fork_spacing_m", self.fork_spacing_m, 0.0, 5.0),
+            ("max_speed_mps", self.max_speed_mps, 0.0, 10.0),
+            ("max_steer_rate_radps", self.max_steer_rate_radps, 0.0, 20.0),
+            ("rated_capacity_kg", self.rated_capacity_kg, 0.0, 100_000.0),
+            (
+                "fork_root_ahead_of_front_axle_m",
+                self.fork_root_ahead_of_front_axle_m,
+                -5.0,
+                5.0,
+            ),
+        ])?;
         if self.fork_spacing_m + self.fork_width_m > self.body_width_m * 1.5 {
             return Err(refused(
                 "fork_spacing_m",

@@ -6,9 +6,11 @@ mod command;
 mod hello;
 mod pool;
 mod process;
+mod tree;
 
 pub use breaker::{BREAKER_THRESHOLD, Breaker};
 pub use call::Callee;
 pub use command::{CommandConfig, MAX_TIMEOUT_S};
 pub use pool::release_pooled;
 pub use process::{EnvPolicy, ExchangeError, MAX_LINE_BYTES, Process, Spawn, clip, kill_all};
+pub use tree::adopt_orphans;

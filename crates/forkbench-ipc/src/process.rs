@@ -25,13 +25,17 @@ const POLL: Duration = Duration::from_millis(20);
 /// Process groups started and not yet killed, for [`kill_all`].
 static LIVE: Mutex<BTreeSet<i32>> = Mutex::new(BTreeSet::new());
 
-/// Kills every process group this process started and has not killed yet: call before
-/// exiting, so a child that ignores end of input, or its own children, do not outlive it.
+/// Kills every process group this process started and has not killed yet, with every
+/// descendant (in the group or not) and, where this process adopts orphans, every orphan:
+/// call before exiting, so a child that ignores end of input, or its own children, do not
+/// outlive it.
 pub fn kill_all() {
     let groups = std::mem::take(&mut *LIVE.lock().unwrap_or_else(PoisonError::into_inner));
     for g in groups {
+        crate::tree::kill_descendants(g);
         let _ = killpg(Pid::from_raw(g), Signal::SIGKILL);
     }
+    crate::tree::kill_orphans();
 }
 
 /// Which environment variables a child gets.
@@ -255,6 +259,9 @@ impl Process {
     /// Kills the whole process group and reaps the child.
     fn kill(&mut self) {
         self.to_child = None;
+        // Descendants first, while their parent links still lead here: one that called
+        // setsid is outside the group.
+        crate::tree::kill_descendants(self.pgid);
         let _ = killpg(Pid::from_raw(self.pgid), Signal::SIGKILL);
         let _ = self.child.wait();
         LIVE.lock()

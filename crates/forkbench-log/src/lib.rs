@@ -61,6 +61,17 @@ pub fn check_writable(path: &Path, force: bool) -> Result<(), LogError> {
             message: "is a directory; give a file name".into(),
         });
     }
+    // Opening a FIFO to write waits for a reader, and a device is not a recording.
+    if let Ok(meta) = std::fs::metadata(path)
+        && !meta.is_file()
+    {
+        return Err(LogError::Io {
+            path: p,
+            message:
+                "exists and is not a regular file (a FIFO, socket or device); give a file name"
+                    .into(),
+        });
+    }
     if path.exists() && !force {
         return Err(LogError::Exists { path: p });
     }

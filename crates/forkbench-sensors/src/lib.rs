@@ -114,17 +114,39 @@ impl PalletEstimateConfig {
                 "must not exceed reference_range_m",
             ));
         }
+        if self.reestimate_at_m.len() > 100 {
+            return Err(SettingsError::field(
+                "reestimate_at_m",
+                "at most 100 ranges",
+            ));
+        }
         if self
             .reestimate_at_m
             .iter()
-            .any(|r| !(r.is_finite() && *r > 0.0))
+            .any(|r| !(r.is_finite() && *r > 0.0 && *r <= 100.0))
         {
             return Err(SettingsError::field(
                 "reestimate_at_m",
-                "ranges must be positive finite numbers",
+                "ranges must lie in (0, 100] m",
             ));
         }
-        Ok(())
+        forkbench_core::settings::in_ranges(&[
+            ("reference_range_m", self.reference_range_m, 0.0, 100.0),
+            (
+                "position_sigma_at_reference_m",
+                self.position_sigma_at_reference_m,
+                0.0,
+                10.0,
+            ),
+            (
+                "heading_sigma_at_reference_rad",
+                self.heading_sigma_at_reference_rad,
+                0.0,
+                std::f64::consts::PI,
+            ),
+            ("near_sigma_fraction", self.near_sigma_fraction, 0.0, 10.0),
+            ("scale", self.scale, 0.0, 100.0),
+        ])
     }
 
     /// σ multiplier at a range: near fraction up to near range, linear to 1 at the

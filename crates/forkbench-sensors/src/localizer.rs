@@ -147,7 +147,17 @@ impl Nav350Config {
                 return Err(SettingsError::field(f, "must be a finite number ≥ 0"));
             }
         }
-        Ok(())
+        forkbench_core::settings::in_ranges(&[
+            ("rate_hz", self.rate_hz, 0.01, 1000.0),
+            ("position_sigma_m", self.position_sigma_m, 0.0, 10.0),
+            (
+                "heading_sigma_rad",
+                self.heading_sigma_rad,
+                0.0,
+                std::f64::consts::PI,
+            ),
+            ("latency_s", self.latency_s, 0.0, 10.0),
+        ])
     }
 }
 

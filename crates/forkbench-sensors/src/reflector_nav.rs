@@ -52,6 +52,11 @@ impl ReflectorNavSettings {
         if !self.mount.is_finite() {
             return Err(SettingsError::field("mount", "must be finite"));
         }
+        forkbench_core::settings::in_ranges(&[
+            ("mount.x_m", self.mount.x_m, -20.0, 20.0),
+            ("mount.y_m", self.mount.y_m, -20.0, 20.0),
+            ("mount.heading_rad", self.mount.heading_rad, -10.0, 10.0),
+        ])?;
         // A world that cannot give one fix would run every trial on dead reckoning (a
         // study that takes reflectors away may leave fewer: that is its question).
         let have = map.len();

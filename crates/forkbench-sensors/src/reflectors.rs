@@ -83,9 +83,19 @@ impl ReflectorNavConfig {
                 "must be at least 3 (a pose has three unknowns)",
             ));
         }
+        if self.min_reflectors > 1000 {
+            return Err(SettingsError::field(
+                "min_reflectors",
+                "must be at most 1000",
+            ));
+        }
         Ok(())
     }
 }
+
+/// A reflector hangs on a face: its sight line ends this short of it, so the face it
+/// is on (met exactly where the line ends, or a rounding error beyond) does not hide it.
+const ON_FACE_M: f64 = 1e-3;
 
 /// Indices of the reflectors in line of sight from `at` and within range: no fixed
 /// surface (rack, wall) between; pallets do not block.
@@ -100,7 +110,12 @@ pub fn visible(
         .enumerate()
         .filter(|(_, r)| {
             let d = (r.x_m - at[0]).hypot(r.y_m - at[1]);
-            (cfg.range_min_m..=cfg.range_max_m).contains(&d) && !sight.blocked(at, [r.x_m, r.y_m])
+            let short = 1.0 - ON_FACE_M / d.max(ON_FACE_M);
+            let end = [
+                at[0] + (r.x_m - at[0]) * short,
+                at[1] + (r.y_m - at[1]) * short,
+            ];
+            (cfg.range_min_m..=cfg.range_max_m).contains(&d) && !sight.blocked(at, end)
         })
         .map(|(i, _)| i)
         .collect()

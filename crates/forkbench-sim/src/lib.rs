@@ -160,7 +160,18 @@ impl SimConfig {
                 "must be a finite number ≥ 0",
             ));
         }
-        Ok(())
+        forkbench_core::settings::in_ranges(&[
+            ("tyre_friction", self.tyre_friction, 0.0, 5.0),
+            (
+                "pallet_floor_friction",
+                self.pallet_floor_friction,
+                0.0,
+                5.0,
+            ),
+            ("fork_friction", self.fork_friction, 0.0, 5.0),
+            ("max_accel_mps2", self.max_accel_mps2, 0.0, 50.0),
+            ("speed_gain_per_s", self.speed_gain_per_s, 0.0, 1000.0),
+        ])
     }
 }
 

@@ -67,7 +67,20 @@ impl TrackerConfig {
                 "must be a positive finite number",
             ));
         }
-        Ok(())
+        forkbench_core::settings::in_ranges(&[
+            ("lookahead_m", self.lookahead_m, 0.0, 20.0),
+            ("min_lookahead_m", self.min_lookahead_m, 0.0, 20.0),
+            ("cruise_speed_mps", self.cruise_speed_mps, 0.0, 10.0),
+            ("approach_speed_mps", self.approach_speed_mps, 0.0, 10.0),
+            ("approach_distance_m", self.approach_distance_m, 0.0, 100.0),
+            ("decel_mps2", self.decel_mps2, 0.0, 50.0),
+            (
+                "lookahead_gain_s",
+                self.lookahead_gain_s.unwrap_or(1.0),
+                0.0,
+                20.0,
+            ),
+        ])
     }
 }
 

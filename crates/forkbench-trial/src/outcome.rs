@@ -29,8 +29,12 @@ pub enum Failure {
     ForkOutsidePocket,
     /// The trial itself broke (panic or non-finite state).
     Error,
-    /// The pallet sensing never found the pallet, so there was nothing to plan to.
+    /// The pallet sensing never found the pallet (from where the pick began, nor in the
+    /// looks from the staging pose), so there was nothing to plan to.
     PalletNotFound,
+    /// The face was not seen from where the pick began and no drive reached the staging
+    /// pose before it.
+    StagingUnreachable,
     /// The lift phase could not lift the pallet (forks not under it, over the truck's
     /// rating, or it would tip the truck).
     LiftFailed,
@@ -56,6 +60,7 @@ impl Failure {
             Failure::ForkOutsidePocket => "fork_outside_pocket",
             Failure::Error => "error",
             Failure::PalletNotFound => "pallet_not_found",
+            Failure::StagingUnreachable => "staging_unreachable",
             Failure::LiftFailed => "lift_failed",
             Failure::LoadShifted => "load_shifted",
             Failure::PlacementError => "placement_error",

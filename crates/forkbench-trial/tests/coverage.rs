@@ -109,3 +109,40 @@ fn coverage_work_is_bounded() {
     // A coarse map of the same world is made.
     assert!(coverage(&world, 1.0, &cfg).is_ok());
 }
+
+/// A reflector exactly on a turned wall's face (its coordinates rounded by the turn) is
+/// accepted and seen from in front of the face, and not from behind the wall.
+#[test]
+fn a_reflector_on_a_face_is_accepted_and_seen_from_its_side_only() {
+    let h = 30f64.to_radians();
+    let wall = forkbench_core::Pose2::new(0.0, 0.0, h);
+    let on_face = wall.to_world(&forkbench_core::Pose2::new(0.5, 0.1, 0.0));
+    let text = format!(
+        "name = \"w\"\n[[wall]]\nx_m = 0.0\ny_m = 0.0\nheading_deg = 30.0\nlength_m = 4.0\n\
+         width_m = 0.2\n[[reflector]]\nname = \"a\"\nx_m = {:?}\ny_m = {:?}\n",
+        on_face.x_m, on_face.y_m
+    );
+    let world = World::parse(&text, "w.toml").expect("a reflector on the face loads");
+    let cfg = ReflectorNavConfig::default();
+    let cov = coverage(&world, 0.25, &cfg).expect("coverage");
+    let side = |c: &forkbench_trial::coverage::CoverageCell| {
+        let l = wall.to_local(&forkbench_core::Pose2::new(c.x_m, c.y_m, 0.0));
+        (l.x_m.abs() < 1.5).then_some(l.y_m)
+    };
+    let front: Vec<_> = cov
+        .cells
+        .iter()
+        .filter(|c| side(c).is_some_and(|y| (1.0..3.0).contains(&y)))
+        .collect();
+    let behind: Vec<_> = cov
+        .cells
+        .iter()
+        .filter(|c| side(c).is_some_and(|y| (-3.0..-1.0).contains(&y)))
+        .collect();
+    assert!(!front.is_empty() && !behind.is_empty());
+    assert!(front.iter().all(|c| c.visible == 1), "seen from the front");
+    assert!(
+        behind.iter().all(|c| c.visible == 0),
+        "hidden behind the wall"
+    );
+}

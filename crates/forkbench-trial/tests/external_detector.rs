@@ -124,7 +124,10 @@ fn a_detector_that_finds_nothing_is_pallet_not_found() {
     let scn = with_detector("blind", &script(body), 5.0);
     let out = run_trial(&scn, &scn.cases[0], &seeded(1));
     assert_eq!(out.failure, Some(Failure::PalletNotFound), "{out:?}");
-    assert_eq!((out.estimates, out.estimates_missed), (1, 1));
+    // One look from the start, then the staging pose's three.
+    assert_eq!((out.estimates, out.estimates_missed), (4, 4));
+    let detail = out.failure_detail.unwrap_or_default();
+    assert!(detail.contains("3 looks from the staging pose"), "{detail}");
 }
 
 #[test]

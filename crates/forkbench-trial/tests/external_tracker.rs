@@ -177,6 +177,15 @@ fn a_slow_tracker_meets_the_trials_wall_time_budget() {
     assert_eq!(out.failure, Some(Failure::Error), "{out:?}");
     let detail = out.failure_detail.unwrap_or_default();
     assert!(detail.contains("wall-time budget of 1 s"), "{detail}");
+    // The error keeps what the trial measured up to it: its simulated time, the fixes
+    // and where the forks stood against the pallet.
+    assert!(out.sim_time_s > 0.1, "sim_time_s {}", out.sim_time_s);
+    assert!(out.fixes > 0, "fixes {}", out.fixes);
+    assert!(
+        out.final_lateral_error_m.is_finite() && out.final_lateral_error_m != 0.0,
+        "{}",
+        out.final_lateral_error_m
+    );
     // A budget out of range is refused before the trial starts.
     let bad = TrialOptions {
         wall_budget_s: Some(f64::NAN),

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use forkbench_trial::scenario::mission::GlobalFile;
-use forkbench_trial::scenario::{NoiseFile, ReplanFile, Tolerances};
+use forkbench_trial::scenario::{NoiseFile, PickFile, ReplanFile, Tolerances};
 use forkbench_trial::{Scenario, World};
 
 fn repo(rel: &str) -> PathBuf {
@@ -54,6 +54,7 @@ fn defaulted_tables() -> Vec<(&'static str, toml::Value)> {
         ("[noise.pallet_estimate]", value(&noise.pallet_estimate)),
         ("[noise.odometry]", value(&noise.odometry)),
         ("[replan]", value(&ReplanFile::default())),
+        ("[pick]", value(&PickFile::default())),
         ("[tolerances]", value(&Tolerances::default())),
         (
             "[planner] bspline",

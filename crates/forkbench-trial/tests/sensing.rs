@@ -43,10 +43,17 @@ fn a_tim561_scan_guides_the_pick() {
 #[test]
 fn a_pallet_beyond_the_scanners_range_is_never_found() {
     let far = "{ x_m = 14.0, y_m = 0.0, heading_deg = 0.0 }";
-    let scn = scenario("[sensors.pallet]\nkind = \"tim561\"\n", far).expect("loads");
+    let once = "[pick]\nwhen_not_seen = \"fail\"\n[sensors.pallet]\nkind = \"tim561\"\n";
+    let scn = scenario(once, far).expect("loads");
     let out = run_trial(&scn, &scn.cases[0], &TrialOptions::default());
     assert_eq!(out.failure, Some(Failure::PalletNotFound), "{out:?}");
     assert_eq!((out.estimates, out.estimates_missed), (1, 1));
+    // Staged (the default), the truck drives to 3 m before where the pallet should stand
+    // and finds it there.
+    let scn = scenario("[sensors.pallet]\nkind = \"tim561\"\n", far).expect("loads");
+    let out = run_trial(&scn, &scn.cases[0], &TrialOptions::default());
+    assert_ne!(out.failure, Some(Failure::PalletNotFound), "{out:?}");
+    assert_eq!((out.estimates_missed, out.legs.len()), (1, 1), "{out:?}");
     // The Gaussian model, by construction, always "sees" it.
     let gaussian = scenario("", far).expect("loads");
     let out = run_trial(&gaussian, &gaussian.cases[0], &TrialOptions::default());

@@ -272,7 +272,20 @@ impl BsplineConfig {
         {
             return bad("sample_spacing_m", "must be a positive finite length");
         }
-        Ok(())
+        // Work grows with the grid's square; lengths beyond a warehouse are typos.
+        if self.grid_points > 1000 {
+            return bad("grid_points", "must be at most 1000");
+        }
+        forkbench_core::settings::in_ranges(&[
+            ("min_handle_m", self.min_handle_m, 0.0, 100.0),
+            (
+                "max_handle_m",
+                self.max_handle_m.unwrap_or(1.0),
+                0.0,
+                1000.0,
+            ),
+            ("sample_spacing_m", self.sample_spacing_m, 0.0, 1.0),
+        ])
     }
 }
 

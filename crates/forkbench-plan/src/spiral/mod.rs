@@ -106,7 +106,18 @@ impl SpiralConfig {
                 ),
             ));
         }
-        Ok(())
+        if self.length_grid_points > 10_000 {
+            return Err(forkbench_core::SettingsError::field(
+                "length_grid_points",
+                "must be at most 10000",
+            ));
+        }
+        forkbench_core::settings::in_ranges(&[(
+            "sample_spacing_m",
+            self.sample_spacing_m,
+            0.0,
+            1.0,
+        )])
     }
 }
 

@@ -212,7 +212,22 @@ impl ScannerConfig {
         if !self.mount.is_finite() {
             return bad("mount", "must be finite");
         }
-        Ok(())
+        // A scanner sits on the truck, reaches a warehouse, and measures to a metre.
+        forkbench_core::settings::in_ranges(&[
+            ("rate_hz", self.rate_hz, 0.01, 1000.0),
+            ("range_max_m", self.range_max_m, 0.0, 1000.0),
+            ("range_sigma_m", self.range_sigma_m, 0.0, 1.0),
+            ("range_sigma_per_m", self.range_sigma_per_m, -1.0, 1.0),
+            ("range_sigma_per_m2", self.range_sigma_per_m2, 0.0, 1.0),
+            ("incidence_sigma", self.incidence_sigma, 0.0, 10.0),
+            ("range_bias_max_m", self.range_bias_max_m, 0.0, 1.0),
+            ("spot_divergence_rad", self.spot_divergence_rad, 0.0, 1.0),
+            ("spot_at_cover_m", self.spot_at_cover_m, 0.0, 1.0),
+            ("echo_separation_m", self.echo_separation_m, 0.0, 10.0),
+            ("mount.x_m", self.mount.x_m, -20.0, 20.0),
+            ("mount.y_m", self.mount.y_m, -20.0, 20.0),
+            ("mount.heading_rad", self.mount.heading_rad, -10.0, 10.0),
+        ])
     }
 
     /// The head-on σ's least value over the working range (a quadratic in range).

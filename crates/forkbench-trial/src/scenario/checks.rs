@@ -95,6 +95,9 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
     if let Err(e) = f.sim.validate() {
         return Err(invalid_setting(file, "sim", &e));
     }
+    if let Err(e) = f.pick.check() {
+        return Err(invalid_setting(file, "pick", &e));
+    }
     for (name, v) in [
         ("position_threshold_m", f.replan.position_threshold_m),
         ("heading_threshold_deg", f.replan.heading_threshold_deg),
@@ -131,6 +134,58 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
                 "must be a positive finite number",
             ));
         }
+    }
+    check_upper_bounds(f, file)
+}
+
+/// Upper bounds of `[replan]` and `[tolerances]`: a threshold or a tolerance beyond them
+/// judges nothing.
+fn check_upper_bounds(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
+    let t = &f.tolerances;
+    let ranges = f.replan.reestimate_at_m.as_deref().unwrap_or_default();
+    let r = &f.replan;
+    forkbench_core::settings::in_ranges(&[
+        (
+            "replan.position_threshold_m",
+            r.position_threshold_m,
+            0.0,
+            100.0,
+        ),
+        (
+            "replan.heading_threshold_deg",
+            r.heading_threshold_deg,
+            0.0,
+            180.0,
+        ),
+        ("tolerances.lateral_m", t.lateral_m, 0.0, 10.0),
+        ("tolerances.heading_deg", t.heading_deg, 0.0, 180.0),
+        (
+            "tolerances.insertion_depth_m",
+            t.insertion_depth_m,
+            0.0,
+            10.0,
+        ),
+        ("tolerances.contact_force_n", t.contact_force_n, 0.0, 1e12),
+        (
+            "tolerances.pallet_displacement_m",
+            t.pallet_displacement_m,
+            0.0,
+            100.0,
+        ),
+        (
+            "tolerances.pallet_rotation_deg",
+            t.pallet_rotation_deg,
+            0.0,
+            180.0,
+        ),
+    ])
+    .map_err(|e| invalid(file, e.field.as_deref().unwrap_or(""), &e.reason))?;
+    if ranges.iter().any(|r| *r > 100.0) {
+        return Err(invalid(
+            file,
+            "replan.reestimate_at_m",
+            "ranges must be at most 100 m",
+        ));
     }
     Ok(())
 }

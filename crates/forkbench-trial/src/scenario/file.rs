@@ -122,6 +122,75 @@ impl Default for ReplanFile {
     }
 }
 
+/// The pick as a docking server runs it (`[pick]`): what the truck does when the pallet's
+/// face is not found from where the pick begins.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PickFile {
+    pub when_not_seen: WhenNotSeen,
+    /// Fork root to the prior face at the staging pose, facing the pallet.
+    pub staging_distance_m: f64,
+    /// Detections tried at the staging pose before `pallet_not_found`.
+    pub looks: u32,
+    /// What the truck does between two looks.
+    pub between_looks: BetweenLooks,
+    /// `wait`: how long it stands (new scans, new noise).
+    pub retry_wait_s: f64,
+    /// `move`: how far it backs away along the staging line (a wider view).
+    pub retry_step_m: f64,
+}
+
+/// What a pick does when the first look finds no pallet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WhenNotSeen {
+    /// Drive (Hybrid-A*, forwards and backwards) to a staging pose before the prior face,
+    /// look again there, up to `looks` times.
+    #[default]
+    Stage,
+    /// End the trial `pallet_not_found` (the papers' setting: one look, from the start).
+    Fail,
+}
+
+/// Between two looks at the staging pose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BetweenLooks {
+    #[default]
+    Wait,
+    Move,
+}
+
+impl Default for PickFile {
+    fn default() -> Self {
+        Self {
+            when_not_seen: WhenNotSeen::Stage,
+            staging_distance_m: 3.0,
+            looks: 3,
+            between_looks: BetweenLooks::Wait,
+            retry_wait_s: 0.5,
+            retry_step_m: 0.5,
+        }
+    }
+}
+
+impl PickFile {
+    /// Every value in its range, naming the field.
+    pub fn check(&self) -> Result<(), forkbench_core::SettingsError> {
+        if !(1..=20).contains(&self.looks) {
+            return Err(forkbench_core::SettingsError::field(
+                "looks",
+                format!("must be 1 to 20 (got {})", self.looks),
+            ));
+        }
+        forkbench_core::settings::in_ranges(&[
+            ("staging_distance_m", self.staging_distance_m, 0.5, 20.0),
+            ("retry_wait_s", self.retry_wait_s, 0.0, 10.0),
+            ("retry_step_m", self.retry_step_m, 0.0, 5.0),
+        ])
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct CaseFile {
@@ -164,6 +233,8 @@ pub(super) struct ScenarioFile {
     pub(super) noise: NoiseFile,
     #[serde(default)]
     pub(super) replan: ReplanFile,
+    #[serde(default)]
+    pub(super) pick: PickFile,
     #[serde(default)]
     pub(super) tolerances: Tolerances,
     /// Fixed error of every pallet estimate, in the pallet frame (a miscalibrated camera);

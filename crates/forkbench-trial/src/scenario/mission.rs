@@ -272,6 +272,13 @@ impl MissionFile {
                 return Err(invalid(file, field, "must be a positive finite number"));
             }
         }
+        if g.connect_m.is_some_and(|v| v > 1000.0) {
+            return Err(invalid(
+                file,
+                "mission.global.connect_m",
+                "must be at most 1000 m",
+            ));
+        }
         if g.inflate_m
             .is_some_and(|v| v > forkbench_nav::MAX_INFLATION_M)
         {

@@ -20,7 +20,10 @@ use crate::components::{ComponentSpec, Registry, Role};
 
 pub(crate) use checks::shrunk;
 pub use checks::{ForkFit, fork_fit, pallet_footprint, truck_footprint};
-pub use file::{NoiseFile, PalletKind, PalletPlacement, ReplanFile, ReplanMethod, Tolerances};
+pub use file::{
+    BetweenLooks, NoiseFile, PalletKind, PalletPlacement, PickFile, ReplanFile, ReplanMethod,
+    Tolerances, WhenNotSeen,
+};
 pub use limits::{Limits, Replan};
 pub use world::{MAX_WORLD_EXTENT_M, PalletSlot, PoseDeg, RectFile, World};
 
@@ -122,6 +125,8 @@ pub struct Scenario {
     pub sim: SimConfig,
     pub noise: NoiseFile,
     pub replan: Replan,
+    /// Staging and looking when the face is not seen from where the pick begins.
+    pub pick: PickFile,
     pub tolerances: Limits,
     /// How the pallet is estimated; the Gaussian default is left out of manifests, so
     /// scenarios without `[sensors]` keep their settings hash.
@@ -291,6 +296,7 @@ impl Scenario {
             sim: f.sim,
             noise: f.noise,
             replan: f.replan.into(),
+            pick: f.pick,
             tolerances: f.tolerances.into(),
             pallet_sensing,
             localizer: ComponentSpec::of_kind(Role::Localizer, "gaussian"),

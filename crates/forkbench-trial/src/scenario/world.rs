@@ -60,6 +60,9 @@ impl PoseDeg {
 
 /// Largest |x| or |y| anywhere in a world or scenario file.
 pub const MAX_WORLD_EXTENT_M: f64 = 1e4;
+/// How far inside an obstacle a reflector may lie and still count as on its face.
+const ON_FACE_TOLERANCE_M: f64 = 1e-9;
+
 /// Most reflector × obstacle pairs a world may have (the NAV350's work per fix).
 pub const MAX_REFLECTOR_WORK: usize = 2_000_000;
 
@@ -261,10 +264,11 @@ impl World {
                     ),
                 ));
             }
-            // On a face is allowed: that is where a reflector hangs.
+            // On a face is allowed: that is where a reflector hangs (a turned face's
+            // coordinates round, so "on" has a nanometre's tolerance).
             if let Some(o) = obstacles
                 .iter()
-                .find(|o| o.depth_inside([r.x_m, r.y_m]) > 0.0)
+                .find(|o| o.depth_inside([r.x_m, r.y_m]) > ON_FACE_TOLERANCE_M)
             {
                 return Err(invalid(
                     file,

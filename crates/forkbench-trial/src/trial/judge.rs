@@ -29,31 +29,11 @@ pub(super) fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
 impl Trial<'_> {
     /// Writes the final measurements and the verdict into the outcome.
     pub(super) fn conclude(&mut self) {
-        let truck = &self.scn.truck;
-        let out = &mut self.out;
-        out.sim_time_s = self.sim.time_s();
-        let period_s = self.localizer.period_s();
-        self.loc.finish_trial(out.sim_time_s, period_s, out);
-        let root = self.sim.fork_root_pose();
-        let pallet_now = self.sim.pallet_pose();
-        let local = in_pallet_frame(&pallet_now, &root);
-        out.final_lateral_error_m = local.y_m;
-        out.final_heading_error_rad = local.heading_rad;
-        out.insertion_depth_m = truck.insertion_depth_m(&pallet_now, &root);
-        out.pallet_displacement_m = pallet_now.distance_to(&self.pallet0);
-        out.pallet_rotation_rad = wrap_angle(pallet_now.heading_rad - self.pallet0.heading_rad);
-        let pockets = self.scn.pallet.pocket_offsets_m();
-        let worst_pocket_miss = truck
-            .fork_points(&root, truck.fork_length_m / 2.0)
-            .iter()
-            .zip(pockets)
-            // Lateral position of the fork's middle in the pallet frame, against its pocket.
-            .map(|(mid, py)| (pallet_now.to_local(mid).y_m - py).abs())
-            .fold(0.0, f64::max);
+        let worst_pocket_miss = self.measure();
         let judged = Judged {
             out: &self.out,
             tol: &self.scn.tolerances,
-            truck,
+            truck: &self.scn.truck,
             pallet: &self.scn.pallet,
             collision: self.collision,
             timed_out: self.timed_out,
@@ -71,6 +51,40 @@ impl Trial<'_> {
             }
             None => self.out.success = true,
         }
+    }
+
+    /// The simulated time and the localisation so far: all a trial that ended before its
+    /// drive to the pallet measured (the forks were never brought to it).
+    pub(crate) fn measure_time(&mut self) {
+        self.out.sim_time_s = self.sim.time_s();
+        let period_s = self.localizer.period_s();
+        self.loc
+            .finish_trial(self.out.sim_time_s, period_s, &mut self.out);
+    }
+
+    /// The trial's measurements as it stands now (time, localisation, where the forks are
+    /// against the pallet, how far the pallet moved), kept also when it ends in an error;
+    /// returns the worst fork's lateral miss of its pocket.
+    pub(crate) fn measure(&mut self) -> f64 {
+        self.measure_time();
+        let truck = &self.scn.truck;
+        let out = &mut self.out;
+        let root = self.sim.fork_root_pose();
+        let pallet_now = self.sim.pallet_pose();
+        let local = in_pallet_frame(&pallet_now, &root);
+        out.final_lateral_error_m = local.y_m;
+        out.final_heading_error_rad = local.heading_rad;
+        out.insertion_depth_m = truck.insertion_depth_m(&pallet_now, &root);
+        out.pallet_displacement_m = pallet_now.distance_to(&self.pallet0);
+        out.pallet_rotation_rad = wrap_angle(pallet_now.heading_rad - self.pallet0.heading_rad);
+        let pockets = self.scn.pallet.pocket_offsets_m();
+        truck
+            .fork_points(&root, truck.fork_length_m / 2.0)
+            .iter()
+            .zip(pockets)
+            // Lateral position of the fork's middle in the pallet frame, against its pocket.
+            .map(|(mid, py)| (pallet_now.to_local(mid).y_m - py).abs())
+            .fold(0.0, f64::max)
     }
 }
 

@@ -15,6 +15,7 @@ mod plan;
 mod sense;
 mod session;
 mod setup;
+mod staging;
 
 use std::time::Instant;
 
@@ -134,6 +135,7 @@ fn run_stages<R: Recorder + ?Sized>(
     if let Err(why) = trial.drive(rec) {
         let why = why.to_string();
         rec.event(trial.sim.time_s(), Level::Error, &why);
+        trial.measure();
         trial.out.fail(Failure::Error, why);
         return trial.out;
     }
@@ -153,6 +155,7 @@ pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
 ) -> Result<Trial<'a>, Box<TrialOutcome>> {
     let mut trial = Trial::setup(scn, case, run, rec)?;
     let end = |mut trial: Trial<'a>, failure: Failure, why: String| {
+        trial.measure_time();
         trial.out.fail(failure, why);
         Err::<Trial<'a>, _>(Box::new(trial.out))
     };
@@ -166,7 +169,6 @@ pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
             pose: case.start,
         };
         if let Err(why) = trial.run_legs(m, &staging, rec) {
-            trial.out.sim_time_s = trial.sim.time_s();
             return end(trial, Failure::LegFailed, why.to_string());
         }
         let pallet = trial.sim.pallet_pose();
@@ -176,10 +178,12 @@ pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
             return end(trial, Failure::Error, why);
         }
     }
-    if trial.out.estimates_missed == trial.out.estimates && trial.out.estimates > 0 {
-        let why = "the pallet sensing found no pallet from the start pose".to_owned();
+    if trial.out.estimates_missed == trial.out.estimates
+        && trial.out.estimates > 0
+        && let Err((failure, why)) = trial.stage_and_look(rec)
+    {
         rec.event(trial.sim.time_s(), Level::Error, &why);
-        return end(trial, Failure::PalletNotFound, why);
+        return end(trial, failure, why);
     }
     let path = match trial.first_plan(rec) {
         Ok(p) => p,

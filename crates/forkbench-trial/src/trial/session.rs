@@ -271,6 +271,7 @@ impl Trial<'_> {
 
     /// The outcome of a trial a stage error stopped, as a batch reports it.
     pub(super) fn stopped_by(&mut self, e: StageError) -> TrialOutcome {
+        self.measure();
         self.out.fail(Failure::Error, e.to_string());
         self.out.clone()
     }
