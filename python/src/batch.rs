@@ -110,8 +110,30 @@ impl Scenario {
     }
 }
 
-/// Most trial records a batch returns to Python (each is a dict of about 40 fields).
-const MAX_RECORDS: u64 = 2_000_000;
+/// Most memory the records a batch returns to Python may take, as dicts.
+const MAX_RECORDS_BYTES: u64 = 2 << 30;
+/// Memory of one pick's record as a Python dict (about 40 fields; measured 5.7 KB).
+const PY_RECORD_BYTES: u64 = 6_000;
+/// What each mission leg or phase adds to a record (its JSON's size about four times).
+const PY_PART_BYTES: u64 = 4_000;
+
+/// The memory `spec`'s records would take in Python: rows × trials × a record's size,
+/// from the legs and phases each scenario's records carry (a staging leg included).
+fn records_bytes(spec: &BatchSpec) -> u64 {
+    spec.scenarios
+        .iter()
+        .map(|s| {
+            let one = BatchSpec {
+                scenarios: vec![s.clone()],
+                ..spec.clone()
+            };
+            let records: u64 = one.row_sizes().iter().map(|(_, n)| n).sum();
+            let legs = s.mission.as_ref().map_or(0, |m| m.via.len() + 1);
+            let parts = (legs + s.phases.len() + 1) as u64;
+            records.saturating_mul(PY_RECORD_BYTES + PY_PART_BYTES * parts)
+        })
+        .fold(0, u64::saturating_add)
+}
 
 /// Runs a batch as the CLI's `batch` does (the same trial seeds from `seed` and each
 /// trial's identity, so the same outcomes), in parallel on `jobs` threads, and returns
@@ -174,19 +196,14 @@ pub fn run_batch<'py>(
         compare_replanning,
         force_new: false,
     };
-    let per_trial: u64 = BatchSpec {
-        trials: 1,
-        ..spec.clone()
-    }
-    .row_sizes()
-    .iter()
-    .map(|(_, n)| n)
-    .sum();
-    let total = per_trial.saturating_mul(trials);
-    if total > MAX_RECORDS {
+    let bytes = records_bytes(&spec);
+    if bytes > MAX_RECORDS_BYTES {
         return Err(BatchError::new_err(format!(
-            "{total} trials: at most {MAX_RECORDS} are returned to Python at once; run the \
-             CLI's batch (sharded if need be) and read its trials.jsonl"
+            "{trials} trials per case: their records would take about {:.1} GiB in Python, \
+             more than {} GiB; run the CLI's batch (sharded if need be) and read its \
+             trials.jsonl",
+            bytes as f64 / f64::from(1u32 << 30),
+            MAX_RECORDS_BYTES >> 30
         )));
     }
     if jobs == Some(0) {

@@ -83,6 +83,16 @@ type VecStep<'py> = (
     Vec<Option<Bound<'py, PyDict>>>,
 );
 
+/// Most memory the environments of one vector environment may take.
+const MAX_ENVS_BYTES: u64 = 4 << 30;
+
+/// One environment's memory: its physics world, components and buffers (about 110–170 KB
+/// measured on the field test), and a little more per rack, wall and reflector.
+fn env_bytes(scn: &forkbench_trial::Scenario) -> u64 {
+    let items = scn.world.obstacles().len() + scn.world.reflector.len();
+    200_000 + 1_000 * items as u64
+}
+
 #[pymethods]
 impl PickVecEnv {
     #[new]
@@ -105,9 +115,14 @@ impl PickVecEnv {
         reward: (f64, f64, f64, f64),
         threads: Option<usize>,
     ) -> PyResult<Self> {
-        if !(1..=65_536).contains(&num_envs) {
+        let bytes = (num_envs as u64).saturating_mul(env_bytes(&scenario.inner));
+        if num_envs == 0 || bytes > MAX_ENVS_BYTES {
             return Err(PyValueError::new_err(format!(
-                "num_envs {num_envs}: must be 1 to 65536"
+                "num_envs {num_envs}: at least 1, and at most what {} GiB holds (about {:.1} \
+                 GiB asked: each environment of this scenario takes about {} KB)",
+                MAX_ENVS_BYTES >> 30,
+                bytes as f64 / f64::from(1u32 << 30),
+                env_bytes(&scenario.inner) / 1000
             )));
         }
         let setup = setup(

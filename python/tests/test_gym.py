@@ -5,7 +5,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
-from conftest import without_clock
+from conftest import ROOT, without_clock
 from gymnasium.utils.env_checker import check_env
 
 import forkbench
@@ -104,9 +104,13 @@ def test_make_vec_uses_the_rust_vector():
     assert rewards.shape == (3,) and term.dtype == np.bool_
 
 
-def test_an_episode_that_ends_before_driving_terminates_on_its_first_step():
-    # spiral-table2's sensing finds no pallet from some start poses: the trial ends at reset.
-    env = PalletPickEnv("spiral-table2")
+def test_an_episode_that_ends_before_driving_terminates_on_its_first_step(tmp_path):
+    # With one look from the start (`when_not_seen = "fail"`), spiral-table2's sensing finds
+    # no pallet from some start poses: the trial ends at reset.
+    once = tmp_path / "spiral-once.toml"
+    text = (ROOT / "scenarios/spiral-table2.toml").read_text()
+    once.write_text(text + '\n[pick]\nwhen_not_seen = "fail"\n')
+    env = PalletPickEnv(forkbench.load(once))
     for seed in range(200):
         _, info = env.reset(seed=seed)
         if "outcome" in info:
@@ -116,7 +120,7 @@ def test_an_episode_that_ends_before_driving_terminates_on_its_first_step():
     assert info["failure"] == "pallet_not_found"
     _, reward, term, trunc, end = env.step([0.5, 0.0])
     assert term and not trunc and reward == -10.0 and end["failure"] == "pallet_not_found"
-    vec = PalletPickVectorEnv(8, "spiral-table2", ticks_per_step=50)
+    vec = PalletPickVectorEnv(8, forkbench.load(once), ticks_per_step=50)
     vec.reset(seed=3)
     ended = 0
     for _ in range(60):  # every reported outcome comes with its episode's last step
@@ -125,3 +129,17 @@ def test_an_episode_that_ends_before_driving_terminates_on_its_first_step():
         assert np.array_equal(mask, term | trunc), (mask, term, trunc)
         ended += int(mask.sum())
     assert ended > 8
+
+
+def test_a_staged_episode_starts_at_the_staging_pose():
+    # Staged (the default), the same geometries start the episode 3 m before the face.
+    env = PalletPickEnv("spiral-table2", case="14", noise=False)
+    _, info = env.reset(seed=1)
+    assert "outcome" not in info, info
+
+
+def test_a_vector_environment_is_capped_by_memory():
+    with pytest.raises(ValueError, match="GiB"):
+        PalletPickVectorEnv(1_000_000)
+    with pytest.raises(ValueError, match="at least 1"):
+        PalletPickVectorEnv(0)

@@ -78,6 +78,9 @@ def test_a_trial_records_to_mcap(tmp_path):
     os.mkfifo(fifo)
     with pytest.raises(forkbench.RecordingError, match="not a regular file"):
         forkbench.run_trial(forkbench.load("field-test"), seed=1, mcap=fifo, force=True)
+    # Records are capped by the memory they would take, refused before any trial runs.
+    with pytest.raises(forkbench.BatchError, match="GiB in Python"):
+        forkbench.run_batch([forkbench.load("warehouse-cycle")], trials=200_000)
     with pytest.raises(forkbench.BatchError, match="jobs 0"):
         forkbench.run_batch([forkbench.load("field-test")], trials=1, jobs=0)
     with pytest.raises(forkbench.BatchError, match="out"):
@@ -112,7 +115,7 @@ def test_bad_input_names_file_field_and_reason(tmp_path):
         forkbench.run_batch([forkbench.load("field-test")], trials=1, modes="sometimes")
     with pytest.raises(forkbench.BatchError, match="trials"):
         forkbench.run_batch([forkbench.load("field-test")], trials=0)
-    with pytest.raises(forkbench.BatchError, match="at most"):
+    with pytest.raises(forkbench.BatchError, match="more than 2 GiB"):
         forkbench.run_batch([forkbench.load("field-test")], trials=10**12)
     with pytest.raises(ValueError, match="path_points"):
         forkbench.PickEnv(forkbench.load("field-test"), path_points=10**9)

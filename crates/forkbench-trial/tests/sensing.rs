@@ -158,3 +158,28 @@ fn a_failed_trial_names_every_broken_criterion_and_the_likely_cause() {
         "{line}"
     );
 }
+
+/// A scanner's `rate_hz` sets how often a look gets a new frame from it: at one frame in
+/// 100 s, the re-estimates during the approach get nothing new (missed, the first estimate
+/// kept); at its datasheet's 15 Hz every look gets one.
+#[test]
+fn a_scanners_frame_rate_bounds_its_looks() {
+    let far = "{ x_m = 8.0, y_m = 0.3, heading_deg = 2.0 }";
+    let run = |rate: &str| {
+        let extra = format!(
+            "[replan]\nenabled = true\n[sensors.pallet]\nkind = \"tim561\"\n\
+             [sensors.pallet.scanner]\n{rate}"
+        );
+        let scn = scenario(&extra, far).expect("loads");
+        run_trial(&scn, &scn.cases[0], &TrialOptions::default())
+    };
+    let fast = run("");
+    assert!(fast.estimates >= 3, "{fast:?}");
+    assert_eq!(fast.estimates_missed, 0);
+    let slow = run("rate_hz = 0.01\n");
+    assert_eq!(
+        slow.estimates, fast.estimates,
+        "the same looks are asked for"
+    );
+    assert_eq!(slow.estimates_missed, slow.estimates - 1, "{slow:?}");
+}

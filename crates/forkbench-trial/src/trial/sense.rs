@@ -57,10 +57,10 @@ impl Trial<'_> {
     /// One scan from `sensor` (its true pose), placed at `placed` (its believed pose).
     fn scan_from(&mut self, k: usize, s: &NamedScanner, sensor: Pose2, placed: Pose2) -> Scan {
         let mut out = if self.run.noise {
-            let (bias_m, rng) = &mut self.scanners[k];
+            let state = &mut self.scanners[k];
             let errors = Errors::Modelled {
-                bias_m: *bias_m,
-                rng,
+                bias_m: state.bias_m,
+                rng: &mut state.rng,
             };
             scan(&s.scanner, &self.sim, sensor, errors)
         } else {
@@ -90,9 +90,12 @@ impl Trial<'_> {
         let mut scans = Vec::with_capacity(sensors.len());
         for (k, s) in sensors.iter().enumerate() {
             let placed = s.scanner.sensor_pose(believed);
-            if !s.scanner.reaches(&placed, &prior) {
+            // A scanner gives a look its latest frame only once: a look sooner than its
+            // frame period after the last gets nothing new from it.
+            if !s.scanner.reaches(&placed, &prior) || t < self.scanners[k].next_frame_s {
                 continue;
             }
+            self.scanners[k].next_frame_s = t + 1.0 / s.scanner.rate_hz;
             let sc = self.scan_from(k, s, s.scanner.sensor_pose(&root), placed);
             let style = SCAN_STYLES[k % SCAN_STYLES.len()];
             rec.signal(t, &format!("sensors/{}", s.name), &Signal::Scan(&sc), style);

@@ -58,9 +58,8 @@ pub struct Trial<'a> {
     /// Where the pallet should stand (the case's placement, before any jitter): the
     /// region a detector looks in before its first estimate.
     pub(super) pallet_nominal: Pose2,
-    /// Each scanner's range bias for the whole trial (its systematic error) and the
-    /// stream its per-beam noise draws from, in the sensing's order.
-    pub(super) scanners: Vec<(f64, ChaCha8Rng)>,
+    /// Each scanner's bias, noise stream and frame timing, in the sensing's order.
+    pub(super) scanners: Vec<ScannerState>,
     /// The pallet detector, when the sensing scans.
     pub(super) detector: Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
     pub(super) collision: bool,
@@ -131,7 +130,16 @@ fn scanner_salt(name: &str, what: &str) -> u64 {
 /// Each scanner's systematic range error for one trial and the stream of its per-beam
 /// noise, each keyed by the scanner's name (nothing for the Gaussian model; no bias with
 /// noise off, where scans draw nothing).
-fn scanner_streams(run: &Resolved) -> Vec<(f64, ChaCha8Rng)> {
+/// One pallet scanner through a trial: its range bias (the systematic error), the stream
+/// its per-beam noise draws from, and when its next frame is ready.
+pub(super) struct ScannerState {
+    pub(super) bias_m: f64,
+    pub(super) rng: ChaCha8Rng,
+    /// A look before this time gets no new frame from this scanner (its `rate_hz`).
+    pub(super) next_frame_s: f64,
+}
+
+fn scanner_streams(run: &Resolved) -> Vec<ScannerState> {
     match &run.pallet_sensing {
         PalletSensing::Scanner { sensors, .. } => sensors
             .iter()
@@ -142,7 +150,11 @@ fn scanner_streams(run: &Resolved) -> Vec<(f64, ChaCha8Rng)> {
                 } else {
                     0.0
                 };
-                (bias, stream(run.seed, scanner_salt(&s.name, "noise")))
+                ScannerState {
+                    bias_m: bias,
+                    rng: stream(run.seed, scanner_salt(&s.name, "noise")),
+                    next_frame_s: f64::NEG_INFINITY,
+                }
             })
             .collect(),
         PalletSensing::Gaussian => Vec::new(),
