@@ -166,6 +166,19 @@ impl RerunRecorder {
         if !o.also_failed.is_empty() {
             detail += &format!("\n- ❌ **also** {}", o.also_failed.join(" · "));
         }
+        if let Some(leg) = o.legs.iter().find(|l| l.name.ends_with("→ staging")) {
+            detail += &format!(
+                "\n- **staged:** the face was not seen from the start; a {:.1} m manoeuvre ({:.1} m \
+                 backwards) to look again from the staging pose{}",
+                leg.planned_length_m,
+                leg.reverse_length_m,
+                if leg.success {
+                    ""
+                } else {
+                    ", and did not reach it"
+                }
+            );
+        }
         if o.estimates_missed > 0 {
             detail += &format!(
                 "\n- {} of {} pallet estimates found no pallet (scans under map/sensors)",
