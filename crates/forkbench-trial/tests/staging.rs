@@ -150,7 +150,7 @@ fn pick_settings_are_range_checked() {
             "[pick]\nstaging_distance_m = 0.1\n",
             "pick.staging_distance_m",
         ),
-        ("[pick]\nwhen_not_seen = \"prior\"\n", "when_not_seen"),
+        ("[pick]\nwhen_not_seen = \"sometimes\"\n", "when_not_seen"),
     ] {
         let text = format!(
             "name = \"x\"\nplanner = \"bspline\"\nstart = {{ x_m = 0, y_m = 0, heading_deg = 0 }}\n\
@@ -161,4 +161,48 @@ fn pick_settings_are_range_checked() {
             .to_string();
         assert!(e.contains(field), "{table}: {e}");
     }
+}
+
+/// `when_not_seen = "prior"`: no staging leg; the truck plans on where the pallet should
+/// stand, looks at every scanner frame on the way until the face is in view, and picks.
+#[test]
+fn prior_plans_on_the_prior_and_looks_on_the_way() {
+    let text = std::fs::read_to_string(repo("scenarios/spiral-table2.toml")).expect("reads");
+    let text = format!("{text}\n[pick]\nwhen_not_seen = \"prior\"\n");
+    let scn = Scenario::parse(&text, "prior.toml", |_| Ok(World::default())).expect("loads");
+    let case = scn.case("20").expect("case 20");
+    let out = run_trial(&scn, case, &no_noise());
+    assert!(out.success, "{out:?}");
+    assert!(out.legs.is_empty());
+    // Missed from the start and on the way (a look per frame), then found.
+    assert!(out.estimates_missed >= 2, "{out:?}");
+    assert_eq!(out.estimates, out.estimates_missed + 1, "{out:?}");
+}
+
+/// The pre-entry gap and the docked check are settings that act: a longer gap moves the
+/// planners' goal back (a longer plan), a looser docked speed ends the pick sooner.
+#[test]
+fn the_pre_entry_gap_and_the_docked_check_are_settings() {
+    let base = std::fs::read_to_string(repo("scenarios/field-test.toml")).expect("reads");
+    let run = |pick: &str| {
+        let text = format!("{base}\n[pick]\n{pick}");
+        let scn = Scenario::parse(&text, "f.toml", |_| Ok(World::default())).expect("loads");
+        run_trial(&scn, &scn.cases[0], &no_noise())
+    };
+    let default = run("");
+    let gap = run("pre_entry_gap_m = 1.0\n");
+    assert!(default.success && gap.success, "{gap:?}");
+    assert!(
+        (gap.path_length_m - default.path_length_m).abs() > 0.05,
+        "{} vs {}",
+        gap.path_length_m,
+        default.path_length_m
+    );
+    let loose = run("docked_speed_mps = 0.3\n");
+    assert!(
+        loose.sim_time_s < default.sim_time_s,
+        "{} vs {}",
+        loose.sim_time_s,
+        default.sim_time_s
+    );
 }

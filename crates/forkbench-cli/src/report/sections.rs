@@ -119,6 +119,10 @@ fn case_geometry(settings: &Value) -> BTreeMap<String, (f64, f64)> {
         forkbench_core::Pose2::new(g("x_m"), g("y_m"), g("heading_rad"))
     };
     let fork_m = settings["truck"]["fork_length_m"].as_f64().unwrap_or(0.0);
+    // Manifests from before `[pick]` have the default gap.
+    let gap_m = settings["pick"]["pre_entry_gap_m"]
+        .as_f64()
+        .unwrap_or(forkbench_trial::trial::APPROACH_GAP_M);
     let cases = settings
         .get("cases")
         .and_then(Value::as_array)
@@ -128,7 +132,7 @@ fn case_geometry(settings: &Value) -> BTreeMap<String, (f64, f64)> {
         .iter()
         .map(|c| {
             let (start, face) = (pose(&c["start"]), pose(&c["pallet"]));
-            let back = fork_m + forkbench_trial::trial::APPROACH_GAP_M;
+            let back = fork_m + gap_m;
             let goal = face.to_world(&forkbench_core::Pose2::new(-back, 0.0, 0.0));
             let local = start.to_local(&goal);
             let name = c["name"].as_str().unwrap_or("").to_owned();

@@ -138,6 +138,11 @@ pub struct PickFile {
     pub retry_wait_s: f64,
     /// `move`: how far it backs away along the staging line (a wider view).
     pub retry_step_m: f64,
+    /// Fork tips to the face where the planned approach curve ends; the forks go in
+    /// straight from there.
+    pub pre_entry_gap_m: f64,
+    /// Docked: the tracker reports the goal reached and the truck moves slower than this.
+    pub docked_speed_mps: f64,
 }
 
 /// What a pick does when the first look finds no pallet.
@@ -148,6 +153,9 @@ pub enum WhenNotSeen {
     /// look again there, up to `looks` times.
     #[default]
     Stage,
+    /// Plan on the prior (where the pallet should stand) and drive; look at every scanner
+    /// frame until the face is found, then replan onto it once.
+    Prior,
     /// End the trial `pallet_not_found` (the papers' setting: one look, from the start).
     Fail,
 }
@@ -170,6 +178,8 @@ impl Default for PickFile {
             between_looks: BetweenLooks::Wait,
             retry_wait_s: 0.5,
             retry_step_m: 0.5,
+            pre_entry_gap_m: crate::trial::APPROACH_GAP_M,
+            docked_speed_mps: 0.01,
         }
     }
 }
@@ -187,6 +197,8 @@ impl PickFile {
             ("staging_distance_m", self.staging_distance_m, 0.5, 20.0),
             ("retry_wait_s", self.retry_wait_s, 0.0, 10.0),
             ("retry_step_m", self.retry_step_m, 0.0, 5.0),
+            ("pre_entry_gap_m", self.pre_entry_gap_m, 0.0, 5.0),
+            ("docked_speed_mps", self.docked_speed_mps, 0.001, 0.5),
         ])
     }
 }

@@ -32,7 +32,7 @@ impl<'a> Trial<'a> {
         while self.sim.time_s() < at.deadline_s {
             self.sense_tick(&mut at, rec)?;
             let cmd = self.tracker_command(at.pose)?;
-            if cmd.done && self.stands() {
+            if self.docked(&cmd) {
                 self.timed_out = false;
                 break;
             }
@@ -69,6 +69,14 @@ impl<'a> Trial<'a> {
     ) -> Result<(), StageError> {
         let (fix, pose) = self.sense(rec)?;
         (at.fix, at.pose) = (fix, pose);
+        if self.on_prior {
+            if self.frame_due() {
+                let missed = self.out.estimates_missed;
+                self.reestimate(&pose, rec)?;
+                self.on_prior = self.out.estimates_missed > missed;
+            }
+            return Ok(());
+        }
         if self.run.replan
             && at
                 .reestimates
@@ -91,6 +99,12 @@ impl<'a> Trial<'a> {
             }),
             None => Ok(cmd),
         }
+    }
+
+    /// The pick's end: the tracker reports the goal reached and the truck moves slower
+    /// than `[pick] docked_speed_mps`.
+    pub(super) fn docked(&self, cmd: &Command) -> bool {
+        cmd.done && self.sim.speed_mps().abs() < self.scn.pick.docked_speed_mps
     }
 
     /// The truck stands (for the end of a drive).

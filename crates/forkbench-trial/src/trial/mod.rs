@@ -36,7 +36,8 @@ pub use phases::{
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use setup::Trial;
 
-/// Gap between the fork tips and the pallet face at the end of the approach curve.
+/// Gap between the fork tips and the pallet face at the end of the approach curve: the
+/// default of `[pick] pre_entry_gap_m`.
 pub const APPROACH_GAP_M: f64 = 0.3;
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face

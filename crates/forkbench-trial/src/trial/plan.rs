@@ -4,8 +4,8 @@ use forkbench_core::{Path, Pose2};
 use forkbench_plan::{Plan, PlanRequest};
 
 use super::error::StageError;
+use super::goal_for;
 use super::setup::Trial;
-use super::{APPROACH_GAP_M, goal_for};
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{ReplanMethod, truck_footprint};
@@ -35,14 +35,14 @@ impl Trial<'_> {
         est: &Pose2,
     ) -> Result<Plan, StageError> {
         let truck = &self.scn.truck;
-        let mut req = PlanRequest::new(pose, goal_for(est, truck, -APPROACH_GAP_M));
+        let mut req = PlanRequest::new(pose, goal_for(est, truck, -self.scn.pick.pre_entry_gap_m));
         req.truck = truck.clone();
         req.start_curvature_per_m = curvature;
         req.obstacles = self.obstacles.clone();
         req.seed = self.run.seed;
         let mut plan = self.planner.plan(&req)?;
         plan.path
-            .extend_straight(APPROACH_GAP_M + self.insertion_m, 0.01);
+            .extend_straight(self.scn.pick.pre_entry_gap_m + self.insertion_m, 0.01);
         Ok(plan)
     }
 
@@ -56,7 +56,10 @@ impl Trial<'_> {
     pub(super) fn replanned(&mut self, pose: &Pose2, est: &Pose2) -> Result<Replanned, StageError> {
         if self.scn.replan.method == ReplanMethod::Deform {
             let from = nearest_s(&self.path, pose);
-            let s_end = self.path.length_m() - APPROACH_GAP_M - self.insertion_m - BLEND_BEFORE_M;
+            let s_end = self.path.length_m()
+                - self.scn.pick.pre_entry_gap_m
+                - self.insertion_m
+                - BLEND_BEFORE_M;
             let path = deformed(
                 &self.path,
                 from,

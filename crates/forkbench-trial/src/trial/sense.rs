@@ -45,6 +45,12 @@ impl Trial<'_> {
         Ok(est)
     }
 
+    /// Whether some scanner has a new frame for a look now.
+    pub(super) fn frame_due(&self) -> bool {
+        let t = self.sim.time_s();
+        self.scanners.iter().any(|s| t >= s.next_frame_s)
+    }
+
     fn gaussian_estimate(&mut self, truth: &Pose2, range_m: f64) -> Pose2 {
         let biased = truth.to_world(&self.scn.estimate_bias);
         if self.run.noise {

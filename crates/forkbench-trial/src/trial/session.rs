@@ -220,7 +220,7 @@ impl Live<'_> {
         let t = &mut self.trial;
         let cmd = match control {
             Control::Tracker => match t.tracker_command(self.at.pose) {
-                Ok(cmd) if cmd.done && t.stands() => {
+                Ok(cmd) if t.docked(&cmd) => {
                     t.timed_out = false;
                     return Some((t.judged(), SessionEnd::Judged));
                 }

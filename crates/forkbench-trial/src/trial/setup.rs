@@ -71,6 +71,9 @@ pub struct Trial<'a> {
     pub(super) leg_loc: LocStats,
     /// The last reading gave no pose (the log says so once, and again when one returns).
     pub(super) fix_lost: bool,
+    /// The plan aims at the prior (`[pick] when_not_seen = "prior"`): every scanner frame
+    /// is looked at until the face is found, then the truck replans once onto it.
+    pub(super) on_prior: bool,
     /// Distance the fork root has travelled, over every physics step, and of that with
     /// the pallet on the forks.
     pub(super) travelled_m: f64,
@@ -304,6 +307,7 @@ impl<'a> Trial<'a> {
             loc: LocStats::new(0.0),
             leg_loc: LocStats::new(0.0),
             fix_lost: false,
+            on_prior: false,
             travelled_m: 0.0,
             travelled_loaded_m: 0.0,
             pick_started: (0.0, 0.0),

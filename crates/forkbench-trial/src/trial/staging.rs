@@ -29,12 +29,25 @@ impl Trial<'_> {
         rec: &mut R,
     ) -> Result<(), (Failure, String)> {
         let pick = self.scn.pick.clone();
-        if pick.when_not_seen == WhenNotSeen::Fail {
-            return Err((
-                Failure::PalletNotFound,
-                "the pallet sensing found no pallet from the start pose ([pick] when_not_seen = \"fail\")"
-                    .into(),
-            ));
+        match pick.when_not_seen {
+            WhenNotSeen::Fail => {
+                return Err((
+                    Failure::PalletNotFound,
+                    "the pallet sensing found no pallet from the start pose ([pick] when_not_seen = \"fail\")"
+                        .into(),
+                ));
+            }
+            WhenNotSeen::Prior => {
+                rec.event(
+                    self.sim.time_s(),
+                    Level::Warn,
+                    "no pallet seen from the start: planning on the prior, looking at every frame",
+                );
+                self.pallet_est = self.pallet_nominal;
+                self.on_prior = true;
+                return Ok(());
+            }
+            WhenNotSeen::Stage => {}
         }
         let staging = self
             .pallet_nominal
