@@ -119,10 +119,8 @@ fn case_geometry(settings: &Value) -> BTreeMap<String, (f64, f64)> {
         forkbench_core::Pose2::new(g("x_m"), g("y_m"), g("heading_rad"))
     };
     let fork_m = settings["truck"]["fork_length_m"].as_f64().unwrap_or(0.0);
-    // Manifests from before `[pick]` have the default gap.
-    let gap_m = settings["pick"]["pre_entry_gap_m"]
-        .as_f64()
-        .unwrap_or(forkbench_trial::trial::APPROACH_GAP_M);
+    let gap = settings["pick"]["pre_entry_gap_m"].as_f64(); // none before `[pick]`
+    let gap_m = gap.unwrap_or(forkbench_trial::trial::APPROACH_GAP_M);
     let cases = settings
         .get("cases")
         .and_then(Value::as_array)
