@@ -793,7 +793,9 @@ fn one_path_for_two_formats_and_unbounded_inputs_are_refused() {
         "--force",
     ]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("both --rrd and --mcap"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("given to two of --rrd, --mcap and --ros2")
+    );
     let dir = std::env::temp_dir();
     let out = forkbench(&[
         "trial",

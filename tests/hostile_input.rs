@@ -283,8 +283,24 @@ fn a_failed_output_skips_none_of_the_others_and_stray_records_are_refused() {
     let dir = tmp("outputs");
     let scn = repo_root().join("scenarios/field-test.toml");
     let out = dir.join("out");
-    std::fs::create_dir_all(&out).expect("dir");
-    // `recordings` is a file: recording the failed trials cannot work.
+    let _ = std::fs::remove_dir_all(&out);
+    // The batch's directory (a batch writes only into its own), then `recordings` made a
+    // file in it: recording the failed trials cannot work.
+    let first = forkbench(&[
+        "batch",
+        scn.to_str().expect("utf8"),
+        "--trials",
+        "4",
+        "--record",
+        "none",
+        "--out",
+        out.to_str().expect("utf8"),
+    ]);
+    assert!(
+        first.status.code().is_some_and(|c| c == 0 || c == 3),
+        "{}",
+        text(&first)
+    );
     std::fs::write(out.join("recordings"), "in the way").expect("write");
     let junit = dir.join("batch.xml");
     let o = forkbench(&[
@@ -477,10 +493,12 @@ fn interrupting_forkbench_kills_its_external_detector() {
             ),
         )
         .expect("write");
+        // Its output kept, so a run that ends otherwise says how.
+        let log = std::fs::File::create(d.join("out.txt")).expect("log");
         let mut child = Command::new(env!("CARGO_BIN_EXE_forkbench"))
             .args(["trial", scn.to_str().expect("utf-8")])
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null())
+            .stdout(log.try_clone().expect("log"))
+            .stderr(log)
             .spawn()
             .expect("spawns");
         let running = || {
@@ -504,7 +522,8 @@ fn interrupting_forkbench_kills_its_external_detector() {
                 .success()
         );
         let status = child.wait().expect("waits");
-        assert_eq!(status.code(), Some(code), "{signal}");
+        let said = std::fs::read_to_string(d.join("out.txt")).unwrap_or_default();
+        assert_eq!(status.code(), Some(code), "{signal}: {said}");
         std::thread::sleep(Duration::from_millis(200));
         assert!(
             !running(),

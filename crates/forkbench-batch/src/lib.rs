@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 mod baseline;
 mod checks;
 mod compare;
+pub mod detect_eval;
 mod export;
 mod gate;
 mod gate_text;
@@ -21,6 +22,7 @@ mod manifest;
 mod mode_pairs;
 mod modes;
 mod order;
+mod outdir;
 mod provenance;
 mod seed;
 mod shard;
@@ -50,7 +52,7 @@ pub use sweep::{
     sweep_points, trials_to_record, write_sweep,
 };
 
-use store::{check_unique, read_records_torn, remove_if_present, rewrite_records};
+use store::{check_unique, read_records_torn, rewrite_records};
 use summary::write_summary;
 
 use forkbench_trial::outcome::TrialOutcome;
@@ -311,89 +313,6 @@ impl BatchSpec {
             // The mode the trial ran in, always written: rows are keyed by it.
             replan: Some(j.replan.unwrap_or(s.replan.enabled)),
             outcome,
-        }
-    }
-}
-
-/// What a batch writes into its directory (besides `recordings/`).
-const BATCH_FILES: [&str; 5] = [
-    "trials.jsonl",
-    "summary.json",
-    "summary.md",
-    manifest::FILE,
-    provenance::RUNS_FILE,
-];
-
-impl BatchSpec {
-    /// Starts `dir` over for `force_new`, deleting only what a batch wrote: refused where
-    /// no manifest says forkbench wrote the directory, and of `recordings/` only the
-    /// recordings (.rrd, .mcap), the folder itself only when that leaves it empty.
-    fn reset_dir(&self, dir: &Path, want: &Manifest) -> Result<(), BatchError> {
-        let ours = Manifest::read(dir).ok().flatten().is_some();
-        let rec = dir.join("recordings");
-        let present: Vec<&str> = BATCH_FILES
-            .iter()
-            .copied()
-            .filter(|f| dir.join(f).exists())
-            .chain(rec.exists().then_some("recordings/"))
-            .collect();
-        if !ours && !present.is_empty() {
-            return Err(BatchError::Invalid(format!(
-                "{}: force_new starts over only a directory a batch wrote, and this one has no \
-                 manifest.json, yet holds {}; nothing was deleted: move them away or choose \
-                 another output directory",
-                dir.display(),
-                present.join(", ")
-            )));
-        }
-        for f in BATCH_FILES {
-            remove_if_present(&dir.join(f))?;
-        }
-        if rec.is_dir() {
-            for entry in std::fs::read_dir(&rec).map_err(io(&rec))?.flatten() {
-                let path = entry.path();
-                let recording = path.extension().is_some_and(|e| e == "rrd" || e == "mcap");
-                if recording && entry.file_type().is_ok_and(|t| t.is_file()) {
-                    remove_if_present(&path)?;
-                }
-            }
-            // Left in place when anything else is in it.
-            let _ = std::fs::remove_dir(&rec);
-        }
-        want.write(dir)
-    }
-
-    /// Makes `dir` hold this batch: a new directory gets the manifest; an existing one
-    /// must have been started with the same settings (or is cleared with `force_new`).
-    fn prepare_dir(&self, dir: &Path) -> Result<(), BatchError> {
-        let want = Manifest::of(self)?;
-        let trials = dir.join("trials.jsonl");
-        if self.force_new {
-            return self.reset_dir(dir, &want);
-        }
-        match Manifest::read(dir)? {
-            Some(have) => {
-                let diff = have.differences(&want);
-                if !diff.is_empty() {
-                    return Err(BatchError::Invalid(format!(
-                        "{}: holds trials of a different batch ({} differences, directory → \
-                         this run: {}); set force_new to discard them, or choose another output directory",
-                        dir.display(),
-                        diff.len(),
-                        diff.iter().take(8).cloned().collect::<Vec<_>>().join("; ")
-                    )));
-                }
-                Ok(())
-            }
-            None if std::fs::metadata(&trials).is_ok_and(|m| m.len() > 0) => {
-                Err(BatchError::Invalid(format!(
-                    "{}: has trials.jsonl but no manifest.json (written by an older forkbench, or \
-                     not by forkbench), so its settings are unknown; move it away or choose \
-                     another output directory",
-                    dir.display()
-                )))
-            }
-            None => want.write(dir),
         }
     }
 }

@@ -63,7 +63,7 @@ fn the_summary_and_compare_pair_the_two_modes() {
 }
 
 /// `force_new` never deletes what forkbench did not write: a directory without a
-/// manifest is refused untouched, and in a batch's own directory a user's file under
+/// manifest is refused untouched (and a new batch does not write into it either), and in a batch's own directory a user's file under
 /// `recordings/` survives while the batch's recordings go.
 #[test]
 fn force_new_deletes_only_what_a_batch_wrote() {
@@ -79,12 +79,16 @@ fn force_new_deletes_only_what_a_batch_wrote() {
         mine.join("thesis.txt").is_file(),
         "the user's file was deleted"
     );
-    // A batch's own directory: its recording goes, the user's file stays.
-    let ours = dir.join("batch");
+    // Nor does a new batch write into it (`out="/"` would have written into `/`).
     let spec = BatchSpec {
         force_new: false,
         ..spec
     };
+    let e = batch::run_batch(&spec, &dir, 1, &|_| {}).expect_err("refused");
+    assert!(e.to_string().contains("is not empty (recordings)"), "{e}");
+    assert!(!dir.join("manifest.json").exists() && !dir.join("trials.jsonl").exists());
+    // A batch's own directory: its recording goes, the user's file stays.
+    let ours = dir.join("batch");
     batch::run_batch(&spec, &ours, 1, &|_| {}).expect("batch");
     std::fs::create_dir_all(ours.join("recordings")).expect("mkdir");
     std::fs::write(ours.join("recordings/t.mcap"), "m").expect("write");

@@ -119,6 +119,10 @@ pub struct BatchArgs {
     /// Which trials to record as .rrd and .mcap under OUT/recordings/.
     #[arg(long, value_enum, default_value_t = RecordWhich::Failures)]
     pub record: RecordWhich,
+    /// Also write each recorded trial as a ROS 2 bag, `<stem>.ros2.mcap` (the MCAP `ros2`
+    /// profile: CDR messages with ros2msg schemas, for `ros2 bag play`, RViz, rosbags).
+    #[arg(long)]
+    pub ros2: bool,
     /// At most this many recordings, spread over scenario × case × failure × mode (one
     /// from each in turn).
     #[arg(long, default_value_t = 20)]
@@ -196,6 +200,9 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         None if a.shard_count.is_some() => bail!("--shard-count goes with --shard auto"),
         None => (0, 1),
     };
+    if a.ros2 && a.record == RecordWhich::None {
+        bail!("--ros2 writes bags of the recorded trials, and --record none records none");
+    }
     let out = batch::shard_dir(&a.out, shard);
     let a = BatchArgs { out, ..a };
     batch::check_floor(a.floor)?;
@@ -409,7 +416,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path, json: bool) -> anyhow::Result<()> {
     ))
 }
 
-/// Records the trials the library picks (failures, or all) as .rrd and .mcap.
+/// Records the trials the library picks (failures, or all) as .rrd and .mcap (and ROS 2
+/// bags with `--ros2`).
 fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
     let choice = RecordChoice::from(a.record);
     if choice == RecordChoice::None {
@@ -420,7 +428,7 @@ fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
     let dir = a.out.join("recordings");
     for j in &jobs {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        crate::record::record_trial(j.scenario, j.case, &j.options, &dir)?;
+        crate::record::record_trial(j.scenario, j.case, &j.options, &dir, a.ros2)?;
     }
     Ok(jobs.len())
 }

@@ -5,6 +5,8 @@ mod batch_cmd;
 mod check_cmd;
 mod corridor_cmd;
 mod coverage_cmd;
+mod detect_cmd;
+mod detect_plot;
 mod gate_cmd;
 mod map_cmd;
 mod map_plot;
@@ -61,6 +63,9 @@ struct RecordFlags {
     /// Write an MCAP log to FILE (.mcap).
     #[arg(long)]
     mcap: Option<PathBuf>,
+    /// Write a ROS 2 bag to FILE (.mcap, the ros2 profile: CDR messages, ros2msg schemas).
+    #[arg(long)]
+    ros2: Option<PathBuf>,
     /// Spawn a rerun viewer and stream to it.
     #[arg(long)]
     rerun: bool,
@@ -77,6 +82,7 @@ impl RecordFlags {
         record::RecordArgs {
             rrd: self.rrd,
             mcap: self.mcap,
+            ros2: self.ros2,
             rerun: self.rerun,
             connect: self.connect,
             force: self.force,
@@ -231,6 +237,10 @@ enum Command {
     /// One scan of a scenario's world from the truck, with the pallet detector's estimate
     /// beside the truth.
     Scan(scan_cmd::ScanArgs),
+    /// A pallet detector on recorded scans (a ROS 2 bag's sensor_msgs/msg/LaserScan, or a
+    /// forkbench MCAP): a JSON line per scan, a summary, and with --labels precision,
+    /// recall and face-pose errors (exit 1 when a scan was unusable, after the rest).
+    Detect(detect_cmd::DetectArgs),
     /// Reflector coverage of a world: reflectors in sight and the NAV350 fix's predicted
     /// 1σ at every free cell.
     Coverage(coverage_cmd::CoverageArgs),
@@ -356,6 +366,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Map(args) => map_cmd::run(&args).map(|()| Done::Ok),
         Command::Scan(args) => scan_cmd::run(&args).map(|()| Done::Ok),
         Command::Coverage(args) => coverage_cmd::run(&args).map(|()| Done::Ok),
+        Command::Detect(args) => detect_cmd::run(&args).map(|()| Done::Ok),
         Command::Check(args) => check_cmd::run(&args).map(|()| Done::Ok),
     }
 }
@@ -403,6 +414,10 @@ fn main() -> ExitCode {
     let result = run(cli);
     // No external process (or its children) outlives the command.
     forkbench_ipc::kill_all();
+    let sig = INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst);
+    if sig != 0 {
+        std::process::exit(128 + sig);
+    }
     match result {
         Ok(Done::Ok) => ExitCode::SUCCESS,
         Ok(Done::PickFailed) => ExitCode::from(3),
@@ -445,8 +460,14 @@ fn kill_children_on_signals() {
     };
     std::thread::spawn(move || {
         if let Some(sig) = signals.forever().next() {
+            // Set first: killing the children wakes the main thread, which must not
+            // then exit with the failed run's status instead of the signal's.
+            INTERRUPTED.store(sig, std::sync::atomic::Ordering::SeqCst);
             forkbench_ipc::kill_all();
             std::process::exit(128 + sig);
         }
     });
 }
+
+/// The signal that interrupted the run (0: none).
+static INTERRUPTED: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);

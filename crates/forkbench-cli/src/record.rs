@@ -3,7 +3,9 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use forkbench_log::{LogError, McapRecorder, RerunRecorder, RerunTarget, check_writable};
+use forkbench_log::{
+    LogError, McapRecorder, RerunRecorder, RerunTarget, Ros2Recorder, check_writable,
+};
 use forkbench_trial::{Recorder, Tee};
 
 /// What to record to.
@@ -11,6 +13,8 @@ use forkbench_trial::{Recorder, Tee};
 pub struct RecordArgs {
     pub rrd: Option<PathBuf>,
     pub mcap: Option<PathBuf>,
+    /// A ROS 2 bag (MCAP, `ros2` profile).
+    pub ros2: Option<PathBuf>,
     pub rerun: bool,
     pub connect: Option<String>,
     pub force: bool,
@@ -20,6 +24,7 @@ pub struct RecordArgs {
 /// their errors reported; a viewer that could not be reached is reported, not fatal.
 pub struct Sinks {
     pub mcap: Option<McapRecorder>,
+    pub ros2: Option<Ros2Recorder>,
     pub rerun: Vec<RerunRecorder>,
     pub viewer_error: Option<LogError>,
 }
@@ -27,15 +32,19 @@ pub struct Sinks {
 impl Sinks {
     /// Checks file targets before anything runs, then opens every sink.
     pub fn open(a: &RecordArgs, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
-        if let (Some(r), Some(m)) = (&a.rrd, &a.mcap)
-            && std::path::absolute(r).ok() == std::path::absolute(m).ok()
-        {
-            return Err(LogError::Io {
-                path: r.display().to_string(),
-                message: "given to both --rrd and --mcap; the two formats need two files".into(),
-            });
-        }
-        for p in a.rrd.iter().chain(&a.mcap) {
+        let files: Vec<&PathBuf> = a.rrd.iter().chain(&a.mcap).chain(&a.ros2).collect();
+        for (i, p) in files.iter().enumerate() {
+            if files[..i]
+                .iter()
+                .any(|q| std::path::absolute(q).ok() == std::path::absolute(p).ok())
+            {
+                return Err(LogError::Io {
+                    path: p.display().to_string(),
+                    message: "given to two of --rrd, --mcap and --ros2; each format needs its \
+                              own file"
+                        .into(),
+                });
+            }
             check_writable(p, a.force)?;
         }
         let mut rerun = Vec::new();
@@ -54,6 +63,11 @@ impl Sinks {
                 Err(e) => viewer_error = Some(e),
             }
         }
+        let ros2 = a
+            .ros2
+            .as_ref()
+            .map(|p| Ros2Recorder::create(p, metadata.clone()))
+            .transpose()?;
         let mcap = a
             .mcap
             .as_ref()
@@ -61,6 +75,7 @@ impl Sinks {
             .transpose()?;
         Ok(Self {
             mcap,
+            ros2,
             rerun,
             viewer_error,
         })
@@ -76,6 +91,9 @@ impl Sinks {
             if let Some(m) = self.mcap.as_mut() {
                 refs.push(m);
             }
+            if let Some(m) = self.ros2.as_mut() {
+                refs.push(m);
+            }
             for r in self.rerun.iter_mut() {
                 refs.push(r);
             }
@@ -84,6 +102,12 @@ impl Sinks {
         let mut result = Ok(());
         if let Some(m) = self.mcap.as_mut()
             && let Err(e) = m.finish()
+        {
+            result = Err(e);
+        }
+        if let Some(m) = self.ros2.as_mut()
+            && let Err(e) = m.finish()
+            && result.is_ok()
         {
             result = Err(e);
         }
@@ -121,12 +145,14 @@ pub fn recording_stem(o: &forkbench_trial::TrialOutcome, replan: bool) -> String
     ))
 }
 
-/// Re-runs one trial of a scenario into `<dir>/<stem>.{rrd,mcap}` ([`recording_stem`]).
+/// Re-runs one trial of a scenario into `<dir>/<stem>.{rrd,mcap}` ([`recording_stem`]),
+/// and `<stem>.ros2.mcap` with `ros2`.
 pub fn record_trial(
     scn: &forkbench_trial::Scenario,
     case: &forkbench_trial::Case,
     opts: &forkbench_trial::TrialOptions,
     dir: &std::path::Path,
+    ros2: bool,
 ) -> anyhow::Result<(forkbench_trial::TrialOutcome, PathBuf)> {
     let run = scn.resolve(opts)?;
     // Names are free text: only letters, digits, '-' and '_' reach the file name, so a
@@ -139,6 +165,7 @@ pub fn record_trial(
     let args = RecordArgs {
         rrd: Some(rrd.clone()),
         mcap: Some(dir.join(format!("{stem}.mcap"))),
+        ros2: ros2.then(|| dir.join(format!("{stem}.ros2.mcap"))),
         force: true,
         ..RecordArgs::default()
     };

@@ -77,9 +77,8 @@ pub fn read_text(path: &Path, max: u64) -> Result<String, FileError> {
     })
 }
 
-/// Writes `bytes` to `path` so that a reader sees the old file or the new one, never a
-/// part: a temporary file in the same folder, flushed to disk, then renamed over `path`.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+/// The temporary file beside `path` that becomes it.
+fn temporary(path: &Path) -> std::path::PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -88,11 +87,70 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     let name = path
         .file_name()
         .map_or_else(|| "output".to_owned(), |n| n.to_string_lossy().into_owned());
-    let tmp = dir.join(format!(
+    dir.join(format!(
         ".{name}.tmp-{}-{}",
         std::process::id(),
         COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
+    ))
+}
+
+/// A file written as it is computed, that appears at its path only when committed (a
+/// temporary file beside it, flushed, renamed), and is removed if never committed.
+#[derive(Debug)]
+pub struct AtomicWriter {
+    path: std::path::PathBuf,
+    tmp: std::path::PathBuf,
+    file: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl AtomicWriter {
+    pub fn create(path: &Path) -> Result<Self, FileError> {
+        let tmp = temporary(path);
+        let file = std::fs::File::create(&tmp).map_err(io_err(path))?;
+        Ok(Self {
+            path: path.to_owned(),
+            tmp,
+            file: Some(std::io::BufWriter::new(file)),
+        })
+    }
+
+    /// Appends `bytes`; an error names the final path.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), FileError> {
+        match self.file.as_mut() {
+            Some(f) => f.write_all(bytes).map_err(io_err(&self.path)),
+            None => Ok(()),
+        }
+    }
+
+    /// Flushes to disk and renames the file into place.
+    pub fn commit(mut self) -> Result<(), FileError> {
+        let Some(f) = self.file.take() else {
+            return Ok(());
+        };
+        let result = f
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|f| f.sync_all())
+            .and_then(|()| std::fs::rename(&self.tmp, &self.path));
+        if result.is_err() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+        result.map_err(io_err(&self.path))
+    }
+}
+
+impl Drop for AtomicWriter {
+    fn drop(&mut self) {
+        if self.file.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Writes `bytes` to `path` so that a reader sees the old file or the new one, never a
+/// part: a temporary file in the same folder, flushed to disk, then renamed over `path`.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    let tmp = temporary(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;

@@ -1,8 +1,11 @@
 //! Recording sinks for forkbench trials: MCAP (Foxglove schemas, JSON) and rerun (.rrd or a live viewer).
 
+pub mod bag;
+pub mod detect;
 pub mod mcap_sink;
 #[cfg(feature = "rerun")]
 pub mod rerun_sink;
+pub mod ros2;
 mod writer;
 
 use std::path::Path;
@@ -13,6 +16,7 @@ use forkbench_core::{PalletSpec, Pose2};
 pub use mcap_sink::McapRecorder;
 #[cfg(feature = "rerun")]
 pub use rerun_sink::{RerunRecorder, RerunTarget};
+pub use ros2::Ros2Recorder;
 
 /// The rerun SDK this crate is built against (pinned with `=` in the workspace; a test
 /// checks this against Cargo.lock), for the recordings' metadata.

@@ -28,6 +28,9 @@ pub struct DetectorConfig {
     pub roi_rad: f64,
     /// A stringer's centre may lie this far off the face line through the others.
     pub line_tolerance_m: f64,
+    /// `face_fit`: a return this close to the face line hit the face; farther behind it,
+    /// the beam passed through an opening (or missed the pallet).
+    pub edge_tolerance_m: f64,
 }
 
 impl Default for DetectorConfig {
@@ -41,6 +44,7 @@ impl Default for DetectorConfig {
             roi_m: 1.0,
             roi_rad: 0.5,
             line_tolerance_m: 0.08,
+            edge_tolerance_m: 0.05,
         }
     }
 }
@@ -56,6 +60,7 @@ impl DetectorConfig {
             ("spacing_tolerance_m", self.spacing_tolerance_m),
             ("roi_m", self.roi_m),
             ("line_tolerance_m", self.line_tolerance_m),
+            ("edge_tolerance_m", self.edge_tolerance_m),
         ];
         for (f, v) in lengths {
             if !(v.is_finite() && v > 0.0 && v <= 10.0) {

@@ -3,6 +3,7 @@
 pub mod detect;
 pub mod detector;
 pub mod external;
+pub mod face_fit;
 pub mod localizer;
 pub mod reflector_nav;
 pub mod reflectors;

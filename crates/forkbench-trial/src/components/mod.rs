@@ -164,6 +164,12 @@ impl Registry {
             cfg.validate()?;
             Ok(Box::new(Pockets { cfg }))
         })
+        .with_detector("face_fit", |s, _| {
+            let cfg: forkbench_sensors::detect::DetectorConfig =
+                forkbench_core::settings::parse(s)?;
+            cfg.validate()?;
+            Ok(Box::new(forkbench_sensors::face_fit::FaceFit { cfg }))
+        })
         .with_detector("external", |s, cx| {
             Ok(Box::new(ExternalDetector::from_settings(
                 s,

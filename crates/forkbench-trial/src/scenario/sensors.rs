@@ -72,10 +72,13 @@ impl PalletSensing {
         }
     }
 
-    /// The pocket detector's settings, when this sensing uses it (else its defaults).
+    /// The pocket detector's settings, when this sensing uses it or the face fit on it
+    /// (else its defaults).
     pub fn pocket_settings(&self) -> DetectorConfig {
         match self {
-            PalletSensing::Scanner { detector, .. } if detector.kind == "pockets" => {
+            PalletSensing::Scanner { detector, .. }
+                if detector.kind == "pockets" || detector.kind == "face_fit" =>
+            {
                 forkbench_core::settings::parse(&detector.settings).unwrap_or_default()
             }
             _ => DetectorConfig::default(),

@@ -1,8 +1,8 @@
-//! The pallet detector's accuracy study (Lü et al. 2019's estimate figure): bias, σ and miss rate of the fused scanners and pocket detector over range, pallet angle and lateral offset, in the simulated world.
+//! The pallet detector's accuracy study (Lü et al. 2019's estimate figure): bias, σ and miss rate of the fused scanners and the scenario's detector over range, pallet angle and lateral offset, in the simulated world.
 
 use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
-use forkbench_sensors::detector::{Pockets, detect_in};
+use forkbench_sensors::detector::detect_in;
 use forkbench_sensors::scan::{Errors, scan};
 use serde::Serialize;
 
@@ -109,9 +109,8 @@ fn study_cell(
     (draws, seed): (u32, u64),
 ) -> Result<AccuracyRow, StageError> {
     let (sim, root, truth, _) = build_world(scn, case, seed, None)?;
-    let mut detector = Pockets {
-        cfg: scn.pallet_sensing.pocket_settings(),
-    };
+    // The scenario's own detector (the pocket detector where it senses without scans).
+    let (_, mut detector) = super::look::scenario_detector(scn)?;
     let (mut lat, mut along, mut head) = (Vec::new(), Vec::new(), Vec::new());
     let mut by_sensor = vec![0u32; sensors.len()];
     for k in 0..u64::from(draws) {
@@ -131,7 +130,9 @@ fn study_cell(
                 )
             })
             .collect();
-        if let Ok(Some(found)) = detect_in(&mut detector, &scans, &scn.pallet, Some(case.pallet)) {
+        if let Ok(Some(found)) =
+            detect_in(detector.as_mut(), &scans, &scn.pallet, Some(case.pallet))
+        {
             let e = truth.to_local(&found.detection.face);
             lat.push(e.y_m);
             along.push(e.x_m);

@@ -2,8 +2,8 @@
 
 use forkbench_core::Pose2;
 use forkbench_core::signal::Scan;
-use forkbench_sensors::detect::{Detection, detect};
-use forkbench_sensors::detector::{DetectorError, detect_in};
+use forkbench_sensors::detect::Detection;
+use forkbench_sensors::detector::{DetectorError, PalletDetector, Pockets, detect_in};
 use forkbench_sensors::scan::{Errors, ScannerConfig, scan};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -56,29 +56,10 @@ pub fn scan_once(
             },
         )
     };
-    // Where the pallet should stand is where the detector looks (as in a trial), and the
-    // detector is the scenario's own (an external one too); the built-in pocket detector
-    // where the scenario senses without scans.
-    let (detector, estimate) = match &scn.pallet_sensing {
-        PalletSensing::Scanner { detector, .. } => {
-            let fail = |reason: String| DetectorError {
-                detector: detector.name.clone(),
-                reason,
-            };
-            let mut d = scn
-                .registry
-                .detector(detector)
-                .map_err(|e| fail(e.to_string()))?;
-            let scans = [(sensor, s.clone())];
-            let found = detect_in(&mut *d, &scans, &scn.pallet, Some(case.pallet))?;
-            (detector.name.clone(), found.map(|f| f.detection))
-        }
-        PalletSensing::Gaussian => {
-            let cfg = scn.pallet_sensing.pocket_settings();
-            let found = detect(&cfg, &s, &scn.pallet, Some(&case.pallet));
-            ("pockets".to_owned(), found)
-        }
-    };
+    // Where the pallet should stand is where the detector looks (as in a trial).
+    let (detector, mut d) = scenario_detector(scn)?;
+    let scans = [(sensor, s.clone())];
+    let estimate = detect_in(&mut *d, &scans, &scn.pallet, Some(case.pallet))?.map(|f| f.detection);
     Ok(ScanReport {
         detector,
         sensor: sensor.to_owned(),
@@ -87,4 +68,24 @@ pub fn scan_once(
         truth,
         estimate,
     })
+}
+
+/// The scenario's own pallet detector (an external one too) and its name, or the built-in
+/// pocket detector with the scenario's settings where it senses without scans.
+pub fn scenario_detector(
+    scn: &Scenario,
+) -> Result<(String, Box<dyn PalletDetector>), DetectorError> {
+    match &scn.pallet_sensing {
+        PalletSensing::Scanner { detector, .. } => {
+            let d = scn.registry.detector(detector).map_err(|e| DetectorError {
+                detector: detector.name.clone(),
+                reason: e.to_string(),
+            })?;
+            Ok((detector.name.clone(), d))
+        }
+        PalletSensing::Gaussian => {
+            let cfg = scn.pallet_sensing.pocket_settings();
+            Ok(("pockets".to_owned(), Box::new(Pockets { cfg })))
+        }
+    }
 }

@@ -28,7 +28,7 @@ use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
 pub use criteria::{Criterion, PICK_CRITERIA};
-pub use look::{ScanReport, scan_once};
+pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
 pub use phases::{
     Context as PhaseContext, PICK, PhaseSpec, phase_defaults, resolve as phases_resolve,

@@ -1,0 +1,232 @@
+//! A pallet detector scored on labelled scans: found or not against present or not (precision, recall), and the face-pose error of each match.
+
+use std::collections::BTreeMap;
+
+use forkbench_core::Pose2;
+use forkbench_core::units::wrap_angle;
+use serde::{Deserialize, Serialize};
+
+use crate::BatchError;
+use crate::stats::percentile_sorted;
+
+/// What is true of one scan: whether the pallet is in it, and where its face is (in the
+/// frame the detections are given in), when known.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Label {
+    pub index: usize,
+    pub present: bool,
+    #[serde(default)]
+    pub face: Option<LabelFace>,
+}
+
+/// A labelled face: centre and heading into the pallet (degrees at the interface).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LabelFace {
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_deg: f64,
+}
+
+impl LabelFace {
+    pub fn pose(&self) -> Pose2 {
+        Pose2::new(self.x_m, self.y_m, self.heading_deg.to_radians())
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LabelFile {
+    scans: Vec<Label>,
+}
+
+/// The labels of a JSON file `{"scans": [{"index": 0, "present": true, "face": {"x_m": …,
+/// "y_m": …, "heading_deg": …}}, …]}`, by scan index; `file` names it in errors.
+pub fn parse_labels(text: &str, file: &str) -> Result<BTreeMap<usize, Label>, BatchError> {
+    let bad = |why: String| BatchError::Invalid(format!("{file}: {why}"));
+    let f: LabelFile = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+    let mut out = BTreeMap::new();
+    for l in f.scans {
+        if let Some(face) = &l.face {
+            let ok = [face.x_m, face.y_m].iter().all(|v| v.abs() <= 1e4)
+                && face.heading_deg.abs() <= 720.0;
+            if !ok {
+                return Err(bad(format!(
+                    "scan {}: face beyond ±10 km or ±720°",
+                    l.index
+                )));
+            }
+            if !l.present {
+                return Err(bad(format!("scan {}: a face but present false", l.index)));
+            }
+        }
+        if out.insert(l.index, l).is_some() {
+            return Err(bad(format!("scan {} is labelled twice", l.index)));
+        }
+    }
+    Ok(out)
+}
+
+/// How far a detection may be from the labelled face and still be that face; farther,
+/// it is a false detection and the face a miss.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Gate {
+    pub position_m: f64,
+    pub heading_rad: f64,
+}
+
+/// A detection against its label: (lateral along the face, depth along the forks' way,
+/// heading) error of the detection in the labelled face's frame.
+pub fn face_error(label: &Pose2, found: &Pose2) -> [f64; 3] {
+    let e = label.to_local(found);
+    [e.y_m, e.x_m, wrap_angle(e.heading_rad)]
+}
+
+/// Median, 95th percentile (nearest rank) and largest absolute value.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Spread {
+    pub median: f64,
+    pub p95: f64,
+    pub max: f64,
+}
+
+fn spread(values: &[f64]) -> Option<Spread> {
+    let mut v: Vec<f64> = values.iter().map(|x| x.abs()).collect();
+    v.sort_by(f64::total_cmp);
+    Some(Spread {
+        median: percentile_sorted(&v, 0.5)?,
+        p95: percentile_sorted(&v, 0.95)?,
+        max: *v.last()?,
+    })
+}
+
+/// Counts and errors over the labelled scans.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Scores {
+    pub labelled: usize,
+    pub true_positives: usize,
+    pub false_positives: usize,
+    pub false_negatives: usize,
+    pub true_negatives: usize,
+    pub precision: Option<f64>,
+    pub recall: Option<f64>,
+    /// Over matches whose label has a face.
+    pub lateral_error_m: Option<Spread>,
+    pub depth_error_m: Option<Spread>,
+    pub heading_error_rad: Option<Spread>,
+}
+
+/// Scores `found` (each scan's detection, by index) against `labels`; scans without a
+/// label, and labels of scans the bag does not have, are left out.
+pub fn score(found: &[Option<Pose2>], labels: &BTreeMap<usize, Label>, gate: Gate) -> Scores {
+    let (mut tp, mut fp, mut fneg, mut tn, mut labelled) = (0, 0, 0, 0, 0);
+    let mut errs: [Vec<f64>; 3] = Default::default();
+    for (i, l) in labels {
+        let Some(det) = found.get(*i) else { continue };
+        labelled += 1;
+        match (l.present, det) {
+            (false, None) => tn += 1,
+            (false, Some(_)) => fp += 1,
+            (true, None) => fneg += 1,
+            (true, Some(d)) => match l.face.map(|f| face_error(&f.pose(), d)) {
+                Some(e) if e[0].hypot(e[1]) > gate.position_m || e[2].abs() > gate.heading_rad => {
+                    fp += 1;
+                    fneg += 1;
+                }
+                Some(e) => {
+                    tp += 1;
+                    for k in 0..3 {
+                        errs[k].push(e[k]);
+                    }
+                }
+                None => tp += 1,
+            },
+        }
+    }
+    let ratio = |a: usize, b: usize| (a + b > 0).then(|| a as f64 / (a + b) as f64);
+    Scores {
+        labelled,
+        true_positives: tp,
+        false_positives: fp,
+        false_negatives: fneg,
+        true_negatives: tn,
+        precision: ratio(tp, fp),
+        recall: ratio(tp, fneg),
+        lateral_error_m: spread(&errs[0]),
+        depth_error_m: spread(&errs[1]),
+        heading_error_rad: spread(&errs[2]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn label(index: usize, present: bool, face: Option<(f64, f64, f64)>) -> (usize, Label) {
+        let face = face.map(|(x_m, y_m, heading_deg)| LabelFace {
+            x_m,
+            y_m,
+            heading_deg,
+        });
+        (
+            index,
+            Label {
+                index,
+                present,
+                face,
+            },
+        )
+    }
+
+    #[test]
+    fn counts_matches_misses_and_far_detections() {
+        let labels: BTreeMap<usize, Label> = [
+            label(0, true, Some((5.0, 0.0, 180.0))),
+            label(1, true, Some((5.0, 0.0, 180.0))),
+            label(2, true, None),
+            label(3, false, None),
+            label(4, false, None),
+        ]
+        .into_iter()
+        .collect();
+        let pi = std::f64::consts::PI;
+        let found = vec![
+            Some(Pose2::new(5.0, 0.01, pi)),
+            Some(Pose2::new(6.0, 0.0, pi)),
+            None,
+            Some(Pose2::new(1.0, 1.0, 0.0)),
+            None,
+            Some(Pose2::new(0.0, 0.0, 0.0)),
+        ];
+        let gate = Gate {
+            position_m: 0.25,
+            heading_rad: 0.2,
+        };
+        let s = score(&found, &labels, gate);
+        // 0 matches; 1 is a metre off (a false detection and a miss); 2 missed; 3 false;
+        // 4 right; scan 5 has no label.
+        assert_eq!(
+            (
+                s.true_positives,
+                s.false_positives,
+                s.false_negatives,
+                s.true_negatives
+            ),
+            (1, 2, 2, 1)
+        );
+        assert_eq!(s.precision, Some(1.0 / 3.0));
+        assert_eq!(s.recall, Some(1.0 / 3.0));
+        let lat = s.lateral_error_m.expect("one match");
+        assert!((lat.median - 0.01).abs() < 1e-12, "{lat:?}");
+        let e = parse_labels(
+            r#"{"scans": [{"index": 1, "present": false}, {"index": 1, "present": true}]}"#,
+            "l.json",
+        );
+        assert!(
+            e.expect_err("twice")
+                .to_string()
+                .contains("l.json: scan 1 is labelled twice")
+        );
+    }
+}

@@ -1,0 +1,290 @@
+//! `forkbench detect`: a pallet detector on recorded scans (a ROS 2 bag or a forkbench MCAP), a JSON line per scan, a summary, and with labels precision, recall and pose errors.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context as _, bail};
+use forkbench_batch::detect_eval::{Gate, Label, Scores, parse_labels, score};
+use forkbench_core::Pose2;
+use forkbench_core::files::AtomicWriter;
+use forkbench_log::bag::BagSummary;
+use forkbench_log::detect::{DetectOptions, DetectRunError, ScanResult, detect_bag};
+use forkbench_trial::{ComponentSpec, Role};
+use serde_json::json;
+
+/// Labels files are small: one line of JSON per scan.
+const MAX_LABELS_BYTES: u64 = 256 << 20;
+
+#[derive(Debug, clap::Args)]
+pub struct DetectArgs {
+    /// A ROS 2 bag in MCAP storage (sensor_msgs/msg/LaserScan, CDR) or an MCAP written by
+    /// forkbench (foxglove.LaserScan).
+    bag: PathBuf,
+    /// Laser-scan topic to read (repeatable; default: every one in the file).
+    #[arg(long)]
+    topic: Vec<String>,
+    /// Scenario (file or embedded name) whose pallet and detector are used.
+    #[arg(long, default_value = "field-test")]
+    scenario: PathBuf,
+    /// A registered detector kind with its default settings instead of the scenario's
+    /// (`pockets`, `face_fit`), to compare detectors on the same bag.
+    #[arg(long)]
+    detector: Option<String>,
+    /// Give faces in FRAME (e.g. map), placing each scan through the file's /tf and
+    /// /tf_static; default: each scan's own frame_id.
+    #[arg(long)]
+    frame: Option<String>,
+    /// Where the pallet should be, `x,y,heading_deg` in that frame (heading into the
+    /// pallet); without it the detector searches the whole scan.
+    #[arg(long, value_parser = crate::parse_pose, allow_hyphen_values = true)]
+    prior: Option<Pose2>,
+    /// Labels (JSON: {"scans": [{"index": 0, "present": true, "face": {"x_m": …, "y_m": …,
+    /// "heading_deg": …}}]}): precision, recall and the face-pose errors.
+    #[arg(long)]
+    labels: Option<PathBuf>,
+    /// A detection farther than this from the labelled face (m) is a false one.
+    #[arg(long, default_value_t = 0.25)]
+    match_m: f64,
+    /// … or turned more than this (degrees).
+    #[arg(long, default_value_t = 10.0)]
+    match_deg: f64,
+    /// Write one JSON line per scan to FILE.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Draw the labelled scans' errors to FILE (.svg or .png; needs --labels).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+impl DetectArgs {
+    fn check(&self) -> anyhow::Result<(Gate, Option<BTreeMap<usize, Label>>)> {
+        if !(self.match_m > 0.0 && self.match_m <= 10.0) {
+            bail!("--match-m {}: from 0 (excluded) to 10 m", self.match_m);
+        }
+        if !(self.match_deg > 0.0 && self.match_deg <= 180.0) {
+            bail!("--match-deg {}: from 0 (excluded) to 180°", self.match_deg);
+        }
+        if let Some(p) = &self.prior {
+            let lim = forkbench_trial::scenario::MAX_WORLD_EXTENT_M;
+            if !(p.x_m.abs() <= lim && p.y_m.abs() <= lim && p.heading_rad.is_finite()) {
+                bail!("--prior ({}, {}) m: must lie within ±{lim} m", p.x_m, p.y_m);
+            }
+        }
+        if self.plot.is_some() && self.labels.is_none() {
+            bail!("--plot draws the errors against the labels: give --labels too");
+        }
+        let labels = match &self.labels {
+            Some(f) => {
+                let text = forkbench_core::files::read_text(f, MAX_LABELS_BYTES)?;
+                Some(parse_labels(&text, &f.display().to_string())?)
+            }
+            None => None,
+        };
+        let gate = Gate {
+            position_m: self.match_m,
+            heading_rad: self.match_deg.to_radians(),
+        };
+        Ok((gate, labels))
+    }
+}
+
+/// What the run saw, for the summary.
+struct Tally {
+    results: Vec<Option<Pose2>>,
+    errors: Vec<String>,
+    found: usize,
+    seconds: f64,
+}
+
+/// Runs `forkbench detect`: reads, detects, writes the lines, scores, prints.
+pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
+    let (gate, labels) = a.check()?;
+    let scn = forkbench_trial::defaults::load_scenario(&a.scenario)?;
+    let (name, mut detector) = build_detector(a, &scn)?;
+    let opts = DetectOptions {
+        topics: a.topic.clone(),
+        frame: a.frame.clone(),
+        prior: a.prior,
+    };
+    let mut lines = a.out.as_deref().map(AtomicWriter::create).transpose()?;
+    let mut tally = Tally {
+        results: Vec::new(),
+        errors: Vec::new(),
+        found: 0,
+        seconds: 0.0,
+    };
+    let mut write_error = None;
+    let started = Instant::now();
+    let ran = detect_bag(&a.bag, &opts, detector.as_mut(), &scn.pallet, &mut |r| {
+        take(r, &mut tally, lines.as_mut(), &mut write_error);
+    });
+    tally.seconds = started.elapsed().as_secs_f64();
+    // What was computed is kept: the lines so far, then the error.
+    if let Some(w) = lines {
+        w.commit()?;
+    }
+    if let Some(e) = write_error {
+        return Err(e);
+    }
+    let summary = ran.map_err(|e| match e {
+        DetectRunError::Bag(e) => anyhow::anyhow!(e),
+        DetectRunError::Detector(e) => anyhow::anyhow!(e),
+    });
+    let summary = summary.with_context(|| format!("after {} scans", tally.results.len()))?;
+    check_topics(a, &summary)?;
+    let scores = labels.as_ref().map(|l| score(&tally.results, l, gate));
+    if let (Some(file), Some(l)) = (&a.plot, &labels) {
+        crate::detect_plot::draw(file, &tally.results, l)?;
+    }
+    report(a, &name, &summary, &tally, scores.as_ref())?;
+    if !tally.errors.is_empty() {
+        bail!(
+            "{} of {} scans could not be used; the first: {}",
+            tally.errors.len(),
+            tally.results.len(),
+            tally.errors[0]
+        );
+    }
+    Ok(())
+}
+
+/// `--detector KIND` with its default settings, or the scenario's own.
+fn build_detector(
+    a: &DetectArgs,
+    scn: &forkbench_trial::Scenario,
+) -> anyhow::Result<(String, Box<dyn forkbench_sensors::detector::PalletDetector>)> {
+    Ok(match &a.detector {
+        Some(kind) => {
+            let spec = ComponentSpec::of_kind(Role::Detector, kind);
+            let d = scn
+                .registry
+                .detector(&spec)
+                .map_err(|e| anyhow::anyhow!("--detector {kind}: {e}"))?;
+            (kind.clone(), d)
+        }
+        None => forkbench_trial::trial::scenario_detector(scn)?,
+    })
+}
+
+/// The file had laser scans, and every `--topic` named one of them.
+fn check_topics(a: &DetectArgs, summary: &BagSummary) -> anyhow::Result<()> {
+    if summary.scan_topics.is_empty() {
+        let topics: Vec<String> = summary
+            .topics
+            .iter()
+            .map(|(t, ty)| format!("{t} ({ty})"))
+            .collect();
+        bail!(
+            "{}: no laser-scan topic (sensor_msgs/msg/LaserScan in CDR, or foxglove.LaserScan); its topics: {}",
+            a.bag.display(),
+            if topics.is_empty() {
+                "none".into()
+            } else {
+                topics.join(", ")
+            }
+        );
+    }
+    for t in &a.topic {
+        if !summary.scan_topics.contains_key(t) {
+            bail!(
+                "--topic {t}: not a laser-scan topic of {} (those: {})",
+                a.bag.display(),
+                summary
+                    .scan_topics
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+    }
+    Ok(())
+}
+
+fn take(
+    r: &ScanResult,
+    tally: &mut Tally,
+    lines: Option<&mut AtomicWriter>,
+    write_error: &mut Option<anyhow::Error>,
+) {
+    tally.results.push(r.face);
+    tally.found += usize::from(r.found);
+    if let Some(e) = &r.error {
+        tally
+            .errors
+            .push(format!("scan {} on {}: {e}", r.index, r.topic));
+    }
+    if let (Some(w), None) = (lines, write_error.as_ref()) {
+        let mut text = line(r).to_string();
+        text.push('\n');
+        if let Err(e) = w.write(text.as_bytes()) {
+            *write_error = Some(e.into());
+        }
+    }
+}
+
+/// A scan's JSON line: the face in degrees at the interface.
+fn line(r: &ScanResult) -> serde_json::Value {
+    json!({
+        "index": r.index,
+        "topic": r.topic,
+        "stamp_s": r.stamp_s.is_finite().then_some(r.stamp_s),
+        "frame_id": r.frame_id,
+        "beams": r.beams,
+        "returns": r.returns,
+        "found": r.found,
+        "face": r.face.map(|f| json!({"x_m": f.x_m, "y_m": f.y_m, "heading_deg": f.heading_rad.to_degrees()})),
+        "points": r.points,
+        "rms_m": r.rms_m,
+        "stringers": r.stringers,
+        "error": r.error,
+    })
+}
+
+fn report(
+    a: &DetectArgs,
+    detector: &str,
+    summary: &BagSummary,
+    t: &Tally,
+    scores: Option<&Scores>,
+) -> anyhow::Result<()> {
+    let n = t.results.len();
+    let rate = n as f64 / t.seconds.max(1e-9);
+    if a.json {
+        let v = json!({
+            "bag": a.bag.display().to_string(),
+            "detector": detector,
+            "frame": a.frame,
+            "scan_topics": summary.scan_topics,
+            "scans": n,
+            "found": t.found,
+            "unusable": t.errors.len(),
+            "seconds": t.seconds,
+            "scans_per_s": rate,
+            "scores": scores,
+        });
+        return crate::emit(&format!("{v}\n"));
+    }
+    let mut s = format!(
+        "detector {detector} on {}: {n} scans ({}), pallet found in {} ({:.1} %), {} unusable; {:.2} s, {rate:.0} scans/s\n",
+        a.bag.display(),
+        summary
+            .scan_topics
+            .iter()
+            .map(|(k, v)| format!("{k}: {v}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        t.found,
+        100.0 * t.found as f64 / n.max(1) as f64,
+        t.errors.len(),
+        t.seconds,
+    );
+    if let Some(sc) = scores {
+        s += &crate::detect_plot::scores_text(sc);
+    }
+    crate::emit(&s)
+}

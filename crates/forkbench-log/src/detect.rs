@@ -1,0 +1,160 @@
+//! A pallet detector run over every scan of a recording (a ROS 2 bag or a forkbench MCAP): each scan placed in the frame asked for, detected, and reported as it comes.
+
+use std::path::Path as FsPath;
+
+use forkbench_core::{PalletSpec, Pose2};
+use forkbench_sensors::detector::{DetectorError, PalletDetector, detect_in};
+use serde::Serialize;
+
+use crate::LogError;
+use crate::bag::{BagEvent, BagScan, BagSummary, Frames, bag_files, read_bag};
+
+/// What to read and where to give the faces.
+#[derive(Debug, Clone, Default)]
+pub struct DetectOptions {
+    /// Laser-scan topics to read (all when empty).
+    pub topics: Vec<String>,
+    /// Give faces (and take the prior) in this frame, placing each scan through the
+    /// bag's transforms; `None`: each scan's `frame_id` (a ROS 2 scanner's own frame, or
+    /// the frame a forkbench scan's pose is given in).
+    pub frame: Option<String>,
+    /// Where the pallet should be, in that frame.
+    pub prior: Option<Pose2>,
+}
+
+/// One scan and what the detector made of it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ScanResult {
+    /// 0-based, over the scans read, in file order.
+    pub index: usize,
+    pub topic: String,
+    pub stamp_s: f64,
+    pub frame_id: String,
+    pub beams: usize,
+    /// Beams with a return.
+    pub returns: usize,
+    pub found: bool,
+    /// The face centre and heading into the pallet, in the frame asked for.
+    pub face: Option<Pose2>,
+    /// Returns on the stringer faces used, their RMS distance from the face line, and
+    /// how many stringer faces.
+    pub points: Option<usize>,
+    pub rms_m: Option<f64>,
+    pub stringers: Option<usize>,
+    /// Why the scan could not be used (malformed, or not placeable in the frame).
+    pub error: Option<String>,
+}
+
+/// Why a run stopped early: the detector could not answer, or the file could not be read
+/// further. The scans before it were reported.
+#[derive(Debug, thiserror::Error)]
+pub enum DetectRunError {
+    #[error(transparent)]
+    Bag(#[from] LogError),
+    #[error(transparent)]
+    Detector(#[from] DetectorError),
+}
+
+/// Runs `detector` on every scan of `path` (an MCAP file, or a rosbag2 directory of
+/// them), calling `on` with each result in file order.
+pub fn detect_bag(
+    path: &FsPath,
+    opts: &DetectOptions,
+    detector: &mut dyn PalletDetector,
+    pallet: &PalletSpec,
+    on: &mut dyn FnMut(&ScanResult),
+) -> Result<BagSummary, DetectRunError> {
+    let mut frames = Frames::default();
+    let mut index = 0;
+    let mut failed: Option<DetectorError> = None;
+    let mut each = |e: BagEvent| {
+        if failed.is_some() {
+            return;
+        }
+        let result = match e {
+            BagEvent::Transform {
+                parent,
+                child,
+                pose,
+            } => return frames.set(&parent, &child, pose),
+            BagEvent::Malformed { topic, reason } => blank(index, topic, Some(reason)),
+            BagEvent::Scan(s) => match one(&s, opts, &frames, detector, pallet, index) {
+                Ok(r) => r,
+                Err(e) => {
+                    failed = Some(e);
+                    return;
+                }
+            },
+        };
+        on(&result);
+        index += 1;
+    };
+    let mut summary = BagSummary::default();
+    for file in bag_files(path)? {
+        let part = read_bag(&file, &opts.topics, &mut each)?;
+        for (t, n) in part.scan_topics {
+            *summary.scan_topics.entry(t).or_insert(0) += n;
+        }
+        summary.topics.extend(part.topics);
+    }
+    match failed {
+        Some(e) => Err(e.into()),
+        None => Ok(summary),
+    }
+}
+
+fn blank(index: usize, topic: String, error: Option<String>) -> ScanResult {
+    ScanResult {
+        index,
+        topic,
+        stamp_s: f64::NAN,
+        frame_id: String::new(),
+        beams: 0,
+        returns: 0,
+        found: false,
+        face: None,
+        points: None,
+        rms_m: None,
+        stringers: None,
+        error,
+    }
+}
+
+fn one(
+    s: &BagScan,
+    opts: &DetectOptions,
+    frames: &Frames,
+    detector: &mut dyn PalletDetector,
+    pallet: &PalletSpec,
+    index: usize,
+) -> Result<ScanResult, DetectorError> {
+    let mut r = blank(index, s.topic.clone(), None);
+    r.stamp_s = s.stamp_s;
+    r.frame_id = s.frame_id.clone();
+    r.beams = s.scan.ranges_m.len();
+    r.returns = s.scan.ranges_m.iter().filter(|x| x.is_finite()).count();
+    let mut scan = s.scan.clone();
+    if let Some(target) = &opts.frame {
+        match frames.pose_in(&s.frame_id, target) {
+            Some(p) => scan.sensor = p.to_world(&scan.sensor),
+            None if s.frame_id.trim_start_matches('/') == target => {}
+            None => {
+                r.error = Some(format!(
+                    "no transform from {:?} to {target:?} before this scan",
+                    s.frame_id
+                ));
+                return Ok(r);
+            }
+        }
+    }
+    let found = detect_in(detector, &[(s.topic.as_str(), scan)], pallet, opts.prior)?;
+    if let Some(f) = found {
+        let d = f.detection;
+        r.found = true;
+        r.face = Some(d.face);
+        r.points = Some(d.points);
+        r.rms_m = Some(d.rms_m);
+        r.stringers = Some(d.stringers);
+    }
+    Ok(r)
+}

@@ -1,0 +1,302 @@
+//! The pallet's face model fitted to every beam near its face: the face line through all returns on it, and its place along that line where the model's solid parts and openings agree with which beams hit the face and which passed through, to a fraction of a beam step.
+
+use forkbench_core::signal::Scan;
+use forkbench_core::{PalletSpec, Pose2};
+
+use crate::detect::{Detection, DetectorConfig, detect};
+use crate::detector::{DetectRequest, DetectorError, Found, PalletDetector};
+
+/// The pocket detector finds the face (anywhere in view, or near a prior); the model fit
+/// then refines it from all the beams that fall on or through the face.
+#[derive(Debug, Clone, Default)]
+pub struct FaceFit {
+    pub cfg: DetectorConfig,
+}
+
+impl PalletDetector for FaceFit {
+    fn name(&self) -> &str {
+        "face_fit"
+    }
+
+    fn detect(&mut self, req: &DetectRequest<'_>) -> Result<Option<Found>, DetectorError> {
+        Ok(req.scans.iter().enumerate().find_map(|(i, s)| {
+            let first = detect(&self.cfg, s.scan, req.pallet, req.prior.as_ref())?;
+            Some(Found {
+                detection: refine(&self.cfg, s.scan, req.pallet, &first),
+                sensor: i,
+            })
+        }))
+    }
+}
+
+/// What a beam did at the face line: hit it, passed through an opening, or was stopped
+/// before it (by something in front, which says nothing about the face).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Beam {
+    On,
+    Through,
+    Blocked,
+}
+
+/// A beam's crossing of the face line: lateral place `u` along the face (face frame y),
+/// range to the line, and what it did there.
+#[derive(Debug, Clone, Copy)]
+struct Crossing {
+    u: f64,
+    point: Option<[f64; 2]>,
+}
+
+/// The beams crossing the face line of `face` within the pallet's width and a margin.
+fn crossings(tol_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Vec<Crossing> {
+    let s = face.to_local(&scan.sensor);
+    let reach = pallet.width_m / 2.0 + 0.3;
+    let mut out = Vec::new();
+    for (i, r) in scan.ranges_m.iter().enumerate() {
+        let a = s.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
+        let (dy, dx) = a.sin_cos();
+        if dx <= 1e-6 {
+            continue;
+        }
+        let t = -s.x_m / dx;
+        let u = s.y_m + t * dy;
+        if t <= 0.0 || u.abs() > reach {
+            continue;
+        }
+        let beam = if !r.is_finite() || *r > t + tol_m {
+            Beam::Through
+        } else if *r < t - tol_m {
+            Beam::Blocked
+        } else {
+            Beam::On
+        };
+        let point = (beam == Beam::On).then(|| {
+            let w = scan.sensor.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
+            [scan.sensor.x_m + r * w.cos(), scan.sensor.y_m + r * w.sin()]
+        });
+        out.push(Crossing { u, point });
+    }
+    out
+}
+
+/// Total-least-squares line: centroid and unit direction.
+fn fit(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
+    let n = points.len() as f64;
+    let c = [
+        points.iter().map(|p| p[0]).sum::<f64>() / n,
+        points.iter().map(|p| p[1]).sum::<f64>() / n,
+    ];
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in points {
+        let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    (c, [theta.cos(), theta.sin()])
+}
+
+/// The face line refitted through every beam that hit it near the solid parts, the face
+/// kept at the same place along it and turned to the new line; and the tolerance that
+/// tells a hit on the face from a beam that went behind it: three robust standard
+/// deviations of the hits (the median absolute deviation), within 3 mm and `max_m`.
+fn refit_line(max_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> (Pose2, f64, usize) {
+    let solid = solid_parts(pallet);
+    let pts: Vec<[f64; 2]> = crossings(max_m, scan, pallet, face)
+        .iter()
+        .filter(|c| solid.iter().any(|(lo, hi)| c.u >= *lo && c.u <= *hi))
+        .filter_map(|c| c.point)
+        .collect();
+    if pts.len() < 3 {
+        return (*face, max_m, 0);
+    }
+    let (c, d) = fit(&pts);
+    let mut res: Vec<f64> = pts
+        .iter()
+        .map(|p| ((p[0] - c[0]) * -d[1] + (p[1] - c[1]) * d[0]).abs())
+        .collect();
+    res.sort_by(f64::total_cmp);
+    let sigma = 1.4826 * res[res.len() / 2];
+    let tol = (3.0 * sigma).clamp(0.003, max_m);
+    let kept: Vec<[f64; 2]> = pts
+        .iter()
+        .zip(&res_unsorted(&pts, c, d))
+        .filter(|(_, r)| **r <= tol)
+        .map(|(p, _)| *p)
+        .collect();
+    let used = kept.len();
+    let (c, d) = if used >= 3 { fit(&kept) } else { (c, d) };
+    // The normal on the same side as before (into the pallet).
+    let (fs, fc) = face.heading_rad.sin_cos();
+    let mut n = [-d[1], d[0]];
+    if n[0] * fc + n[1] * fs < 0.0 {
+        n = [-n[0], -n[1]];
+    }
+    // The old centre moved onto the new line along its normal.
+    let off = (face.x_m - c[0]) * d[0] + (face.y_m - c[1]) * d[1];
+    let moved = Pose2::new(c[0] + off * d[0], c[1] + off * d[1], n[1].atan2(n[0]));
+    (moved, tol, used)
+}
+
+fn res_unsorted(pts: &[[f64; 2]], c: [f64; 2], d: [f64; 2]) -> Vec<f64> {
+    pts.iter()
+        .map(|p| ((p[0] - c[0]) * -d[1] + (p[1] - c[1]) * d[0]).abs())
+        .collect()
+}
+
+/// The solid parts across the face (stringers or blocks), as lateral intervals.
+fn solid_parts(pallet: &PalletSpec) -> Vec<(f64, f64)> {
+    let w = pallet.stringer_width_m() / 2.0;
+    pallet
+        .stringer_offsets_m()
+        .iter()
+        .map(|o| (o - w, o + w))
+        .collect()
+}
+
+/// The range at which a beam from `o` along `d` (face frame) first meets a solid part of
+/// the model placed `du` along the face: the parts are boxes from the face back.
+fn model_range(o: [f64; 2], d: [f64; 2], parts: &[(f64, f64)], depth_m: f64, du: f64) -> f64 {
+    let mut best = f64::INFINITY;
+    for (lo, hi) in parts {
+        let (lo, hi) = (lo + du, hi + du);
+        // Slab intersection with [0, depth] × [lo, hi].
+        let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+        for (o, d, a, b) in [(o[0], d[0], 0.0, depth_m), (o[1], d[1], lo, hi)] {
+            if d.abs() < 1e-12 {
+                if o < a || o > b {
+                    t1 = -1.0;
+                }
+                continue;
+            }
+            let (ta, tb) = ((a - o) / d, (b - o) / d);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+        if t0 <= t1 && t0 < best {
+            best = t0;
+        }
+    }
+    best
+}
+
+/// Only this far behind the face does a beam tell where the solid parts are: deeper, a
+/// small error in the face's heading would move the parts' long sides by more than the
+/// fit resolves.
+const ZONE_M: f64 = 0.15;
+
+/// How well the model placed `du` along the face explains the beams: within the zone
+/// behind the face, each beam's range against the range it would have to the model's
+/// solid parts, squared and capped at `cap_m`; a return in the zone where the model has
+/// none (or the other way round) costs the cap; a beam stopped in front of the face
+/// costs nothing (it says nothing of the pallet).
+fn misfit(
+    beams: &[([f64; 2], [f64; 2], f64, f64)],
+    parts: &[(f64, f64)],
+    depth_m: f64,
+    du: f64,
+    cap_m: f64,
+) -> f64 {
+    beams
+        .iter()
+        .map(|(o, d, r, line_t)| {
+            if *r < line_t - cap_m {
+                return 0.0;
+            }
+            let deep = line_t + ZONE_M / d[0];
+            let want = model_range(*o, *d, parts, depth_m, du);
+            match (r.is_finite() && *r <= deep, want <= deep) {
+                (false, false) => 0.0,
+                (true, true) => (r - want).abs().min(cap_m).powi(2),
+                _ => cap_m * cap_m,
+            }
+        })
+        .sum()
+}
+
+/// How far along the face the model sits: the offset (within ±0.1 m) at which its solid
+/// parts best explain every beam that falls on or through the face, searched in 2 mm
+/// steps then 0.1 mm, the middle of the best offsets where several fit equally.
+fn lateral_offset(scan: &Scan, pallet: &PalletSpec, face: &Pose2, tol_m: f64) -> Option<f64> {
+    let s = face.to_local(&scan.sensor);
+    let reach = pallet.width_m / 2.0 + 0.12;
+    let beams: Vec<([f64; 2], [f64; 2], f64, f64)> = scan
+        .ranges_m
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            let a = s.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
+            let (dy, dx) = a.sin_cos();
+            let t = -s.x_m / dx;
+            (dx > 1e-6 && t > 0.0 && (s.y_m + t * dy).abs() <= reach).then_some((
+                [s.x_m, s.y_m],
+                [dx, dy],
+                *r,
+                t,
+            ))
+        })
+        .collect();
+    if beams.len() < 4 {
+        return None;
+    }
+    let parts = solid_parts(pallet);
+    let cap = tol_m.max(0.01);
+    let cost = |du: f64| misfit(&beams, &parts, pallet.depth_m, du, cap);
+    let best_of = |centre: f64, step: f64, n: i32| {
+        let costs: Vec<(f64, f64)> = (-n..=n)
+            .map(|k| centre + k as f64 * step)
+            .map(|du| (du, cost(du)))
+            .collect();
+        let min = costs.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+        let ties: Vec<f64> = costs
+            .iter()
+            .filter(|c| c.1 <= min + 1e-12)
+            .map(|c| c.0)
+            .collect();
+        ties.iter().sum::<f64>() / ties.len() as f64
+    };
+    let coarse = best_of(0.0, 0.002, 50);
+    Some(best_of(coarse, 0.0001, 25))
+}
+
+/// The first detection refined: its line refitted through all the face's returns, then
+/// moved along it to where the model fits the beams.
+pub fn refine(
+    cfg: &DetectorConfig,
+    scan: &Scan,
+    pallet: &PalletSpec,
+    first: &Detection,
+) -> Detection {
+    let mut face = first.face;
+    let mut tol = cfg.edge_tolerance_m;
+    let mut used = 0;
+    for _ in 0..3 {
+        (face, tol, used) = refit_line(cfg.edge_tolerance_m.min(tol * 2.0), scan, pallet, &face);
+    }
+    // Far fewer returns than the first fit used (noise trimmed them): its line is the better
+    // informed one, kept through the same centre.
+    if used * 3 < first.points * 2 {
+        let back = first.face.to_local(&face);
+        face = first.face.to_world(&Pose2::new(0.0, back.y_m, 0.0));
+    }
+    if let Some(du) = lateral_offset(scan, pallet, &face, tol) {
+        face = face.to_world(&Pose2::new(0.0, du, 0.0));
+    }
+    let on: Vec<[f64; 2]> = crossings(tol, scan, pallet, &face)
+        .iter()
+        .filter_map(|c| c.point)
+        .collect();
+    let (sn, cn) = face.heading_rad.sin_cos();
+    let rms = (on
+        .iter()
+        .map(|p| ((p[0] - face.x_m) * cn + (p[1] - face.y_m) * sn).powi(2))
+        .sum::<f64>()
+        / on.len().max(1) as f64)
+        .sqrt();
+    Detection {
+        face,
+        stringers: first.stringers,
+        points: on.len(),
+        rms_m: rms,
+    }
+}
