@@ -43,17 +43,23 @@ pub fn run(
         to_file(file, (1100, 520), |a| draw(a, &rows), |a| draw(a, &rows))?;
     }
     let sensors = sensor_names(&scn);
+    let detector = match &scn.pallet_sensing {
+        forkbench_trial::scenario::sensors::PalletSensing::Scanner { detector, .. } => {
+            detector.name.clone()
+        }
+        forkbench_trial::scenario::sensors::PalletSensing::Gaussian => "pockets".to_owned(),
+    };
     let text = if json {
         let paper = rows.iter().find(|r| is_paper_cell(r));
         format!(
             "{}\n",
-            json!({"scenario": scn.name, "sensors": sensors, "draws": draws, "rows": rows,
+            json!({"scenario": scn.name, "detector": detector, "sensors": sensors, "draws": draws, "rows": rows,
                 "paper": {"range_m": PAPER_CELL.0, "angle_deg": PAPER_CELL.1, "lateral_m": PAPER_CELL.2,
                     "position_m": PAPER_POSITION_M, "heading_deg": PAPER_HEADING_DEG},
                 "paper_cell": paper})
         )
     } else {
-        markdown(&rows, &sensors, draws)
+        markdown(&rows, (&detector, &sensors), draws)
     };
     crate::emit(&text)
 }
@@ -71,9 +77,9 @@ fn mm(s: &forkbench_trial::trial::accuracy::Spread) -> String {
     format!("{:+.0} ± {:.0}", 1e3 * s.bias, 1e3 * s.sigma)
 }
 
-fn markdown(rows: &[AccuracyRow], sensors: &[String], draws: u32) -> String {
+fn markdown(rows: &[AccuracyRow], (detector, sensors): (&str, &[String]), draws: u32) -> String {
     let mut t = format!(
-        "Pocket detector on {} scans, {draws} draws per cell (bias ± σ of the estimate in the \
+        "Detector {detector} on {} scans, {draws} draws per cell (bias ± σ of the estimate in the \
          true pallet's frame)\n\n| range (m) | angle (°) | lateral (m) | found | lateral (mm) | \
          along (mm) | heading (°) | decided by ({}) |\n|---|---|---|---|---|---|---|---|\n",
         sensors.join(" + "),
