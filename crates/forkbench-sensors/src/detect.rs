@@ -178,7 +178,7 @@ fn straight_pieces(points: &[[f64; 2]], tol_m: f64) -> Vec<Vec<[f64; 2]>> {
 }
 
 /// Total-least-squares line through `points`: (centroid, unit direction, RMS residual).
-fn fit_line(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2], f64) {
+pub(crate) fn fit_line(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2], f64) {
     let n = points.len() as f64;
     let c = [
         points.iter().map(|p| p[0]).sum::<f64>() / n,

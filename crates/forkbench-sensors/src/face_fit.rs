@@ -3,7 +3,7 @@
 use forkbench_core::signal::Scan;
 use forkbench_core::{PalletSpec, Pose2};
 
-use crate::detect::{Detection, DetectorConfig, detect};
+use crate::detect::{Detection, DetectorConfig, detect, fit_line};
 use crate::detector::{DetectRequest, DetectorError, Found, PalletDetector};
 
 /// The pocket detector finds the face (anywhere in view, or near a prior); the model fit
@@ -78,24 +78,6 @@ fn crossings(tol_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Vec<
     out
 }
 
-/// Total-least-squares line: centroid and unit direction.
-fn fit(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
-    let n = points.len() as f64;
-    let c = [
-        points.iter().map(|p| p[0]).sum::<f64>() / n,
-        points.iter().map(|p| p[1]).sum::<f64>() / n,
-    ];
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for p in points {
-        let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
-        sxx += dx * dx;
-        sxy += dx * dy;
-        syy += dy * dy;
-    }
-    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    (c, [theta.cos(), theta.sin()])
-}
-
 /// The face line refitted through every beam that hit it near the solid parts, the face
 /// kept at the same place along it and turned to the new line; and the tolerance that
 /// tells a hit on the face from a beam that went behind it: three robust standard
@@ -110,7 +92,7 @@ fn refit_line(max_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> (Po
     if pts.len() < 3 {
         return (*face, max_m, 0);
     }
-    let (c, d) = fit(&pts);
+    let (c, d, _) = fit_line(&pts);
     let mut res: Vec<f64> = pts
         .iter()
         .map(|p| ((p[0] - c[0]) * -d[1] + (p[1] - c[1]) * d[0]).abs())
@@ -125,7 +107,12 @@ fn refit_line(max_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> (Po
         .map(|(p, _)| *p)
         .collect();
     let used = kept.len();
-    let (c, d) = if used >= 3 { fit(&kept) } else { (c, d) };
+    let (c, d) = if used >= 3 {
+        let (c, d, _) = fit_line(&kept);
+        (c, d)
+    } else {
+        (c, d)
+    };
     // The normal on the same side as before (into the pallet).
     let (fs, fc) = face.heading_rad.sin_cos();
     let mut n = [-d[1], d[0]];

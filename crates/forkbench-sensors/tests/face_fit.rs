@@ -9,6 +9,18 @@ use forkbench_sensors::scan::{Errors, RayHit, ScannerConfig, Seen, Surface, Worl
 /// The pallet's stringers as boxes, seen exactly.
 struct Stringers(Vec<(Pose2, f64, f64)>);
 
+impl Stringers {
+    fn of(pallet: &PalletSpec, face: &Pose2) -> Self {
+        Self(
+            pallet
+                .stringer_centres(face)
+                .iter()
+                .map(|c| (*c, pallet.depth_m, pallet.stringer_width_m()))
+                .collect(),
+        )
+    }
+}
+
 impl WorldView for Stringers {
     fn cast_ray(&self, _: [f64; 2], _: [f64; 2], _: f64) -> Option<RayHit> {
         None
@@ -38,13 +50,7 @@ fn the_face_fit_is_within_5_mm_and_0_3_degrees_at_6_7_m_without_noise() {
         for turn_deg in [-30.0, -15.0, -7.0, 0.0, 5.0, 15.0, 30.0] {
             let b = f64::to_radians(bearing_deg);
             let face = Pose2::new(6.7 * b.cos(), 6.7 * b.sin(), b + f64::to_radians(turn_deg));
-            let world = Stringers(
-                pallet
-                    .stringer_centres(&face)
-                    .iter()
-                    .map(|c| (*c, pallet.depth_m, pallet.stringer_width_m()))
-                    .collect(),
-            );
+            let world = Stringers::of(&pallet, &face);
             let s = scan::<rand::rngs::ThreadRng>(
                 &scanner,
                 &world,
@@ -97,13 +103,7 @@ fn with_the_scanners_errors_the_fit_stays_near_the_pockets() {
                     range * b.sin(),
                     b + f64::to_radians(turn_deg),
                 );
-                let world = Stringers(
-                    pallet
-                        .stringer_centres(&face)
-                        .iter()
-                        .map(|c| (*c, pallet.depth_m, pallet.stringer_width_m()))
-                        .collect(),
-                );
+                let world = Stringers::of(&pallet, &face);
                 let bias_m = scanner.draw_bias(&mut rng);
                 let errors = Errors::Modelled {
                     bias_m,
