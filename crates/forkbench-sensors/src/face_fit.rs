@@ -38,8 +38,45 @@ enum Beam {
     Blocked,
 }
 
-/// A beam's crossing of the face line: lateral place `u` along the face (face frame y),
-/// range to the line, and what it did there.
+/// A beam in the face's frame (x into the pallet, y along the face) where it crosses the
+/// face line: its index, direction, measured range, range to the line `t` and lateral
+/// place `u` there.
+#[derive(Debug, Clone, Copy)]
+struct FaceBeam {
+    index: usize,
+    dir: [f64; 2],
+    range_m: f64,
+    t: f64,
+    u: f64,
+}
+
+/// The sensor's place in the face's frame, and the beams that cross the face line ahead
+/// of it within `reach` of the face's centre.
+fn face_beams(scan: &Scan, face: &Pose2, reach: f64) -> ([f64; 2], Vec<FaceBeam>) {
+    let s = face.to_local(&scan.sensor);
+    let beams = scan
+        .ranges_m
+        .iter()
+        .enumerate()
+        .filter_map(|(index, r)| {
+            let a = s.heading_rad + scan.angle_min_rad + index as f64 * scan.angle_step_rad;
+            let (dy, dx) = a.sin_cos();
+            let t = -s.x_m / dx;
+            let u = s.y_m + t * dy;
+            (dx > 1e-6 && t > 0.0 && u.abs() <= reach).then_some(FaceBeam {
+                index,
+                dir: [dx, dy],
+                range_m: *r,
+                t,
+                u,
+            })
+        })
+        .collect();
+    ([s.x_m, s.y_m], beams)
+}
+
+/// A beam's crossing of the face line: its lateral place `u`, and where it hit the face
+/// (map frame) when it did.
 #[derive(Debug, Clone, Copy)]
 struct Crossing {
     u: f64,
@@ -48,34 +85,27 @@ struct Crossing {
 
 /// The beams crossing the face line of `face` within the pallet's width and a margin.
 fn crossings(tol_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Vec<Crossing> {
-    let s = face.to_local(&scan.sensor);
-    let reach = pallet.width_m / 2.0 + 0.3;
-    let mut out = Vec::new();
-    for (i, r) in scan.ranges_m.iter().enumerate() {
-        let a = s.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
-        let (dy, dx) = a.sin_cos();
-        if dx <= 1e-6 {
-            continue;
-        }
-        let t = -s.x_m / dx;
-        let u = s.y_m + t * dy;
-        if t <= 0.0 || u.abs() > reach {
-            continue;
-        }
-        let beam = if !r.is_finite() || *r > t + tol_m {
-            Beam::Through
-        } else if *r < t - tol_m {
-            Beam::Blocked
-        } else {
-            Beam::On
-        };
-        let point = (beam == Beam::On).then(|| {
-            let w = scan.sensor.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
-            [scan.sensor.x_m + r * w.cos(), scan.sensor.y_m + r * w.sin()]
-        });
-        out.push(Crossing { u, point });
-    }
-    out
+    let (_, beams) = face_beams(scan, face, pallet.width_m / 2.0 + 0.3);
+    beams
+        .iter()
+        .map(|b| {
+            let r = b.range_m;
+            let beam = if !r.is_finite() || r > b.t + tol_m {
+                Beam::Through
+            } else if r < b.t - tol_m {
+                Beam::Blocked
+            } else {
+                Beam::On
+            };
+            let point = (beam == Beam::On).then(|| {
+                let w = scan.sensor.heading_rad
+                    + scan.angle_min_rad
+                    + b.index as f64 * scan.angle_step_rad;
+                [scan.sensor.x_m + r * w.cos(), scan.sensor.y_m + r * w.sin()]
+            });
+            Crossing { u: b.u, point }
+        })
+        .collect()
 }
 
 /// The face line refitted through every beam that hit it near the solid parts, the face
@@ -93,16 +123,17 @@ fn refit_line(max_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> (Po
         return (*face, max_m, 0);
     }
     let (c, d, _) = fit_line(&pts);
-    let mut res: Vec<f64> = pts
+    let res: Vec<f64> = pts
         .iter()
         .map(|p| ((p[0] - c[0]) * -d[1] + (p[1] - c[1]) * d[0]).abs())
         .collect();
-    res.sort_by(f64::total_cmp);
-    let sigma = 1.4826 * res[res.len() / 2];
+    let mut sorted = res.clone();
+    sorted.sort_by(f64::total_cmp);
+    let sigma = 1.4826 * sorted[sorted.len() / 2];
     let tol = (3.0 * sigma).clamp(0.003, max_m);
     let kept: Vec<[f64; 2]> = pts
         .iter()
-        .zip(&res_unsorted(&pts, c, d))
+        .zip(&res)
         .filter(|(_, r)| **r <= tol)
         .map(|(p, _)| *p)
         .collect();
@@ -123,12 +154,6 @@ fn refit_line(max_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> (Po
     let off = (face.x_m - c[0]) * d[0] + (face.y_m - c[1]) * d[1];
     let moved = Pose2::new(c[0] + off * d[0], c[1] + off * d[1], n[1].atan2(n[0]));
     (moved, tol, used)
-}
-
-fn res_unsorted(pts: &[[f64; 2]], c: [f64; 2], d: [f64; 2]) -> Vec<f64> {
-    pts.iter()
-        .map(|p| ((p[0] - c[0]) * -d[1] + (p[1] - c[1]) * d[0]).abs())
-        .collect()
 }
 
 /// The solid parts across the face (stringers or blocks), as lateral intervals.
@@ -178,7 +203,8 @@ const ZONE_M: f64 = 0.15;
 /// none (or the other way round) costs the cap; a beam stopped in front of the face
 /// costs nothing (it says nothing of the pallet).
 fn misfit(
-    beams: &[([f64; 2], [f64; 2], f64, f64)],
+    origin: [f64; 2],
+    beams: &[FaceBeam],
     parts: &[(f64, f64)],
     depth_m: f64,
     du: f64,
@@ -186,13 +212,14 @@ fn misfit(
 ) -> f64 {
     beams
         .iter()
-        .map(|(o, d, r, line_t)| {
-            if *r < line_t - cap_m {
+        .map(|b| {
+            let r = b.range_m;
+            if r < b.t - cap_m {
                 return 0.0;
             }
-            let deep = line_t + ZONE_M / d[0];
-            let want = model_range(*o, *d, parts, depth_m, du);
-            match (r.is_finite() && *r <= deep, want <= deep) {
+            let deep = b.t + ZONE_M / b.dir[0];
+            let want = model_range(origin, b.dir, parts, depth_m, du);
+            match (r.is_finite() && r <= deep, want <= deep) {
                 (false, false) => 0.0,
                 (true, true) => (r - want).abs().min(cap_m).powi(2),
                 _ => cap_m * cap_m,
@@ -205,30 +232,13 @@ fn misfit(
 /// parts best explain every beam that falls on or through the face, searched in 2 mm
 /// steps then 0.1 mm, the middle of the best offsets where several fit equally.
 fn lateral_offset(scan: &Scan, pallet: &PalletSpec, face: &Pose2, tol_m: f64) -> Option<f64> {
-    let s = face.to_local(&scan.sensor);
-    let reach = pallet.width_m / 2.0 + 0.12;
-    let beams: Vec<([f64; 2], [f64; 2], f64, f64)> = scan
-        .ranges_m
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| {
-            let a = s.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
-            let (dy, dx) = a.sin_cos();
-            let t = -s.x_m / dx;
-            (dx > 1e-6 && t > 0.0 && (s.y_m + t * dy).abs() <= reach).then_some((
-                [s.x_m, s.y_m],
-                [dx, dy],
-                *r,
-                t,
-            ))
-        })
-        .collect();
+    let (origin, beams) = face_beams(scan, face, pallet.width_m / 2.0 + 0.12);
     if beams.len() < 4 {
         return None;
     }
     let parts = solid_parts(pallet);
     let cap = tol_m.max(0.01);
-    let cost = |du: f64| misfit(&beams, &parts, pallet.depth_m, du, cap);
+    let cost = |du: f64| misfit(origin, &beams, &parts, pallet.depth_m, du, cap);
     let best_of = |centre: f64, step: f64, n: i32| {
         let costs: Vec<(f64, f64)> = (-n..=n)
             .map(|k| centre + k as f64 * step)
