@@ -19,7 +19,8 @@ pub fn run(a: &CheckArgs) -> anyhow::Result<()> {
     crate::warn_slips(&scn);
     let fit = scn.fork_fit();
     if a.json {
-        let v = serde_json::json!({"scenario": scn, "fork_fit": fit});
+        let v =
+            serde_json::json!({"scenario": scn, "pallet_kind": scn.pallet_kind, "fork_fit": fit});
         let text = serde_json::to_string_pretty(&v).context("serialising the scenario")?;
         return crate::emit(&(text + "\n"));
     }
@@ -56,6 +57,7 @@ fn summary(scn: &Scenario) -> String {
             scn.tracker.kind,
             scn.localizer.kind
         ),
+        pallet_line(scn),
         format!(
             "forks        spacing {:.3} m, pockets allow {:.3}..{:.3} m: {}",
             fit.fork_spacing_m,
@@ -117,4 +119,21 @@ fn cases(scn: &Scenario) -> Vec<String> {
         ));
     }
     lines
+}
+
+/// The pallet: its kind and face, size, pockets and parts.
+fn pallet_line(scn: &forkbench_trial::Scenario) -> String {
+    let p = &scn.pallet;
+    let height = p
+        .pocket_height_m
+        .map_or(String::new(), |h| format!(", {h:.3} m high"));
+    format!(
+        "pallet       {}: {:.3} m deep × {:.3} m wide, {} parts; pockets {:.4} m wide{height} at ±{:.4} m",
+        scn.pallet_kind,
+        p.depth_m,
+        p.width_m,
+        p.parts().len(),
+        p.pocket_width_m,
+        p.pocket_offsets_m()[0]
+    )
 }

@@ -210,10 +210,10 @@ where
         .map_err(err)?;
     let outline = |face: &Pose2| -> Vec<Vec<(f64, f64)>> {
         pallet
-            .stringer_centres(face)
+            .part_boxes(face)
             .iter()
-            .map(|c| {
-                forkbench_core::geometry::rect_outline(c, pallet.depth_m, pallet.stringer_width_m())
+            .map(|(c, l, w)| {
+                forkbench_core::geometry::rect_outline(c, *l, *w)
                     .iter()
                     .map(|p| (p[0], p[1]))
                     .collect()

@@ -32,6 +32,9 @@ pub struct ForkliftSpec {
     /// Heaviest load (pallet with its payload) the truck is rated to lift.
     #[serde(skip_serializing_if = "is_default_capacity")]
     pub rated_capacity_kg: f64,
+    /// Fork blade thickness; when given, a pallet whose pockets are lower is refused.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fork_thickness_m: Option<f64>,
 }
 
 /// The A30's rating: 3 t.
@@ -60,6 +63,7 @@ impl Default for ForkliftSpec {
             max_speed_mps: 0.8,
             max_steer_rate_radps: 0.8,
             rated_capacity_kg: DEFAULT_RATED_CAPACITY_KG,
+            fork_thickness_m: None,
         }
     }
 }
@@ -155,6 +159,9 @@ impl ForkliftSpec {
         }
         // Upper bounds: beyond them no forklift exists, and the geometry and the physics
         // would only be asked for absurd work.
+        if let Some(t) = self.fork_thickness_m {
+            crate::settings::in_ranges(&[("fork_thickness_m", t, 0.005, 0.3)])?;
+        }
         crate::settings::in_ranges(&[
             ("wheelbase_m", self.wheelbase_m, 0.0, 10.0),
             ("body_length_m", self.body_length_m, 0.0, 20.0),

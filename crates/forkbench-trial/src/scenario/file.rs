@@ -26,6 +26,27 @@ pub enum PalletKind {
     /// 1.0 × 1.0 m (the papers' simulations).
     #[serde(rename = "sim-1000")]
     Sim1000,
+    /// EUR/EPAL 1, 1200 × 800 mm, nine blocks, four-way.
+    #[serde(rename = "epal-1")]
+    Epal1,
+    /// ISO 1200 × 1000 mm, nine blocks, four-way.
+    #[serde(rename = "iso-1200x1000")]
+    Iso1200x1000,
+    /// GMA 48 × 40 in, three notched stringers, partial four-way.
+    #[serde(rename = "gma-48x40")]
+    Gma48x40,
+}
+
+impl PalletKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Field1200 => "field-1200",
+            Self::Sim1000 => "sim-1000",
+            Self::Epal1 => "epal-1",
+            Self::Iso1200x1000 => "iso-1200x1000",
+            Self::Gma48x40 => "gma-48x40",
+        }
+    }
 }
 
 /// Success tolerances of a pick.
@@ -223,8 +244,12 @@ pub(super) struct ScenarioFile {
     pub(super) planner: toml::Spanned<toml::Value>,
     #[serde(default)]
     pub(super) seed: u64,
-    #[serde(default = "default_pallet_kind")]
-    pub(super) pallet_kind: PalletKind,
+    /// A built-in pallet (default `field-1200`); or `[pallet_model]`, a custom one.
+    pub(super) pallet_kind: Option<PalletKind>,
+    /// A custom pallet kind: its parts, notches and entry faces.
+    pub(super) pallet_model: Option<forkbench_core::pallet::PalletModel>,
+    /// The face the forks enter (default `front`).
+    pub(super) pallet_entry: Option<forkbench_core::pallet::PalletFace>,
     /// Goods on the pallet: they press it on the floor (a pushed pallet resists more)
     /// and, once lifted, load the truck.
     #[serde(default)]
@@ -273,10 +298,6 @@ pub(super) struct ScenarioFile {
 
 fn default_true() -> bool {
     true
-}
-
-fn default_pallet_kind() -> PalletKind {
-    PalletKind::Field1200
 }
 
 fn default_timeout() -> f64 {

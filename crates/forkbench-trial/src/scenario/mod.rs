@@ -5,6 +5,7 @@ mod file;
 mod hints;
 mod limits;
 pub mod mission;
+mod pallet;
 pub mod sensors;
 mod world;
 
@@ -118,6 +119,10 @@ pub struct Scenario {
     pub registry: Arc<Registry>,
     pub seed: u64,
     pub pallet: PalletSpec,
+    /// How the scenario names its pallet (`pallet_kind epal-1`, `pallet_model NAME`);
+    /// the geometry in `pallet` is what a run and a manifest use.
+    #[serde(skip)]
+    pub pallet_kind: String,
     pub timeout_s: f64,
     /// Plans whose swept truck body hits a rack or wall count as `plan_failed`.
     pub validate_paths: bool,
@@ -251,13 +256,10 @@ impl Scenario {
             None => World::default(),
         };
         check_values(&f, file)?;
-        let pallet = match f.pallet_kind {
-            PalletKind::Field1200 => PalletSpec::field_1200(),
-            PalletKind::Sim1000 => PalletSpec::sim_1000(),
-        }
-        .with_payload(f.payload_kg);
+        let (pallet, pallet_label) = pallet::resolve(&f, (file, text))?;
         checks::check_payload(&f.truck, &pallet, (file, text))?;
-        checks::check_geometry(&f, &pallet, file)?;
+        checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
+        pallet::check_thickness(&f, (&pallet, &pallet_label), file)?;
         let cases = resolve_cases(&f, &world, &pallet, file).map_err(|e| match e {
             TrialError::Invalid {
                 file,
@@ -290,6 +292,7 @@ impl Scenario {
             registry: Registry::shared(),
             seed: f.seed,
             pallet,
+            pallet_kind: pallet_label,
             timeout_s: f.timeout_s,
             validate_paths: f.validate_paths,
             truck: f.truck,
