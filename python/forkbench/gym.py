@@ -14,7 +14,21 @@ this tick brought a localiser fix; then, with ``path_points=K``, K (x, y) points
 planned path ahead in the truck's frame, ``path_spacing_m`` apart.
 
 Action (float32): speed (m/s, forward positive) and equivalent steering angle (rad,
-positive left), bounded by the truck's limits.
+positive left), bounded by the truck's limits. Options:
+
+- ``normalize_actions=True``: the action space is [-1, 1]² and maps linearly onto the
+  bounds (the truck's limits, or the residual's), as Stable-Baselines3 recommends;
+- ``action_mode="residual"``: the action is a correction added to the scenario's
+  tracker's command (speed, steering), within ``residual_limits`` (default 0.3 m/s and
+  0.3 rad); the sum is clamped to the truck's limits. Episodes then end as the tracker's
+  trial does (the tracker reports the goal reached and the truck stands, or the time
+  limit), so a zero action is exactly the tracker's own trial.
+
+Rendering: ``render_mode="rgb_array"`` returns a top-down image (height × width × 3,
+uint8; ``render_size=(width, height)``, default 320 × 320) of the racks, the plan (blue),
+the true pallet (brown) and its estimate (red outline), the truck (yellow) with its forks
+and the last scan returns (magenta); ``"human"`` shows it in a matplotlib window where a
+display exists. ``metadata["render_fps"]`` is the simulated rate: 100 / ``ticks_per_step``.
 
 Episode end: terminated when the truck stands with the forks at the required depth, or
 as soon as a criterion fails for good (a rack or wall touched, fork contact force,
@@ -65,15 +79,68 @@ def _reward(reward: Sequence[float]) -> Reward:
     return (r[0], r[1], r[2], r[3])
 
 
-def _spaces(scn: Scenario, size: int) -> tuple[spaces.Box, spaces.Box]:
-    speed, steer = scn.command_limits
-    obs = spaces.Box(-np.inf, np.inf, shape=(size,), dtype=np.float32)
-    act = spaces.Box(
-        np.array([-speed, -steer], dtype=np.float32),
-        np.array([speed, steer], dtype=np.float32),
-        dtype=np.float32,
-    )
-    return obs, act
+RENDER_MODES = ["rgb_array", "human"]
+
+
+def _render_modes() -> list[str]:
+    """The modes this process can show: ``human`` only where a display exists."""
+    shown = bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    return RENDER_MODES if shown else ["rgb_array"]
+
+
+ACTION_MODES = ("command", "residual")
+
+
+class _Actions:
+    """How an agent's action becomes the command the core takes: its bounds, whether it
+    is normalised to [-1, 1], and whether it corrects the tracker's command."""
+
+    def __init__(
+        self,
+        scn: Scenario,
+        mode: str,
+        normalize: bool,
+        residual_limits: Sequence[float],
+    ) -> None:
+        if mode not in ACTION_MODES:
+            raise ValueError(f"action_mode {mode!r}: one of {', '.join(ACTION_MODES)}")
+        speed, steer = scn.command_limits
+        if mode == "residual":
+            lim = [float(x) for x in residual_limits]
+            if len(lim) != 2 or not all(0.0 < x <= 10.0 for x in lim):
+                raise ValueError(
+                    f"residual_limits {residual_limits!r}: two bounds (m/s, rad) in (0, 10]"
+                )
+            speed, steer = min(lim[0], 2 * speed), min(lim[1], 2 * steer)
+        self.residual = mode == "residual"
+        self.normalize = normalize
+        self.bounds = np.array([speed, steer], dtype=np.float64)
+
+    def space(self) -> spaces.Box:
+        hi = np.ones(2) if self.normalize else self.bounds
+        return spaces.Box(-hi.astype(np.float32), hi.astype(np.float32), dtype=np.float32)
+
+    def command(self, action: Any) -> np.ndarray:
+        """(…, 2) actions as (speed, steering) commands or corrections, float64."""
+        a = np.asarray(action, dtype=np.float64)
+        if self.normalize:
+            a = np.clip(a, -1.0, 1.0) * self.bounds
+        return a
+
+
+# Every observation field is finite and far inside this (map coordinates in metres,
+# unwrapped headings in radians, seconds); a finite bound keeps the checkers quiet.
+OBS_BOUND = 1e6
+
+
+def _spaces(size: int, actions: _Actions) -> tuple[spaces.Box, spaces.Box]:
+    obs = spaces.Box(-OBS_BOUND, OBS_BOUND, shape=(size,), dtype=np.float32)
+    return obs, actions.space()
+
+
+def _render_size(size: Sequence[int]) -> tuple[int, int]:
+    w, h = (int(x) for x in size)
+    return (w, h)
 
 
 class PalletPickEnv(gymnasium.Env):
@@ -81,11 +148,12 @@ class PalletPickEnv(gymnasium.Env):
 
     ``scenario``: a `Scenario`, an embedded scenario's name or a scenario file;
     ``case``: a fixed case (default: each episode draws one); ``planner``, ``tracker``,
-    ``noise``, ``replan``: as for `run_trial` (the tracker only drives `expert_step`).
+    ``noise``, ``replan``: as for `run_trial` (the tracker drives `expert_step` and the
+    residual mode).
     """
 
     # Gymnasium declares metadata per instance; a class attribute is its convention.
-    metadata = {"render_modes": []}  # noqa: RUF012
+    metadata = {"render_modes": RENDER_MODES, "render_fps": 100}  # noqa: RUF012
 
     def __init__(
         self,
@@ -100,9 +168,24 @@ class PalletPickEnv(gymnasium.Env):
         path_points: int = 0,
         path_spacing_m: float = 0.5,
         reward: Reward = (10.0, 10.0, 0.1, 1.0),
+        render_mode: str | None = None,
+        render_size: Sequence[int] = (320, 320),
+        normalize_actions: bool = False,
+        action_mode: str = "command",
+        residual_limits: Sequence[float] = (0.3, 0.3),
     ) -> None:
+        modes = _render_modes()
+        if render_mode is not None and render_mode not in modes:
+            raise ValueError(
+                f"render_mode {render_mode!r}: None or one of {modes}"
+                + ("" if render_mode not in RENDER_MODES else " (no display for 'human')")
+            )
+        self.render_mode = render_mode
+        self.metadata = {"render_modes": modes, "render_fps": 100 / ticks_per_step}
         self.scenario = _scenario(scenario)
         self._case = case
+        self._actions = _Actions(self.scenario, action_mode, normalize_actions, residual_limits)
+        self._window: Any = None
         self._core = _forkbench.PickEnv(
             self.scenario,
             case=case,
@@ -114,10 +197,13 @@ class PalletPickEnv(gymnasium.Env):
             path_points=path_points,
             path_spacing_m=path_spacing_m,
             reward=_reward(reward),
+            render_size=None if render_mode is None else _render_size(render_size),
         )
         self.observation_space, self.action_space = _spaces(
-            self.scenario, self._core.observation_size
+            self._core.observation_size, self._actions
         )
+        if render_mode == "human":
+            self._window = _HumanWindow()
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -134,8 +220,28 @@ class PalletPickEnv(gymnasium.Env):
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         self._refuse_after_end()
-        a = np.asarray(action, dtype=np.float64).reshape(2)
-        return self._mark_end(self._core.step(float(a[0]), float(a[1])))
+        a = self._actions.command(action).reshape(2)
+        step = self._core.residual_step if self._actions.residual else self._core.step
+        out = self._mark_end(step(float(a[0]), float(a[1])))
+        if self._window is not None:
+            self.render()
+        return out
+
+    def render(self) -> np.ndarray | None:
+        """The episode now as an RGB image (``rgb_array``), or shown in a window
+        (``human``); None without a render mode."""
+        if self.render_mode is None:
+            return None
+        frame = self._core.render()
+        if self._window is not None and frame is not None:
+            self._window.show(frame)
+            return None
+        return frame
+
+    def close(self) -> None:
+        if self._window is not None:
+            self._window.close()
+            self._window = None
 
     def expert_step(self) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """One step under the scenario's own tracker (a reference to compare against)."""
@@ -153,6 +259,30 @@ class PalletPickEnv(gymnasium.Env):
     ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         self._ended = bool(out[2] or out[3])
         return out
+
+
+class _HumanWindow:
+    """A matplotlib window the frames are shown in (``render_mode="human"``)."""
+
+    def __init__(self) -> None:
+        try:
+            import matplotlib.pyplot as plt
+        except ImportError as e:
+            raise RuntimeError("render_mode='human' needs matplotlib") from e
+        self._plt = plt
+        self._image: Any = None
+
+    def show(self, frame: np.ndarray) -> None:
+        if self._image is None:
+            self._plt.ion()
+            self._image = self._plt.imshow(frame)
+            self._plt.axis("off")
+        else:
+            self._image.set_data(frame)
+        self._plt.pause(0.001)
+
+    def close(self) -> None:
+        self._plt.close()
 
 
 class PalletPickVectorEnv(VectorEnv):
@@ -180,8 +310,12 @@ class PalletPickVectorEnv(VectorEnv):
         path_points: int = 0,
         path_spacing_m: float = 0.5,
         reward: Reward = (10.0, 10.0, 0.1, 1.0),
+        normalize_actions: bool = False,
+        action_mode: str = "command",
+        residual_limits: Sequence[float] = (0.3, 0.3),
     ) -> None:
         self.scenario = _scenario(scenario)
+        self._actions = _Actions(self.scenario, action_mode, normalize_actions, residual_limits)
         self._core = _forkbench.PickVecEnv(
             self.scenario,
             num_envs,
@@ -198,7 +332,7 @@ class PalletPickVectorEnv(VectorEnv):
         )
         self.num_envs = num_envs
         self.single_observation_space, self.single_action_space = _spaces(
-            self.scenario, self._core.observation_size
+            self._core.observation_size, self._actions
         )
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
@@ -215,21 +349,27 @@ class PalletPickVectorEnv(VectorEnv):
             seed = int(seed[0])
         self._np_random_seed = seed
         obs, infos = self._core.reset(seed)
-        return obs, self._batch_infos(infos)
+        return obs, self._batch_infos(list(enumerate(infos)))
 
     def step(
         self, actions: Any
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        a = np.ascontiguousarray(actions, dtype=np.float64).reshape(self.num_envs, 2)
-        obs, rewards, terminated, truncated, ended = self._core.step(a)
-        return obs, rewards, terminated, truncated, self._batch_infos(ended)
+        a = self._actions.command(actions).reshape(self.num_envs, 2)
+        obs, rewards, terminated, truncated, ended = self._core.step(a, self._actions.residual)
+        return obs, rewards, terminated, truncated, self._batch_infos(ended) if ended else {}
 
-    def _batch_infos(self, infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
+    @property
+    def stepping_s(self) -> float:
+        """Seconds spent stepping in Rust since the last reset (the rest of a step's time
+        is the Python side's)."""
+        return self._core.stepping_s
+
+    def _batch_infos(self, infos: Sequence[tuple[int, dict[str, Any]]]) -> dict[str, Any]:
         """Per-environment dicts as Gymnasium's vector info: a key's values in an array,
         ``_key`` marking the environments that have it."""
         out: dict[str, Any] = {}
-        for i, info in enumerate(infos):
-            for key, value in (info or {}).items():
+        for i, info in infos:
+            for key, value in info.items():
                 if key not in out:
                     out[key] = np.full(self.num_envs, None, dtype=object)
                     out["_" + key] = np.zeros(self.num_envs, dtype=bool)

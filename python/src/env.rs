@@ -4,13 +4,14 @@ use std::sync::Arc;
 
 use forkbench_trial::trial::{Control, Session, SessionEnd};
 use forkbench_trial::{Scenario as Inner, TrialError, TrialOptions};
-use numpy::PyArray1;
+use numpy::{IntoPyArray, PyArray1, PyArray3};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{scenario_error, serde_to_py};
 use crate::obs::{self, ObsConfig, RewardConfig};
+use crate::render::Window;
 use crate::scenario::Scenario;
 
 /// Most path points an observation carries (it is allocated per step).
@@ -26,6 +27,8 @@ pub(crate) struct Setup {
     pub(crate) obs: ObsConfig,
     reward: RewardConfig,
     ticks_per_step: u32,
+    /// Frame size (width, height) when episodes are drawn; `None`: no views kept.
+    pub(crate) render: Option<[u32; 2]>,
 }
 
 /// One environment: the episode's session and the reward's running potential.
@@ -35,6 +38,8 @@ pub(crate) struct Core {
     potential: f64,
     seed: u64,
     case: String,
+    /// Where the episode is drawn, when it is.
+    window: Option<Window>,
 }
 
 /// One step's result.
@@ -51,13 +56,21 @@ impl Core {
             seed: Some(seed),
             ..s.opts.clone()
         };
-        let session = Session::start(s.scn.clone(), case, &opts)?;
+        let session = if s.render.is_some() {
+            Session::start_viewed(s.scn.clone(), case, &opts)?
+        } else {
+            Session::start(s.scn.clone(), case, &opts)?
+        };
         let potential = s.reward.distance(session.truth());
+        let window = session
+            .view()
+            .map(|v| Window::around(&session.truth().fork_root, &v.pallet));
         Ok(Core {
             session,
             potential,
             seed,
             case: case.to_owned(),
+            window,
         })
     }
 
@@ -89,6 +102,14 @@ impl Core {
             }
         }
         out
+    }
+
+    /// The episode drawn at the setup's frame size (RGB rows); `None` when the setup does
+    /// not draw, or the episode ended before its first tick.
+    pub(crate) fn frame(&self, s: &Setup) -> Option<(Vec<u8>, [u32; 2])> {
+        let (size, window, view) = (s.render?, self.window?, self.session.view()?);
+        let pixels = crate::render::draw(view, &s.scn.truck, &s.scn.pallet, window, size);
+        Some((pixels, size))
     }
 
     pub(crate) fn write_obs(&self, s: &Setup, out: &mut [f32]) {
@@ -170,21 +191,33 @@ pub(crate) fn setup(
             heading_m_per_rad,
         },
         ticks_per_step,
+        render: None,
     })
 }
 
-/// A command from Python: finite numbers (the session clamps them to the truck's limits).
-pub(crate) fn command(speed_mps: f64, steer_rad: f64) -> PyResult<Control> {
+/// A command from Python: finite numbers (the session clamps them to the truck's
+/// limits); `residual`: a correction to the scenario's tracker's command.
+pub(crate) fn command(speed_mps: f64, steer_rad: f64, residual: bool) -> PyResult<Control> {
     if !(speed_mps.is_finite() && steer_rad.is_finite()) {
         return Err(PyValueError::new_err(format!(
             "action ({speed_mps}, {steer_rad}): speed and steering must be finite"
         )));
     }
-    Ok(Control::Command {
-        speed_mps,
-        steer_rad,
+    Ok(if residual {
+        Control::Residual {
+            speed_mps,
+            steer_rad,
+        }
+    } else {
+        Control::Command {
+            speed_mps,
+            steer_rad,
+        }
     })
 }
+
+/// Frame sizes `render_size` may ask for, in pixels a side.
+const RENDER_PX: (u32, u32) = (16, 4096);
 
 /// One pick trial per episode, stepped from Python (see `forkbench.gym.PalletPickEnv`).
 #[pyclass(module = "forkbench")]
@@ -209,7 +242,7 @@ impl PickEnv {
     #[new]
     #[pyo3(signature = (scenario, *, case=None, planner=None, tracker=None, noise=true,
                         replan=None, ticks_per_step=1, path_points=0, path_spacing_m=0.5,
-                        reward=(10.0, 10.0, 0.1, 1.0)))]
+                        reward=(10.0, 10.0, 0.1, 1.0), render_size=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -223,8 +256,9 @@ impl PickEnv {
         path_points: usize,
         path_spacing_m: f64,
         reward: (f64, f64, f64, f64),
+        render_size: Option<(u32, u32)>,
     ) -> PyResult<Self> {
-        let setup = setup(
+        let mut setup = setup(
             py,
             scenario,
             case,
@@ -237,6 +271,15 @@ impl PickEnv {
             path_spacing_m,
             reward,
         )?;
+        if let Some((w, h)) = render_size {
+            let (lo, hi) = RENDER_PX;
+            if !((lo..=hi).contains(&w) && (lo..=hi).contains(&h)) {
+                return Err(PyValueError::new_err(format!(
+                    "render_size ({w}, {h}): each side {lo}–{hi} pixels"
+                )));
+            }
+            setup.render = Some([w, h]);
+        }
         Ok(PickEnv {
             setup,
             core: std::sync::Mutex::new(None),
@@ -279,7 +322,34 @@ impl PickEnv {
         speed_mps: f64,
         steer_rad: f64,
     ) -> PyResult<StepTuple<'py>> {
-        self.advance(py, command(speed_mps, steer_rad)?)
+        self.advance(py, command(speed_mps, steer_rad, false)?)
+    }
+
+    /// One step under the scenario's tracker's command corrected by (speed m/s, steering
+    /// rad); a zero correction is the tracker's own step.
+    fn residual_step<'py>(
+        &mut self,
+        py: Python<'py>,
+        speed_mps: f64,
+        steer_rad: f64,
+    ) -> PyResult<StepTuple<'py>> {
+        self.advance(py, command(speed_mps, steer_rad, true)?)
+    }
+
+    /// The episode as an RGB image (height × width × 3, uint8); `None` without a
+    /// `render_size` or before the first reset.
+    fn render<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray3<u8>>>> {
+        let setup = &self.setup;
+        let core = self
+            .core
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let Some((pixels, [w, h])) = core.as_ref().and_then(|c| c.frame(setup)) else {
+            return Ok(None);
+        };
+        let a = numpy::ndarray::Array3::from_shape_vec((h as usize, w as usize, 3), pixels)
+            .map_err(|e| PyRuntimeError::new_err(format!("frame: {e}")))?;
+        Ok(Some(a.into_pyarray(py)))
     }
 
     /// One step under the scenario's own tracker (the bench's reference controller).

@@ -4,6 +4,7 @@ mod batch;
 mod convert;
 mod env;
 mod obs;
+mod render;
 mod scenario;
 mod vec_env;
 

@@ -71,6 +71,9 @@ pub struct PickVecEnv {
     /// methods take it exclusively and never lock.
     slots: std::sync::Mutex<Vec<Slot>>,
     pool: rayon::ThreadPool,
+    /// Time spent stepping in Rust (the GIL released) since the last reset: what the
+    /// Python side's overhead is measured against.
+    stepping: std::time::Duration,
 }
 
 type VecReset<'py> = (Bound<'py, PyArray2<f32>>, Vec<Bound<'py, PyDict>>);
@@ -80,7 +83,7 @@ type VecStep<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
-    Vec<Option<Bound<'py, PyDict>>>,
+    Vec<(usize, Bound<'py, PyDict>)>,
 );
 
 /// Most memory the environments of one vector environment may take.
@@ -157,6 +160,7 @@ impl PickVecEnv {
             n: num_envs,
             slots: std::sync::Mutex::new(slots),
             pool,
+            stepping: std::time::Duration::ZERO,
         })
     }
 
@@ -181,6 +185,7 @@ impl PickVecEnv {
         }
         let controls = vec![Control::Tracker; self.n];
         let (obs, _) = self.run(py, &controls)?;
+        self.stepping = std::time::Duration::ZERO;
         let infos = self
             .slots()
             .iter()
@@ -192,13 +197,22 @@ impl PickVecEnv {
         Ok((obs.into_pyarray(py), infos))
     }
 
+    /// Seconds spent stepping the environments in Rust since the last reset.
+    #[getter]
+    fn stepping_s(&self) -> f64 {
+        self.stepping.as_secs_f64()
+    }
+
     /// One step of every environment under `actions` (num_envs × 2: speed m/s, steering
-    /// rad). Returns observations, rewards, terminated, truncated, and the judged outcome
-    /// of each environment whose episode ended on this step (else None).
+    /// rad; with `residual`, corrections to the tracker's command). Returns
+    /// observations, rewards, terminated, truncated, and (index, info with the judged
+    /// outcome) of each environment whose episode ended on this step.
+    #[pyo3(signature = (actions, residual=false))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         actions: PyReadonlyArray2<'py, f64>,
+        residual: bool,
     ) -> PyResult<VecStep<'py>> {
         let a = actions.as_array();
         if a.shape() != [self.n, 2] {
@@ -211,15 +225,16 @@ impl PickVecEnv {
         let controls = a
             .rows()
             .into_iter()
-            .map(|r| command(r[0], r[1]))
+            .map(|r| command(r[0], r[1], residual))
             .collect::<PyResult<Vec<_>>>()?;
         let (obs, outs) = self.run(py, &controls)?;
         let outcomes = self
             .slots()
             .iter()
-            .map(|s| match &s.core {
-                Some(core) if s.pending_reset => core.info(py).map(Some),
-                _ => Ok(None),
+            .enumerate()
+            .filter_map(|(i, s)| match &s.core {
+                Some(core) if s.pending_reset => Some(core.info(py).map(|d| (i, d))),
+                _ => None,
             })
             .collect::<PyResult<_>>()?;
         let col = |f: fn(&StepOut) -> bool| outs.iter().map(f).collect::<Vec<_>>().into_pyarray(py);
@@ -259,6 +274,7 @@ impl PickVecEnv {
         let flat = obs
             .as_slice_mut()
             .ok_or_else(|| PyRuntimeError::new_err("observation buffer not contiguous"))?;
+        let started = std::time::Instant::now();
         let outs = py.detach(|| {
             // One thread: no hand-over to the pool (it costs more than a tick).
             if pool.current_num_threads() == 1 {
@@ -278,6 +294,7 @@ impl PickVecEnv {
                     .collect::<Vec<_>>()
             })
         });
+        self.stepping += started.elapsed();
         if let Some(e) = self.slots().iter_mut().find_map(|s| s.error.take()) {
             return Err(PyRuntimeError::new_err(format!(
                 "an episode could not start: {e}"

@@ -87,6 +87,20 @@ impl ForkliftSpec {
         1.0 / self.max_curvature_per_m()
     }
 
+    /// Closed outlines of the truck at a fork-root pose: the chassis, then the two forks.
+    pub fn outlines(&self, root: &crate::Pose2) -> Vec<[[f64; 2]; 5]> {
+        use crate::geometry::rect_outline;
+        let mut v = vec![rect_outline(
+            &self.chassis_centre(root),
+            self.body_length_m,
+            self.body_width_m,
+        )];
+        for f in self.fork_points(root, self.fork_length_m / 2.0) {
+            v.push(rect_outline(&f, self.fork_length_m, self.fork_width_m));
+        }
+        v
+    }
+
     /// Centre pose of the chassis for a fork-root pose (the chassis ends at the fork root).
     pub fn chassis_centre(&self, root: &crate::Pose2) -> crate::Pose2 {
         root.to_world(&crate::Pose2::new(-self.body_length_m / 2.0, 0.0, 0.0))

@@ -10,7 +10,6 @@ mod writer;
 
 use std::path::Path;
 
-use forkbench_core::geometry::rect_outline;
 use forkbench_core::{PalletSpec, Pose2};
 
 pub use mcap_sink::McapRecorder;
@@ -107,22 +106,10 @@ pub(crate) fn truck_outlines(
     truck: &forkbench_core::ForkliftSpec,
     root: &Pose2,
 ) -> Vec<[[f64; 2]; 5]> {
-    let mut v = vec![rect_outline(
-        &truck.chassis_centre(root),
-        truck.body_length_m,
-        truck.body_width_m,
-    )];
-    for f in truck.fork_points(root, truck.fork_length_m / 2.0) {
-        v.push(rect_outline(&f, truck.fork_length_m, truck.fork_width_m));
-    }
-    v
+    truck.outlines(root)
 }
 
 /// Outlines of the pallet's solid parts (stringers or blocks) at its face pose.
 pub(crate) fn pallet_outlines(pallet: &PalletSpec, face: &Pose2) -> Vec<[[f64; 2]; 5]> {
-    pallet
-        .part_boxes(face)
-        .iter()
-        .map(|(c, l, w)| rect_outline(c, *l, *w))
-        .collect()
+    pallet.outlines(face)
 }

@@ -157,6 +157,14 @@ impl PalletSpec {
             .collect()
     }
 
+    /// Closed outlines of the solid parts for a pallet whose face centre is at `face`.
+    pub fn outlines(&self, face: &Pose2) -> Vec<[[f64; 2]; 5]> {
+        self.part_boxes(face)
+            .iter()
+            .map(|(c, l, w)| crate::geometry::rect_outline(c, *l, *w))
+            .collect()
+    }
+
     /// The material across the entry face, as lateral intervals `[right, left]`: the right
     /// edge part, the centre part and the left edge part around the two pockets.
     pub fn face_solids(&self) -> [[f64; 2]; 3] {

@@ -14,6 +14,7 @@ mod phases;
 mod plan;
 mod sense;
 mod session;
+mod session_view;
 mod setup;
 mod staging;
 
@@ -34,6 +35,7 @@ pub use phases::{
     Context as PhaseContext, PICK, PhaseSpec, phase_defaults, resolve as phases_resolve,
 };
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
+pub use session_view::SceneView;
 pub use setup::Trial;
 
 /// Gap between the fork tips and the pallet face at the end of the approach curve: the

@@ -8,6 +8,7 @@ use forkbench_track::Command;
 
 use super::drive::DriveState;
 use super::error::StageError;
+use super::session_view::{ScanKeeper, SceneView};
 use super::setup::Trial;
 use super::{Resolved, TrialOptions, goal_for, prepare};
 use crate::TrialError;
@@ -27,6 +28,8 @@ struct Owned {
 struct Live<'a> {
     trial: Trial<'a>,
     at: DriveState,
+    /// Set once the session's caller asks for views: the scans it keeps for them.
+    keeper: Option<ScanKeeper>,
 }
 
 self_cell::self_cell!(
@@ -49,6 +52,10 @@ pub enum Control {
     /// soon as a criterion has failed for good (a collision, contact force, pallet moved,
     /// entry outside the limits).
     Command { speed_mps: f64, steer_rad: f64 },
+    /// The scenario's tracker's command plus the caller's correction (speed m/s,
+    /// steering rad), clamped to the truck's limits; the episode ends as under
+    /// [`Control::Tracker`], so a zero correction is the tracker's own trial.
+    Residual { speed_mps: f64, steer_rad: f64 },
 }
 
 /// What the truck's controller knows at a tick (never the truth).
@@ -98,6 +105,8 @@ pub struct Session {
     inner: Inner,
     last: Observation,
     truth: Truth,
+    /// The scene as of the observation, for a session started viewed.
+    view: Option<Box<SceneView>>,
 }
 
 #[derive(Debug)]
@@ -111,16 +120,49 @@ impl Session {
     /// not usable. A trial that ends before driving (no plan, no pallet found) starts
     /// already ended.
     pub fn start(scn: Arc<Scenario>, case: &str, opts: &TrialOptions) -> Result<Self, TrialError> {
+        Self::start_with(scn, case, opts, false)
+    }
+
+    /// As [`Session::start`], keeping a [`SceneView`] of every tick from the first scan
+    /// on (for drawing an episode; a snapshot per tick).
+    pub fn start_viewed(
+        scn: Arc<Scenario>,
+        case: &str,
+        opts: &TrialOptions,
+    ) -> Result<Self, TrialError> {
+        Self::start_with(scn, case, opts, true)
+    }
+
+    fn start_with(
+        scn: Arc<Scenario>,
+        case: &str,
+        opts: &TrialOptions,
+        viewed: bool,
+    ) -> Result<Self, TrialError> {
         let run = scn.resolve(opts)?;
         let case = scn.case(case)?.clone();
         let owner = Owned { scn, run };
         let built = Cell::try_new(owner, |o| -> Result<Live<'_>, Box<TrialOutcome>> {
-            let mut trial = prepare(&o.scn, &case, &o.run, &mut NoRecorder)?;
+            let mut keeper = ScanKeeper::default();
+            let mut trial = if viewed {
+                prepare(&o.scn, &case, &o.run, &mut keeper)?
+            } else {
+                prepare(&o.scn, &case, &o.run, &mut NoRecorder)?
+            };
             let mut at = trial.begin_drive();
-            if let Err(e) = trial.sense_tick(&mut at, &mut NoRecorder) {
+            let sensed = if viewed {
+                trial.sense_tick(&mut at, &mut keeper)
+            } else {
+                trial.sense_tick(&mut at, &mut NoRecorder)
+            };
+            if let Err(e) = sensed {
                 return Err(Box::new(trial.stopped_by(e)));
             }
-            Ok(Live { trial, at })
+            Ok(Live {
+                trial,
+                at,
+                keeper: viewed.then_some(keeper),
+            })
         });
         let last = Observation {
             t_s: 0.0,
@@ -144,9 +186,30 @@ impl Session {
             },
             last,
             truth,
+            view: None,
         };
+        if viewed {
+            session.keep_view();
+        }
         session.observe();
         Ok(session)
+    }
+
+    /// Starts keeping a [`SceneView`] of each tick.
+    fn keep_view(&mut self) {
+        if let Inner::Live(cell) = &mut self.inner {
+            let view = cell.with_dependent_mut(|_, live| {
+                let keeper = live.keeper.get_or_insert_with(ScanKeeper::default);
+                SceneView::of(&live.trial, keeper)
+            });
+            self.view = Some(Box::new(view));
+        }
+    }
+
+    /// The scene as of the observation (kept at the end), for a session started with
+    /// [`Session::start_viewed`].
+    pub fn view(&self) -> Option<&SceneView> {
+        self.view.as_deref()
     }
 
     /// The controller's view now (at the end: the last one).
@@ -194,7 +257,14 @@ impl Session {
         let Inner::Live(cell) = &self.inner else {
             return;
         };
-        let Live { trial: t, at } = cell.borrow_dependent();
+        let Live {
+            trial: t,
+            at,
+            keeper,
+        } = cell.borrow_dependent();
+        if let (Some(view), Some(keeper)) = (&mut self.view, keeper) {
+            **view = SceneView::of(t, keeper);
+        }
         self.last = Observation {
             t_s: t.sim.time_s(),
             time_left_s: (at.deadline_s - t.sim.time_s()).max(0.0),
@@ -231,6 +301,24 @@ impl Live<'_> {
                 speed_mps,
                 steer_rad,
             } => clamped(t, speed_mps, steer_rad),
+            Control::Residual {
+                speed_mps,
+                steer_rad,
+            } => match t.tracker_command(self.at.pose) {
+                Ok(cmd) if t.docked(&cmd) => {
+                    t.timed_out = false;
+                    return Some((t.judged(), SessionEnd::Judged));
+                }
+                Ok(cmd) => {
+                    let c = clamped(t, cmd.speed_mps + speed_mps, cmd.steer_rad + steer_rad);
+                    Command {
+                        speed_mps: c.speed_mps,
+                        steer_rad: c.steer_rad,
+                        ..cmd
+                    }
+                }
+                Err(e) => return Some((t.stopped_by(e), SessionEnd::Judged)),
+            },
         };
         t.step(&cmd, self.at.fix, self.at.pose, &mut NoRecorder);
         if matches!(control, Control::Command { .. }) && t.settled() {
@@ -240,7 +328,11 @@ impl Live<'_> {
         if t.sim.time_s() >= self.at.deadline_s {
             return Some((t.judged(), SessionEnd::TimeLimit));
         }
-        match t.sense_tick(&mut self.at, &mut NoRecorder) {
+        let sensed = match &mut self.keeper {
+            Some(k) => t.sense_tick(&mut self.at, k),
+            None => t.sense_tick(&mut self.at, &mut NoRecorder),
+        };
+        match sensed {
             Ok(()) => None,
             Err(e) => Some((t.stopped_by(e), SessionEnd::Judged)),
         }
