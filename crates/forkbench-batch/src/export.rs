@@ -53,55 +53,82 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
     let mut sorted: Vec<&TrialRecord> = records.iter().collect();
     sorted.sort_by_key(|r| r.key());
     let mut w = csv::Writer::from_writer(Vec::new());
+    // The step criteria's measurements follow the fixed columns, one column each.
+    let measures = forkbench_trial::trial::step_measures();
+    let mut header_written = false;
     let finite = |v: f64| v.is_finite().then_some(v);
     for r in sorted {
         let o = &r.outcome;
-        w.serialize(Row {
-            scenario: csv_text(&o.scenario),
-            case: csv_text(&o.case),
-            planner: csv_text(&o.planner),
-            tracker: csv_text(&o.tracker),
-            trial: r.trial,
-            seed: o.seed,
-            noise: o.noise,
-            replan: r.replan,
-            pallet_noise_scale: r.overrides.pallet_noise_scale,
-            localization_noise_scale: r.overrides.localization_noise_scale,
-            odometry_noise_scale: r.overrides.odometry_noise_scale,
-            success: o.success,
-            failure: o.failure.map_or("", |f| f.name()),
-            failure_detail: csv_text(o.failure_detail.as_deref().unwrap_or("")),
-            lateral_error_m: o.lateral_error_m,
-            heading_error_rad: o.heading_error_rad,
-            final_lateral_error_m: finite(o.final_lateral_error_m),
-            final_heading_error_rad: finite(o.final_heading_error_rad),
-            insertion_depth_m: finite(o.insertion_depth_m),
-            max_steer_rad: o.max_steer_rad,
-            max_contact_force_n: o.max_contact_force_n,
-            pallet_displacement_m: o.pallet_displacement_m,
-            pallet_rotation_rad: o.pallet_rotation_rad,
-            replans: o.replans,
-            replans_failed: o.replans_failed,
-            path_length_m: o.path_length_m,
-            sim_time_s: o.sim_time_s,
-            wall_time_ms: o.wall_time_ms,
-            phases_done: (!o.phases.is_empty())
-                .then(|| o.phases.iter().filter(|p| p.success).count()),
-            failed_phase: o
-                .phases
-                .iter()
-                .find(|p| !p.success)
-                .map_or("", |p| p.name.as_str()),
-            cycle_time_s: o.cycle.map(|c| c.time_s),
-            distance_loaded_m: o.cycle.map(|c| c.distance_loaded_m),
-            distance_unloaded_m: o.cycle.map(|c| c.distance_unloaded_m),
-        })
-        .map_err(|e| csv_error(path, e))?;
+        let (header, mut record) = fields(&row(r, finite)).map_err(|e| csv_error(path, e))?;
+        if !header_written {
+            let mut h = header;
+            h.extend(measures.iter().copied());
+            w.write_record(&h).map_err(|e| csv_error(path, e))?;
+            header_written = true;
+        }
+        for m in &measures {
+            record.push_field(&o.measures.get(*m).map_or(String::new(), |v| v.to_string()));
+        }
+        w.write_record(&record).map_err(|e| csv_error(path, e))?;
     }
     let bytes = w
         .into_inner()
         .map_err(|e| BatchError::Invalid(format!("{}: {e}", path.display())))?;
     super::write_atomic(path, &bytes)
+}
+
+/// A row's column names and values, as csv writes them.
+fn fields(row: &Row<'_>) -> Result<(csv::StringRecord, csv::StringRecord), csv::Error> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.serialize(row)?;
+    let bytes = w.into_inner().map_err(|e| e.into_error())?;
+    let mut rd = csv::Reader::from_reader(bytes.as_slice());
+    let header = rd.headers()?.clone();
+    let record = rd.records().next().transpose()?.unwrap_or_default();
+    Ok((header, record))
+}
+
+fn row<'a>(r: &'a TrialRecord, finite: impl Fn(f64) -> Option<f64>) -> Row<'a> {
+    let o = &r.outcome;
+    Row {
+        scenario: csv_text(&o.scenario),
+        case: csv_text(&o.case),
+        planner: csv_text(&o.planner),
+        tracker: csv_text(&o.tracker),
+        trial: r.trial,
+        seed: o.seed,
+        noise: o.noise,
+        replan: r.replan,
+        pallet_noise_scale: r.overrides.pallet_noise_scale,
+        localization_noise_scale: r.overrides.localization_noise_scale,
+        odometry_noise_scale: r.overrides.odometry_noise_scale,
+        success: o.success,
+        failure: o.failure.map_or("", |f| f.name()),
+        failure_detail: csv_text(o.failure_detail.as_deref().unwrap_or("")),
+        lateral_error_m: o.lateral_error_m,
+        heading_error_rad: o.heading_error_rad,
+        final_lateral_error_m: finite(o.final_lateral_error_m),
+        final_heading_error_rad: finite(o.final_heading_error_rad),
+        insertion_depth_m: finite(o.insertion_depth_m),
+        max_steer_rad: o.max_steer_rad,
+        max_contact_force_n: o.max_contact_force_n,
+        pallet_displacement_m: o.pallet_displacement_m,
+        pallet_rotation_rad: o.pallet_rotation_rad,
+        replans: o.replans,
+        replans_failed: o.replans_failed,
+        path_length_m: o.path_length_m,
+        sim_time_s: o.sim_time_s,
+        wall_time_ms: o.wall_time_ms,
+        phases_done: (!o.phases.is_empty()).then(|| o.phases.iter().filter(|p| p.success).count()),
+        failed_phase: o
+            .phases
+            .iter()
+            .find(|p| !p.success)
+            .map_or("", |p| p.name.as_str()),
+        cycle_time_s: o.cycle.map(|c| c.time_s),
+        distance_loaded_m: o.cycle.map(|c| c.distance_loaded_m),
+        distance_unloaded_m: o.cycle.map(|c| c.distance_unloaded_m),
+    }
 }
 
 fn csv_error(path: &Path, e: csv::Error) -> BatchError {

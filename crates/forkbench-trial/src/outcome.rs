@@ -3,8 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 /// The criteria a pick can fail, in the order they are checked.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Failure {
     /// A mission leg before the pick failed (no drivable path, a collision, or the truck
     /// did not arrive).
@@ -43,6 +42,54 @@ pub enum Failure {
     /// The placed pallet stands farther from its slot, or turned more, than the place
     /// tolerances allow.
     PlacementError,
+    /// A criterion that measures while the truck drives (`trial::STEP_CRITERIA`), by
+    /// its name.
+    Criterion(&'static str),
+}
+
+/// Every failure with a fixed name, for reading names back.
+const NAMED: [Failure; 16] = [
+    Failure::LegFailed,
+    Failure::PlanFailed,
+    Failure::Collision,
+    Failure::ContactForce,
+    Failure::PalletDisplaced,
+    Failure::LateralError,
+    Failure::HeadingError,
+    Failure::Timeout,
+    Failure::InsertionDepth,
+    Failure::ForkOutsidePocket,
+    Failure::Error,
+    Failure::PalletNotFound,
+    Failure::StagingUnreachable,
+    Failure::LiftFailed,
+    Failure::LoadShifted,
+    Failure::PlacementError,
+];
+
+impl Failure {
+    /// The failure a name stands for: a fixed one, or a step criterion's.
+    pub fn from_name(name: &str) -> Option<Failure> {
+        NAMED
+            .iter()
+            .copied()
+            .find(|f| f.name() == name)
+            .or_else(|| crate::trial::step_criterion_name(name).map(Failure::Criterion))
+    }
+}
+
+impl Serialize for Failure {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for Failure {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        Failure::from_name(&name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown failure `{name}`")))
+    }
 }
 
 impl Failure {
@@ -64,6 +111,7 @@ impl Failure {
             Failure::LiftFailed => "lift_failed",
             Failure::LoadShifted => "load_shifted",
             Failure::PlacementError => "placement_error",
+            Failure::Criterion(name) => name,
         }
     }
 }
@@ -134,6 +182,10 @@ pub struct TrialOutcome {
     pub path_length_m: f64,
     pub sim_time_s: f64,
     pub wall_time_ms: f64,
+    /// What the pick's step criteria measured, by name with its unit
+    /// (`fork_tip_clearance_mm`).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub measures: std::collections::BTreeMap<String, f64>,
     /// Every other criterion the trial broke, after the first, each with its value and
     /// limit (`criterion: detail`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -309,6 +361,7 @@ impl TrialOutcome {
             legs: Vec::new(),
             phases: Vec::new(),
             cycle: None,
+            measures: std::collections::BTreeMap::new(),
             also_failed: Vec::new(),
             likely_cause: None,
         }

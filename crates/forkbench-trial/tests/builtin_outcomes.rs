@@ -52,8 +52,9 @@ fn rerun(want: &Value) -> Value {
     let m = v.as_object_mut().expect("object");
     m.remove("wall_time_ms");
     // Fields the records predate (pallet-estimate counts and errors, every broken
-    // criterion and the likely cause).
+    // criterion and the likely cause, the step criteria's measures).
     for later in [
+        "measures",
         "estimates",
         "estimates_missed",
         "estimate_lateral_error_m",

@@ -49,6 +49,14 @@ fn legs_table(o: &TrialOutcome) -> String {
     s + "\n"
 }
 
+/// The step criteria's measurements as rows of the verdict's table (`measure | value`).
+fn measures_rows(o: &TrialOutcome) -> String {
+    o.measures
+        .iter()
+        .map(|(k, v)| format!("| {} | {v:.1} | |\n", k.replace('_', " ")))
+        .collect()
+}
+
 /// The handling cycle's phases: each one's verdict, time, distance and load.
 fn phases_table(o: &TrialOutcome) -> String {
     if o.phases.is_empty() {
@@ -149,16 +157,14 @@ impl RerunRecorder {
 
     /// The verdict view's text: the outcome first, then what the map's colours mean.
     fn verdict_text(&self, o: &TrialOutcome) -> String {
+        let failure = o.failure.map_or("unknown", |f| f.name());
         let head = if o.success {
             "#### ✅ SUCCESS".to_owned()
         } else {
-            format!(
-                "#### ❌ FAILED: {}",
-                o.failure.map_or("unknown", |f| f.name())
-            )
+            format!("#### ❌ FAILED: {failure}")
         };
-        // The first failed criterion, the likely cause, then every other one broken.
-        // A tight list, so the whole verdict fits its panel.
+        // The first failed criterion, the likely cause, then every other one broken: a
+        // tight list, so the whole verdict fits its panel.
         let mut detail = o.failure_detail.clone().unwrap_or_default();
         if let Some(c) = &o.likely_cause {
             detail += &format!("\n- **likely cause:** {c}");
@@ -199,7 +205,7 @@ impl RerunRecorder {
              | lateral offset | {} | {lat_limit} m |\n\
              | heading | {} | {head_limit}° |\n\
              | fork depth | {:.3} m | |\n\
-             | max contact force | {:.0} N | |\n\n\
+             | max contact force | {:.0} N | |\n{}\n\
              {}**{}** · case `{}` · planner `{}` · tracker `{}` · seed {} · {:.2} s simulated, {} replans\n\n\
              Map (y up, 1 m grid): white arrow start · light-blue arrow goal (pre-entry) · \
              blue plan being driven (thin: its control polygon), faded plans superseded · \
@@ -216,6 +222,7 @@ impl RerunRecorder {
             num(o.heading_error_rad, &|v| format!("{:.2}°", v.to_degrees())),
             o.insertion_depth_m,
             o.max_contact_force_n,
+            measures_rows(o),
             legs_table(o),
             o.scenario,
             o.case,

@@ -226,6 +226,7 @@ impl<'a> Trial<'a> {
                 .max_contact_force_n
                 .max(self.sim.fork_contact_force_n());
         }
+        self.observe_step_criteria(root, pallet_now, rec);
         let local = in_pallet_frame(&pallet_now, &root);
         if self.out.lateral_error_m.is_none()
             && depth >= 0.0
@@ -241,6 +242,32 @@ impl<'a> Trial<'a> {
                     local.y_m, local.heading_rad
                 ),
             );
+        }
+    }
+
+    /// Each step criterion's view of this step, and its measurement recorded at the
+    /// signal rate under `criteria/<measure>`.
+    fn observe_step_criteria<R: Recorder + ?Sized>(
+        &mut self,
+        fork_root: Pose2,
+        pallet_pose: Pose2,
+        rec: &mut R,
+    ) {
+        let t_s = self.sim.time_s();
+        let view = super::step_criteria::StepView {
+            t_s,
+            truck: &self.scn.truck,
+            pallet: &self.scn.pallet,
+            fork_root,
+            pallet_pose,
+        };
+        let record = ((t_s / self.sim.dt_s()).round() as u64).is_multiple_of(SIGNAL_EVERY_STEPS);
+        for c in &mut self.step_criteria {
+            c.observe(&view);
+            if let (true, Some(v)) = (record, c.value()) {
+                let path = format!("criteria/{}", c.measure());
+                rec.signal(t_s, &path, &Signal::Scalar(v), Style::default());
+            }
         }
     }
 

@@ -6,6 +6,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::criteria::Judged;
 use super::setup::Trial;
+use crate::outcome::Failure;
 use crate::text::compact_numbers;
 
 /// The pallet pose moved by a draw of N(0, σ) per axis in its own frame, truncated at 3σ.
@@ -40,7 +41,16 @@ impl Trial<'_> {
             timeout_s: self.scn.timeout_s,
             worst_pocket_miss_m: worst_pocket_miss,
         };
-        let mut broken = super::criteria::broken(&judged).into_iter();
+        let mut broken = super::criteria::broken(&judged);
+        for c in &self.step_criteria {
+            if let Some(v) = c.value() {
+                self.out.measures.insert(c.measure().to_owned(), v);
+            }
+            if let Some(why) = c.broken() {
+                broken.push((Failure::Criterion(c.name()), why));
+            }
+        }
+        let mut broken = broken.into_iter();
         match broken.next() {
             Some((f, why)) => {
                 self.out.also_failed = broken

@@ -17,6 +17,7 @@ mod session;
 mod session_view;
 mod setup;
 mod staging;
+mod step_criteria;
 
 use std::time::Instant;
 
@@ -37,6 +38,9 @@ pub use phases::{
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use session_view::SceneView;
 pub use setup::Trial;
+pub use step_criteria::{
+    STEP_CRITERIA, StepCriterion, StepView, step_criterion_name, step_measures,
+};
 
 /// Gap between the fork tips and the pallet face at the end of the approach curve: the
 /// default of `[pick] pre_entry_gap_m`.

@@ -384,7 +384,12 @@ impl Trial<'_> {
             .scn
             .truck
             .insertion_depth_m(&pallet, &self.sim.fork_root_pose());
+        let step_broken = self
+            .step_criteria
+            .iter()
+            .any(|c| c.irreversible() && c.broken().is_some());
         self.collision
+            || step_broken
             || out.max_contact_force_n > tol.contact_force_n
             || moved
             || entry_off

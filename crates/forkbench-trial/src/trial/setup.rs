@@ -64,6 +64,8 @@ pub struct Trial<'a> {
     pub(super) detector: Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
     pub(super) collision: bool,
     pub(super) timed_out: bool,
+    /// The pick's criteria that measure at every step.
+    pub(super) step_criteria: Vec<Box<dyn super::step_criteria::StepCriterion>>,
     /// The odometry's speed-scale error and steering offset for this trial.
     pub(super) odometry_error: (f64, f64),
     /// Localisation over the whole trial, and over the current mission leg.
@@ -303,6 +305,7 @@ impl<'a> Trial<'a> {
             detector,
             collision: false,
             timed_out: true,
+            step_criteria: super::step_criteria::build_all(),
             odometry_error: odometry_error(run),
             loc: LocStats::new(0.0),
             leg_loc: LocStats::new(0.0),
