@@ -107,11 +107,14 @@ class _Actions:
         speed, steer = scn.command_limits
         if mode == "residual":
             lim = [float(x) for x in residual_limits]
-            if len(lim) != 2 or not all(0.0 < x <= 10.0 for x in lim):
+            # A correction beyond twice the truck's limit cannot act: the sum is clamped.
+            top = (2 * speed, 2 * steer)
+            if len(lim) != 2 or not all(0.0 < x <= t for x, t in zip(lim, top)):
                 raise ValueError(
-                    f"residual_limits {residual_limits!r}: two bounds (m/s, rad) in (0, 10]"
+                    f"residual_limits {residual_limits!r}: two bounds, speed in (0, {top[0]:g}] "
+                    f"m/s and steering in (0, {top[1]:g}] rad (twice the truck's limits)"
                 )
-            speed, steer = min(lim[0], 2 * speed), min(lim[1], 2 * steer)
+            speed, steer = lim[0], lim[1]
         self.residual = mode == "residual"
         self.normalize = normalize
         self.bounds = np.array([speed, steer], dtype=np.float64)

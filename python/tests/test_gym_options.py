@@ -49,6 +49,8 @@ def test_normalised_actions_map_onto_the_bounds():
         PalletPickEnv(action_mode="torque")
     with pytest.raises(ValueError, match="residual_limits"):
         PalletPickEnv(action_mode="residual", residual_limits=(0.0, 0.1))
+    with pytest.raises(ValueError, match="twice the truck's limits"):
+        PalletPickEnv(action_mode="residual", residual_limits=(5.0, 0.1))
     with pytest.raises(ValueError, match="render_size"):
         PalletPickEnv(render_mode="rgb_array", render_size=(4, 4))
 
