@@ -330,6 +330,23 @@ fn detect_reports_malformed_scans_truncated_bags_and_missing_topics() {
         let ch = w
             .add_channel(schema, "/scan", "cdr", &BTreeMap::new())
             .expect("channel");
+        // A transform message cut short: reported, not skipped.
+        let tf_schema = w
+            .add_schema("tf2_msgs/msg/TFMessage", "ros2msg", b"")
+            .expect("schema");
+        let tf = w
+            .add_channel(tf_schema, "/tf", "cdr", &BTreeMap::new())
+            .expect("channel");
+        let mut c = CdrWriter::new();
+        c.u32(3);
+        let tf_header = mcap::records::MessageHeader {
+            channel_id: tf,
+            sequence: 0,
+            log_time: 0,
+            publish_time: 0,
+        };
+        w.write_to_known_channel(&tf_header, &c.into_bytes())
+            .expect("message");
         for (i, angle_max) in [1.0f32, 2.0, 1.0].iter().enumerate() {
             let mut c = CdrWriter::new();
             c.i32(i as i32);
@@ -364,6 +381,17 @@ fn detect_reports_malformed_scans_truncated_bags_and_missing_topics() {
             && err.contains("150.0 increments, but the scan has 101 ranges"),
         "{err}"
     );
+    // The summary counts the transform message that could not be decoded.
+    let out = detect(&[
+        bag.to_str().expect("utf-8"),
+        "--out",
+        lines.to_str().expect("utf-8"),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let summary: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("the summary is still printed");
+    assert_eq!(summary["bad_transforms"], 1, "{summary}");
     assert_eq!(
         std::fs::read_to_string(&lines)
             .expect("lines")

@@ -149,6 +149,12 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
             tally.errors[0]
         );
     }
+    if let Some(first) = &summary.first_bad_transform {
+        bail!(
+            "{} transform messages could not be decoded (scans that needed them found no transform); the first: {first}",
+            summary.bad_transforms
+        );
+    }
     Ok(())
 }
 
@@ -263,6 +269,7 @@ fn report(
             "scans": n,
             "found": t.found,
             "unusable": t.errors.len(),
+            "bad_transforms": summary.bad_transforms,
             "seconds": t.seconds,
             "scans_per_s": rate,
             "scores": scores,

@@ -47,6 +47,12 @@ pub enum BagEvent {
         topic: String,
         reason: String,
     },
+    /// A transform message that could not be decoded, and why (the reading goes on;
+    /// scans that needed it find no transform).
+    BadTransform {
+        topic: String,
+        reason: String,
+    },
 }
 
 /// The kinds of topic read; others are passed over.
@@ -71,6 +77,9 @@ fn kind(schema: &str, encoding: &str) -> Option<Kind> {
 pub struct BagSummary {
     pub scan_topics: BTreeMap<String, usize>,
     pub topics: BTreeMap<String, String>,
+    /// Transform messages that could not be decoded, and the first one's topic and reason.
+    pub bad_transforms: usize,
+    pub first_bad_transform: Option<String>,
 }
 
 /// The MCAP files of a recording: `path` itself, or a rosbag2 directory's `*.mcap` files
@@ -189,7 +198,14 @@ impl State {
 
 fn decode(topic: &str, k: Kind, data: &[u8]) -> Vec<BagEvent> {
     let scan = match k {
-        Kind::Ros2Tf => return transforms(data).unwrap_or_default(),
+        Kind::Ros2Tf => {
+            return transforms(data).unwrap_or_else(|e| {
+                vec![BagEvent::BadTransform {
+                    topic: topic.to_owned(),
+                    reason: e.to_string(),
+                }]
+            });
+        }
         Kind::Ros2Scan => ros2_scan(data),
         Kind::FoxgloveScan => foxglove_scan(data),
     };

@@ -67,6 +67,7 @@ pub fn detect_bag(
     let mut frames = Frames::default();
     let mut index = 0;
     let mut failed: Option<DetectorError> = None;
+    let mut bad_tf: (usize, Option<String>) = (0, None);
     let mut each = |e: BagEvent| {
         if failed.is_some() {
             return;
@@ -77,6 +78,11 @@ pub fn detect_bag(
                 child,
                 pose,
             } => return frames.set(&parent, &child, pose),
+            BagEvent::BadTransform { topic, reason } => {
+                bad_tf.0 += 1;
+                bad_tf.1.get_or_insert(format!("{topic}: {reason}"));
+                return;
+            }
             BagEvent::Malformed { topic, reason } => blank(index, topic, Some(reason)),
             BagEvent::Scan(s) => match one(&s, opts, &frames, detector, pallet, index) {
                 Ok(r) => r,
@@ -97,6 +103,7 @@ pub fn detect_bag(
         }
         summary.topics.extend(part.topics);
     }
+    (summary.bad_transforms, summary.first_bad_transform) = bad_tf;
     match failed {
         Some(e) => Err(e.into()),
         None => Ok(summary),
