@@ -108,7 +108,7 @@ impl Core {
     /// not draw, or the episode ended before its first tick.
     pub(crate) fn frame(&self, s: &Setup) -> Option<(Vec<u8>, [u32; 2])> {
         let (size, window, view) = (s.render?, self.window?, self.session.view()?);
-        let pixels = crate::render::draw(view, &s.scn.truck, &s.scn.pallet, window, size);
+        let pixels = crate::render::draw(&view, &s.scn.truck, &s.scn.pallet, window, size);
         Some((pixels, size))
     }
 

@@ -370,10 +370,6 @@ mod tests {
         }
     }
 
-    fn pallet_boxes(p: &PalletSpec, face: &Pose2) -> Vec<(Pose2, f64, f64)> {
-        p.part_boxes(face)
-    }
-
     fn ideal(world: &Boxes) -> Scan {
         let cfg = ScannerConfig::tim561();
         scan::<rand::rngs::ThreadRng>(&cfg, world, Pose2::new(0.0, 0.0, 0.0), Errors::Ideal)
@@ -395,7 +391,7 @@ mod tests {
             Pose2::new(6.5, 1.5, -15f64.to_radians()),
             Pose2::new(2.0, -0.4, 0.0),
         ] {
-            let world = Boxes(pallet_boxes(&p, &truth));
+            let world = Boxes(p.part_boxes(&truth));
             let d = detect(&DetectorConfig::default(), &ideal(&world), &p, None).expect("found");
             assert_eq!(d.stringers, 3);
             // Exact up to the beam spacing: each stringer's edges are known to within
@@ -410,7 +406,7 @@ mod tests {
     fn a_hidden_stringer_leaves_two_and_the_prior_decides() {
         let p = PalletSpec::field_1200();
         let truth = Pose2::new(4.0, 0.0, 0.0);
-        let mut boxes = pallet_boxes(&p, &truth);
+        let mut boxes = p.part_boxes(&truth);
         // An upright in front of the right-hand stringer (negative y).
         let y = -p.edge_part_m().1;
         boxes.push((Pose2::new(3.0, y, 0.0), 0.1, 0.3));
@@ -444,7 +440,7 @@ mod tests {
         use rand::SeedableRng;
         let p = PalletSpec::field_1200();
         let truth = Pose2::new(4.0, 0.3, 10f64.to_radians());
-        let world = Boxes(pallet_boxes(&p, &truth));
+        let world = Boxes(p.part_boxes(&truth));
         let cfg = ScannerConfig::tim561();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let mut heading_errors = Vec::new();

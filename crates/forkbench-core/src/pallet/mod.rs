@@ -165,49 +165,43 @@ impl PalletSpec {
             .collect()
     }
 
-    /// The material across the entry face, as lateral intervals `[right, left]`: the right
-    /// edge part, the centre part and the left edge part around the two pockets.
-    pub fn face_solids(&self) -> [[f64; 2]; 3] {
+    /// The three parts across the entry face, right to left, as (centre, width) across
+    /// it: a stringer pallet's stringers as built, or the material between a block
+    /// pallet's pockets.
+    fn face_parts(&self) -> [(f64, f64); 3] {
+        if self.blocks.is_empty() {
+            let sw = self.stringer_width_m();
+            let o = (self.width_m - sw) / 2.0;
+            return [(-o, sw), (0.0, sw), (o, sw)];
+        }
         let (h, o, p) = (
             self.width_m / 2.0,
             self.pocket_centre_m(),
             self.pocket_width_m / 2.0,
         );
-        if self.blocks.is_empty() {
-            let sw = self.stringer_width_m();
-            let c = (self.width_m - sw) / 2.0;
-            let w = sw / 2.0;
-            return [[-c - w, -c + w], [-w, w], [c - w, c + w]];
-        }
-        [[-h, -o - p], [-(o - p), o - p], [o + p, h]]
+        [[-h, -o - p], [-(o - p), o - p], [o + p, h]].map(|[lo, hi]| ((lo + hi) / 2.0, hi - lo))
+    }
+
+    /// The material across the entry face, as lateral intervals `[right, left]`: the right
+    /// edge part, the centre part and the left edge part around the two pockets.
+    pub fn face_solids(&self) -> [[f64; 2]; 3] {
+        self.face_parts().map(|(c, w)| [c - w / 2.0, c + w / 2.0])
     }
 
     /// The face's two edge parts: their width, and their centres' offset from the axis.
     pub fn edge_part_m(&self) -> (f64, f64) {
-        if self.blocks.is_empty() {
-            let sw = self.stringer_width_m();
-            return (sw, (self.width_m - sw) / 2.0);
-        }
-        let [_, _, [lo, hi]] = self.face_solids();
-        (hi - lo, (lo + hi) / 2.0)
+        let (c, w) = self.face_parts()[2];
+        (w, c)
     }
 
     /// The face parts' centres across the face, right to left.
     pub fn face_part_centres_m(&self) -> [f64; 3] {
-        let (_, o) = self.edge_part_m();
-        if self.blocks.is_empty() {
-            return [-o, 0.0, o];
-        }
-        self.face_solids().map(|[lo, hi]| (lo + hi) / 2.0)
+        self.face_parts().map(|(c, _)| c)
     }
 
     /// Width of the face's centre part.
     pub fn centre_part_width_m(&self) -> f64 {
-        if self.blocks.is_empty() {
-            return self.stringer_width_m();
-        }
-        let [_, [lo, hi], _] = self.face_solids();
-        hi - lo
+        self.face_parts()[1].1
     }
 
     pub fn validate(&self) -> Result<(), crate::SettingsError> {

@@ -32,21 +32,18 @@ pub(super) fn resolve(
             }
         }
     };
-    let at = if f.pallet_model.is_some() {
+    let custom = f.pallet_model.is_some();
+    let at = if custom {
         "[pallet_model]"
     } else {
         "pallet_entry"
     };
     let spec = model.entered_from(face).map_err(|e| {
-        let field = match e.field.as_deref() {
-            Some("pallet_entry") => "pallet_entry".to_owned(),
-            Some(k) => format!("pallet_model.{k}"),
-            None => "pallet_model".to_owned(),
-        };
-        let field = if f.pallet_model.is_none() && field != "pallet_entry" {
-            "pallet_kind".to_owned()
-        } else {
-            field
+        let field = match (e.field.as_deref(), custom) {
+            (Some("pallet_entry"), _) => "pallet_entry".to_owned(),
+            (_, false) => "pallet_kind".to_owned(),
+            (Some(k), true) => format!("pallet_model.{k}"),
+            (None, true) => "pallet_model".to_owned(),
         };
         invalid(&at_line(file, text, at), &field, &e.reason)
     })?;

@@ -13,7 +13,7 @@ use super::setup::Trial;
 use super::{Resolved, TrialOptions, goal_for, prepare};
 use crate::TrialError;
 use crate::outcome::{Failure, TrialOutcome};
-use crate::recorder::NoRecorder;
+use crate::recorder::{NoRecorder, Recorder};
 use crate::scenario::Scenario;
 
 /// What a session owns for its trial to borrow.
@@ -28,7 +28,7 @@ struct Owned {
 struct Live<'a> {
     trial: Trial<'a>,
     at: DriveState,
-    /// Set once the session's caller asks for views: the scans it keeps for them.
+    /// For a session started viewed: the scans its views draw.
     keeper: Option<ScanKeeper>,
 }
 
@@ -105,8 +105,9 @@ pub struct Session {
     inner: Inner,
     last: Observation,
     truth: Truth,
-    /// The scene as of the observation, for a session started viewed.
-    view: Option<Box<SceneView>>,
+    /// The scene at the end, for a session started viewed (while live it is drawn from
+    /// the trial when asked for).
+    final_view: Option<Box<SceneView>>,
 }
 
 #[derive(Debug)]
@@ -143,19 +144,12 @@ impl Session {
         let case = scn.case(case)?.clone();
         let owner = Owned { scn, run };
         let built = Cell::try_new(owner, |o| -> Result<Live<'_>, Box<TrialOutcome>> {
-            let mut keeper = ScanKeeper::default();
-            let mut trial = if viewed {
-                prepare(&o.scn, &case, &o.run, &mut keeper)?
-            } else {
-                prepare(&o.scn, &case, &o.run, &mut NoRecorder)?
-            };
+            // Starting is not the hot path: one recorder, the keeper or none.
+            let (mut keeper, mut none) = (ScanKeeper::default(), NoRecorder);
+            let rec: &mut dyn Recorder = if viewed { &mut keeper } else { &mut none };
+            let mut trial = prepare(&o.scn, &case, &o.run, rec)?;
             let mut at = trial.begin_drive();
-            let sensed = if viewed {
-                trial.sense_tick(&mut at, &mut keeper)
-            } else {
-                trial.sense_tick(&mut at, &mut NoRecorder)
-            };
-            if let Err(e) = sensed {
+            if let Err(e) = trial.sense_tick(&mut at, rec) {
                 return Err(Box::new(trial.stopped_by(e)));
             }
             Ok(Live {
@@ -186,30 +180,22 @@ impl Session {
             },
             last,
             truth,
-            view: None,
+            final_view: None,
         };
-        if viewed {
-            session.keep_view();
-        }
         session.observe();
         Ok(session)
     }
 
-    /// Starts keeping a [`SceneView`] of each tick.
-    fn keep_view(&mut self) {
-        if let Inner::Live(cell) = &mut self.inner {
-            let view = cell.with_dependent_mut(|_, live| {
-                let keeper = live.keeper.get_or_insert_with(ScanKeeper::default);
-                SceneView::of(&live.trial, keeper)
-            });
-            self.view = Some(Box::new(view));
+    /// The scene as of the observation (the last one at the end), for a session started
+    /// with [`Session::start_viewed`].
+    pub fn view(&self) -> Option<SceneView> {
+        match &self.inner {
+            Inner::Live(cell) => {
+                let live = cell.borrow_dependent();
+                live.keeper.as_ref().map(|k| SceneView::of(&live.trial, k))
+            }
+            Inner::Ended(..) => self.final_view.as_deref().cloned(),
         }
-    }
-
-    /// The scene as of the observation (kept at the end), for a session started with
-    /// [`Session::start_viewed`].
-    pub fn view(&self) -> Option<&SceneView> {
-        self.view.as_deref()
     }
 
     /// The controller's view now (at the end: the last one).
@@ -249,6 +235,7 @@ impl Session {
         let end = cell.with_dependent_mut(|_, live| live.tick(control));
         self.observe();
         let (out, end) = end?;
+        self.final_view = self.view().map(Box::new);
         self.inner = Inner::Ended(Box::new(out), end);
         Some(end)
     }
@@ -257,14 +244,7 @@ impl Session {
         let Inner::Live(cell) = &self.inner else {
             return;
         };
-        let Live {
-            trial: t,
-            at,
-            keeper,
-        } = cell.borrow_dependent();
-        if let (Some(view), Some(keeper)) = (&mut self.view, keeper) {
-            **view = SceneView::of(t, keeper);
-        }
+        let Live { trial: t, at, .. } = cell.borrow_dependent();
         self.last = Observation {
             t_s: t.sim.time_s(),
             time_left_s: (at.deadline_s - t.sim.time_s()).max(0.0),

@@ -1,5 +1,6 @@
 //! Fork-tip clearance: the least lateral gap between a fork and the pallet's solid parts beside it while the tips are inside the pallet, in millimetres.
 
+use forkbench_core::pallet::PalletBlock;
 use forkbench_core::units::wrap_angle;
 
 use super::{StepCriterion, StepView};
@@ -14,6 +15,9 @@ const MAX_TURN_RAD: f64 = 0.35;
 #[derive(Debug, Default)]
 struct ForkTipClearance {
     least_mm: Option<f64>,
+    /// The pallet's parts, taken at the first step (a trial's pallet keeps its parts), so
+    /// each step does not build them again.
+    parts: Vec<PalletBlock>,
 }
 
 pub(super) fn build() -> Box<dyn StepCriterion> {
@@ -34,7 +38,10 @@ impl StepCriterion for ForkTipClearance {
     }
 
     fn observe(&mut self, v: &StepView<'_>) {
-        if let Some(gap_m) = clearance_m(v) {
+        if self.parts.is_empty() {
+            self.parts = v.pallet.parts();
+        }
+        if let Some(gap_m) = clearance_m(v, &self.parts) {
             let mm = gap_m * 1e3;
             self.least_mm = Some(self.least_mm.map_or(mm, |l| l.min(mm)));
         }
@@ -60,7 +67,7 @@ impl StepCriterion for ForkTipClearance {
 /// part the fork's centre line runs into is not beside it: that fork is not in a pocket,
 /// which the contact and entry criteria judge. `None` while the tips are outside the
 /// pallet.
-fn clearance_m(v: &StepView<'_>) -> Option<f64> {
+fn clearance_m(v: &StepView<'_>, parts: &[PalletBlock]) -> Option<f64> {
     let (truck, pallet) = (v.truck, v.pallet);
     let rel = v.pallet_pose.to_local(&v.fork_root);
     let (s, c) = wrap_angle(rel.heading_rad).sin_cos();
@@ -80,7 +87,7 @@ fn clearance_m(v: &StepView<'_>) -> Option<f64> {
         }
         let y_at = |x: f64| root[1] + (x - root[0]) * s / c;
         let inside = [root[0].max(0.0), tip_x.min(pallet.depth_m)];
-        for part in pallet.parts() {
+        for part in parts {
             let ([x0, x1], [y0, y1]) = (part.x_range(), part.y_range());
             let (a, b) = (inside[0].max(x0), inside[1].min(x1));
             if a > b {
