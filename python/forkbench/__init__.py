@@ -13,6 +13,7 @@ from typing import Any
 
 from ._forkbench import (
     OBSERVATION_FIELDS,
+    STAGE_FIELD,
     BatchError,
     PickEnv,
     PickVecEnv,
@@ -27,6 +28,7 @@ from ._forkbench import (
 
 __all__ = [
     "OBSERVATION_FIELDS",
+    "STAGE_FIELD",
     "BatchError",
     "PickEnv",
     "PickVecEnv",

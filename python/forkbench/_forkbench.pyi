@@ -10,6 +10,7 @@ from typing_extensions import TypeAlias
 
 __version__: str
 OBSERVATION_FIELDS: list[str]
+STAGE_FIELD: str
 
 Outcome: TypeAlias = dict[str, Any]
 """A judged trial: the CLI's `trial --json` record (a batch's also has `trial`, `replan`)."""
@@ -108,6 +109,8 @@ class PickEnv:
         path_spacing_m: float = 0.5,
         reward: Reward = (10.0, 10.0, 0.1, 1.0),
         render_size: tuple[int, int] | None = None,
+        episode: str = "pick",
+        phase_reward: float | None = None,
     ) -> None: ...
     @property
     def observation_size(self) -> int: ...
@@ -135,6 +138,8 @@ class PickVecEnv:
         path_spacing_m: float = 0.5,
         reward: Reward = (10.0, 10.0, 0.1, 1.0),
         threads: int | None = None,
+        episode: str = "pick",
+        phase_reward: float | None = None,
     ) -> None: ...
     @property
     def num_envs(self) -> int: ...

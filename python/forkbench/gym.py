@@ -41,6 +41,28 @@ plus 1 m per radian of heading error; minus 0.1 per simulated second; plus 10 wh
 trial is judged a success, minus 10 when judged a failure before the time limit (0 at
 the time limit). ``reward=(success, failure, time_per_s, heading_m_per_rad)`` changes the
 weights.
+
+Whole cycles: ``episode="cycle"`` makes an episode the scenario's whole handling cycle,
+every tick of it the agent's: the mission's legs, a staging drive, the pick, and each
+phase the scenario lists after it (lift, reverse out, carry, place, return). The
+observation gains a field after the 13 fixed ones, ``forkbench.STAGE_FIELD``: 0 on a
+mission leg, 1 staging, 2 the pick, 2 + k the k-th phase after the pick. The agent's
+action acts on every stage (``"residual"`` corrects each stage's own controller: the
+legs' path follower, the pick's tracker, a phase's commands). The episode is terminated
+at the cycle's verdict (a failed phase ends it) and truncated at a time limit (the pick's
+or a phase's). Its reward, per part:
+
+- legs and staging: minus ``time_per_s`` per simulated second;
+- the pick: as above, the potential's decrease and the time;
+- leaving the pick or a phase for the next (the cycle only goes on past a success):
+  plus ``phase_reward`` (default 2.0) for each part passed, and for the last part at a
+  successful end; the phases after the pick: minus ``time_per_s`` per second;
+- the end: plus ``success`` for a successful cycle, minus ``failure`` for a failed one
+  (0 at a time limit).
+
+``info["outcome"]`` is then the cycle's outcome, equal to `run_trial`'s for the same
+seed when every step is `expert_step`. ``phase_reward`` with ``episode="pick"`` is
+refused.
 """
 
 from __future__ import annotations
@@ -176,6 +198,8 @@ class PalletPickEnv(gymnasium.Env):
         normalize_actions: bool = False,
         action_mode: str = "command",
         residual_limits: Sequence[float] = (0.3, 0.3),
+        episode: str = "pick",
+        phase_reward: float | None = None,
     ) -> None:
         modes = _render_modes()
         if render_mode is not None and render_mode not in modes:
@@ -201,6 +225,8 @@ class PalletPickEnv(gymnasium.Env):
             path_spacing_m=path_spacing_m,
             reward=_reward(reward),
             render_size=None if render_mode is None else _render_size(render_size),
+            episode=episode,
+            phase_reward=phase_reward,
         )
         self.observation_space, self.action_space = _spaces(
             self._core.observation_size, self._actions
@@ -316,6 +342,8 @@ class PalletPickVectorEnv(VectorEnv):
         normalize_actions: bool = False,
         action_mode: str = "command",
         residual_limits: Sequence[float] = (0.3, 0.3),
+        episode: str = "pick",
+        phase_reward: float | None = None,
     ) -> None:
         self.scenario = _scenario(scenario)
         self._actions = _Actions(self.scenario, action_mode, normalize_actions, residual_limits)
@@ -332,6 +360,8 @@ class PalletPickVectorEnv(VectorEnv):
             path_spacing_m=path_spacing_m,
             reward=_reward(reward),
             threads=threads,
+            episode=episode,
+            phase_reward=phase_reward,
         )
         self.num_envs = num_envs
         self.single_observation_space, self.single_action_space = _spaces(

@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use forkbench_trial::trial::{Control, Session, SessionEnd};
+use forkbench_trial::trial::{Control, Episode, Session, SessionEnd, Stage};
 use forkbench_trial::{Scenario as Inner, TrialError, TrialOptions};
 use numpy::{IntoPyArray, PyArray1, PyArray3};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -29,6 +29,8 @@ pub(crate) struct Setup {
     ticks_per_step: u32,
     /// Frame size (width, height) when episodes are drawn; `None`: no views kept.
     pub(crate) render: Option<[u32; 2]>,
+    /// The pick alone, or the whole cycle.
+    episode: Episode,
 }
 
 /// One environment: the episode's session and the reward's running potential.
@@ -36,6 +38,8 @@ pub(crate) struct Setup {
 pub(crate) struct Core {
     session: Session,
     potential: f64,
+    /// Parts of the cycle rewarded as passed so far (the pick and the phases).
+    passed: usize,
     seed: u64,
     case: String,
     /// Where the episode is drawn, when it is.
@@ -56,11 +60,8 @@ impl Core {
             seed: Some(seed),
             ..s.opts.clone()
         };
-        let session = if s.render.is_some() {
-            Session::start_viewed(s.scn.clone(), case, &opts)?
-        } else {
-            Session::start(s.scn.clone(), case, &opts)?
-        };
+        let session =
+            Session::start_episode(s.scn.clone(), case, &opts, s.episode, s.render.is_some())?;
         let potential = s.reward.distance(session.truth());
         let window = session
             .view()
@@ -68,6 +69,7 @@ impl Core {
         Ok(Core {
             session,
             potential,
+            passed: 0,
             seed,
             case: case.to_owned(),
             window,
@@ -83,17 +85,28 @@ impl Core {
     pub(crate) fn step(&mut self, s: &Setup, control: Control) -> StepOut {
         let mut out = StepOut::default();
         for _ in 0..s.ticks_per_step {
-            let t0 = self.session.observation().t_s;
+            let (t0, before) = {
+                let o = self.session.observation();
+                (o.t_s, o.stage)
+            };
             let end = match self.session.ended() {
                 Some((_, end)) => Some(end),
                 None => self.session.step(control),
             };
-            let now = s.reward.distance(self.session.truth());
-            let dt = self.session.observation().t_s - t0;
-            out.reward += self.potential - now - s.reward.time_per_s * dt;
-            self.potential = now;
+            let o = self.session.observation();
+            out.reward -= s.reward.time_per_s * (o.t_s - t0);
+            out.reward += self.progress(s, before, o.stage);
             if let Some(end) = end {
                 if let Some((o, _)) = self.session.ended() {
+                    let passed = if o.phases.is_empty() {
+                        usize::from(o.success)
+                    } else {
+                        o.phases.iter().filter(|p| p.success).count()
+                    };
+                    if s.episode == Episode::Cycle && passed > self.passed {
+                        out.reward += s.reward.phase * (passed - self.passed) as f64;
+                        self.passed = passed;
+                    }
                     out.reward += s.reward.terminal(o, end);
                 }
                 out.terminated = end == SessionEnd::Judged;
@@ -102,6 +115,28 @@ impl Core {
             }
         }
         out
+    }
+
+    /// The shaping of one tick that went from stage `before` to `now`: during the pick,
+    /// the potential's decrease; on leaving the pick or a phase (a whole cycle goes on
+    /// only past a success), the phase reward.
+    fn progress(&mut self, s: &Setup, before: Stage, now: Stage) -> f64 {
+        let mut reward = 0.0;
+        if now == Stage::Pick {
+            let d = s.reward.distance(self.session.truth());
+            if before == Stage::Pick {
+                reward += self.potential - d;
+            }
+            self.potential = d;
+        }
+        if let (Stage::Pick | Stage::Phase(_), Stage::Phase(k)) = (before, now)
+            && before != now
+        {
+            let passed = usize::from(k);
+            reward += s.reward.phase * passed.saturating_sub(self.passed) as f64;
+            self.passed = self.passed.max(passed);
+        }
+        reward
     }
 
     /// The episode drawn at the setup's frame size (RGB rows); `None` when the setup does
@@ -146,6 +181,7 @@ pub(crate) fn setup(
     path_points: usize,
     path_spacing_m: f64,
     reward: (f64, f64, f64, f64),
+    (episode, phase_reward): (&str, Option<f64>),
 ) -> PyResult<Setup> {
     let scn = scenario.inner.clone();
     if let Some(c) = &case {
@@ -169,6 +205,7 @@ pub(crate) fn setup(
             "path_points {path_points}: at most {MAX_PATH_POINTS}"
         )));
     }
+    let (episode, phase) = episode_of(episode, phase_reward)?;
     let (success, failure, time_per_s, heading_m_per_rad) = reward;
     if ![success, failure, time_per_s, heading_m_per_rad]
         .iter()
@@ -181,6 +218,7 @@ pub(crate) fn setup(
         case,
         opts,
         obs: ObsConfig {
+            stage: episode == Episode::Cycle,
             path_points,
             path_spacing_m,
         },
@@ -189,10 +227,40 @@ pub(crate) fn setup(
             failure,
             time_per_s,
             heading_m_per_rad,
+            phase,
         },
         ticks_per_step,
         render: None,
+        episode,
     })
+}
+
+/// The episode's extent and its phase reward: `phase_reward` only for whole cycles.
+fn episode_of(episode: &str, phase_reward: Option<f64>) -> PyResult<(Episode, f64)> {
+    let episode = match episode {
+        "pick" => Episode::Pick,
+        "cycle" => Episode::Cycle,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "episode {other:?}: \"pick\" or \"cycle\""
+            )));
+        }
+    };
+    let phase = match (episode, phase_reward) {
+        (Episode::Pick, Some(_)) => {
+            return Err(PyValueError::new_err(
+                "phase_reward rewards the parts of a whole cycle: it needs episode=\"cycle\"",
+            ));
+        }
+        (_, Some(p)) if !(p.is_finite() && p.abs() <= 1e6) => {
+            return Err(PyValueError::new_err(format!(
+                "phase_reward {p}: a finite weight within ±1e6"
+            )));
+        }
+        (Episode::Cycle, p) => p.unwrap_or(DEFAULT_PHASE_REWARD),
+        (Episode::Pick, None) => 0.0,
+    };
+    Ok((episode, phase))
 }
 
 /// A command from Python: finite numbers (the session clamps them to the truck's
@@ -215,6 +283,9 @@ pub(crate) fn command(speed_mps: f64, steer_rad: f64, residual: bool) -> PyResul
         }
     })
 }
+
+/// A whole cycle's reward for each part of it judged a success, by default.
+const DEFAULT_PHASE_REWARD: f64 = 2.0;
 
 /// Frame sizes `render_size` may ask for, in pixels a side.
 const RENDER_PX: (u32, u32) = (16, 4096);
@@ -242,7 +313,8 @@ impl PickEnv {
     #[new]
     #[pyo3(signature = (scenario, *, case=None, planner=None, tracker=None, noise=true,
                         replan=None, ticks_per_step=1, path_points=0, path_spacing_m=0.5,
-                        reward=(10.0, 10.0, 0.1, 1.0), render_size=None))]
+                        reward=(10.0, 10.0, 0.1, 1.0), render_size=None, episode="pick",
+                        phase_reward=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -257,6 +329,8 @@ impl PickEnv {
         path_spacing_m: f64,
         reward: (f64, f64, f64, f64),
         render_size: Option<(u32, u32)>,
+        episode: &str,
+        phase_reward: Option<f64>,
     ) -> PyResult<Self> {
         let mut setup = setup(
             py,
@@ -270,6 +344,7 @@ impl PickEnv {
             path_points,
             path_spacing_m,
             reward,
+            (episode, phase_reward),
         )?;
         if let Some((w, h)) = render_size {
             let (lo, hi) = RENDER_PX;

@@ -25,5 +25,6 @@ fn _forkbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(batch::run_trial, m)?)?;
     m.add_function(wrap_pyfunction!(batch::run_batch, m)?)?;
     m.add("OBSERVATION_FIELDS", obs::FIELDS.to_vec())?;
+    m.add("STAGE_FIELD", obs::STAGE_FIELD)?;
     Ok(())
 }

@@ -3,7 +3,7 @@
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Path, Pose2};
 use forkbench_trial::TrialOutcome;
-use forkbench_trial::trial::{Observation, SessionEnd, Truth};
+use forkbench_trial::trial::{Observation, SessionEnd, Stage, Truth};
 
 /// The fixed part of an observation, in order; `path_points` (x, y) pairs of the planned
 /// path ahead in the truck's frame follow when asked for.
@@ -23,9 +23,25 @@ pub const FIELDS: [&str; 13] = [
     "fix",
 ];
 
+/// The field a whole-cycle episode adds after the fixed ones: [`stage_code`].
+pub const STAGE_FIELD: &str = "stage";
+
+/// The part of the cycle as a number: 0 a mission leg, 1 staging, 2 the pick, 2 + k the
+/// k-th phase after it.
+pub fn stage_code(stage: Stage) -> f64 {
+    match stage {
+        Stage::Leg => 0.0,
+        Stage::Staging => 1.0,
+        Stage::Pick => 2.0,
+        Stage::Phase(k) => 2.0 + f64::from(k),
+    }
+}
+
 /// What an observation holds beyond the fixed fields.
 #[derive(Debug, Clone, Copy)]
 pub struct ObsConfig {
+    /// The stage field (whole-cycle episodes).
+    pub stage: bool,
     /// Points of the planned path ahead (0: none).
     pub path_points: usize,
     /// Arc length between them.
@@ -34,7 +50,7 @@ pub struct ObsConfig {
 
 impl ObsConfig {
     pub fn size(&self) -> usize {
-        FIELDS.len() + 2 * self.path_points
+        FIELDS.len() + usize::from(self.stage) + 2 * self.path_points
     }
 }
 
@@ -59,7 +75,12 @@ pub fn write(o: &Observation, path: Option<&Path>, cfg: &ObsConfig, out: &mut [f
     for (slot, v) in out.iter_mut().zip(fixed) {
         *slot = v as f32;
     }
-    let ahead = &mut out[FIELDS.len()..];
+    let mut at = FIELDS.len();
+    if cfg.stage {
+        out[at] = stage_code(o.stage) as f32;
+        at += 1;
+    }
+    let ahead = &mut out[at..];
     path_ahead(&o.pose, path, cfg, ahead);
 }
 
@@ -100,6 +121,8 @@ pub struct RewardConfig {
     pub time_per_s: f64,
     /// Metres of distance one radian of heading error counts as.
     pub heading_m_per_rad: f64,
+    /// Added for each part of a whole cycle judged a success (the pick and each phase).
+    pub phase: f64,
 }
 
 impl RewardConfig {

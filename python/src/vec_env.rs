@@ -101,7 +101,8 @@ impl PickVecEnv {
     #[new]
     #[pyo3(signature = (scenario, num_envs, *, case=None, planner=None, tracker=None,
                         noise=true, replan=None, ticks_per_step=1, path_points=0,
-                        path_spacing_m=0.5, reward=(10.0, 10.0, 0.1, 1.0), threads=None))]
+                        path_spacing_m=0.5, reward=(10.0, 10.0, 0.1, 1.0), threads=None,
+                        episode="pick", phase_reward=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -117,6 +118,8 @@ impl PickVecEnv {
         path_spacing_m: f64,
         reward: (f64, f64, f64, f64),
         threads: Option<usize>,
+        episode: &str,
+        phase_reward: Option<f64>,
     ) -> PyResult<Self> {
         let bytes = (num_envs as u64).saturating_mul(env_bytes(&scenario.inner));
         if num_envs == 0 || bytes > MAX_ENVS_BYTES {
@@ -140,6 +143,7 @@ impl PickVecEnv {
             path_points,
             path_spacing_m,
             reward,
+            (episode, phase_reward),
         )?;
         let threads =
             threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));

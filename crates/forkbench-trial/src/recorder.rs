@@ -55,8 +55,9 @@ pub enum Level {
     Error,
 }
 
-/// Receives a trial as it happens. Every method has an empty default.
-pub trait Recorder {
+/// Receives a trial as it happens. Every method has an empty default. `Send`, so a
+/// trial (and a session stepping it) can move between threads with its recorder.
+pub trait Recorder: Send {
     fn scene(&mut self, _scene: &SceneInfo<'_>) {}
     /// A plan (index 0) or a replan (1, 2, …); `control_polygon` for B-splines.
     fn plan(
@@ -76,7 +77,7 @@ pub trait Recorder {
     fn outcome(&mut self, _t_s: f64, _outcome: &TrialOutcome) {}
 }
 
-/// Records nothing; the trial loop is generic, so this compiles away.
+/// Records nothing.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoRecorder;
 

@@ -5,7 +5,7 @@ mod common;
 use std::sync::Arc;
 
 use forkbench_trial::defaults::default_scenarios;
-use forkbench_trial::trial::{Control, Session, SessionEnd};
+use forkbench_trial::trial::{Control, Episode, Session, SessionEnd, Stage};
 use forkbench_trial::{Failure, Scenario, TrialOptions};
 use serde_json::Value;
 
@@ -18,7 +18,7 @@ fn options(seed: u64, replan: Option<bool>) -> TrialOptions {
 }
 
 /// Steps a session to its end under `control`, at most `max_ticks` ticks.
-fn run(session: &mut Session, max_ticks: u64, control: impl Fn(&Session) -> Control) -> u64 {
+fn run(session: &mut Session, max_ticks: u64, mut control: impl FnMut(&Session) -> Control) -> u64 {
     for tick in 0..max_ticks {
         if session.ended().is_some() || session.step(control(session)).is_some() {
             return tick;
@@ -133,4 +133,71 @@ fn caller_commands_are_judged_and_deterministic() {
         "ended early: {ticks} ticks"
     );
     assert_eq!(drive(5), (ticks, out));
+}
+
+/// A whole-cycle scenario from the repository, loaded from its file.
+fn cycle_scenario(file: &str) -> Arc<Scenario> {
+    let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios"));
+    let text = std::fs::read_to_string(dir.join(file)).expect("the scenario");
+    let scn = Scenario::parse(&text, file, |w| forkbench_trial::World::load(&dir.join(w)))
+        .expect("valid");
+    Arc::new(scn)
+}
+
+/// The warehouse cycle (legs, pick, lift, reverse out, carry, place, return) and the rack
+/// cycle, stepped tick by tick as whole-cycle episodes under their own controllers, give
+/// `run_trial`'s outcome to the bit; the caller takes the ticks of every stage.
+#[test]
+fn a_cycle_episode_stepped_tick_by_tick_equals_run_trial() {
+    for (file, seeds) in [
+        ("warehouse-cycle.toml", 1..3),
+        ("rack-pick-cycle.toml", 1..4),
+    ] {
+        let scn = cycle_scenario(file);
+        for seed in seeds {
+            let opts = options(seed, None);
+            let batch = forkbench_trial::run_trial(&scn, &scn.cases[0], &opts).without_wall_times();
+            let mut s =
+                Session::start_episode(scn.clone(), "default", &opts, Episode::Cycle, false)
+                    .expect("starts");
+            let mut stages = Vec::new();
+            let ticks = run(&mut s, 10_000_000, |s| {
+                let stage = s.observation().stage;
+                if stages.last() != Some(&stage) {
+                    stages.push(stage);
+                }
+                Control::Tracker
+            });
+            let stepped = s.ended().expect("ended").0.without_wall_times();
+            assert_eq!(stepped, batch, "{file} seed {seed}");
+            assert!(ticks > 100, "{file} seed {seed}: {ticks} ticks");
+            // Every phase the trial reached was a stage the caller stepped through.
+            let reached = batch.phases.len().saturating_sub(1);
+            for i in 1..=reached {
+                let phase = Stage::Phase(i as u16);
+                assert!(stages.contains(&phase), "{file} seed {seed}: {stages:?}");
+            }
+            assert!(
+                stages.contains(&Stage::Pick),
+                "{file} seed {seed}: {stages:?}"
+            );
+            if scn.mission.is_some() {
+                assert_eq!(stages.first(), Some(&Stage::Leg), "{file} seed {seed}");
+            }
+        }
+    }
+}
+
+/// A pick episode of a cycle scenario ends at the pick's verdict: no phase is run.
+#[test]
+fn a_pick_episode_of_a_cycle_scenario_ends_at_the_pick() {
+    let scn = cycle_scenario("rack-pick-cycle.toml");
+    let mut s = Session::start(scn.clone(), "default", &options(3, None)).expect("starts");
+    run(&mut s, 1_000_000, |s| {
+        assert_eq!(s.observation().stage, Stage::Pick);
+        Control::Tracker
+    });
+    let out = s.ended().expect("ended").0;
+    assert!(out.phases.is_empty(), "{:?}", out.phases);
+    assert!(out.cycle.is_none());
 }

@@ -76,6 +76,8 @@ pub struct Registry {
     /// Localiser kinds that apply `LocalizerContext::noise_scale`.
     scaled_localizers: std::collections::BTreeSet<String>,
     estimator: EstimatorCtor,
+    /// The phases a scenario may list after the pick, in registration order.
+    phases: Vec<crate::trial::PhaseKind>,
 }
 
 impl std::fmt::Debug for Registry {
@@ -85,6 +87,10 @@ impl std::fmt::Debug for Registry {
             .field("trackers", &self.trackers.keys().collect::<Vec<_>>())
             .field("detectors", &self.detectors.keys().collect::<Vec<_>>())
             .field("localizers", &self.localizers.keys().collect::<Vec<_>>())
+            .field(
+                "phases",
+                &self.phases.iter().map(|k| &k.name).collect::<Vec<_>>(),
+            )
             .finish_non_exhaustive()
     }
 }
@@ -135,6 +141,7 @@ impl Registry {
             localizers: BTreeMap::new(),
             scaled_localizers: std::collections::BTreeSet::new(),
             estimator: Arc::new(|cfg| Box::new(cfg.clone())),
+            phases: crate::trial::builtin_phases(),
         }
         .with_scaled_localizer("gaussian", |s, cx| {
             forkbench_core::settings::parse::<Empty>(s)?;
@@ -254,6 +261,18 @@ impl Registry {
     }
 
     /// Replaces the pallet-estimate model.
+    /// Adds a phase kind a scenario may list after the pick (replacing one of its name).
+    pub fn with_phase(mut self, kind: crate::trial::PhaseKind) -> Self {
+        self.phases.retain(|k| k.name != kind.name);
+        self.phases.push(kind);
+        self
+    }
+
+    /// The phase kinds, in registration order.
+    pub fn phase_kinds(&self) -> &[crate::trial::PhaseKind] {
+        &self.phases
+    }
+
     pub fn with_estimator(mut self, ctor: EstimatorCtor) -> Self {
         self.estimator = ctor;
         self

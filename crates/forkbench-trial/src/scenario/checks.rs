@@ -194,8 +194,8 @@ fn check_upper_bounds(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
 pub(super) fn resolve_phases(
     f: &ScenarioFile,
     (world, pallet, mission): (&World, &PalletSpec, Option<&super::mission::MissionSpec>),
-    text: &str,
-    file: &str,
+    (text, file): (&str, &str),
+    kinds: &[crate::trial::PhaseKind],
 ) -> Result<Vec<crate::trial::PhaseSpec>, TrialError> {
     let names = f.phases.as_ref();
     let list = names.map_or_else(
@@ -207,7 +207,7 @@ pub(super) fn resolve_phases(
         pallet,
         mission,
     };
-    crate::trial::phases_resolve(&list, &f.phase, &cx).map_err(|(field, reason)| {
+    crate::trial::phases_resolve(&list, &f.phase, &cx, kinds).map_err(|(field, reason)| {
         // A phase's settings are at their table's header; the list's errors, and those of
         // a phase without a table, at the list.
         let list_at = || {

@@ -190,8 +190,19 @@ impl Scenario {
         file: &str,
         load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
     ) -> Result<Self, TrialError> {
+        Self::parse_with(text, file, load_world, Registry::shared())
+    }
+
+    /// As [`Scenario::parse`], with a registry that may hold the caller's own components
+    /// and phases.
+    pub fn parse_with(
+        text: &str,
+        file: &str,
+        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
+        registry: Arc<Registry>,
+    ) -> Result<Self, TrialError> {
         let s = Self::parse_layout(text, file, load_world)?;
-        s.with_components(text, Registry::shared(), PathBuf::from("."))
+        s.with_components(text, registry, PathBuf::from("."))
     }
 
     /// Reads the `[planner]` and `[tracker]` tables against `registry`; errors name the
@@ -234,6 +245,12 @@ impl Scenario {
                 .check(detector)
                 .map_err(|e| invalid_setting(&self.file, "sensors.pallet.detector", &e))?;
         }
+        self.phases = checks::resolve_phases(
+            &f,
+            (&self.world, &self.pallet, self.mission.as_ref()),
+            (text, &self.file),
+            registry.phase_kinds(),
+        )?;
         self.registry = registry;
         Ok(self)
     }
@@ -282,7 +299,6 @@ impl Scenario {
         };
         let zero = Pose2::new(0.0, 0.0, 0.0);
         let pallet_sensing = sensors::resolve(f.sensors.as_ref(), &f.truck, file)?;
-        let phases = checks::resolve_phases(&f, (&world, &pallet, mission.as_ref()), text, file)?;
         Ok(Scenario {
             file: file.to_owned(),
             name: f.name,
@@ -308,7 +324,7 @@ impl Scenario {
             world,
             cases,
             mission,
-            phases,
+            phases: Vec::new(),
             warnings: hints::unit_warnings(text, file),
         })
     }

@@ -1,92 +1,113 @@
-//! Drive stage: each control tick (fix, replan check, tracker command, physics step, record) until stopped or timed out.
+//! The pick's drive: each control tick's re-estimate (maybe a replan), tracker command, physics step, record and entry checks, until docked or timed out.
 
 use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 use forkbench_track::{Command, TrackerInput};
 
+use super::engine::{Stage, Steering};
 use super::error::StageError;
 use super::judge::in_pallet_frame;
+use super::session::Control;
 use super::setup::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
 use forkbench_core::{Signal, Style};
 
-/// Where a drive stands between control ticks.
-#[derive(Debug, Clone)]
-pub(crate) struct DriveState {
+/// The pick's approach and insertion as a drive: the re-estimates due on the way (a
+/// replan when the estimate moved), the scenario's tracker, the entry checks; it ends
+/// docked, or for a caller's own commands once settled.
+pub(super) struct PickDrive {
     /// Re-estimate ranges still ahead, nearest last.
     reestimates: Vec<f64>,
-    pub(super) deadline_s: f64,
-    /// This tick's localiser fix (none between sweeps) and the controller's pose.
-    pub(super) fix: Option<Pose2>,
-    pub(super) pose: Pose2,
 }
 
 /// The trial's own scalar signals go out every this many control steps.
 pub(in crate::trial) const SIGNAL_EVERY_STEPS: u64 = 10;
 
-impl<'a> Trial<'a> {
-    /// Drives until the tracker reports the goal reached and the truck stands, or the
-    /// scenario's time limit. Err: the state went non-finite, or the tracker failed.
-    pub(super) fn drive<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), StageError> {
-        let mut at = self.begin_drive();
-        while self.sim.time_s() < at.deadline_s {
-            self.sense_tick(&mut at, rec)?;
-            let cmd = self.tracker_command(at.pose)?;
-            if self.docked(&cmd) {
-                self.timed_out = false;
-                break;
+impl<'a> Steering<'a, StageError> for PickDrive {
+    fn sensed<R: Recorder + ?Sized>(
+        &mut self,
+        t: &mut Trial<'a>,
+        pose: Pose2,
+        rec: &mut R,
+    ) -> Result<(), StageError> {
+        if t.sense.on_prior {
+            if t.frame_due() {
+                let missed = t.verdict.out.estimates_missed;
+                t.reestimate(&pose, rec)?;
+                t.sense.on_prior = t.verdict.out.estimates_missed > missed;
             }
-            self.step(&cmd, at.fix, at.pose, rec);
+            return Ok(());
+        }
+        if t.run.replan
+            && self
+                .reestimates
+                .first()
+                .is_some_and(|r| pose.distance_to(&t.sense.pallet_est) <= *r)
+        {
+            self.reestimates.remove(0);
+            t.reestimate(&pose, rec)?;
         }
         Ok(())
     }
 
-    /// The drive's schedule: re-estimate ranges still ahead of the truck (nearest last)
-    /// and the deadline.
-    pub(super) fn begin_drive(&self) -> DriveState {
-        let start_range = self.first_fix.distance_to(&self.pallet_est);
+    fn command(
+        &mut self,
+        t: &mut Trial<'a>,
+        control: Control,
+        pose: Pose2,
+    ) -> Result<Option<Command>, StageError> {
+        if let Control::Command { .. } = control {
+            // The caller steers; the scenario's tracker is not asked.
+            return Ok(Some(super::phases::open_loop(0.0, 0.0, &pose)));
+        }
+        let cmd = t.tracker_command(pose)?;
+        if t.docked(&cmd) {
+            t.verdict.timed_out = false;
+            return Ok(None);
+        }
+        Ok(Some(cmd))
+    }
+
+    fn stepped<R: Recorder + ?Sized>(
+        &mut self,
+        t: &mut Trial<'a>,
+        control: Control,
+        _cmd: &Command,
+        rec: &mut R,
+    ) -> Result<bool, StageError> {
+        t.check_entry(rec);
+        let settled = matches!(control, Control::Command { .. }) && t.settled();
+        if settled {
+            t.verdict.timed_out = false;
+        }
+        Ok(settled)
+    }
+}
+
+impl<'a> Trial<'a> {
+    /// Drives until the tracker reports the goal reached and the truck stands, or the
+    /// scenario's time limit. Err: the state went non-finite, or the tracker failed.
+    pub(super) async fn drive<R: Recorder + ?Sized>(
+        &mut self,
+        rec: &mut R,
+    ) -> Result<(), StageError> {
+        let mut pick = self.pick_drive();
+        self.stage = Stage::Pick;
+        self.drive_by(self.scn.timeout_s, &mut pick, rec).await?;
+        Ok(())
+    }
+
+    /// The re-estimate ranges still ahead of the truck (nearest last).
+    fn pick_drive(&self) -> PickDrive {
+        let start_range = self.loc.first_fix.distance_to(&self.sense.pallet_est);
         let schedule = self.scn.replan.reestimate_at_m.clone();
         let mut reestimates: Vec<f64> = schedule
-            .unwrap_or_else(|| self.estimator.reestimate_at_m())
+            .unwrap_or_else(|| self.sense.estimator.reestimate_at_m())
             .into_iter()
             .filter(|r| *r < start_range)
             .collect();
         reestimates.sort_by(|a, b| b.total_cmp(a));
-        DriveState {
-            reestimates,
-            deadline_s: self.sim.time_s() + self.scn.timeout_s,
-            fix: None,
-            pose: self.first_fix,
-        }
-    }
-
-    /// The start of a control tick: the localiser's reading, and a re-estimate (maybe a
-    /// replan) when the truck came within the next re-estimate range.
-    pub(super) fn sense_tick<R: Recorder + ?Sized>(
-        &mut self,
-        at: &mut DriveState,
-        rec: &mut R,
-    ) -> Result<(), StageError> {
-        let (fix, pose) = self.sense(rec)?;
-        (at.fix, at.pose) = (fix, pose);
-        if self.on_prior {
-            if self.frame_due() {
-                let missed = self.out.estimates_missed;
-                self.reestimate(&pose, rec)?;
-                self.on_prior = self.out.estimates_missed > missed;
-            }
-            return Ok(());
-        }
-        if self.run.replan
-            && at
-                .reestimates
-                .first()
-                .is_some_and(|r| pose.distance_to(&self.pallet_est) <= *r)
-        {
-            at.reestimates.remove(0);
-            self.reestimate(&pose, rec)?;
-        }
-        Ok(())
+        PickDrive { reestimates }
     }
 
     /// The scenario's tracker's command at the measured `pose`. Err: it failed.
@@ -104,33 +125,21 @@ impl<'a> Trial<'a> {
     /// The pick's end: the tracker reports the goal reached and the truck moves slower
     /// than `[pick] docked_speed_mps`.
     pub(super) fn docked(&self, cmd: &Command) -> bool {
-        cmd.done && self.sim.speed_mps().abs() < self.scn.pick.docked_speed_mps
+        cmd.done && self.world.sim.speed_mps().abs() < self.scn.pick.docked_speed_mps
     }
 
     /// The truck stands (for the end of a drive).
     pub(super) fn stands(&self) -> bool {
-        self.sim.speed_mps().abs() < 0.01
-    }
-
-    /// One physics step under `cmd`, its record, and the entry check.
-    pub(super) fn step<R: Recorder + ?Sized>(
-        &mut self,
-        cmd: &Command,
-        fix: Option<Pose2>,
-        pose: Pose2,
-        rec: &mut R,
-    ) {
-        self.physics_step(cmd, fix, pose, rec);
-        self.check_entry(rec);
+        self.world.sim.speed_mps().abs() < 0.01
     }
 
     /// What a tracker sees now, at the measured `pose`.
     pub(super) fn tracker_input(&self, pose: Pose2) -> TrackerInput<'a> {
         TrackerInput {
-            t_s: self.sim.time_s(),
+            t_s: self.world.sim.time_s(),
             pose,
-            speed_mps: self.sim.speed_mps(),
-            steer_rad: self.sim.steer_rad(),
+            speed_mps: self.world.sim.speed_mps(),
+            steer_rad: self.world.sim.steer_rad(),
             truck: &self.scn.truck,
         }
     }
@@ -144,98 +153,108 @@ impl<'a> Trial<'a> {
         rec: &mut R,
     ) {
         let truck = &self.scn.truck;
-        let before = self.sim.fork_root_pose();
-        self.sim.step(cmd.speed_mps, cmd.steer_rad);
-        let moved_m = before.distance_to(&self.sim.fork_root_pose());
-        self.travelled_m += moved_m;
-        if self.sim.carrying() {
-            self.travelled_loaded_m += moved_m;
+        let before = self.world.sim.fork_root_pose();
+        self.world.sim.step(cmd.speed_mps, cmd.steer_rad);
+        let moved_m = before.distance_to(&self.world.sim.fork_root_pose());
+        self.world.travelled_m += moved_m;
+        if self.world.sim.carrying() {
+            self.world.travelled_loaded_m += moved_m;
         }
-        let (scale, offset) = self.odometry_error;
+        let (scale, offset) = self.loc.odometry_error;
         let (v, steer) = (
-            self.sim.speed_mps() * (1.0 + scale),
-            self.sim.steer_rad() + offset,
+            self.world.sim.speed_mps() * (1.0 + scale),
+            self.world.sim.steer_rad() + offset,
         );
-        for p in [&mut self.predictor, &mut self.odometry] {
+        for p in [&mut self.loc.predictor, &mut self.loc.odometry] {
             p.propagate(
                 v,
                 steer,
                 truck.wheelbase_m,
                 truck.fork_root_ahead_of_front_axle_m,
-                self.sim.dt_s(),
+                self.world.sim.dt_s(),
             );
         }
-        self.out.max_steer_rad = self.out.max_steer_rad.max(self.sim.steer_rad().abs());
-        if self.sim.obstacle_contact() && !self.collision {
+        self.verdict.out.max_steer_rad = self
+            .verdict
+            .out
+            .max_steer_rad
+            .max(self.world.sim.steer_rad().abs());
+        if self.world.sim.obstacle_contact() && !self.world.collision {
             rec.event(
-                self.sim.time_s(),
+                self.world.sim.time_s(),
                 Level::Error,
                 "truck touched a rack or wall",
             );
         }
-        self.collision |= self.sim.obstacle_contact();
-        let t = self.sim.time_s();
-        let truth = self.sim.fork_root_pose();
-        // What a failed entry is most often traced to: how far off the localisation
-        // was, and how far off the path the tracker let the truck run; at 10 Hz, which
-        // shows both and costs a recording a tenth of the control rate.
-        let step = (t / self.sim.dt_s()).round() as u64;
-        if step.is_multiple_of(SIGNAL_EVERY_STEPS) {
-            let loc_error = (pose.x_m - truth.x_m).hypot(pose.y_m - truth.y_m);
-            let none = Style::default();
-            rec.signal(
-                t,
-                "localisation/position_error_m",
-                &Signal::Scalar(loc_error),
-                none,
-            );
-            rec.signal(
-                t,
-                "track/cross_track_m",
-                &Signal::Scalar(cmd.cross_track_m),
-                none,
-            );
-        }
+        self.world.collision |= self.world.sim.obstacle_contact();
+        self.record_signals(cmd, pose, rec);
         rec.step(&StepRecord {
-            t_s: self.sim.time_s(),
-            truth: self.sim.fork_root_pose(),
+            t_s: self.world.sim.time_s(),
+            truth: self.world.sim.fork_root_pose(),
             fix,
             estimate: pose,
-            pallet: self.sim.pallet_pose(),
-            pallet_estimate: self.pallet_est,
+            pallet: self.world.sim.pallet_pose(),
+            pallet_estimate: self.sense.pallet_est,
             steer_cmd_rad: cmd.steer_rad,
-            steer_rad: self.sim.steer_rad(),
+            steer_rad: self.world.sim.steer_rad(),
             speed_cmd_mps: cmd.speed_mps,
-            speed_mps: self.sim.speed_mps(),
+            speed_mps: self.world.sim.speed_mps(),
             lookahead: cmd.lookahead_point,
             cross_track_m: cmd.cross_track_m,
             path_curvature_per_m: cmd.path_curvature_per_m,
-            contact_force_n: self.sim.fork_contact_force_n(),
+            contact_force_n: self.world.sim.fork_contact_force_n(),
         });
+    }
+
+    /// What a failed entry is most often traced to: how far off the localisation was,
+    /// and how far off the path the tracker let the truck run; at 10 Hz, which shows both
+    /// and costs a recording a tenth of the control rate.
+    fn record_signals<R: Recorder + ?Sized>(&self, cmd: &Command, pose: Pose2, rec: &mut R) {
+        let t = self.world.sim.time_s();
+        let step = (t / self.world.sim.dt_s()).round() as u64;
+        if !step.is_multiple_of(SIGNAL_EVERY_STEPS) {
+            return;
+        }
+        let truth = self.world.sim.fork_root_pose();
+        let loc_error = (pose.x_m - truth.x_m).hypot(pose.y_m - truth.y_m);
+        let none = Style::default();
+        rec.signal(
+            t,
+            "localisation/position_error_m",
+            &Signal::Scalar(loc_error),
+            none,
+        );
+        rec.signal(
+            t,
+            "track/cross_track_m",
+            &Signal::Scalar(cmd.cross_track_m),
+            none,
+        );
     }
 
     /// Contact force before full depth, and the entry errors once the tips cross the face
     /// plane within the face (not beside the pallet).
-    fn check_entry<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
-        let root = self.sim.fork_root_pose();
-        let pallet_now = self.sim.pallet_pose();
+    pub(super) fn check_entry<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
+        let root = self.world.sim.fork_root_pose();
+        let pallet_now = self.world.sim.pallet_pose();
         let depth = self.scn.truck.insertion_depth_m(&pallet_now, &root);
         if depth < self.insertion_m - 0.01 {
-            self.out.max_contact_force_n = self
+            self.verdict.out.max_contact_force_n = self
+                .verdict
                 .out
                 .max_contact_force_n
-                .max(self.sim.fork_contact_force_n());
+                .max(self.world.sim.fork_contact_force_n());
         }
         self.observe_step_criteria(root, pallet_now, rec);
         let local = in_pallet_frame(&pallet_now, &root);
-        if self.out.lateral_error_m.is_none()
+        if self.verdict.out.lateral_error_m.is_none()
             && depth >= 0.0
             && local.y_m.abs() < self.scn.pallet.width_m / 2.0
         {
-            self.out.lateral_error_m = Some(local.y_m);
-            self.out.heading_error_rad = Some(local.heading_rad);
+            self.verdict.out.lateral_error_m = Some(local.y_m);
+            self.verdict.out.heading_error_rad = Some(local.heading_rad);
             rec.event(
-                self.sim.time_s(),
+                self.world.sim.time_s(),
                 Level::Info,
                 &format!(
                     "fork entry: {:.4} m lateral, {:.4} rad heading",
@@ -253,7 +272,7 @@ impl<'a> Trial<'a> {
         pallet_pose: Pose2,
         rec: &mut R,
     ) {
-        let t_s = self.sim.time_s();
+        let t_s = self.world.sim.time_s();
         let view = super::step_criteria::StepView {
             t_s,
             truck: &self.scn.truck,
@@ -261,8 +280,9 @@ impl<'a> Trial<'a> {
             fork_root,
             pallet_pose,
         };
-        let record = ((t_s / self.sim.dt_s()).round() as u64).is_multiple_of(SIGNAL_EVERY_STEPS);
-        for c in &mut self.step_criteria {
+        let record =
+            ((t_s / self.world.sim.dt_s()).round() as u64).is_multiple_of(SIGNAL_EVERY_STEPS);
+        for c in &mut self.verdict.step_criteria {
             c.observe(&view);
             if let (true, Some(v)) = (record, c.value()) {
                 let path = format!("criteria/{}", c.measure());
@@ -278,27 +298,27 @@ impl<'a> Trial<'a> {
         pose: &Pose2,
         rec: &mut R,
     ) -> Result<(), StageError> {
-        let range = pose.distance_to(&self.pallet_est);
-        let truth = self.sim.pallet_pose();
+        let range = pose.distance_to(&self.sense.pallet_est);
+        let truth = self.world.sim.pallet_pose();
         let Some(new_est) = self.estimate(&truth, range, pose, rec)? else {
             rec.event(
-                self.sim.time_s(),
+                self.world.sim.time_s(),
                 Level::Warn,
                 &format!("no pallet found at {range:.2} m; keeping the last estimate"),
             );
             return Ok(());
         };
-        let moved = new_est.distance_to(&self.pallet_est);
-        let turned = wrap_angle(new_est.heading_rad - self.pallet_est.heading_rad).abs();
+        let moved = new_est.distance_to(&self.sense.pallet_est);
+        let turned = wrap_angle(new_est.heading_rad - self.sense.pallet_est.heading_rad).abs();
         let limits = &self.scn.replan;
         if moved <= limits.position_threshold_m && turned <= limits.heading_threshold_rad {
             return Ok(());
         }
-        let t = self.sim.time_s();
+        let t = self.world.sim.time_s();
         let replan = self.replanned(pose, &new_est);
         match replan {
             Ok((path, polygon)) => {
-                rec.plan(t, self.out.replans + 1, &path, polygon.as_deref());
+                rec.plan(t, self.verdict.out.replans + 1, &path, polygon.as_deref());
                 rec.event(
                     t,
                     Level::Info,
@@ -308,9 +328,9 @@ impl<'a> Trial<'a> {
                     ),
                 );
                 self.tracker.reset(&path, &self.scn.truck);
-                self.path = path;
+                self.set_path(path);
                 self.adopt_estimate(new_est, &truth);
-                self.out.replans += 1;
+                self.verdict.out.replans += 1;
             }
             Err(e) => {
                 rec.event(
@@ -318,9 +338,40 @@ impl<'a> Trial<'a> {
                     Level::Warn,
                     &format!("replan refused, keeping the old plan: {e}"),
                 );
-                self.out.replans_failed += 1;
+                self.verdict.out.replans_failed += 1;
             }
         }
         Ok(())
+    }
+}
+
+impl Trial<'_> {
+    /// A caller-driven pick is over: the truck stands with the forks at the required
+    /// depth, or a criterion has failed in a way later ticks cannot undo.
+    fn settled(&self) -> bool {
+        let (tol, out) = (&self.scn.tolerances, &self.verdict.out);
+        let pallet = self.world.sim.pallet_pose();
+        let moved = pallet.distance_to(&self.world.pallet0) > tol.pallet_displacement_m
+            || wrap_angle(pallet.heading_rad - self.world.pallet0.heading_rad).abs()
+                > tol.pallet_rotation_rad;
+        let entry_off = out.lateral_error_m.is_some_and(|e| e.abs() > tol.lateral_m)
+            || out
+                .heading_error_rad
+                .is_some_and(|e| e.abs() > tol.heading_rad);
+        let depth = self
+            .scn
+            .truck
+            .insertion_depth_m(&pallet, &self.world.sim.fork_root_pose());
+        let step_broken = self
+            .verdict
+            .step_criteria
+            .iter()
+            .any(|c| c.irreversible() && c.broken().is_some());
+        self.world.collision
+            || step_broken
+            || out.max_contact_force_n > tol.contact_force_n
+            || moved
+            || entry_off
+            || (self.stands() && depth >= tol.insertion_depth_m)
     }
 }

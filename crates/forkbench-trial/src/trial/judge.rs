@@ -32,19 +32,19 @@ impl Trial<'_> {
     pub(super) fn conclude(&mut self) {
         let worst_pocket_miss = self.measure();
         let judged = Judged {
-            out: &self.out,
+            out: &self.verdict.out,
             tol: &self.scn.tolerances,
             truck: &self.scn.truck,
             pallet: &self.scn.pallet,
-            collision: self.collision,
-            timed_out: self.timed_out,
+            collision: self.world.collision,
+            timed_out: self.verdict.timed_out,
             timeout_s: self.scn.timeout_s,
             worst_pocket_miss_m: worst_pocket_miss,
         };
         let mut broken = super::criteria::broken(&judged);
-        for c in &self.step_criteria {
+        for c in &self.verdict.step_criteria {
             if let Some(v) = c.value() {
-                self.out.measures.insert(c.measure().to_owned(), v);
+                self.verdict.out.measures.insert(c.measure().to_owned(), v);
             }
             if let Some(why) = c.broken() {
                 broken.push((Failure::Criterion(c.name()), why));
@@ -53,23 +53,24 @@ impl Trial<'_> {
         let mut broken = broken.into_iter();
         match broken.next() {
             Some((f, why)) => {
-                self.out.also_failed = broken
+                self.verdict.out.also_failed = broken
                     .map(|(f, why)| format!("{}: {}", f.name(), compact_numbers(&why)))
                     .collect();
-                self.out.likely_cause = likely_cause(self);
-                self.out.fail(f, why);
+                self.verdict.out.likely_cause = likely_cause(self);
+                self.verdict.out.fail(f, why);
             }
-            None => self.out.success = true,
+            None => self.verdict.out.success = true,
         }
     }
 
     /// The simulated time and the localisation so far: all a trial that ended before its
     /// drive to the pallet measured (the forks were never brought to it).
     pub(crate) fn measure_time(&mut self) {
-        self.out.sim_time_s = self.sim.time_s();
-        let period_s = self.localizer.period_s();
+        self.verdict.out.sim_time_s = self.world.sim.time_s();
+        let period_s = self.loc.localizer.period_s();
         self.loc
-            .finish_trial(self.out.sim_time_s, period_s, &mut self.out);
+            .stats
+            .finish_trial(self.verdict.out.sim_time_s, period_s, &mut self.verdict.out);
     }
 
     /// The trial's measurements as it stands now (time, localisation, where the forks are
@@ -78,15 +79,16 @@ impl Trial<'_> {
     pub(crate) fn measure(&mut self) -> f64 {
         self.measure_time();
         let truck = &self.scn.truck;
-        let out = &mut self.out;
-        let root = self.sim.fork_root_pose();
-        let pallet_now = self.sim.pallet_pose();
+        let out = &mut self.verdict.out;
+        let root = self.world.sim.fork_root_pose();
+        let pallet_now = self.world.sim.pallet_pose();
         let local = in_pallet_frame(&pallet_now, &root);
         out.final_lateral_error_m = local.y_m;
         out.final_heading_error_rad = local.heading_rad;
         out.insertion_depth_m = truck.insertion_depth_m(&pallet_now, &root);
-        out.pallet_displacement_m = pallet_now.distance_to(&self.pallet0);
-        out.pallet_rotation_rad = wrap_angle(pallet_now.heading_rad - self.pallet0.heading_rad);
+        out.pallet_displacement_m = pallet_now.distance_to(&self.world.pallet0);
+        out.pallet_rotation_rad =
+            wrap_angle(pallet_now.heading_rad - self.world.pallet0.heading_rad);
         let pockets = self.scn.pallet.pocket_offsets_m();
         truck
             .fork_points(&root, truck.fork_length_m / 2.0)
@@ -102,7 +104,7 @@ impl Trial<'_> {
 /// estimate the truck last aimed at (off by more than half the entry limits), then the
 /// steering held at its limit. `None` when neither stands out.
 fn likely_cause(t: &Trial<'_>) -> Option<String> {
-    let (out, tol, truck) = (&t.out, &t.scn.tolerances, &t.scn.truck);
+    let (out, tol, truck) = (&t.verdict.out, &t.scn.tolerances, &t.scn.truck);
     let lateral = out.estimate_lateral_error_m.unwrap_or(0.0);
     let heading = out.estimate_heading_error_rad.unwrap_or(0.0);
     if lateral.abs() > tol.lateral_m / 2.0 || heading.abs() > tol.heading_rad / 2.0 {

@@ -98,59 +98,59 @@ impl Trial<'_> {
         if self.wall_start.elapsed().as_secs_f64() > budget_s {
             return Err(StageError::WallBudget { budget_s });
         }
-        let truth = self.sim.fork_root_pose();
-        let t_s = self.sim.time_s();
+        let truth = self.world.sim.fork_root_pose();
+        let t_s = self.world.sim.time_s();
         let input = LocalizerInput {
             t_s,
             truth,
-            predicted: self.predictor.pose(),
-            odometry: self.odometry.pose(),
+            predicted: self.loc.predictor.pose(),
+            odometry: self.loc.odometry.pose(),
         };
-        let reading = self.localizer.update(&input, &mut self.nav_rng);
+        let reading = self.loc.localizer.update(&input, &mut self.loc.nav_rng);
         let fix = reading.as_ref().and_then(|r| r.pose);
         if let Some(r) = &reading {
             self.take_reading(t_s, r, rec);
         }
         if let Some(fix) = fix {
-            self.predictor.fix(fix);
+            self.loc.predictor.fix(fix);
         }
-        let pose = self.predictor.pose().unwrap_or(self.first_fix);
+        let pose = self.loc.predictor.pose().unwrap_or(self.loc.first_fix);
         if !(pose.is_finite() && truth.is_finite()) {
             return Err(StageError::NonFinite { t_s });
         }
         let error_m = pose.distance_to(&truth);
-        self.loc.error(error_m);
-        self.leg_loc.error(error_m);
+        self.loc.stats.error(error_m);
+        self.loc.leg_stats.error(error_m);
         Ok((fix, pose))
     }
 
     /// Counts a reading, logs a fix lost or regained, and records the reflectors used.
     fn take_reading<R: Recorder + ?Sized>(&mut self, t_s: f64, r: &Reading, rec: &mut R) {
         let got = r.pose.is_some();
-        match (got, self.fix_lost) {
+        match (got, self.loc.fix_lost) {
             (false, false) => {
-                self.fix_lost = true;
+                self.loc.fix_lost = true;
                 let text = format!(
                     "{}: no fix ({} reflectors detected); dead reckoning on odometry",
-                    self.localizer.name(),
+                    self.loc.localizer.name(),
                     r.detected
                 );
                 rec.event(t_s, Level::Warn, &text);
             }
             (true, true) => {
-                self.fix_lost = false;
+                self.loc.fix_lost = false;
                 let text = format!(
                     "{}: fix regained after {:.2} s",
-                    self.localizer.name(),
-                    t_s - self.loc.last_fix_s
+                    self.loc.localizer.name(),
+                    t_s - self.loc.stats.last_fix_s
                 );
                 rec.event(t_s, Level::Info, &text);
             }
             _ => {}
         }
-        self.loc.reading(t_s, got);
-        self.leg_loc.reading(t_s, got);
-        let name = self.localizer.name().to_owned();
+        self.loc.stats.reading(t_s, got);
+        self.loc.leg_stats.reading(t_s, got);
+        let name = self.loc.localizer.name().to_owned();
         let none = Style::default();
         let at = |key: &str| format!("{name}/{key}");
         let Some(fix) = &r.fix else {

@@ -20,7 +20,7 @@ const MAX_PLANS: u32 = 16;
 impl Trial<'_> {
     /// Plans from where the truck stands to `to`, drives the first segment, and again from
     /// the cusp, until a plan's only segment is driven.
-    pub(super) fn manoeuvre_leg<R: Recorder + ?Sized>(
+    pub(super) async fn manoeuvre_leg<R: Recorder + ?Sized>(
         &mut self,
         map: &NavMap,
         m: &MissionSpec,
@@ -50,7 +50,7 @@ impl Trial<'_> {
                 leg.route_length_m = plan.length_m;
             }
             leg.min_clearance_m = leg.min_clearance_m.min(clearance(map, &q, &plan));
-            record_manoeuvre(rec, self.sim.time_s(), i, &plan);
+            record_manoeuvre(rec, self.world.sim.time_s(), i, &plan);
             let Some(first) = plan.segments.first() else {
                 return Ok(());
             };
@@ -59,7 +59,8 @@ impl Trial<'_> {
             }
             let mut follower =
                 SegmentFollower::new(vec![first.clone()], m.tracker.clone(), &self.scn.truck);
-            self.drive_with(&mut |input| follower.command(input), m, stats, rec)?;
+            self.drive_with(|input| follower.command(input), m, &mut *stats, rec)
+                .await?;
             if plan.segments.len() == 1 {
                 return Ok(());
             }
@@ -72,10 +73,14 @@ impl Trial<'_> {
     /// The pallet on the forks, as a footprint ahead of the fork root (`None` unloaded):
     /// a loaded truck plans round it.
     fn load(&self) -> Option<forkbench_geom::Footprint> {
-        if !self.sim.carrying() {
+        if !self.world.sim.carrying() {
             return None;
         }
-        let at = self.sim.fork_root_pose().to_local(&self.sim.pallet_pose());
+        let at = self
+            .world
+            .sim
+            .fork_root_pose()
+            .to_local(&self.world.sim.pallet_pose());
         let pallet = &self.scn.pallet;
         Some(forkbench_geom::Footprint {
             length_m: pallet.depth_m,

@@ -6,7 +6,6 @@ use forkbench_core::units::wrap_angle;
 use forkbench_core::{Path, Pose2, Signal, Style};
 use forkbench_nav::smooth::{SmoothParams, smooth};
 use forkbench_nav::{GlobalPlan, GlobalQuery, NavMap, plan_global, truck_parts};
-use forkbench_track::{PurePursuit, Tracker};
 
 use super::error::{LegError, StageError};
 use super::setup::Trial;
@@ -74,23 +73,23 @@ fn record_route<R: Recorder + ?Sized>(
 /// Running totals of one leg's drive.
 #[derive(Debug, Default)]
 pub(super) struct DriveStats {
-    cross_track_sum_m: f64,
-    cross_track_max_m: f64,
-    steps: u64,
-    collisions: u32,
+    pub(super) cross_track_sum_m: f64,
+    pub(super) cross_track_max_m: f64,
+    pub(super) steps: u64,
+    pub(super) collisions: u32,
 }
 
 impl Trial<'_> {
     /// Drives every leg to the staging pose; Err names the leg that failed and why.
-    pub(super) fn run_legs<R: Recorder + ?Sized>(
+    pub(super) async fn run_legs<R: Recorder + ?Sized>(
         &mut self,
         m: &MissionSpec,
         staging: &Waypoint,
         rec: &mut R,
     ) -> Result<(), StageError> {
-        let map = NavMap::shared_from_world(&self.obstacles, m.global.resolution_m)?;
+        let map = NavMap::shared_from_world(&self.world.obstacles, m.global.resolution_m)?;
         rec.signal(
-            self.sim.time_s(),
+            self.world.sim.time_s(),
             "nav/occupied",
             &Signal::Grid(&map.grid.to_signal()),
             OCCUPIED,
@@ -98,19 +97,19 @@ impl Trial<'_> {
         let mut from = m.start.clone();
         let targets: Vec<&Waypoint> = m.via.iter().chain(std::iter::once(staging)).collect();
         for (i, to) in targets.into_iter().enumerate() {
-            let leg = self.leg(&map, m, (i, &from, to), rec);
+            let leg = self.leg(&map, m, (i, &from, to), rec).await;
             let ok = leg.success;
             let why = leg.failure_detail.clone();
             rec.event(
-                self.sim.time_s(),
+                self.world.sim.time_s(),
                 if ok { Level::Info } else { Level::Error },
                 &format!("leg {}: {}", leg.name, why.as_deref().unwrap_or("arrived")),
             );
-            self.out.legs.push(leg);
+            self.verdict.out.legs.push(leg);
             if !ok {
                 return Err(StageError::Leg {
                     number: i + 1,
-                    name: self.out.legs[i].name.clone(),
+                    name: self.verdict.out.legs[i].name.clone(),
                     detail: why.unwrap_or_default(),
                 });
             }
@@ -121,56 +120,70 @@ impl Trial<'_> {
 
     /// One leg: back out of the place it starts at (all but the first), plan from where
     /// the truck stands, drive, and measure the arrival.
-    pub(super) fn leg<R: Recorder + ?Sized>(
+    pub(super) async fn leg<R: Recorder + ?Sized>(
         &mut self,
         map: &NavMap,
         m: &MissionSpec,
         (i, from, to): (usize, &Waypoint, &Waypoint),
         rec: &mut R,
     ) -> LegOutcome {
-        let t0 = self.sim.time_s();
-        self.leg_loc = super::localize::LocStats::new(t0);
+        let t0 = self.world.sim.time_s();
+        self.loc.leg_stats = super::localize::LocStats::new(t0);
         let mut leg = blank_leg(format!("{} → {}", from.name, to.name));
         let mut stats = DriveStats::default();
-        let mut run = || -> Result<(), LegError> {
-            if m.global.planner.kinodynamic() {
-                // Hybrid-A* plans the way out of the station itself, reversing as needed.
-                return self.manoeuvre_leg(map, m, (i, to), (&mut leg, &mut stats), rec);
-            }
-            if i > 0 {
-                self.back_out(map, m, (i, from, to), (&mut leg, &mut stats), rec)?;
-            }
-            let here = self.sense(rec)?.1;
-            let (plan, attempts, secs) = plan_leg(
-                map,
-                m,
-                (&here, &to.pose),
-                &self.scn.truck,
-                self.run.seed ^ ((i as u64 + 1) << 32),
-            );
-            leg.planning_time_s = secs;
-            leg.planning_attempts = attempts;
-            leg.route_length_m = plan.as_ref().map_or(f64::NAN, |p| p.route.length_m);
-            let p = plan?;
-            let s = accepted(&p, m).ok_or_else(|| LegError::Smoothing(leg_plan_failure(&p)))?;
-            leg.smoothing = "ok".into();
-            leg.planned_length_m = s.path.length_m();
-            leg.min_clearance_m = leg.min_clearance_m.min(s.min_clearance_m);
-            record_route(rec, self.sim.time_s(), i, &p, (&s.polyline, &s.path));
-            self.drive_path(&s.path, m, &mut stats, rec)?;
-            Ok(())
-        };
-        let result = run();
-        finish_leg(&mut leg, result, &stats, self.sim.time_s() - t0);
-        self.leg_loc.finish_leg(self.sim.time_s(), &mut leg);
+        let result = self
+            .leg_drives(map, m, (i, from, to), (&mut leg, &mut stats), rec)
+            .await;
+        finish_leg(&mut leg, result, &stats, self.world.sim.time_s() - t0);
+        self.loc
+            .leg_stats
+            .finish_leg(self.world.sim.time_s(), &mut leg);
         if leg.success {
-            check_arrival(&mut leg, m, to, &self.sim.fork_root_pose());
+            check_arrival(&mut leg, m, to, &self.world.sim.fork_root_pose());
         }
         leg
     }
 
+    /// A leg's plans and drives: Hybrid-A*'s manoeuvre, or a back-out (all but the first
+    /// leg) and the smoothed route.
+    async fn leg_drives<R: Recorder + ?Sized>(
+        &mut self,
+        map: &NavMap,
+        m: &MissionSpec,
+        (i, from, to): (usize, &Waypoint, &Waypoint),
+        (leg, stats): (&mut LegOutcome, &mut DriveStats),
+        rec: &mut R,
+    ) -> Result<(), LegError> {
+        if m.global.planner.kinodynamic() {
+            // Hybrid-A* plans the way out of the station itself, reversing as needed.
+            return self.manoeuvre_leg(map, m, (i, to), (leg, stats), rec).await;
+        }
+        if i > 0 {
+            self.back_out(map, m, (i, from, to), (leg, stats), rec)
+                .await?;
+        }
+        let here = self.sense(rec)?.1;
+        let (plan, attempts, secs) = plan_leg(
+            map,
+            m,
+            (&here, &to.pose),
+            &self.scn.truck,
+            self.run.seed ^ ((i as u64 + 1) << 32),
+        );
+        leg.planning_time_s = secs;
+        leg.planning_attempts = attempts;
+        leg.route_length_m = plan.as_ref().map_or(f64::NAN, |p| p.route.length_m);
+        let p = plan?;
+        let s = accepted(&p, m).ok_or_else(|| LegError::Smoothing(leg_plan_failure(&p)))?;
+        leg.smoothing = "ok".into();
+        leg.planned_length_m = s.path.length_m();
+        leg.min_clearance_m = leg.min_clearance_m.min(s.min_clearance_m);
+        record_route(rec, self.world.sim.time_s(), i, &p, (&s.polyline, &s.path));
+        self.drive_path(&s.path, m, stats, rec).await
+    }
+
     /// Backs out of the place a leg starts at, the way `plan_backout` finds, and drives it.
-    fn back_out<R: Recorder + ?Sized>(
+    async fn back_out<R: Recorder + ?Sized>(
         &mut self,
         map: &NavMap,
         m: &MissionSpec,
@@ -189,66 +202,13 @@ impl Trial<'_> {
         leg.reverse_length_m = back.length_m();
         let points = path_points(&back);
         rec.signal(
-            self.sim.time_s(),
+            self.world.sim.time_s(),
             &format!("nav/route/{i}/reverse"),
             &Signal::Path(&points),
             REVERSE,
         );
         leg.min_clearance_m = clearance;
-        self.drive_path(&back, m, stats, rec)
-    }
-
-    /// Follows `path` (forward or reverse) with the mission's pure pursuit until it stops at
-    /// the end; a touch of a rack or wall ends the leg.
-    fn drive_path<R: Recorder + ?Sized>(
-        &mut self,
-        path: &Path,
-        m: &MissionSpec,
-        stats: &mut DriveStats,
-        rec: &mut R,
-    ) -> Result<(), LegError> {
-        let mut tracker = PurePursuit::with_config(m.tracker.clone());
-        tracker.reset(path, &self.scn.truck);
-        self.drive_with(
-            &mut |input| Tracker::command(&mut tracker, input),
-            m,
-            stats,
-            rec,
-        )
-    }
-
-    /// Drives with `next` giving each tick's command until it reports done with the truck
-    /// standing; a touch of a rack or wall ends the leg.
-    pub(super) fn drive_with<R: Recorder + ?Sized>(
-        &mut self,
-        next: &mut dyn FnMut(&forkbench_track::TrackerInput) -> forkbench_track::Command,
-        m: &MissionSpec,
-        stats: &mut DriveStats,
-        rec: &mut R,
-    ) -> Result<(), LegError> {
-        let deadline_s = self.sim.time_s() + m.leg_timeout_s;
-        while self.sim.time_s() < deadline_s {
-            let (fix, pose) = self.sense(rec)?;
-            let cmd = next(&self.tracker_input(pose));
-            if cmd.done && self.sim.speed_mps().abs() < 0.01 {
-                return Ok(());
-            }
-            self.physics_step(&cmd, fix, pose, rec);
-            stats.steps += 1;
-            stats.cross_track_sum_m += cmd.cross_track_m.abs();
-            stats.cross_track_max_m = stats.cross_track_max_m.max(cmd.cross_track_m.abs());
-            if self.sim.obstacle_contact() {
-                stats.collisions += 1;
-                let p = self.sim.fork_root_pose();
-                return Err(LegError::Struck {
-                    x_m: p.x_m,
-                    y_m: p.y_m,
-                });
-            }
-        }
-        Err(LegError::NotStopped {
-            timeout_s: m.leg_timeout_s,
-        })
+        self.drive_path(&back, m, stats, rec).await
     }
 }
 

@@ -3,8 +3,10 @@
 pub mod accuracy;
 mod criteria;
 mod drive;
+mod engine;
 mod error;
 mod judge;
+mod leg_drive;
 mod localize;
 mod look;
 mod manoeuvre_leg;
@@ -17,6 +19,7 @@ mod session;
 mod session_view;
 mod setup;
 mod staging;
+mod state;
 mod step_criteria;
 
 use std::time::Instant;
@@ -30,10 +33,13 @@ use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
 pub use criteria::{Criterion, PICK_CRITERIA};
+pub use engine::{Episode, Stage};
 pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
 pub use phases::{
-    Context as PhaseContext, PICK, PhaseSpec, phase_defaults, resolve as phases_resolve,
+    Context as PhaseContext, Failed, PICK, Phase, PhaseCtor, PhaseKind, PhaseRun, PhaseSpec,
+    builtin_phases, defaults_of as phase_settings_defaults, open_loop, phase_defaults,
+    positive_at_most, resolve as phases_resolve, settings as phase_settings,
 };
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use session_view::SceneView;
@@ -103,7 +109,8 @@ pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutco
     run_trial_recorded(scn, case, opts, &mut NoRecorder)
 }
 
-/// Runs one case and reports every step to `rec`.
+/// Runs one case and reports every step to `rec`: the same engine a [`Session`] steps,
+/// run to its end with nobody taking the ticks.
 pub fn run_trial_recorded<R: Recorder + ?Sized>(
     scn: &Scenario,
     case: &Case,
@@ -112,59 +119,70 @@ pub fn run_trial_recorded<R: Recorder + ?Sized>(
 ) -> TrialOutcome {
     let wall = Instant::now();
     let mut out = match scn.resolve(opts) {
-        Ok(run) => run_stages(scn, case, &run, rec),
-        Err(e) => {
-            let names = (
-                opts.planner.as_deref().unwrap_or(&scn.planner.name),
-                opts.tracker.as_deref().unwrap_or(&scn.tracker.name),
-            );
-            let seed = opts.seed.unwrap_or(scn.seed);
-            let mut out = TrialOutcome::blank(&scn.name, &case.name, names, seed, false);
-            out.fail(Failure::Error, e.to_string());
-            out
-        }
+        Ok(run) => engine::run_to_end(run_stages(scn, case, &run, None, rec)),
+        Err(e) => unresolved(scn, case, opts, &e),
     };
     out.wall_time_ms = wall.elapsed().as_secs_f64() * 1e3;
     rec.outcome(out.sim_time_s, &out);
     out
 }
 
-fn run_stages<R: Recorder + ?Sized>(
+/// The outcome of a run whose options do not resolve.
+fn unresolved(scn: &Scenario, case: &Case, opts: &TrialOptions, e: &TrialError) -> TrialOutcome {
+    let names = (
+        opts.planner.as_deref().unwrap_or(&scn.planner.name),
+        opts.tracker.as_deref().unwrap_or(&scn.tracker.name),
+    );
+    let seed = opts.seed.unwrap_or(scn.seed);
+    let mut out = TrialOutcome::blank(&scn.name, &case.name, names, seed, false);
+    out.fail(Failure::Error, e.to_string());
+    out
+}
+
+/// The whole trial: setup, the mission's legs, staging, the pick and its verdict, and
+/// (unless a session takes the pick alone) the phases after it.
+pub(crate) async fn run_stages<R: Recorder + ?Sized>(
     scn: &Scenario,
     case: &Case,
     run: &Resolved,
+    link: Option<engine::Link>,
     rec: &mut R,
 ) -> TrialOutcome {
-    let mut trial = match prepare(scn, case, run, rec) {
+    let pick_only = link.as_ref().is_some_and(engine::Link::pick_only);
+    let mut trial = match prepare(scn, case, run, link, rec).await {
         Ok(t) => t,
         Err(out) => return *out,
     };
-    if let Err(why) = trial.drive(rec) {
+    if let Err(why) = trial.drive(rec).await {
         let why = why.to_string();
-        rec.event(trial.sim.time_s(), Level::Error, &why);
+        rec.event(trial.world.sim.time_s(), Level::Error, &why);
         trial.measure();
-        trial.out.fail(Failure::Error, why);
-        return trial.out;
+        trial.verdict.out.fail(Failure::Error, why);
+        return trial.verdict.out;
     }
     trial.conclude();
-    trial.run_phases(rec);
-    trial.out
+    if !pick_only {
+        trial.run_phases(rec).await;
+    }
+    trial.verdict.out
 }
 
 /// A trial up to its drive: the world and components, the mission's legs, the first fix
 /// and estimate, the first plan handed to the tracker. Err: the outcome of a trial that
 /// ended before driving to the pallet.
-pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
+async fn prepare<'a, R: Recorder + ?Sized>(
     scn: &'a Scenario,
     case: &Case,
     run: &'a Resolved,
+    link: Option<engine::Link>,
     rec: &mut R,
 ) -> Result<Trial<'a>, Box<TrialOutcome>> {
     let mut trial = Trial::setup(scn, case, run, rec)?;
+    trial.link = link;
     let end = |mut trial: Trial<'a>, failure: Failure, why: String| {
         trial.measure_time();
-        trial.out.fail(failure, why);
-        Err::<Trial<'a>, _>(Box::new(trial.out))
+        trial.verdict.out.fail(failure, why);
+        Err::<Trial<'a>, _>(Box::new(trial.verdict.out))
     };
     if let Some(m) = &scn.mission {
         let staging = crate::scenario::mission::Waypoint {
@@ -175,21 +193,21 @@ pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
             },
             pose: case.start,
         };
-        if let Err(why) = trial.run_legs(m, &staging, rec) {
+        if let Err(why) = trial.run_legs(m, &staging, rec).await {
             return end(trial, Failure::LegFailed, why.to_string());
         }
-        let pallet = trial.sim.pallet_pose();
+        let pallet = trial.world.sim.pallet_pose();
         if let Err(e) = trial.first_fix_and_estimate(&pallet, rec) {
             let why = e.to_string();
-            rec.event(trial.sim.time_s(), Level::Error, &why);
+            rec.event(trial.world.sim.time_s(), Level::Error, &why);
             return end(trial, Failure::Error, why);
         }
     }
-    if trial.out.estimates_missed == trial.out.estimates
-        && trial.out.estimates > 0
-        && let Err((failure, why)) = trial.stage_and_look(rec)
+    if trial.verdict.out.estimates_missed == trial.verdict.out.estimates
+        && trial.verdict.out.estimates > 0
+        && let Err((failure, why)) = trial.stage_and_look(rec).await
     {
-        rec.event(trial.sim.time_s(), Level::Error, &why);
+        rec.event(trial.world.sim.time_s(), Level::Error, &why);
         return end(trial, failure, why);
     }
     let path = match trial.first_plan(rec) {
@@ -197,7 +215,7 @@ pub(crate) fn prepare<'a, R: Recorder + ?Sized>(
         Err((failure, why)) => return end(trial, failure, why),
     };
     trial.tracker.reset(&path, &scn.truck);
-    trial.path = path;
-    trial.pick_started = (trial.sim.time_s(), trial.travelled_m);
+    trial.set_path(path);
+    trial.verdict.pick_started = (trial.world.sim.time_s(), trial.world.travelled_m);
     Ok(trial)
 }

@@ -38,7 +38,7 @@ impl Trial<'_> {
         let mut req = PlanRequest::new(pose, goal_for(est, truck, -self.scn.pick.pre_entry_gap_m));
         req.truck = truck.clone();
         req.start_curvature_per_m = curvature;
-        req.obstacles = self.obstacles.clone();
+        req.obstacles = self.world.obstacles.clone();
         req.seed = self.run.seed;
         let mut plan = self.planner.plan(&req)?;
         plan.path
@@ -64,7 +64,7 @@ impl Trial<'_> {
                 &self.path,
                 from,
                 s_end.max(from + BLEND_MIN_M),
-                (&self.pallet_est, est),
+                (&self.sense.pallet_est, est),
             );
             let kappa_max = self.scn.truck.max_curvature_per_m();
             let within = path
@@ -75,7 +75,7 @@ impl Trial<'_> {
                 return Ok((path, None));
             }
         }
-        let k0 = self.sim.steer_rad().tan() / self.scn.truck.wheelbase_m;
+        let k0 = self.world.sim.steer_rad().tan() / self.scn.truck.wheelbase_m;
         let plan = self.plan_from(*pose, k0, est)?;
         match self.clash(&plan.path) {
             Some(why) => Err(why),
@@ -89,7 +89,7 @@ impl Trial<'_> {
         if !self.scn.validate_paths {
             return None;
         }
-        let (obstacles, labels) = &self.footprints;
+        let (obstacles, labels) = &self.world.footprints;
         let body = truck_footprint(&self.scn.truck);
         obstacles
             .first_hit_along(&body, path, PATH_CHECK_STEP_M)
@@ -104,14 +104,14 @@ impl Trial<'_> {
         &mut self,
         rec: &mut R,
     ) -> Result<Path, (Failure, String)> {
-        let est = self.pallet_est;
-        let t = self.sim.time_s();
-        let plan = self.plan_from(self.first_fix, 0.0, &est).map_err(|e| {
+        let est = self.sense.pallet_est;
+        let t = self.world.sim.time_s();
+        let plan = self.plan_from(self.loc.first_fix, 0.0, &est).map_err(|e| {
             rec.event(t, Level::Error, &format!("planning failed: {e}"));
             (Failure::PlanFailed, e.to_string())
         })?;
         rec.plan(t, 0, &plan.path, plan.control_polygon_m.as_deref());
-        self.out.path_length_m = plan.path.length_m();
+        self.verdict.out.path_length_m = plan.path.length_m();
         if let Some(why) = self.clash(&plan.path) {
             let why = why.to_string();
             rec.event(t, Level::Error, &why);

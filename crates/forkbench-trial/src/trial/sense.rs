@@ -34,27 +34,29 @@ impl Trial<'_> {
         believed: &Pose2,
         rec: &mut R,
     ) -> Result<Option<Pose2>, StageError> {
-        self.out.estimates += 1;
+        self.verdict.out.estimates += 1;
         let est = match &self.run.pallet_sensing {
             PalletSensing::Gaussian => Some(self.gaussian_estimate(truth, range_m)),
             PalletSensing::Scanner { .. } => self.scanned_estimate(believed, rec)?,
         };
         if est.is_none() {
-            self.out.estimates_missed += 1;
+            self.verdict.out.estimates_missed += 1;
         }
         Ok(est)
     }
 
     /// Whether some scanner has a new frame for a look now.
     pub(super) fn frame_due(&self) -> bool {
-        let t = self.sim.time_s();
-        self.scanners.iter().any(|s| t >= s.next_frame_s)
+        let t = self.world.sim.time_s();
+        self.sense.scanners.iter().any(|s| t >= s.next_frame_s)
     }
 
     fn gaussian_estimate(&mut self, truth: &Pose2, range_m: f64) -> Pose2 {
         let biased = truth.to_world(&self.scn.estimate_bias);
         if self.run.noise {
-            self.estimator.estimate(&biased, range_m, &mut self.est_rng)
+            self.sense
+                .estimator
+                .estimate(&biased, range_m, &mut self.sense.est_rng)
         } else {
             biased
         }
@@ -63,14 +65,14 @@ impl Trial<'_> {
     /// One scan from `sensor` (its true pose), placed at `placed` (its believed pose).
     fn scan_from(&mut self, k: usize, s: &NamedScanner, sensor: Pose2, placed: Pose2) -> Scan {
         let mut out = if self.run.noise {
-            let state = &mut self.scanners[k];
+            let state = &mut self.sense.scanners[k];
             let errors = Errors::Modelled {
                 bias_m: state.bias_m,
                 rng: &mut state.rng,
             };
-            scan(&s.scanner, &self.sim, sensor, errors)
+            scan(&s.scanner, &self.world.sim, sensor, errors)
         } else {
-            scan::<ChaCha8Rng>(&s.scanner, &self.sim, sensor, Errors::Ideal)
+            scan::<ChaCha8Rng>(&s.scanner, &self.world.sim, sensor, Errors::Ideal)
         };
         out.sensor = placed;
         out
@@ -86,28 +88,28 @@ impl Trial<'_> {
         };
         // Where to look: the last estimate, or before the first, where the pallet should
         // stand (a warehouse system knows the slot, not the placement error).
-        let prior = if self.out.estimates > 1 {
-            self.pallet_est
+        let prior = if self.verdict.out.estimates > 1 {
+            self.sense.pallet_est
         } else {
-            self.pallet_nominal
+            self.world.pallet_nominal
         };
-        let root = self.sim.fork_root_pose();
-        let t = self.sim.time_s();
+        let root = self.world.sim.fork_root_pose();
+        let t = self.world.sim.time_s();
         let mut scans = Vec::with_capacity(sensors.len());
         for (k, s) in sensors.iter().enumerate() {
             let placed = s.scanner.sensor_pose(believed);
             // A scanner gives a look its latest frame only once: a look sooner than its
             // frame period after the last gets nothing new from it.
-            if !s.scanner.reaches(&placed, &prior) || t < self.scanners[k].next_frame_s {
+            if !s.scanner.reaches(&placed, &prior) || t < self.sense.scanners[k].next_frame_s {
                 continue;
             }
-            self.scanners[k].next_frame_s = t + 1.0 / s.scanner.rate_hz;
+            self.sense.scanners[k].next_frame_s = t + 1.0 / s.scanner.rate_hz;
             let sc = self.scan_from(k, s, s.scanner.sensor_pose(&root), placed);
             let style = SCAN_STYLES[k % SCAN_STYLES.len()];
             rec.signal(t, &format!("sensors/{}", s.name), &Signal::Scan(&sc), style);
             scans.push((s.name.as_str(), sc));
         }
-        let Some(detector) = self.detector.as_mut() else {
+        let Some(detector) = self.sense.detector.as_mut() else {
             return Ok(None);
         };
         let Some(found) = detect_in(detector.as_mut(), &scans, &self.scn.pallet, Some(prior))?
@@ -127,9 +129,9 @@ impl Trial<'_> {
     /// Makes `est` the estimate the truck aims at, and records its error against the
     /// true face `truth`.
     pub(super) fn adopt_estimate(&mut self, est: Pose2, truth: &Pose2) {
-        self.pallet_est = est;
+        self.sense.pallet_est = est;
         let e = truth.to_local(&est);
-        self.out.estimate_lateral_error_m = Some(e.y_m);
-        self.out.estimate_heading_error_rad = Some(wrap_angle(e.heading_rad));
+        self.verdict.out.estimate_lateral_error_m = Some(e.y_m);
+        self.verdict.out.estimate_heading_error_rad = Some(wrap_angle(e.heading_rad));
     }
 }

@@ -2,7 +2,6 @@
 
 use forkbench_core::{Pose2, Signal, Style};
 
-use super::setup::Trial;
 use crate::recorder::Recorder;
 
 /// A snapshot of the world a session's trial stands in, in map coordinates.
@@ -24,7 +23,7 @@ pub struct SceneView {
 
 /// Keeps the returns of the latest scan of each scanner, for [`SceneView::scan`].
 #[derive(Debug, Default)]
-pub(super) struct ScanKeeper {
+pub(crate) struct ScanKeeper {
     /// Per scanner path: its last returns.
     last: Vec<(String, Vec<[f64; 2]>)>,
 }
@@ -42,24 +41,12 @@ impl Recorder for ScanKeeper {
     }
 }
 
-impl SceneView {
-    /// The scene of `t` now, with the scans `keeper` holds.
-    pub(super) fn of(t: &Trial<'_>, keeper: &ScanKeeper) -> Self {
-        SceneView {
-            fork_root: t.sim.fork_root_pose(),
-            pallet: t.sim.pallet_pose(),
-            pallet_estimate: t.pallet_est,
-            path: t.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect(),
-            obstacles: t
-                .obstacles
-                .iter()
-                .map(|o| forkbench_core::geometry::rect_outline(&o.centre, o.length_m, o.width_m))
-                .collect(),
-            scan: keeper
-                .last
-                .iter()
-                .flat_map(|(_, v)| v.iter().copied())
-                .collect(),
-        }
+impl ScanKeeper {
+    /// The returns of every scanner's last scan, as map points.
+    pub(crate) fn points(&self) -> Vec<[f64; 2]> {
+        self.last
+            .iter()
+            .flat_map(|(_, v)| v.iter().copied())
+            .collect()
     }
 }

@@ -3,7 +3,7 @@
 use forkbench_core::hash::fnv1a;
 use forkbench_core::{Pose2, SettingsError};
 use forkbench_plan::Planner;
-use forkbench_sensors::{Localizer, PalletEstimator};
+use forkbench_sensors::Localizer;
 use forkbench_sim::Sim;
 use forkbench_track::{PosePredictor, Tracker};
 use rand::SeedableRng;
@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use super::error::StageError;
 use super::judge::jitter;
 use super::localize::{LocStats, record_reflectors};
+use super::state::{Localisation, Perception, Verdict, WorldState};
 use super::{Resolved, target_insertion_m};
 use crate::components::LocalizerContext;
 use crate::outcome::{Failure, TrialOutcome};
@@ -25,71 +26,36 @@ pub(super) fn stream(seed: u64, salt: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed ^ salt.wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
 
-/// A trial in progress: its world, sensors, components and what it has measured so far.
+/// A trial in progress: its scenario and run, the controllers and the plan they follow,
+/// and its state by concern (the world, the localisation, the perception, the verdict
+/// being built).
 pub struct Trial<'a> {
     /// When the trial began, for its wall-time budget.
     pub(super) wall_start: std::time::Instant,
     pub(super) scn: &'a Scenario,
     pub(super) run: &'a Resolved,
-    pub(super) out: TrialOutcome,
-    pub(super) sim: Sim,
+    pub(super) world: WorldState,
+    pub(super) loc: Localisation,
+    pub(super) sense: Perception,
+    pub(super) verdict: Verdict,
     pub(super) planner: Box<dyn Planner>,
     pub(super) tracker: Box<dyn Tracker>,
-    pub(super) localizer: Box<dyn Localizer>,
-    pub(super) estimator: Box<dyn PalletEstimator>,
-    pub(super) nav_rng: ChaCha8Rng,
-    pub(super) est_rng: ChaCha8Rng,
-    pub(super) predictor: PosePredictor,
-    /// The truck's odometry alone from its start, never reset by a fix (a NAV350's speed
-    /// input).
-    pub(super) odometry: PosePredictor,
-    pub(super) first_fix: Pose2,
-    /// The pallet pose the current plan aims at.
-    pub(super) pallet_est: Pose2,
-    /// The path the tracker follows now (the first plan or the last replan).
+    /// The path the tracker follows now (the first plan, the last replan, a phase's).
     pub(super) path: forkbench_core::Path,
+    /// Counts the changes of `path`, so a session copies it only when it changed.
+    pub(super) path_version: u64,
     /// Depth the forks are driven to past the face.
     pub(super) insertion_m: f64,
-    pub(super) obstacles: Vec<forkbench_sim::Obstacle>,
-    /// Racks and walls for the swept-body check of every plan, built once per trial.
-    pub(super) footprints: (forkbench_geom::Obstacles, Vec<String>),
-    /// Pallet pose before the truck moved: displacement is measured from it.
-    pub(super) pallet0: Pose2,
-    /// Where the pallet should stand (the case's placement, before any jitter): the
-    /// region a detector looks in before its first estimate.
-    pub(super) pallet_nominal: Pose2,
-    /// Each scanner's bias, noise stream and frame timing, in the sensing's order.
-    pub(super) scanners: Vec<ScannerState>,
-    /// The pallet detector, when the sensing scans.
-    pub(super) detector: Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
-    pub(super) collision: bool,
-    pub(super) timed_out: bool,
-    /// The pick's criteria that measure at every step.
-    pub(super) step_criteria: Vec<Box<dyn super::step_criteria::StepCriterion>>,
-    /// The odometry's speed-scale error and steering offset for this trial.
-    pub(super) odometry_error: (f64, f64),
-    /// Localisation over the whole trial, and over the current mission leg.
-    pub(super) loc: LocStats,
-    pub(super) leg_loc: LocStats,
-    /// The last reading gave no pose (the log says so once, and again when one returns).
-    pub(super) fix_lost: bool,
-    /// The plan aims at the prior (`[pick] when_not_seen = "prior"`): every scanner frame
-    /// is looked at until the face is found, then the truck replans once onto it.
-    pub(super) on_prior: bool,
-    /// Distance the fork root has travelled, over every physics step, and of that with
-    /// the pallet on the forks.
-    pub(super) travelled_m: f64,
-    pub(super) travelled_loaded_m: f64,
-    /// Simulated time and distance travelled when the pick's drive began.
-    pub(super) pick_started: (f64, f64),
-    /// What the running phase measured, by name (see `PhaseOutcome::measures`).
-    pub(super) phase_measures: std::collections::BTreeMap<String, f64>,
+    /// The session whose caller takes the ticks, if one does.
+    pub(super) link: Option<super::engine::Link>,
+    /// The part of the cycle being driven.
+    pub(super) stage: super::engine::Stage,
 }
 
 impl std::fmt::Debug for Trial<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Trial")
-            .field("out", &self.out)
+            .field("out", &self.verdict.out)
             .finish_non_exhaustive()
     }
 }
@@ -283,38 +249,32 @@ impl<'a> Trial<'a> {
         let mut trial = Trial {
             scn,
             run,
-            out,
-            sim,
+            world: WorldState {
+                sim,
+                obstacles,
+                footprints: scn.world.footprint_obstacles(),
+                pallet0,
+                pallet_nominal: case.pallet,
+                collision: false,
+                travelled_m: 0.0,
+                travelled_loaded_m: 0.0,
+            },
+            loc: localisation(localizer, run, start),
+            sense: perception(scn, run, detector, true_pallet),
+            verdict: Verdict {
+                out,
+                step_criteria: super::step_criteria::build_all(),
+                timed_out: true,
+                pick_started: (0.0, 0.0),
+                phase_measures: std::collections::BTreeMap::new(),
+            },
             planner,
             tracker,
-            localizer,
-            estimator: scn.registry.estimator(&run.pallet_estimate),
-            nav_rng: stream(run.seed, 1),
-            est_rng: stream(run.seed, 2),
-            predictor: PosePredictor::new(),
-            odometry: odometry_from(start),
-            first_fix: start,
-            pallet_est: true_pallet,
             path: forkbench_core::Path::default(),
+            path_version: 0,
             insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
-            obstacles,
-            footprints: scn.world.footprint_obstacles(),
-            pallet0,
-            pallet_nominal: case.pallet,
-            scanners: scanner_streams(run),
-            detector,
-            collision: false,
-            timed_out: true,
-            step_criteria: super::step_criteria::build_all(),
-            odometry_error: odometry_error(run),
-            loc: LocStats::new(0.0),
-            leg_loc: LocStats::new(0.0),
-            fix_lost: false,
-            on_prior: false,
-            travelled_m: 0.0,
-            travelled_loaded_m: 0.0,
-            pick_started: (0.0, 0.0),
-            phase_measures: std::collections::BTreeMap::new(),
+            link: None,
+            stage: super::engine::Stage::Leg,
             wall_start: std::time::Instant::now(),
         };
         if scn.mission.is_none()
@@ -322,10 +282,16 @@ impl<'a> Trial<'a> {
         {
             let why = e.to_string();
             rec.event(0.0, Level::Error, &why);
-            trial.out.fail(Failure::Error, why);
-            return Err(Box::new(trial.out));
+            trial.verdict.out.fail(Failure::Error, why);
+            return Err(Box::new(trial.verdict.out));
         }
         Ok(trial)
+    }
+
+    /// Follows `path` from now on (the first plan, a replan, a phase's plan).
+    pub(super) fn set_path(&mut self, path: forkbench_core::Path) {
+        self.path = path;
+        self.path_version += 1;
     }
 
     /// The fix the pick plans from (the odometry-predicted pose when no fix is due) and
@@ -336,13 +302,48 @@ impl<'a> Trial<'a> {
         rec: &mut R,
     ) -> Result<(), StageError> {
         let (fix, _) = self.sense(rec)?;
-        self.first_fix = fix.or(self.predictor.pose()).unwrap_or(self.first_fix);
-        self.predictor.fix(self.first_fix);
-        let range = self.first_fix.distance_to(true_pallet);
-        let believed = self.first_fix;
+        self.loc.first_fix = fix
+            .or(self.loc.predictor.pose())
+            .unwrap_or(self.loc.first_fix);
+        self.loc.predictor.fix(self.loc.first_fix);
+        let range = self.loc.first_fix.distance_to(true_pallet);
+        let believed = self.loc.first_fix;
         if let Some(est) = self.estimate(true_pallet, range, &believed, rec)? {
             self.adopt_estimate(est, true_pallet);
         }
         Ok(())
+    }
+}
+
+/// The localisation at the start: the localiser, its stream, odometry from `start`.
+fn localisation(localizer: Box<dyn Localizer>, run: &Resolved, start: Pose2) -> Localisation {
+    Localisation {
+        localizer,
+        nav_rng: stream(run.seed, 1),
+        predictor: PosePredictor::new(),
+        odometry: odometry_from(start),
+        first_fix: start,
+        odometry_error: odometry_error(run),
+        stats: LocStats::new(0.0),
+        leg_stats: LocStats::new(0.0),
+        fix_lost: false,
+    }
+}
+
+/// The perception at the start: the estimator, the scanners' streams, the detector, and
+/// the estimate (the truth until a first look).
+fn perception(
+    scn: &Scenario,
+    run: &Resolved,
+    detector: Option<Box<dyn forkbench_sensors::detector::PalletDetector>>,
+    pallet_est: Pose2,
+) -> Perception {
+    Perception {
+        estimator: scn.registry.estimator(&run.pallet_estimate),
+        est_rng: stream(run.seed, 2),
+        scanners: scanner_streams(run),
+        detector,
+        pallet_est,
+        on_prior: false,
     }
 }

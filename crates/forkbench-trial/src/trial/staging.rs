@@ -24,7 +24,7 @@ const PALLET_GROWTH_M: f64 = 0.2;
 impl Trial<'_> {
     /// When the first look found nothing: the scenario's policy. `Ok` with the pallet
     /// found (the truck at the staging pose, the estimate and first fix taken there).
-    pub(super) fn stage_and_look<R: Recorder + ?Sized>(
+    pub(super) async fn stage_and_look<R: Recorder + ?Sized>(
         &mut self,
         rec: &mut R,
     ) -> Result<(), (Failure, String)> {
@@ -39,21 +39,22 @@ impl Trial<'_> {
             }
             WhenNotSeen::Prior => {
                 rec.event(
-                    self.sim.time_s(),
+                    self.world.sim.time_s(),
                     Level::Warn,
                     "no pallet seen from the start: planning on the prior, looking at every frame",
                 );
-                self.pallet_est = self.pallet_nominal;
-                self.on_prior = true;
+                self.sense.pallet_est = self.world.pallet_nominal;
+                self.sense.on_prior = true;
                 return Ok(());
             }
             WhenNotSeen::Stage => {}
         }
-        let staging = self
-            .pallet_nominal
-            .to_world(&Pose2::new(-pick.staging_distance_m, 0.0, 0.0));
+        let staging =
+            self.world
+                .pallet_nominal
+                .to_world(&Pose2::new(-pick.staging_distance_m, 0.0, 0.0));
         rec.event(
-            self.sim.time_s(),
+            self.world.sim.time_s(),
             Level::Warn,
             &format!(
                 "no pallet seen from the start: staging at ({:.2}, {:.2}) m, {:.1}°, {:.1} m before the expected face",
@@ -63,20 +64,23 @@ impl Trial<'_> {
                 pick.staging_distance_m
             ),
         );
+        self.stage = super::engine::Stage::Staging;
         self.staging_leg(staging, rec)
+            .await
             .map_err(|why| (Failure::StagingUnreachable, why))?;
-        let truth = self.sim.pallet_pose();
+        let truth = self.world.sim.pallet_pose();
         for look in 1..=pick.looks {
             if look > 1 {
                 self.between_looks(pick.between_looks, &pick, rec)
+                    .await
                     .map_err(|e| (Failure::Error, e.to_string()))?;
             }
-            let missed = self.out.estimates_missed;
+            let missed = self.verdict.out.estimates_missed;
             self.first_fix_and_estimate(&truth, rec)
                 .map_err(|e| (Failure::Error, e.to_string()))?;
-            let found = self.out.estimates_missed == missed;
+            let found = self.verdict.out.estimates_missed == missed;
             rec.event(
-                self.sim.time_s(),
+                self.world.sim.time_s(),
                 if found { Level::Info } else { Level::Warn },
                 &format!(
                     "look {look} of {} from the staging pose: {}",
@@ -99,12 +103,12 @@ impl Trial<'_> {
 
     /// Drives to `staging` as a mission leg planned by Hybrid-A*, round the racks, the
     /// walls and the pallet where it should stand. Err: why it was not reached.
-    fn staging_leg<R: Recorder + ?Sized>(
+    async fn staging_leg<R: Recorder + ?Sized>(
         &mut self,
         staging: Pose2,
         rec: &mut R,
     ) -> Result<(), String> {
-        let here = self.sim.fork_root_pose();
+        let here = self.world.sim.fork_root_pose();
         let map = self
             .staging_map(&here, &staging)
             .map_err(|e| e.to_string())?;
@@ -113,15 +117,15 @@ impl Trial<'_> {
             name: "staging".into(),
             pose: staging,
         };
-        let i = self.out.legs.len();
-        let leg = self.leg(&map, &m, (i, &m.start, &to), rec);
+        let i = self.verdict.out.legs.len();
+        let leg = self.leg(&map, &m, (i, &m.start, &to), rec).await;
         let (ok, why) = (leg.success, leg.failure_detail.clone());
         rec.event(
-            self.sim.time_s(),
+            self.world.sim.time_s(),
             if ok { Level::Info } else { Level::Error },
             &format!("leg {}: {}", leg.name, why.as_deref().unwrap_or("arrived")),
         );
-        self.out.legs.push(leg);
+        self.verdict.out.legs.push(leg);
         if ok {
             Ok(())
         } else {
@@ -136,9 +140,10 @@ impl Trial<'_> {
     /// the truck and the staging pose with room to manoeuvre.
     fn staging_map(&self, here: &Pose2, staging: &Pose2) -> Result<NavMap, StageError> {
         let p = &self.scn.pallet;
-        let mut obstacles = self.obstacles.clone();
+        let mut obstacles = self.world.obstacles.clone();
         obstacles.push(Obstacle {
             centre: self
+                .world
                 .pallet_nominal
                 .to_world(&Pose2::new(p.depth_m / 2.0, 0.0, 0.0)),
             length_m: p.depth_m + 2.0 * PALLET_GROWTH_M,
@@ -186,19 +191,19 @@ impl Trial<'_> {
 
     /// Between two looks: stand `retry_wait_s`, or back `retry_step_m` straight away
     /// from the pallet.
-    fn between_looks<R: Recorder + ?Sized>(
+    async fn between_looks<R: Recorder + ?Sized>(
         &mut self,
         how: BetweenLooks,
         pick: &crate::scenario::PickFile,
         rec: &mut R,
     ) -> Result<(), StageError> {
-        let here = self.sim.fork_root_pose();
+        let here = self.world.sim.fork_root_pose();
         let m = self.staging_mission(here);
         let mut stats = DriveStats::default();
         let result = match how {
             BetweenLooks::Wait => {
-                let until_s = self.sim.time_s() + pick.retry_wait_s;
-                let mut stand = |input: &forkbench_track::TrackerInput| forkbench_track::Command {
+                let until_s = self.world.sim.time_s() + pick.retry_wait_s;
+                let stand = |input: &forkbench_track::TrackerInput| forkbench_track::Command {
                     speed_mps: 0.0,
                     steer_rad: input.steer_rad,
                     lookahead_point: [input.pose.x_m, input.pose.y_m],
@@ -207,18 +212,19 @@ impl Trial<'_> {
                     path_curvature_per_m: 0.0,
                     done: input.t_s >= until_s,
                 };
-                self.drive_with(&mut stand, &m, &mut stats, rec)
+                self.drive_with(stand, &m, &mut stats, rec).await
             }
             BetweenLooks::Move => {
                 let back = here.to_world(&Pose2::new(-pick.retry_step_m, 0.0, 0.0));
                 let seg = forkbench_core::Path::straight(&back, pick.retry_step_m, 0.02)
                     .driven_backwards();
                 let mut f = SegmentFollower::new(vec![seg], m.tracker.clone(), &self.scn.truck);
-                self.drive_with(&mut |input| f.command(input), &m, &mut stats, rec)
+                self.drive_with(|input| f.command(input), &m, &mut stats, rec)
+                    .await
             }
         };
         result.map_err(|e| StageError::Leg {
-            number: self.out.legs.len(),
+            number: self.verdict.out.legs.len(),
             name: "between looks".into(),
             detail: e.to_string(),
         })?;

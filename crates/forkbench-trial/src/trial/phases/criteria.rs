@@ -10,7 +10,7 @@ use crate::trial::setup::Trial;
 /// What every phase holds at every step: no rack or wall touched, the load still on the
 /// forks.
 pub(super) fn every_step(t: &Trial<'_>) -> Result<(), Failed> {
-    if t.collision {
+    if t.world.collision {
         return Err((
             Failure::Collision,
             "truck touched a rack or wall".to_owned(),
@@ -22,13 +22,13 @@ pub(super) fn every_step(t: &Trial<'_>) -> Result<(), Failed> {
 /// The carried load stayed on the forks: the truck never accelerated it harder than its
 /// friction on them holds (μ g).
 pub(super) fn load_held(t: &Trial<'_>) -> Result<(), Failed> {
-    if t.sim.load_shifted() {
-        let limit = t.sim.load_grip_mps2();
+    if t.world.sim.load_shifted() {
+        let limit = t.world.sim.load_grip_mps2();
         return Err((
             Failure::LoadShifted,
             format!(
                 "the load was accelerated at {:.2} m/s² (its friction on the forks holds {limit:.2} m/s²)",
-                t.sim.peak_load_accel_mps2()
+                t.world.sim.peak_load_accel_mps2()
             ),
         ));
     }
@@ -38,7 +38,7 @@ pub(super) fn load_held(t: &Trial<'_>) -> Result<(), Failed> {
 /// A pallet left standing stayed where it stood (the forks did not drag it) within the
 /// pick's displacement and rotation limits.
 pub(super) fn pallet_stayed(t: &Trial<'_>, from: &Pose2) -> Result<(), Failed> {
-    let now = t.sim.pallet_pose();
+    let now = t.world.sim.pallet_pose();
     let (moved, turned) = (
         now.distance_to(from),
         wrap_angle(now.heading_rad - from.heading_rad),

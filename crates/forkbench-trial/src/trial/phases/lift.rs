@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Failed, Phase, criteria, settings};
+use super::{Context, Phase, PhaseRun, criteria, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 use crate::trial::setup::Trial;
@@ -30,11 +30,14 @@ pub(super) fn build(table: &toml::Table, _cx: &Context<'_>) -> Result<Box<dyn Ph
 }
 
 impl Phase for Lift {
-    fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
-        t.sim
-            .lift()
-            .map_err(|e| (Failure::LiftFailed, e.to_string()))?;
-        t.stand_for(self.time_s, rec)?;
-        criteria::load_held(t)
+    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+        Box::pin(async move {
+            t.world
+                .sim
+                .lift()
+                .map_err(|e| (Failure::LiftFailed, e.to_string()))?;
+            t.stand_for(self.time_s, rec).await?;
+            criteria::load_held(t)
+        })
     }
 }

@@ -7,6 +7,10 @@ mod return_leg;
 mod reverse_out;
 mod run;
 
+pub use run::open_loop;
+
+use std::sync::Arc;
+
 use serde::Serialize;
 
 use super::setup::Trial;
@@ -24,86 +28,143 @@ pub struct Context<'a> {
     pub mission: Option<&'a crate::scenario::mission::MissionSpec>,
 }
 
-/// A phase after the pick as a scenario lists it: its name and its `[phase.NAME]` settings.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// A phase after the pick as a scenario lists it: its name and its `[phase.NAME]` settings,
+/// and the phase they build (built once, when the scenario loads).
+#[derive(Debug, Clone, Serialize)]
 pub struct PhaseSpec {
     pub name: String,
     pub settings: toml::Table,
+    #[serde(skip)]
+    pub(crate) phase: Arc<dyn Phase>,
+}
+
+impl PartialEq for PhaseSpec {
+    /// Equal settings build equal phases.
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name && self.settings == other.settings
+    }
 }
 
 /// Why a phase failed: its first failed criterion, with the value against the limit.
-pub(crate) type Failed = (Failure, String);
+pub type Failed = (Failure, String);
 
-/// One phase after the pick.
-pub(crate) trait Phase: std::fmt::Debug {
+/// A phase's run: it drives the trial tick by tick, yielding where a session's caller
+/// takes a tick.
+pub type PhaseRun<'t> =
+    std::pin::Pin<Box<dyn std::future::Future<Output = Result<(), Failed>> + Send + 't>>;
+
+/// One phase after the pick. A phase drives the truck with [`Trial::drive_under`] and
+/// [`Trial::stand_for`] (the one drive loop), measures with [`Trial::record_measure`]
+/// and judges with its own criteria; `run` returns `Box::pin(async move { … })`.
+pub trait Phase: std::fmt::Debug + Send + Sync {
     /// Drives the trial through the phase. Err: its first failed criterion.
-    fn run(&self, trial: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed>;
+    fn run<'t, 'a: 't>(
+        &'t self,
+        trial: &'t mut Trial<'a>,
+        rec: &'t mut dyn Recorder,
+    ) -> PhaseRun<'t>;
 }
 
 /// Builds a phase from its settings table, checked against the scenario's context.
-type Build = fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, String>;
+pub type PhaseCtor =
+    Arc<dyn Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, String> + Send + Sync>;
 
 /// A phase kind: its name, the phases it may follow, the load it needs and leaves, and
-/// how its settings (and the world, for slots) build it.
-struct Kind {
-    name: &'static str,
-    after: &'static [&'static str],
+/// how its settings (and the world, for slots) build it. Registered with
+/// [`crate::Registry::with_phase`].
+#[derive(Clone)]
+pub struct PhaseKind {
+    pub name: String,
+    /// The phases (or `pick`) it may follow.
+    pub after: Vec<String>,
     /// Whether the pallet must be on the forks (`Some(true)`) or not, to start it.
-    needs_loaded: Option<bool>,
+    pub needs_loaded: Option<bool>,
     /// Whether the pallet is on the forks after it (`None`: as before).
-    leaves_loaded: Option<bool>,
-    build: Build,
+    pub leaves_loaded: Option<bool>,
+    pub build: PhaseCtor,
     /// Its settings at their defaults (for the format document).
-    defaults: fn() -> toml::Value,
+    pub defaults: toml::Value,
 }
 
-/// Every phase by name: adding one is its file and a row here.
-const KINDS: &[Kind] = &[
-    Kind {
-        name: "lift",
-        after: &["pick"],
-        needs_loaded: Some(false),
-        leaves_loaded: Some(true),
-        build: lift::build,
-        defaults: defaults_of::<lift::Lift>,
-    },
-    Kind {
-        name: "reverse_out",
-        after: &["pick", "lift"],
-        needs_loaded: None,
-        leaves_loaded: None,
-        build: reverse_out::build,
-        defaults: defaults_of::<reverse_out::ReverseOut>,
-    },
-    Kind {
-        name: "carry",
-        after: &["lift", "reverse_out"],
-        needs_loaded: Some(true),
-        leaves_loaded: None,
-        build: return_leg::build_carry,
-        defaults: defaults_of::<return_leg::LegFile>,
-    },
-    Kind {
-        name: "place",
-        after: &["lift", "reverse_out", "carry"],
-        needs_loaded: Some(true),
-        leaves_loaded: Some(false),
-        build: place::build,
-        defaults: defaults_of::<place::PlaceFile>,
-    },
-    Kind {
-        name: "return",
-        after: &["place", "reverse_out"],
-        needs_loaded: None,
-        leaves_loaded: None,
-        build: return_leg::build_return,
-        defaults: defaults_of::<return_leg::LegFile>,
-    },
-];
+impl std::fmt::Debug for PhaseKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PhaseKind")
+            .field("name", &self.name)
+            .field("after", &self.after)
+            .finish_non_exhaustive()
+    }
+}
 
-/// Each phase after the pick with its settings at their defaults.
-pub fn phase_defaults() -> Vec<(&'static str, toml::Value)> {
-    KINDS.iter().map(|k| (k.name, (k.defaults)())).collect()
+impl PhaseKind {
+    /// A kind from its parts (`after`: the phases it may follow).
+    pub fn new(
+        name: &str,
+        after: &[&str],
+        (needs_loaded, leaves_loaded): (Option<bool>, Option<bool>),
+        build: impl Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, String>
+        + Send
+        + Sync
+        + 'static,
+        defaults: toml::Value,
+    ) -> Self {
+        PhaseKind {
+            name: name.to_owned(),
+            after: after.iter().map(|a| (*a).to_owned()).collect(),
+            needs_loaded,
+            leaves_loaded,
+            build: Arc::new(build),
+            defaults,
+        }
+    }
+}
+
+/// The phases forkbench ships: adding one is its file and a row here.
+pub fn builtin_phases() -> Vec<PhaseKind> {
+    vec![
+        PhaseKind::new(
+            "lift",
+            &["pick"],
+            (Some(false), Some(true)),
+            lift::build,
+            defaults_of::<lift::Lift>(),
+        ),
+        PhaseKind::new(
+            "reverse_out",
+            &["pick", "lift"],
+            (None, None),
+            reverse_out::build,
+            defaults_of::<reverse_out::ReverseOut>(),
+        ),
+        PhaseKind::new(
+            "carry",
+            &["lift", "reverse_out"],
+            (Some(true), None),
+            return_leg::build_carry,
+            defaults_of::<return_leg::LegFile>(),
+        ),
+        PhaseKind::new(
+            "place",
+            &["lift", "reverse_out", "carry"],
+            (Some(true), Some(false)),
+            place::build,
+            defaults_of::<place::PlaceFile>(),
+        ),
+        PhaseKind::new(
+            "return",
+            &["place", "reverse_out"],
+            (None, None),
+            return_leg::build_return,
+            defaults_of::<return_leg::LegFile>(),
+        ),
+    ]
+}
+
+/// Each built-in phase after the pick with its settings at their defaults.
+pub fn phase_defaults() -> Vec<(String, toml::Value)> {
+    builtin_phases()
+        .into_iter()
+        .map(|k| (k.name, k.defaults))
+        .collect()
 }
 
 /// The phase list's name for the pick itself (approach and insertion), always first.
@@ -116,6 +177,7 @@ pub fn resolve(
     names: &[String],
     settings: &toml::Table,
     cx: &Context<'_>,
+    kinds: &[PhaseKind],
 ) -> Result<Vec<PhaseSpec>, (String, String)> {
     if names.first().map(String::as_str) != Some(PICK) {
         return Err((
@@ -128,17 +190,18 @@ pub fn resolve(
     for (i, pair) in names.windows(2).enumerate() {
         let (prev, name) = (pair[0].as_str(), pair[1].as_str());
         let field = format!("phases[{}]", i + 1);
-        let kind = runnable(prev, name, loaded).map_err(|why| (field, why))?;
+        let kind = runnable(kinds, (prev, name), loaded).map_err(|why| (field, why))?;
         loaded = kind.leaves_loaded.unwrap_or(loaded);
         let table = match settings.get(name) {
             Some(toml::Value::Table(t)) => t.clone(),
             Some(_) => return Err((format!("phase.{name}"), "must be a table".into())),
             None => toml::Table::new(),
         };
-        (kind.build)(&table, cx).map_err(|e| (format!("phase.{name}"), e))?;
+        let phase = (kind.build)(&table, cx).map_err(|e| (format!("phase.{name}"), e))?;
         out.push(PhaseSpec {
             name: name.to_owned(),
             settings: table,
+            phase: phase.into(),
         });
     }
     if let Some(extra) = settings.keys().find(|k| !names.contains(k)) {
@@ -152,15 +215,19 @@ pub fn resolve(
 
 /// The kind of phase `name`, if it can run after `prev` with the pallet on the forks or
 /// not (`loaded`).
-fn runnable(prev: &str, name: &str, loaded: bool) -> Result<&'static Kind, String> {
-    let Some(kind) = KINDS.iter().find(|k| k.name == name) else {
-        let known: Vec<_> = KINDS.iter().map(|k| k.name).collect();
+fn runnable<'k>(
+    kinds: &'k [PhaseKind],
+    (prev, name): (&str, &str),
+    loaded: bool,
+) -> Result<&'k PhaseKind, String> {
+    let Some(kind) = kinds.iter().find(|k| k.name == name) else {
+        let known: Vec<_> = kinds.iter().map(|k| k.name.as_str()).collect();
         return Err(format!(
             "no phase {name:?} (phases after the pick: {})",
             known.join(", ")
         ));
     };
-    if !kind.after.contains(&prev) {
+    if !kind.after.iter().any(|a| a == prev) {
         return Err(format!(
             "{name:?} cannot follow {prev:?} (it follows {})",
             kind.after.join(" or ")
@@ -176,12 +243,12 @@ fn runnable(prev: &str, name: &str, loaded: bool) -> Result<&'static Kind, Strin
 }
 
 /// A settings struct at its defaults as a TOML table (for the format document).
-fn defaults_of<T: Serialize + Default>() -> toml::Value {
+pub fn defaults_of<T: Serialize + Default>() -> toml::Value {
     toml::Value::try_from(T::default()).unwrap_or(toml::Value::Table(toml::Table::new()))
 }
 
 /// Each `(name, value, max)` a positive finite number of at most `max`.
-pub(crate) fn positive_at_most(fields: &[(&str, f64, f64)]) -> Result<(), String> {
+pub fn positive_at_most(fields: &[(&str, f64, f64)]) -> Result<(), String> {
     for &(name, v, max) in fields {
         if !(v.is_finite() && v > 0.0 && v <= max) {
             return Err(format!(
@@ -193,7 +260,7 @@ pub(crate) fn positive_at_most(fields: &[(&str, f64, f64)]) -> Result<(), String
 }
 
 /// A phase's settings from its table, refusing unknown keys; `check` then the values.
-pub(crate) fn settings<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T, String> {
+pub fn settings<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T, String> {
     T::deserialize(toml::Value::Table(table.clone()))
         .map_err(|e| e.to_string().trim_end().to_owned())
 }

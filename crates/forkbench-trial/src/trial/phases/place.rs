@@ -5,7 +5,7 @@ use forkbench_core::{Pose2, Signal, Style};
 use serde::{Deserialize, Serialize};
 
 use super::reverse_out::back_straight;
-use super::{Context, Failed, Phase, criteria, positive_at_most, settings};
+use super::{Context, Failed, Phase, PhaseRun, criteria, positive_at_most, settings};
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{World, pallet_footprint, shrunk};
@@ -102,27 +102,33 @@ fn slot_pose(world: &World, name: &str) -> Result<Pose2, String> {
 }
 
 impl Phase for Place {
-    fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
-        if !t.sim.carrying() {
-            return Err((Failure::Error, "nothing on the forks to place".into()));
-        }
-        self.approach(t, rec)?;
-        t.sim.lower();
-        t.stand_for(self.cfg.lower_time_s, rec)?;
-        let placed = t.sim.pallet_pose();
-        self.measure(t, &placed);
-        back_straight(t, (self.cfg.retract_m, 0.5, 30.0), rec)?;
-        self.placement(t)?;
-        criteria::pallet_stayed(t, &placed)
+    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+        Box::pin(async move {
+            if !t.world.sim.carrying() {
+                return Err((Failure::Error, "nothing on the forks to place".into()));
+            }
+            self.approach(t, rec).await?;
+            t.world.sim.lower();
+            t.stand_for(self.cfg.lower_time_s, rec).await?;
+            let placed = t.world.sim.pallet_pose();
+            self.measure(t, &placed);
+            back_straight(t, (self.cfg.retract_m, 0.5, 30.0), rec).await?;
+            self.placement(t)?;
+            criteria::pallet_stayed(t, &placed)
+        })
     }
 }
 
 impl Place {
     /// Plans to the fork-root pose that sets the carried pallet's face on the slot (as
     /// if picking a pallet standing there) and drives it with the scenario's tracker.
-    fn approach(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
+    async fn approach(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
         let truck = &t.scn.truck;
-        let root_on_pallet = t.sim.pallet_pose().to_local(&t.sim.fork_root_pose());
+        let root_on_pallet = t
+            .world
+            .sim
+            .pallet_pose()
+            .to_local(&t.world.sim.fork_root_pose());
         let aim = self
             .at
             .to_world(&Pose2::new(-self.cfg.stop_short_m, 0.0, 0.0));
@@ -130,8 +136,8 @@ impl Place {
         // The face a pick would aim at to end with the fork root at `root_goal`.
         let face = root_goal.to_world(&Pose2::new(truck.fork_length_m - t.insertion_m, 0.0, 0.0));
         let pose = t.sense(rec).map_err(|e| (Failure::Error, e.to_string()))?.1;
-        let k0 = t.sim.steer_rad().tan() / truck.wheelbase_m;
-        let time = t.sim.time_s();
+        let k0 = t.world.sim.steer_rad().tan() / truck.wheelbase_m;
+        let time = t.world.sim.time_s();
         let refused = |why: String| {
             (
                 Failure::PlanFailed,
@@ -146,7 +152,7 @@ impl Place {
         }
         rec.plan(
             time,
-            t.out.replans + 1,
+            t.verdict.out.replans + 1,
             &plan.path,
             plan.control_polygon_m.as_deref(),
         );
@@ -163,14 +169,16 @@ impl Place {
             ),
         );
         t.tracker.reset(&plan.path, truck);
-        t.path = plan.path;
+        t.set_path(plan.path);
         let timeout_s = self.cfg.timeout_s;
-        let arrived = t.drive_by(timeout_s, rec, |t, pose| {
-            let cmd = t
-                .tracker_command(pose)
-                .map_err(|e| (Failure::Error, e.to_string()))?;
-            Ok((!(cmd.done && t.stands())).then_some(cmd))
-        })?;
+        let arrived = t
+            .drive_under(timeout_s, rec, |t, pose| {
+                let cmd = t
+                    .tracker_command(pose)
+                    .map_err(|e| (Failure::Error, e.to_string()))?;
+                Ok((!(cmd.done && t.stands())).then_some(cmd))
+            })
+            .await?;
         if arrived {
             Ok(())
         } else {
@@ -183,9 +191,9 @@ impl Place {
 
     /// The placed pallet against the slot, and the room left around it.
     fn measure(&self, t: &mut Trial<'_>, placed: &Pose2) {
-        let (obstacles, _) = &t.footprints;
+        let (obstacles, _) = &t.world.footprints;
         let clearance = obstacles.clearance(&pallet_footprint(&t.scn.pallet), placed, 1.0);
-        let m = &mut t.phase_measures;
+        let m = &mut t.verdict.phase_measures;
         m.insert("position_error_m".into(), placed.distance_to(&self.at));
         m.insert(
             "heading_error_rad".into(),
@@ -196,7 +204,7 @@ impl Place {
 
     /// The pallet set down within the place tolerances of its slot.
     fn placement(&self, t: &Trial<'_>) -> Result<(), Failed> {
-        let m = &t.phase_measures;
+        let m = &t.verdict.phase_measures;
         let (d, h) = (m["position_error_m"], m["heading_error_rad"]);
         if d > self.cfg.position_m || h.abs() > self.cfg.heading_deg.to_radians() {
             return Err((

@@ -3,7 +3,7 @@
 use forkbench_nav::NavMap;
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Failed, Phase, settings};
+use super::{Context, Phase, PhaseRun, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 use crate::scenario::PoseDeg;
@@ -94,41 +94,44 @@ fn station(cx: &Context<'_>, name: &str) -> Result<Waypoint, String> {
 }
 
 impl Phase for Leg {
-    fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
-        let scn = t.scn;
-        let m = scn
-            .mission
-            .as_ref()
-            .ok_or((Failure::Error, "no [mission]".to_owned()))?;
-        let map = NavMap::shared_from_world(&t.obstacles, m.global.resolution_m)
-            .map_err(|e| (Failure::Error, e.to_string()))?;
-        let here = Waypoint {
-            name: "here".to_owned(),
-            pose: t.sim.fork_root_pose(),
-        };
-        // Numbered after the mission's legs and the cycle's earlier ones (its seed and
-        // recorded route are its own); a leg after the first backs out of where it
-        // starts, as from a station.
-        let number = m.via.len() + 1 + t.out.phases.len();
-        let leg = t.leg(&map, m, (number, &here, &self.to), rec);
-        let measures = [
-            ("planned_length_m", leg.planned_length_m),
-            ("final_position_error_m", leg.final_position_error_m),
-            ("cross_track_max_m", leg.cross_track_max_m),
-        ];
-        t.phase_measures
-            .extend(measures.map(|(k, v)| (k.to_owned(), v)));
-        if leg.success {
-            Ok(())
-        } else {
-            Err((
-                Failure::LegFailed,
-                format!(
-                    "to {}: {}",
-                    self.to.name,
-                    leg.failure_detail.unwrap_or_default()
-                ),
-            ))
-        }
+    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+        Box::pin(async move {
+            let scn = t.scn;
+            let m = scn
+                .mission
+                .as_ref()
+                .ok_or((Failure::Error, "no [mission]".to_owned()))?;
+            let map = NavMap::shared_from_world(&t.world.obstacles, m.global.resolution_m)
+                .map_err(|e| (Failure::Error, e.to_string()))?;
+            let here = Waypoint {
+                name: "here".to_owned(),
+                pose: t.world.sim.fork_root_pose(),
+            };
+            // Numbered after the mission's legs and the cycle's earlier ones (its seed and
+            // recorded route are its own); a leg after the first backs out of where it
+            // starts, as from a station.
+            let number = m.via.len() + 1 + t.verdict.out.phases.len();
+            let leg = t.leg(&map, m, (number, &here, &self.to), rec).await;
+            let measures = [
+                ("planned_length_m", leg.planned_length_m),
+                ("final_position_error_m", leg.final_position_error_m),
+                ("cross_track_max_m", leg.cross_track_max_m),
+            ];
+            t.verdict
+                .phase_measures
+                .extend(measures.map(|(k, v)| (k.to_owned(), v)));
+            if leg.success {
+                Ok(())
+            } else {
+                Err((
+                    Failure::LegFailed,
+                    format!(
+                        "to {}: {}",
+                        self.to.name,
+                        leg.failure_detail.unwrap_or_default()
+                    ),
+                ))
+            }
+        })
     }
 }

@@ -4,7 +4,7 @@ use forkbench_core::Pose2;
 use serde::{Deserialize, Serialize};
 
 use super::run::open_loop;
-use super::{Context, Failed, Phase, criteria, positive_at_most, settings};
+use super::{Context, Failed, Phase, PhaseRun, criteria, positive_at_most, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 use crate::trial::setup::Trial;
@@ -41,38 +41,42 @@ pub(super) fn build(table: &toml::Table, _cx: &Context<'_>) -> Result<Box<dyn Ph
 }
 
 impl Phase for ReverseOut {
-    fn run(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
-        let (pallet0, carrying) = (t.sim.pallet_pose(), t.sim.carrying());
-        back_straight(t, (self.distance_m, self.speed_mps, self.timeout_s), rec)?;
-        if carrying {
-            criteria::load_held(t)
-        } else {
-            criteria::pallet_stayed(t, &pallet0)
-        }
+    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+        Box::pin(async move {
+            let (pallet0, carrying) = (t.world.sim.pallet_pose(), t.world.sim.carrying());
+            back_straight(t, (self.distance_m, self.speed_mps, self.timeout_s), rec).await?;
+            if carrying {
+                criteria::load_held(t)
+            } else {
+                criteria::pallet_stayed(t, &pallet0)
+            }
+        })
     }
 }
 
 /// Backs the truck straight out (steering centred) until the fork root, by the
 /// controller's pose, is `distance_m` back and the truck stands; `timeout` if it is not
 /// within `timeout_s`.
-pub(super) fn back_straight(
+pub(super) async fn back_straight(
     t: &mut Trial<'_>,
     (distance_m, speed_mps, timeout_s): (f64, f64, f64),
     rec: &mut dyn Recorder,
 ) -> Result<(), Failed> {
     let mut from: Option<Pose2> = None;
     let mut backed_m = 0.0;
-    let finished = t.drive_by(timeout_s, rec, |t, pose| {
-        let start = *from.get_or_insert(pose);
-        backed_m = start.distance_to(&pose);
-        let left_m = distance_m - backed_m;
-        Ok(if left_m > 0.0 {
-            // Slows over the last metres so the truck stands near the distance.
-            Some(open_loop(-speed_mps.min(0.05 + 1.5 * left_m), 0.0, &pose))
-        } else {
-            (!t.stands()).then(|| open_loop(0.0, 0.0, &pose))
+    let finished = t
+        .drive_under(timeout_s, rec, |t, pose| {
+            let start = *from.get_or_insert(pose);
+            backed_m = start.distance_to(&pose);
+            let left_m = distance_m - backed_m;
+            Ok(if left_m > 0.0 {
+                // Slows over the last metres so the truck stands near the distance.
+                Some(open_loop(-speed_mps.min(0.05 + 1.5 * left_m), 0.0, &pose))
+            } else {
+                (!t.stands()).then(|| open_loop(0.0, 0.0, &pose))
+            })
         })
-    })?;
+        .await?;
     if finished {
         Ok(())
     } else {

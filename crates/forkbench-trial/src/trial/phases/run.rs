@@ -5,13 +5,15 @@ use std::collections::BTreeMap;
 use forkbench_core::{Pose2, Signal, Style};
 use forkbench_track::Command;
 
-use super::{Failed, KINDS, PICK, PhaseSpec};
-use crate::outcome::{Failure, PhaseOutcome};
+use super::{Failed, PICK, PhaseSpec};
+use crate::outcome::PhaseOutcome;
 use crate::recorder::{Level, Recorder};
+use crate::trial::engine::{Stage, Steering};
+use crate::trial::session::Control;
 use crate::trial::setup::Trial;
 
 /// A command holding `speed_mps` and `steer_rad`, for phases that drive without a path.
-pub(crate) fn open_loop(speed_mps: f64, steer_rad: f64, pose: &Pose2) -> Command {
+pub fn open_loop(speed_mps: f64, steer_rad: f64, pose: &Pose2) -> Command {
     Command {
         speed_mps,
         steer_rad,
@@ -47,69 +49,62 @@ impl<R: Recorder + ?Sized> Recorder for DynRec<'_, R> {
     }
 }
 
-impl Trial<'_> {
+impl<'a> Trial<'a> {
     /// After the judged pick: the pick's phase result, then each listed phase in order
     /// up to the first that fails, whose criterion becomes the trial's verdict.
-    pub(in crate::trial) fn run_phases<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
+    pub(in crate::trial) async fn run_phases<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
         if self.scn.phases.is_empty() {
             return;
         }
-        let (t0, d0) = self.pick_started;
-        self.out.phases.push(PhaseOutcome {
+        let (t0, d0) = self.verdict.pick_started;
+        self.verdict.out.phases.push(PhaseOutcome {
             name: PICK.to_owned(),
-            success: self.out.success,
-            failure: self.out.failure,
-            failure_detail: self.out.failure_detail.clone(),
-            time_s: self.sim.time_s() - t0,
-            distance_m: self.travelled_m - d0,
+            success: self.verdict.out.success,
+            failure: self.verdict.out.failure,
+            failure_detail: self.verdict.out.failure_detail.clone(),
+            time_s: self.world.sim.time_s() - t0,
+            distance_m: self.world.travelled_m - d0,
             loaded: false,
             measures: BTreeMap::new(),
         });
         let mut rec = DynRec(rec);
         let scn = self.scn;
-        for spec in &scn.phases {
-            if !self.out.success {
+        for (i, spec) in scn.phases.iter().enumerate() {
+            if !self.verdict.out.success {
                 break;
             }
-            self.run_phase(spec, &mut rec);
+            self.stage = Stage::Phase(u16::try_from(i + 1).unwrap_or(u16::MAX));
+            self.run_phase(spec, &mut rec).await;
         }
-        self.out.sim_time_s = self.sim.time_s();
-        self.out.cycle = Some(crate::outcome::CycleTotals {
-            time_s: self.sim.time_s(),
-            distance_loaded_m: self.travelled_loaded_m,
-            distance_unloaded_m: self.travelled_m - self.travelled_loaded_m,
+        self.verdict.out.sim_time_s = self.world.sim.time_s();
+        self.verdict.out.cycle = Some(crate::outcome::CycleTotals {
+            time_s: self.world.sim.time_s(),
+            distance_loaded_m: self.world.travelled_loaded_m,
+            distance_unloaded_m: self.world.travelled_m - self.world.travelled_loaded_m,
         });
     }
 
     /// One phase: built from its spec, run, timed and judged.
-    fn run_phase(&mut self, spec: &PhaseSpec, rec: &mut dyn Recorder) {
-        let (t0, d0, loaded) = (self.sim.time_s(), self.travelled_m, self.sim.carrying());
-        self.phase_measures.clear();
+    async fn run_phase(&mut self, spec: &PhaseSpec, rec: &mut dyn Recorder) {
+        let (t0, d0, loaded) = (
+            self.world.sim.time_s(),
+            self.world.travelled_m,
+            self.world.sim.carrying(),
+        );
+        self.verdict.phase_measures.clear();
         rec.event(t0, Level::Info, &format!("phase {}: start", spec.name));
         rec.signal(t0, "phase", &Signal::Text(&spec.name), Style::default());
-        let result = KINDS
-            .iter()
-            .find(|k| k.name == spec.name)
-            .ok_or_else(|| (Failure::Error, format!("no phase {:?}", spec.name)))
-            .and_then(|k| {
-                let cx = super::Context {
-                    world: &self.scn.world,
-                    pallet: &self.scn.pallet,
-                    mission: self.scn.mission.as_ref(),
-                };
-                (k.build)(&spec.settings, &cx).map_err(|e| (Failure::Error, e))
-            })
-            .and_then(|phase| phase.run(self, rec));
-        let t = self.sim.time_s();
+        let result = spec.phase.run(self, rec).await;
+        let t = self.world.sim.time_s();
         let mut done = PhaseOutcome {
             name: spec.name.clone(),
             success: result.is_ok(),
             failure: None,
             failure_detail: None,
             time_s: t - t0,
-            distance_m: self.travelled_m - d0,
-            loaded: loaded || self.sim.carrying(),
-            measures: std::mem::take(&mut self.phase_measures),
+            distance_m: self.world.travelled_m - d0,
+            loaded: loaded || self.world.sim.carrying(),
+            measures: std::mem::take(&mut self.verdict.phase_measures),
         };
         match result {
             Ok(()) => rec.event(t, Level::Info, &format!("phase {}: done", spec.name)),
@@ -121,50 +116,99 @@ impl Trial<'_> {
                     &format!("phase {} failed: {}: {why}", spec.name, failure.name()),
                 );
                 (done.failure, done.failure_detail) = (Some(failure), Some(why.clone()));
-                self.out.fail(failure, format!("{}: {why}", spec.name));
+                self.verdict
+                    .out
+                    .fail(failure, format!("{}: {why}", spec.name));
             }
         }
-        self.out.phases.push(done);
+        self.verdict.out.phases.push(done);
     }
 
     /// Holds the truck standing (steering where it is) for `time_s`, as while the mast
     /// lifts or lowers; the every-step criteria still hold.
-    pub(crate) fn stand_for(&mut self, time_s: f64, rec: &mut dyn Recorder) -> Result<(), Failed> {
-        let end_s = self.sim.time_s() + time_s;
-        self.drive_by(time_s + 1.0, rec, |t, pose| {
-            Ok((t.sim.time_s() < end_s).then(|| open_loop(0.0, t.sim.steer_rad(), &pose)))
-        })?;
+    pub async fn stand_for(&mut self, time_s: f64, rec: &mut dyn Recorder) -> Result<(), Failed> {
+        let end_s = self.world.sim.time_s() + time_s;
+        self.drive_under(time_s + 1.0, rec, |t, pose| {
+            Ok((t.world.sim.time_s() < end_s)
+                .then(|| open_loop(0.0, t.world.sim.steer_rad(), &pose)))
+        })
+        .await?;
         Ok(())
     }
 
     /// Steps the truck under `command` (from the controller's pose) until it returns
     /// `None` (Ok(true)), `limit_s` passes (Ok(false)), it fails, or a criterion every
     /// phase holds at every step breaks (Err).
-    pub(crate) fn drive_by(
+    pub async fn drive_under(
         &mut self,
         limit_s: f64,
         rec: &mut dyn Recorder,
-        mut command: impl FnMut(&mut Self, Pose2) -> Result<Option<Command>, Failed>,
+        command: impl FnMut(&mut Trial<'a>, Pose2) -> Result<Option<Command>, Failed>,
     ) -> Result<bool, Failed> {
-        let deadline = self.sim.time_s() + limit_s;
-        while self.sim.time_s() < deadline {
-            let (fix, pose) = self
-                .sense(rec)
-                .map_err(|e| (Failure::Error, e.to_string()))?;
-            let Some(cmd) = command(self, pose)? else {
-                return Ok(true);
-            };
-            self.physics_step(&cmd, fix, pose, rec);
-            super::criteria::every_step(self)?;
-            let t = self.sim.time_s();
-            let step = (t / self.sim.dt_s()).round() as u64;
-            if step.is_multiple_of(crate::trial::drive::SIGNAL_EVERY_STEPS) {
-                let [front, rear] = self.sim.axle_loads_n();
-                let none = Style::default();
-                rec.signal(t, "load/front_axle_n", &Signal::Scalar(front), none);
-                rec.signal(t, "load/rear_axle_n", &Signal::Scalar(rear), none);
-            }
+        self.drive_by(limit_s, &mut PhaseDrive(command), rec).await
+    }
+}
+
+/// A phase's drive: its commands, the criteria every phase holds at every step, and the
+/// axle loads recorded.
+struct PhaseDrive<F>(F);
+
+impl<'a, F> Steering<'a, Failed> for PhaseDrive<F>
+where
+    F: FnMut(&mut Trial<'a>, Pose2) -> Result<Option<Command>, Failed>,
+{
+    fn command(
+        &mut self,
+        t: &mut Trial<'a>,
+        _control: Control,
+        pose: Pose2,
+    ) -> Result<Option<Command>, Failed> {
+        (self.0)(t, pose)
+    }
+
+    fn stepped<R: Recorder + ?Sized>(
+        &mut self,
+        t: &mut Trial<'a>,
+        _control: Control,
+        _cmd: &Command,
+        rec: &mut R,
+    ) -> Result<bool, Failed> {
+        super::criteria::every_step(t)?;
+        let now = t.world.sim.time_s();
+        let step = (now / t.world.sim.dt_s()).round() as u64;
+        if step.is_multiple_of(crate::trial::drive::SIGNAL_EVERY_STEPS) {
+            let [front, rear] = t.world.sim.axle_loads_n();
+            let none = Style::default();
+            rec.signal(now, "load/front_axle_n", &Signal::Scalar(front), none);
+            rec.signal(now, "load/rear_axle_n", &Signal::Scalar(rear), none);
         }
         Ok(false)
+    }
+}
+
+impl Trial<'_> {
+    /// The physics world: the truck, the pallet, the mast (`lift`, `lower`).
+    pub fn sim(&self) -> &forkbench_sim::Sim {
+        &self.world.sim
+    }
+
+    /// The physics world, to lift or lower the pallet.
+    pub fn sim_mut(&mut self) -> &mut forkbench_sim::Sim {
+        &mut self.world.sim
+    }
+
+    /// The scenario the trial runs.
+    pub fn scenario(&self) -> &crate::scenario::Scenario {
+        self.scn
+    }
+
+    /// The truck stands (under 0.01 m/s).
+    pub fn is_standing(&self) -> bool {
+        self.stands()
+    }
+
+    /// Records `value` as the running phase's measure `name` (its outcome's `measures`).
+    pub fn record_measure(&mut self, name: &str, value: f64) {
+        self.verdict.phase_measures.insert(name.to_owned(), value);
     }
 }

@@ -1,0 +1,356 @@
+//! The one drive loop every part of a trial runs through (the mission legs, staging, the pick, each phase), and the yield point where a session's caller takes each tick.
+
+use std::future::Future;
+use std::pin::Pin;
+use std::sync::{Arc, Mutex, PoisonError};
+use std::task::{Context, Poll, Waker};
+
+use forkbench_core::Pose2;
+use forkbench_track::Command;
+
+use super::error::StageError;
+use super::goal_for;
+use super::session::{Control, Observation, Truth};
+use super::session_view::ScanKeeper;
+use super::setup::Trial;
+use crate::recorder::Recorder;
+
+/// Which part of the cycle a drive belongs to (what a caller's observation names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// A mission leg before the pick.
+    Leg,
+    /// The drive to a staging pose and the moves between looks.
+    Staging,
+    /// The approach and insertion.
+    Pick,
+    /// A phase after the pick, by its index in the scenario's `phases` list (1 is the
+    /// first after the pick).
+    Phase(u16),
+}
+
+impl Stage {
+    /// The stage's name: `leg`, `staging`, `pick`, or the phase's index.
+    pub fn index(self) -> u16 {
+        match self {
+            Stage::Leg | Stage::Staging | Stage::Pick => 0,
+            Stage::Phase(i) => i,
+        }
+    }
+}
+
+/// A drive's command source, its stop condition and its per-step criteria.
+pub(crate) trait Steering<'a, E> {
+    /// After the tick's reading, before the command (a re-estimate, a replan).
+    fn sensed<R: Recorder + ?Sized>(
+        &mut self,
+        _t: &mut Trial<'a>,
+        _pose: Pose2,
+        _rec: &mut R,
+    ) -> Result<(), E> {
+        Ok(())
+    }
+    /// The tick's command from the controller's `pose` (`control` says whether a caller
+    /// replaces it); `None` ends the drive.
+    fn command(
+        &mut self,
+        t: &mut Trial<'a>,
+        control: Control,
+        pose: Pose2,
+    ) -> Result<Option<Command>, E>;
+    /// After the physics step under `cmd`: the per-step criteria. `Ok(true)` ends the
+    /// drive.
+    fn stepped<R: Recorder + ?Sized>(
+        &mut self,
+        _t: &mut Trial<'a>,
+        _control: Control,
+        _cmd: &Command,
+        _rec: &mut R,
+    ) -> Result<bool, E> {
+        Ok(false)
+    }
+}
+
+impl<'a> Trial<'a> {
+    /// Steps the truck, tick by tick, under `steering` until it ends the drive (`Ok(true)`),
+    /// `limit_s` passes (`Ok(false)`), or it fails. Every tick: the reading, the steering's
+    /// re-estimate, a caller's turn (in a session that covers the trial's stage), the
+    /// command, the physics step, the criteria.
+    pub(crate) async fn drive_by<R, E, S>(
+        &mut self,
+        limit_s: f64,
+        steering: &mut S,
+        rec: &mut R,
+    ) -> Result<bool, E>
+    where
+        R: Recorder + ?Sized,
+        E: From<StageError>,
+        S: Steering<'a, E>,
+    {
+        let (stage, deadline_s) = (self.stage, self.world.sim.time_s() + limit_s);
+        let mut last = None;
+        let ended = loop {
+            if self.world.sim.time_s() >= deadline_s {
+                break Ok(false);
+            }
+            let (fix, pose) = match self.sense(rec) {
+                Ok(r) => r,
+                Err(e) => break Err(E::from(e)),
+            };
+            if let Err(e) = steering.sensed(self, pose, rec) {
+                break Err(e);
+            }
+            last = Some((fix, pose));
+            let control = self.caller_turn(stage, deadline_s, fix, pose).await;
+            let cmd = match steering.command(self, control, pose) {
+                Ok(Some(cmd)) => applied(control, cmd, &self.scn.truck),
+                Ok(None) => break Ok(true),
+                Err(e) => break Err(e),
+            };
+            self.physics_step(&cmd, fix, pose, rec);
+            match steering.stepped(self, control, &cmd, rec) {
+                Ok(false) => {}
+                Ok(true) => break Ok(true),
+                Err(e) => break Err(e),
+            }
+        };
+        if let Some((fix, pose)) = last {
+            self.publish(stage, deadline_s, fix, pose);
+        }
+        ended
+    }
+
+    /// In a session covering `stage`: the controller's view goes to the caller, and the
+    /// trial waits for its control. Elsewhere the scenario's own controller steers.
+    async fn caller_turn(
+        &mut self,
+        stage: Stage,
+        deadline_s: f64,
+        fix: Option<Pose2>,
+        pose: Pose2,
+    ) -> Control {
+        if !self.link.as_ref().is_some_and(|l| l.covers(stage)) {
+            return Control::Tracker;
+        }
+        self.publish(stage, deadline_s, fix, pose);
+        let waited = std::time::Instant::now();
+        Yield(false).await;
+        // A caller's thinking time is not the trial's: the wall budget is for components.
+        self.wall_start += waited.elapsed();
+        self.link.as_ref().map_or(Control::Tracker, Link::control)
+    }
+
+    /// The controller's view and the truth now, to the session's caller.
+    fn publish(&mut self, stage: Stage, deadline_s: f64, fix: Option<Pose2>, pose: Pose2) {
+        let Some(link) = &self.link else {
+            return;
+        };
+        if !link.covers(stage) {
+            return;
+        }
+        let truck = &self.scn.truck;
+        let (root, pallet) = (
+            self.world.sim.fork_root_pose(),
+            self.world.sim.pallet_pose(),
+        );
+        let t_s = self.world.sim.time_s();
+        let mut slot = link.lock();
+        slot.obs = Some(Observation {
+            t_s,
+            time_left_s: (deadline_s - t_s).max(0.0),
+            pose,
+            fix: fix.is_some(),
+            pallet_estimate: self.sense.pallet_est,
+            goal: goal_for(&self.sense.pallet_est, truck, self.insertion_m),
+            speed_mps: self.world.sim.speed_mps(),
+            steer_rad: self.world.sim.steer_rad(),
+            stage,
+        });
+        slot.truth = Some(Truth {
+            fork_root: root,
+            goal: goal_for(&pallet, truck, self.insertion_m),
+            insertion_depth_m: truck.insertion_depth_m(&pallet, &root),
+            pallet,
+        });
+        if slot.path_version != Some(self.path_version) {
+            slot.path_version = Some(self.path_version);
+            slot.path = Some(self.path.clone());
+        }
+        if slot.viewed && !slot.obstacles_sent {
+            slot.obstacles_sent = true;
+            slot.obstacles = Some(
+                self.world
+                    .obstacles
+                    .iter()
+                    .map(|o| {
+                        forkbench_core::geometry::rect_outline(&o.centre, o.length_m, o.width_m)
+                    })
+                    .collect(),
+            );
+        }
+    }
+}
+
+/// The tick's command under the caller's `control`.
+fn applied(control: Control, cmd: Command, truck: &forkbench_core::ForkliftSpec) -> Command {
+    let clamp = |speed_mps: f64, steer_rad: f64| {
+        let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+        (
+            finite(speed_mps).clamp(-truck.max_speed_mps, truck.max_speed_mps),
+            finite(steer_rad).clamp(-truck.max_steer_rad, truck.max_steer_rad),
+        )
+    };
+    match control {
+        Control::Tracker => cmd,
+        Control::Residual {
+            speed_mps,
+            steer_rad,
+        } => {
+            let (speed_mps, steer_rad) =
+                clamp(cmd.speed_mps + speed_mps, cmd.steer_rad + steer_rad);
+            Command {
+                speed_mps,
+                steer_rad,
+                ..cmd
+            }
+        }
+        Control::Command {
+            speed_mps,
+            steer_rad,
+        } => {
+            let (speed_mps, steer_rad) = clamp(speed_mps, steer_rad);
+            Command {
+                speed_mps,
+                steer_rad,
+                lookahead_point: [f64::NAN; 2],
+                cross_track_m: f64::NAN,
+                remaining_m: f64::NAN,
+                path_curvature_per_m: f64::NAN,
+                done: false,
+            }
+        }
+    }
+}
+
+/// Pending once, then ready: hands the tick back to whoever polls the trial.
+struct Yield(bool);
+
+impl Future for Yield {
+    type Output = ();
+    fn poll(mut self: Pin<&mut Self>, _cx: &mut Context<'_>) -> Poll<()> {
+        if self.0 {
+            Poll::Ready(())
+        } else {
+            self.0 = true;
+            Poll::Pending
+        }
+    }
+}
+
+/// Polls `fut` once: `Some` once it has finished.
+pub(crate) fn poll_once<T>(fut: Pin<&mut (dyn Future<Output = T> + Send + '_)>) -> Option<T> {
+    match fut.poll(&mut Context::from_waker(Waker::noop())) {
+        Poll::Ready(v) => Some(v),
+        Poll::Pending => None,
+    }
+}
+
+/// Runs a trial with no caller to its end (it never yields without a link).
+pub(crate) fn run_to_end<T>(fut: impl Future<Output = T>) -> T {
+    let mut fut = std::pin::pin!(fut);
+    loop {
+        if let Poll::Ready(v) = fut.as_mut().poll(&mut Context::from_waker(Waker::noop())) {
+            return v;
+        }
+    }
+}
+
+/// Which stages a session's caller takes the ticks of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Episode {
+    /// The pick alone (the legs and staging before it run on their own; the episode ends
+    /// at the pick's verdict).
+    Pick,
+    /// The whole cycle: every leg, the staging, the pick and each phase.
+    Cycle,
+}
+
+/// What a session and its trial share: the caller's control in, the view out.
+#[derive(Debug, Clone)]
+pub(crate) struct Link {
+    episode: Episode,
+    slot: Arc<Mutex<Slot>>,
+}
+
+/// The shared state behind a [`Link`].
+#[derive(Debug, Default)]
+pub(crate) struct Slot {
+    pub(crate) control: Option<Control>,
+    pub(crate) obs: Option<Observation>,
+    pub(crate) truth: Option<Truth>,
+    /// The path the trial follows, when it changed since the session took it.
+    pub(crate) path: Option<forkbench_core::Path>,
+    path_version: Option<u64>,
+    /// The session draws its scene: the racks' outlines (once) and the last scans.
+    pub(crate) viewed: bool,
+    pub(crate) obstacles: Option<Vec<[[f64; 2]; 5]>>,
+    obstacles_sent: bool,
+    pub(crate) scans: ScanKeeper,
+}
+
+impl Link {
+    pub(crate) fn new(episode: Episode, viewed: bool) -> Self {
+        let slot = Slot {
+            viewed,
+            ..Slot::default()
+        };
+        Link {
+            episode,
+            slot: Arc::new(Mutex::new(slot)),
+        }
+    }
+
+    pub(crate) fn lock(&self) -> std::sync::MutexGuard<'_, Slot> {
+        self.slot.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// The session ends at the pick's verdict.
+    pub(crate) fn pick_only(&self) -> bool {
+        self.episode == Episode::Pick
+    }
+
+    fn covers(&self, stage: Stage) -> bool {
+        self.episode == Episode::Cycle || stage == Stage::Pick
+    }
+
+    fn control(&self) -> Control {
+        self.lock().control.unwrap_or(Control::Tracker)
+    }
+}
+
+/// A session's recorder: keeps the last scans for its view, when it is drawn.
+#[derive(Debug)]
+pub(crate) struct LinkRecorder(pub(crate) Link);
+
+impl Recorder for LinkRecorder {
+    fn signal(
+        &mut self,
+        t_s: f64,
+        path: &str,
+        signal: &forkbench_core::Signal<'_>,
+        style: forkbench_core::Style,
+    ) {
+        if matches!(signal, forkbench_core::Signal::Scan(_)) {
+            let mut slot = self.0.lock();
+            if slot.viewed {
+                slot.scans.signal(t_s, path, signal, style);
+            }
+        }
+    }
+}
+
+impl From<StageError> for (crate::outcome::Failure, String) {
+    fn from(e: StageError) -> Self {
+        (crate::outcome::Failure::Error, e.to_string())
+    }
+}
