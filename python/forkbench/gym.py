@@ -49,8 +49,8 @@ observation gains a field after the 13 fixed ones, ``forkbench.STAGE_FIELD``: 0 
 mission leg, 1 staging, 2 the pick, 2 + k the k-th phase after the pick. The agent's
 action acts on every stage (``"residual"`` corrects each stage's own controller: the
 legs' path follower, the pick's tracker, a phase's commands). The episode is terminated
-at the cycle's verdict (a failed phase ends it) and truncated at a time limit (the pick's
-or a phase's). Its reward, per part:
+at the cycle's verdict (a failed phase ends it) and truncated when a drive's time limit
+ends it (the pick's, a leg's or a phase's). Its reward, per part:
 
 - legs and staging: minus ``time_per_s`` per simulated second;
 - the pick: as above, the potential's decrease and the time;

@@ -117,6 +117,10 @@ impl<'a> Trial<'a> {
         if let Some((fix, pose)) = last {
             self.publish(stage, deadline_s, fix, pose);
         }
+        if let Some(link) = self.link.as_ref().filter(|l| l.covers(stage)) {
+            // Whether the caller's episode, if it ends with this drive, was cut short.
+            link.lock().deadline_hit = matches!(ended, Ok(false));
+        }
         ended
     }
 
@@ -296,6 +300,8 @@ pub(crate) struct Slot {
     pub(crate) obstacles: Option<Vec<[[f64; 2]; 5]>>,
     obstacles_sent: bool,
     pub(crate) scans: ScanKeeper,
+    /// The last drive the caller stepped ended at its time limit.
+    pub(crate) deadline_hit: bool,
 }
 
 impl Link {

@@ -10,7 +10,7 @@ use super::engine::{Episode, Link, LinkRecorder, Stage, poll_once};
 use super::session_view::SceneView;
 use super::{Resolved, TrialOptions, run_stages};
 use crate::TrialError;
-use crate::outcome::{Failure, TrialOutcome};
+use crate::outcome::TrialOutcome;
 use crate::scenario::{Case, Scenario};
 
 /// What a session owns for its trial to borrow.
@@ -60,7 +60,7 @@ pub enum Control {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Observation {
     pub t_s: f64,
-    /// Time left before the scenario's time limit.
+    /// Time left before the current drive's time limit (the pick's is the scenario's).
     pub time_left_s: f64,
     /// The controller's fork-root pose: the localiser's fix, or odometry between fixes.
     pub pose: Pose2,
@@ -94,7 +94,7 @@ pub struct Truth {
 pub enum SessionEnd {
     /// Judged before the time limit: a success, or a failure that no later tick can undo.
     Judged,
-    /// A time limit: the scenario's, or a phase's (the outcome's failure is `timeout`).
+    /// A time limit: the scenario's (the pick's), or a leg's or phase's.
     TimeLimit,
 }
 
@@ -275,9 +275,10 @@ impl Session {
         if let Some(obstacles) = slot.obstacles.take() {
             self.obstacles = obstacles;
         }
+        let deadline_hit = slot.deadline_hit;
         drop(slot);
         if let Some(out) = done {
-            let end = if out.failure == Some(Failure::Timeout) {
+            let end = if deadline_hit {
                 SessionEnd::TimeLimit
             } else {
                 SessionEnd::Judged
