@@ -7,6 +7,7 @@ pub mod mission_summary;
 pub mod outcome;
 pub mod recorder;
 pub mod scenario;
+pub mod step_criteria;
 pub mod text;
 pub mod trial;
 

@@ -42,8 +42,8 @@ pub enum Failure {
     /// The placed pallet stands farther from its slot, or turned more, than the place
     /// tolerances allow.
     PlacementError,
-    /// A criterion that measures while the truck drives (`trial::STEP_CRITERIA`), by
-    /// its name.
+    /// A criterion outside the fixed ones, by its name: one that measures while the pick
+    /// drives (`STEP_CRITERIA`), or a registered phase's own.
     Criterion(&'static str),
 }
 
@@ -68,14 +68,50 @@ const NAMED: [Failure; 16] = [
 ];
 
 impl Failure {
-    /// The failure a name stands for: a fixed one, or a step criterion's.
+    /// The failure a name stands for: a fixed one, a step criterion's, or another
+    /// criterion's (a registered phase's) when the name is one a criterion can have.
     pub fn from_name(name: &str) -> Option<Failure> {
         NAMED
             .iter()
             .copied()
             .find(|f| f.name() == name)
-            .or_else(|| crate::trial::step_criterion_name(name).map(Failure::Criterion))
+            .or_else(|| crate::step_criteria::step_criterion_name(name).map(Failure::Criterion))
+            .or_else(|| criterion_name(name).map(Failure::Criterion))
     }
+}
+
+/// Most distinct criterion names outside the code that records may carry in one process.
+const MAX_CRITERION_NAMES: usize = 256;
+
+/// The longest criterion name.
+const MAX_CRITERION_NAME_BYTES: usize = 64;
+
+/// `name` as the `&'static str` a [`Failure::Criterion`] holds: a snake-case word of at
+/// most 64 bytes, kept once per process, at most 256 of them (so what records read back
+/// can hold stays bounded).
+fn criterion_name(name: &str) -> Option<&'static str> {
+    static NAMES: std::sync::Mutex<Vec<&'static str>> = std::sync::Mutex::new(Vec::new());
+    let word = !name.is_empty()
+        && name.len() <= MAX_CRITERION_NAME_BYTES
+        && name.starts_with(|c: char| c.is_ascii_lowercase())
+        && name
+            .bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_');
+    if !word {
+        return None;
+    }
+    let mut names = NAMES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some(n) = names.iter().find(|n| **n == name) {
+        return Some(n);
+    }
+    if names.len() >= MAX_CRITERION_NAMES {
+        return None;
+    }
+    let kept: &'static str = Box::leak(name.to_owned().into_boxed_str());
+    names.push(kept);
+    Some(kept)
 }
 
 impl Serialize for Failure {
@@ -87,8 +123,13 @@ impl Serialize for Failure {
 impl<'de> Deserialize<'de> for Failure {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let name = String::deserialize(d)?;
-        Failure::from_name(&name)
-            .ok_or_else(|| serde::de::Error::custom(format!("unknown failure `{name}`")))
+        Failure::from_name(&name).ok_or_else(|| {
+            serde::de::Error::custom(format!(
+                "unknown failure `{name}` (a criterion's name is a snake-case word of at most \
+                 {MAX_CRITERION_NAME_BYTES} bytes; at most {MAX_CRITERION_NAMES} others than the \
+                 built-in ones)"
+            ))
+        })
     }
 }
 

@@ -144,3 +144,19 @@ fn a_phase_is_refused_where_it_is_not_registered_or_its_settings_are_bad() {
     let err = scenario(registry, "sped_mps = 0.1").expect_err("unknown key");
     assert!(err.contains("sped_mps"), "{err}");
 }
+
+/// A record whose verdict is a registered phase's own criterion reads back as written,
+/// as a batch's summary and gate read it; a name no criterion can have is refused.
+#[test]
+fn a_custom_criterion_in_a_record_reads_back() {
+    let registry = Arc::new(Registry::builtin().with_phase(creep_kind()));
+    let strict = scenario(registry, "time_s = 1.0\nmin_distance_m = 5.0").expect("loads");
+    let out = run_trial(&strict, &strict.cases[0], &seed(4));
+    let line = serde_json::to_string(&out).expect("serialises");
+    assert!(line.contains(r#""failure":"creep_distance""#), "{line}");
+    let back: forkbench_trial::TrialOutcome = serde_json::from_str(&line).expect("reads back");
+    assert_eq!(back.failure, Some(Failure::Criterion("creep_distance")));
+    let bad = line.replace("creep_distance", "Creep Distance!");
+    let err = serde_json::from_str::<forkbench_trial::TrialOutcome>(&bad).expect_err("refused");
+    assert!(err.to_string().contains("unknown failure"), "{err}");
+}

@@ -9,6 +9,10 @@ use serde::{Deserialize, Serialize};
 
 use super::PoseDeg;
 
+/// Gap between the fork tips and the pallet face at the end of the approach curve: the
+/// default of `[pick] pre_entry_gap_m`.
+pub const APPROACH_GAP_M: f64 = 0.3;
+
 /// Where the pallet stands: a pose, or a slot of the world.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
@@ -199,7 +203,7 @@ impl Default for PickFile {
             between_looks: BetweenLooks::Wait,
             retry_wait_s: 0.5,
             retry_step_m: 0.5,
-            pre_entry_gap_m: crate::trial::APPROACH_GAP_M,
+            pre_entry_gap_m: APPROACH_GAP_M,
             docked_speed_mps: 0.01,
         }
     }

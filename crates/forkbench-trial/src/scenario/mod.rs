@@ -22,8 +22,8 @@ use crate::components::{ComponentSpec, Registry, Role};
 pub(crate) use checks::shrunk;
 pub use checks::{ForkFit, fork_fit, pallet_footprint, truck_footprint};
 pub use file::{
-    BetweenLooks, NoiseFile, PalletKind, PalletPlacement, PickFile, ReplanFile, ReplanMethod,
-    Tolerances, WhenNotSeen,
+    APPROACH_GAP_M, BetweenLooks, NoiseFile, PalletKind, PalletPlacement, PickFile, ReplanFile,
+    ReplanMethod, Tolerances, WhenNotSeen,
 };
 pub use limits::{Limits, Replan};
 pub use world::{MAX_WORLD_EXTENT_M, PalletSlot, PoseDeg, RectFile, World};
@@ -334,34 +334,6 @@ impl Scenario {
     /// a run compares sensing models on the same seeds.
     pub fn with_pallet_sensing(mut self, kind: &str) -> Result<Self, TrialError> {
         self.pallet_sensing = self.sensing_for(Some(kind))?;
-        Ok(self)
-    }
-
-    /// The same scenario localising with `kind` (`gaussian`, `nav350`) at its default
-    /// settings: how a run compares localisation models on the same seeds.
-    pub fn with_localizer(mut self, kind: &str) -> Result<Self, TrialError> {
-        let spec = self.localizer_for(&crate::trial::Overrides {
-            localizer: Some(kind.to_owned()),
-            ..Default::default()
-        })?;
-        let registry = Arc::clone(&self.registry);
-        self.check_localizer(&registry, &spec)
-            .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;
-        self.localizer = spec;
-        Ok(self)
-    }
-
-    /// The same scenario with `names` missing from the NAV350's world (a layout review's
-    /// "what if these go"); its map still holds them.
-    pub fn with_missing_reflectors(mut self, names: &[String]) -> Result<Self, TrialError> {
-        let spec = self.localizer_for(&crate::trial::Overrides {
-            missing_reflectors: Some(names.to_vec()),
-            ..Default::default()
-        })?;
-        let registry = Arc::clone(&self.registry);
-        self.check_localizer(&registry, &spec)
-            .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;
-        self.localizer = spec;
         Ok(self)
     }
 

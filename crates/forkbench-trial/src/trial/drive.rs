@@ -273,7 +273,7 @@ impl<'a> Trial<'a> {
         rec: &mut R,
     ) {
         let t_s = self.world.sim.time_s();
-        let view = super::step_criteria::StepView {
+        let view = crate::step_criteria::StepView {
             t_s,
             truck: &self.scn.truck,
             pallet: &self.scn.pallet,

@@ -20,7 +20,6 @@ mod session_view;
 mod setup;
 mod staging;
 mod state;
-mod step_criteria;
 
 use std::time::Instant;
 
@@ -32,6 +31,10 @@ use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
+pub use crate::scenario::APPROACH_GAP_M;
+pub use crate::step_criteria::{
+    STEP_CRITERIA, StepCriterion, StepView, step_criterion_name, step_measures,
+};
 pub use criteria::{Criterion, PICK_CRITERIA};
 pub use engine::{Episode, Stage};
 pub use look::{ScanReport, scan_once, scenario_detector};
@@ -44,13 +47,6 @@ pub use phases::{
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use session_view::SceneView;
 pub use setup::Trial;
-pub use step_criteria::{
-    STEP_CRITERIA, StepCriterion, StepView, step_criterion_name, step_measures,
-};
-
-/// Gap between the fork tips and the pallet face at the end of the approach curve: the
-/// default of `[pick] pre_entry_gap_m`.
-pub const APPROACH_GAP_M: f64 = 0.3;
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
 /// (negative: before it).

@@ -1,11 +1,13 @@
 //! A run's choices on top of a scenario file (`TrialOptions`, its `Overrides`), checked once, and their resolution into what a trial runs with.
 
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 
 use crate::TrialError;
 use crate::components::{ComponentSpec, Role};
 use crate::scenario::sensors::PalletSensing;
-use crate::scenario::{Scenario, invalid};
+use crate::scenario::{Scenario, invalid, invalid_setting};
 
 /// Largest noise scale a run may ask for: far past any sweep's use, and a bound that
 /// keeps scaled σ finite and meaningful.
@@ -224,6 +226,35 @@ impl Scenario {
         self.check_localizer(&registry, &run.localizer)
             .map_err(|e| crate::scenario::invalid_setting(&self.file, "sensors.localizer", &e))?;
         Ok(run)
+    }
+
+    /// The same scenario localising with `kind` (`gaussian`, `nav350`) at its default
+    /// settings: how a run compares localisation models on the same seeds.
+    pub fn with_localizer(self, kind: &str) -> Result<Self, TrialError> {
+        let spec = self.localizer_for(&Overrides {
+            localizer: Some(kind.to_owned()),
+            ..Default::default()
+        })?;
+        self.localizing_with(spec)
+    }
+
+    /// The same scenario with `names` missing from the NAV350's world (a layout review's
+    /// "what if these go"); its map still holds them.
+    pub fn with_missing_reflectors(self, names: &[String]) -> Result<Self, TrialError> {
+        let spec = self.localizer_for(&Overrides {
+            missing_reflectors: Some(names.to_vec()),
+            ..Default::default()
+        })?;
+        self.localizing_with(spec)
+    }
+
+    /// The same scenario with the localiser `spec`, built once in its world to check it.
+    fn localizing_with(mut self, spec: ComponentSpec) -> Result<Self, TrialError> {
+        let registry = Arc::clone(&self.registry);
+        self.check_localizer(&registry, &spec)
+            .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;
+        self.localizer = spec;
+        Ok(self)
     }
 
     /// The pallet sensing a run names by kind (at its defaults), or the scenario's own.

@@ -11,8 +11,8 @@ use rand_chacha::ChaCha8Rng;
 
 use super::localize::LocStats;
 use super::setup::ScannerState;
-use super::step_criteria::StepCriterion;
 use crate::outcome::TrialOutcome;
+use crate::step_criteria::StepCriterion;
 
 /// The physical world and what happened in it.
 pub(crate) struct WorldState {
