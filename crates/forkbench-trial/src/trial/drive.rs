@@ -128,8 +128,8 @@ impl<'a> Trial<'a> {
         cmd.done && self.world.sim.speed_mps().abs() < self.scn.pick.docked_speed_mps
     }
 
-    /// The truck stands (for the end of a drive).
-    pub(super) fn stands(&self) -> bool {
+    /// The truck stands (under 0.01 m/s: how a drive ends).
+    pub fn stands(&self) -> bool {
         self.world.sim.speed_mps().abs() < 0.01
     }
 

@@ -29,16 +29,6 @@ pub enum Stage {
     Phase(u16),
 }
 
-impl Stage {
-    /// The stage's name: `leg`, `staging`, `pick`, or the phase's index.
-    pub fn index(self) -> u16 {
-        match self {
-            Stage::Leg | Stage::Staging | Stage::Pick => 0,
-            Stage::Phase(i) => i,
-        }
-    }
-}
-
 /// A drive's command source, its stop condition and its per-step criteria.
 pub(crate) trait Steering<'a, E> {
     /// After the tick's reading, before the command (a re-estimate, a replan).
@@ -87,7 +77,7 @@ impl<'a> Trial<'a> {
         E: From<StageError>,
         S: Steering<'a, E>,
     {
-        let (stage, deadline_s) = (self.stage, self.world.sim.time_s() + limit_s);
+        let deadline_s = self.world.sim.time_s() + limit_s;
         let mut last = None;
         let ended = loop {
             if self.world.sim.time_s() >= deadline_s {
@@ -101,7 +91,7 @@ impl<'a> Trial<'a> {
                 break Err(e);
             }
             last = Some((fix, pose));
-            let control = self.caller_turn(stage, deadline_s, fix, pose).await;
+            let control = self.caller_turn(deadline_s, fix, pose).await;
             let cmd = match steering.command(self, control, pose) {
                 Ok(Some(cmd)) => applied(control, cmd, &self.scn.truck),
                 Ok(None) => break Ok(true),
@@ -115,28 +105,27 @@ impl<'a> Trial<'a> {
             }
         };
         if let Some((fix, pose)) = last {
-            self.publish(stage, deadline_s, fix, pose);
+            self.publish(deadline_s, fix, pose);
         }
-        if let Some(link) = self.link.as_ref().filter(|l| l.covers(stage)) {
+        if let Some(link) = self.caller() {
             // Whether the caller's episode, if it ends with this drive, was cut short.
             link.lock().deadline_hit = matches!(ended, Ok(false));
         }
         ended
     }
 
-    /// In a session covering `stage`: the controller's view goes to the caller, and the
+    /// The session whose caller takes this stage's ticks, if one does.
+    fn caller(&self) -> Option<&Link> {
+        self.link.as_ref().filter(|l| l.covers(self.stage))
+    }
+
+    /// In a session covering the stage: the controller's view goes to the caller, and the
     /// trial waits for its control. Elsewhere the scenario's own controller steers.
-    async fn caller_turn(
-        &mut self,
-        stage: Stage,
-        deadline_s: f64,
-        fix: Option<Pose2>,
-        pose: Pose2,
-    ) -> Control {
-        if !self.link.as_ref().is_some_and(|l| l.covers(stage)) {
+    async fn caller_turn(&mut self, deadline_s: f64, fix: Option<Pose2>, pose: Pose2) -> Control {
+        if self.caller().is_none() {
             return Control::Tracker;
         }
-        self.publish(stage, deadline_s, fix, pose);
+        self.publish(deadline_s, fix, pose);
         let waited = std::time::Instant::now();
         Yield(false).await;
         // A caller's thinking time is not the trial's: the wall budget is for components.
@@ -145,13 +134,10 @@ impl<'a> Trial<'a> {
     }
 
     /// The controller's view and the truth now, to the session's caller.
-    fn publish(&mut self, stage: Stage, deadline_s: f64, fix: Option<Pose2>, pose: Pose2) {
-        let Some(link) = &self.link else {
+    fn publish(&self, deadline_s: f64, fix: Option<Pose2>, pose: Pose2) {
+        let Some(link) = self.caller() else {
             return;
         };
-        if !link.covers(stage) {
-            return;
-        }
         let truck = &self.scn.truck;
         let (root, pallet) = (
             self.world.sim.fork_root_pose(),
@@ -168,7 +154,7 @@ impl<'a> Trial<'a> {
             goal: goal_for(&self.sense.pallet_est, truck, self.insertion_m),
             speed_mps: self.world.sim.speed_mps(),
             steer_rad: self.world.sim.steer_rad(),
-            stage,
+            stage: self.stage,
         });
         slot.truth = Some(Truth {
             fork_root: root,

@@ -66,7 +66,7 @@ where
         pose: Pose2,
     ) -> Result<Option<Command>, LegError> {
         let cmd = (self.next)(&t.tracker_input(pose));
-        Ok((!(cmd.done && t.world.sim.speed_mps().abs() < 0.01)).then_some(cmd))
+        Ok((!(cmd.done && t.stands())).then_some(cmd))
     }
 
     fn stepped<R: Recorder + ?Sized>(

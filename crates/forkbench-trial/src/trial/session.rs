@@ -111,8 +111,9 @@ pub struct Session {
     truth: Truth,
     /// The path the trial follows, as of the observation.
     path: Option<Path>,
-    /// For a viewed session: the racks' outlines, copied once.
-    obstacles: Vec<[[f64; 2]; 5]>,
+    /// For a viewed session: the racks' outlines, copied at its first tick (none before:
+    /// a trial that ended before it has no scene to show).
+    obstacles: Option<Vec<[[f64; 2]; 5]>>,
 }
 
 #[derive(Debug)]
@@ -126,7 +127,7 @@ impl Session {
     /// the case name are not usable. A trial that ends before driving (no plan, no pallet
     /// found) starts already ended.
     pub fn start(scn: Arc<Scenario>, case: &str, opts: &TrialOptions) -> Result<Self, TrialError> {
-        Self::start_with(scn, case, opts, Episode::Pick, false)
+        Self::start_episode(scn, case, opts, Episode::Pick, false)
     }
 
     /// As [`Session::start`], keeping what [`Session::view`] draws (the last scans).
@@ -135,22 +136,12 @@ impl Session {
         case: &str,
         opts: &TrialOptions,
     ) -> Result<Self, TrialError> {
-        Self::start_with(scn, case, opts, Episode::Pick, true)
+        Self::start_episode(scn, case, opts, Episode::Pick, true)
     }
 
     /// Starts an episode of `episode`'s extent (the pick, or the whole cycle: legs,
     /// staging, pick and every phase), viewed or not.
     pub fn start_episode(
-        scn: Arc<Scenario>,
-        case: &str,
-        opts: &TrialOptions,
-        episode: Episode,
-        viewed: bool,
-    ) -> Result<Self, TrialError> {
-        Self::start_with(scn, case, opts, episode, viewed)
-    }
-
-    fn start_with(
         scn: Arc<Scenario>,
         case: &str,
         opts: &TrialOptions,
@@ -190,19 +181,17 @@ impl Session {
                 pallet,
             },
             path: None,
-            obstacles: Vec::new(),
+            obstacles: None,
         };
         session.advance(Control::Tracker);
         Ok(session)
     }
 
     /// The scene as of the observation (the last one at the end), for a session started
-    /// viewed.
+    /// viewed that reached its first tick.
     pub fn view(&self) -> Option<SceneView> {
+        let obstacles = self.obstacles.clone()?;
         let slot = self.link.lock();
-        if !slot.viewed {
-            return None;
-        }
         Some(SceneView {
             fork_root: self.truth.fork_root,
             pallet: self.truth.pallet,
@@ -212,7 +201,7 @@ impl Session {
                 .as_ref()
                 .map(|p| p.samples.iter().map(|s| [s.x_m, s.y_m]).collect())
                 .unwrap_or_default(),
-            obstacles: self.obstacles.clone(),
+            obstacles,
             scan: slot.scans.points(),
         })
     }
@@ -273,7 +262,7 @@ impl Session {
             self.path = Some(path);
         }
         if let Some(obstacles) = slot.obstacles.take() {
-            self.obstacles = obstacles;
+            self.obstacles = Some(obstacles);
         }
         let deadline_hit = slot.deadline_hit;
         drop(slot);

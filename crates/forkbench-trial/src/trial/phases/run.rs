@@ -202,11 +202,6 @@ impl Trial<'_> {
         self.scn
     }
 
-    /// The truck stands (under 0.01 m/s).
-    pub fn is_standing(&self) -> bool {
-        self.stands()
-    }
-
     /// Records `value` as the running phase's measure `name` (its outcome's `measures`).
     pub fn record_measure(&mut self, name: &str, value: f64) {
         self.verdict.phase_measures.insert(name.to_owned(), value);
