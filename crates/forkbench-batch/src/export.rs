@@ -55,6 +55,8 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
     let mut w = csv::Writer::from_writer(Vec::new());
     // The step criteria's measurements follow the fixed columns, one column each.
     let measures = forkbench_trial::trial::step_measures();
+    // Safety columns only in batches with people or safety fields, so others keep theirs.
+    let safety = sorted.iter().any(|r| r.outcome.safety.is_some());
     let mut header_written = false;
     let finite = |v: f64| v.is_finite().then_some(v);
     for r in sorted {
@@ -63,11 +65,19 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
         if !header_written {
             let mut h = header;
             h.extend(measures.iter().copied());
+            if safety {
+                h.extend(SAFETY_COLUMNS);
+            }
             w.write_record(&h).map_err(|e| csv_error(path, e))?;
             header_written = true;
         }
         for m in &measures {
             record.push_field(&o.measures.get(*m).map_or(String::new(), |v| v.to_string()));
+        }
+        if safety {
+            for cell in safety_cells(o.safety.as_ref()) {
+                record.push_field(&cell);
+            }
         }
         w.write_record(&record).map_err(|e| csv_error(path, e))?;
     }
@@ -75,6 +85,33 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
         .into_inner()
         .map_err(|e| BatchError::Invalid(format!("{}: {e}", path.display())))?;
     super::write_atomic(path, &bytes)
+}
+
+/// The safety columns, after the step criteria's.
+const SAFETY_COLUMNS: [&str; 7] = [
+    "safety_stops",
+    "safety_false_trips",
+    "safety_stop_time_s",
+    "safety_slowdowns",
+    "safety_slowdown_time_s",
+    "person_contacts",
+    "closest_person_m",
+];
+
+/// A trial's safety cells (empty without people or fields).
+fn safety_cells(s: Option<&forkbench_trial::SafetyOutcome>) -> [String; 7] {
+    let Some(s) = s else {
+        return Default::default();
+    };
+    [
+        s.stops.to_string(),
+        s.false_trips.to_string(),
+        s.stop_time_s.to_string(),
+        s.slowdowns.to_string(),
+        s.slowdown_time_s.to_string(),
+        s.person_contacts.to_string(),
+        s.closest_any_m().map_or(String::new(), |v| v.to_string()),
+    ]
 }
 
 /// A row's column names and values, as csv writes them.

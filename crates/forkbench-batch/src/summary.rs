@@ -51,6 +51,10 @@ pub struct SummaryRow {
     /// reached the phase.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub phases: Vec<LegSummary>,
+    /// People and safety fields: stops, false trips, slowdowns, contacts (rows whose
+    /// scenario has them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safety: Option<super::SafetySummary>,
 }
 
 /// Success of one mission leg (or cycle phase) across a row's trials.
@@ -122,6 +126,7 @@ struct Acc {
     phases: Vec<(String, u64, u64)>,
     est: Vec<f64>,
     loc: Vec<f64>,
+    safety: super::safety_summary::SafetyAcc,
 }
 
 impl Acc {
@@ -154,6 +159,9 @@ impl Acc {
             &mut self.phases,
             o.phases.iter().map(|p| (p.name.as_str(), p.success)),
         );
+        if let Some(s) = &o.safety {
+            self.safety.add(s);
+        }
     }
 }
 
@@ -202,6 +210,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 wall_time_total_s: a.wall.iter().sum::<f64>() / 1e3,
                 legs: leg_summaries(a.legs),
                 phases: leg_summaries(a.phases),
+                safety: a.safety.finish(),
             }
         })
         .collect();
@@ -278,6 +287,7 @@ impl Summary {
         s.push_str(&super::mode_pairs_markdown(&self.replanning));
         s.push_str(&self.legs_markdown());
         s.push_str(&self.phases_markdown());
+        s.push_str(&super::safety_summary::markdown(&self.rows));
         s
     }
 }

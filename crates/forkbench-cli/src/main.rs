@@ -19,6 +19,7 @@ mod replay_cmd;
 mod report;
 mod reproduce_cmd;
 mod route_cmd;
+mod safety_cmd;
 mod scan_cmd;
 mod trial_cmd;
 
@@ -244,6 +245,10 @@ enum Command {
     /// Reflector coverage of a world: reflectors in sight and the NAV350 fix's predicted
     /// 1σ at every free cell.
     Coverage(coverage_cmd::CoverageArgs),
+    /// The safety scanner's protective field per speed range (ISO 3691-4 people
+    /// detection): each term of the makers' formula, braking measured in the physics
+    /// empty and at rated load on the scenario's floor.
+    SafetyFields(safety_cmd::SafetyFieldsArgs),
     /// Load a scenario as a run would and print what it resolved to: world, components,
     /// how the forks fit the pallet, limits and cases (exit 1 with the file, field and
     /// reason when it does not load).
@@ -368,6 +373,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Coverage(args) => coverage_cmd::run(&args).map(|()| Done::Ok),
         Command::Detect(args) => detect_cmd::run(&args).map(|()| Done::Ok),
         Command::Check(args) => check_cmd::run(&args).map(|()| Done::Ok),
+        Command::SafetyFields(args) => safety_cmd::run(&args).map(|()| Done::Ok),
     }
 }
 

@@ -114,6 +114,9 @@ fn text_report(out: &TrialOutcome) -> String {
         // A planner's message may carry terminal escapes: shown, never obeyed.
         lines.push(format!("reason               {}", one_line(d)));
     }
+    if let Some(c) = &out.likely_cause {
+        lines.push(format!("likely cause         {}", one_line(c)));
+    }
     lines.extend([
         format!(
             "lateral error entry  {}",
@@ -155,11 +158,23 @@ fn text_report(out: &TrialOutcome) -> String {
         format!("replans              {}", out.replans),
     ]);
     lines.extend(phase_lines(out));
+    lines.extend(out.safety.iter().map(safety_line));
     lines.extend([
         format!("sim time             {:.2} s", out.sim_time_s),
         format!("wall time            {:.1} ms", out.wall_time_ms),
     ]);
     lines.join("\n") + "\n"
+}
+
+/// What the people and the safety function did.
+fn safety_line(s: &forkbench_trial::SafetyOutcome) -> String {
+    let closest = s
+        .closest_any_m()
+        .map_or("–".to_owned(), |d| format!("{d:.2} m"));
+    format!(
+        "safety               protective stops {} ({} with nobody in the field), {:.1} s stopped; slowdowns {}, {:.1} s slowed; contacts {}; closest {closest}",
+        s.stops, s.false_trips, s.stop_time_s, s.slowdowns, s.slowdown_time_s, s.person_contacts
+    )
 }
 
 /// One line per phase of a handling cycle (its verdict, time, distance and load), then

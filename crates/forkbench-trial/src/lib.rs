@@ -13,7 +13,7 @@ pub mod trial;
 
 pub use components::{ComponentSpec, Registry, Role};
 pub use mission_summary::MissionSummary;
-pub use outcome::{Failure, TrialOutcome};
+pub use outcome::{Failure, SafetyOutcome, TrialOutcome};
 pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord, Tee};
 pub use scenario::{Case, Limits, PoseDeg, Replan, Scenario, Tolerances, World};
 pub use trial::{Resolved, TrialOptions, run_trial, run_trial_recorded};

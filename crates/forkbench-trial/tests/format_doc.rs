@@ -57,6 +57,10 @@ fn defaulted_tables() -> Vec<(&'static str, toml::Value)> {
         ("[pick]", value(&PickFile::default())),
         ("[tolerances]", value(&Tolerances::default())),
         (
+            "[safety]",
+            value(&forkbench_safety::SafetyConfig::default()),
+        ),
+        (
             "[planner] bspline",
             value(&forkbench_plan::BsplineConfig::default()),
         ),

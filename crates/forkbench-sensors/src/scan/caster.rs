@@ -102,17 +102,7 @@ impl Caster {
         let members = &self.members[self.starts[bin] as usize..self.starts[bin + 1] as usize];
         for &k in members {
             let f = &self.surfaces[k as usize];
-            let e = [f.b[0] - f.a[0], f.b[1] - f.a[1]];
-            let den = d[0] * e[1] - d[1] * e[0];
-            if den.abs() < 1e-12 {
-                continue;
-            }
-            let w = [f.a[0] - o[0], f.a[1] - o[1]];
-            let t = (w[0] * e[1] - w[1] * e[0]) / den;
-            let u = (w[0] * d[1] - w[1] * d[0]) / den;
-            if t >= 0.0
-                && t <= self.max_m
-                && (0.0..=1.0).contains(&u)
+            if let Some(t) = f.ray_range(o, d, self.max_m)
                 && best.is_none_or(|h| t < h.range_m)
             {
                 best = Some(RayHit {

@@ -39,6 +39,20 @@ pub struct Surface {
 }
 
 impl Surface {
+    /// How far along the ray from `o` in the unit direction `d` it meets this surface,
+    /// within `max_m`.
+    pub fn ray_range(&self, o: [f64; 2], d: [f64; 2], max_m: f64) -> Option<f64> {
+        let e = [self.b[0] - self.a[0], self.b[1] - self.a[1]];
+        let den = d[0] * e[1] - d[1] * e[0];
+        if den.abs() < 1e-12 {
+            return None;
+        }
+        let w = [self.a[0] - o[0], self.a[1] - o[1]];
+        let t = (w[0] * e[1] - w[1] * e[0]) / den;
+        let u = (w[0] * d[1] - w[1] * d[0]) / den;
+        (t >= 0.0 && t <= max_m && (0.0..=1.0).contains(&u)).then_some(t)
+    }
+
     /// The four sides of a `length_m` × `width_m` rectangle centred on `centre` (length
     /// along its heading), each facing outward.
     pub fn rect(centre: &Pose2, length_m: f64, width_m: f64, seen: Seen) -> [Surface; 4] {

@@ -296,6 +296,12 @@ pub(super) struct ScenarioFile {
     pub(super) phase: toml::Table,
     /// A warehouse mission that ends where the pick starts.
     pub(super) mission: Option<super::mission::MissionFile>,
+    /// The truck's safety fields (`[safety]`): the scanner, response times, supplements
+    /// and the speed ranges that switch field sets.
+    pub(super) safety: Option<forkbench_safety::SafetyConfig>,
+    /// People and other vehicles moving on routes (`[[mover]]`).
+    #[serde(default)]
+    pub(super) mover: Vec<forkbench_safety::MoverSpec>,
     /// Sensors beyond the defaults (`[sensors.pallet]`).
     pub(super) sensors: Option<super::sensors::SensorsFile>,
 }

@@ -6,6 +6,7 @@ mod hints;
 mod limits;
 pub mod mission;
 mod pallet;
+mod safety;
 pub mod sensors;
 mod world;
 
@@ -153,6 +154,13 @@ pub struct Scenario {
     /// The phases after the pick, in order (none: the trial is the pick).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub phases: Vec<crate::trial::PhaseSpec>,
+    /// How the truck's safety fields are sized (`[safety]`; none: the defaults, and the
+    /// settings hash of scenarios without it is kept).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub safety: Option<forkbench_safety::SafetyConfig>,
+    /// People and other vehicles on routes through the world (`[[mover]]`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub movers: Vec<forkbench_safety::MoverSpec>,
     /// Likely slips the file is still valid with (radians in a degrees key), as
     /// `file:line: …`; front ends print them.
     #[serde(skip)]
@@ -275,6 +283,8 @@ impl Scenario {
         check_values(&f, file)?;
         let (pallet, pallet_label) = pallet::resolve(&f, (file, text))?;
         checks::check_payload(&f.truck, &pallet, (file, text))?;
+        safety::check(&f, (file, text))?;
+        safety::check_movers(&f, &world, (file, text))?;
         checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
         pallet::check_thickness(&f, (&pallet, &pallet_label), file)?;
         let cases = resolve_cases(&f, &world, &pallet, file).map_err(|e| match e {
@@ -325,6 +335,8 @@ impl Scenario {
             cases,
             mission,
             phases: Vec::new(),
+            safety: f.safety,
+            movers: f.mover,
             warnings: hints::unit_warnings(text, file),
         })
     }

@@ -187,6 +187,7 @@ impl<'a> Trial<'a> {
             );
         }
         self.world.collision |= self.world.sim.obstacle_contact();
+        self.safety_step(rec);
         self.record_signals(cmd, pose, rec);
         rec.step(&StepRecord {
             t_s: self.world.sim.time_s(),

@@ -93,7 +93,11 @@ impl<'a> Trial<'a> {
             last = Some((fix, pose));
             let control = self.caller_turn(deadline_s, fix, pose).await;
             let cmd = match steering.command(self, control, pose) {
-                Ok(Some(cmd)) => applied(control, cmd, &self.scn.truck),
+                Ok(Some(cmd)) => {
+                    let mut cmd = applied(control, cmd, &self.scn.truck);
+                    cmd.speed_mps = self.safety_gate(cmd.speed_mps, rec);
+                    cmd
+                }
                 Ok(None) => break Ok(true),
                 Err(e) => break Err(e),
             };

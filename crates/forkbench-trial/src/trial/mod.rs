@@ -11,9 +11,11 @@ mod localize;
 mod look;
 mod manoeuvre_leg;
 mod mission;
+mod movers_view;
 mod options;
 mod phases;
 mod plan;
+mod safety;
 mod sense;
 mod session;
 mod session_view;
@@ -32,6 +34,10 @@ use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 
 pub use crate::scenario::APPROACH_GAP_M;
+
+/// The criterion a trial fails when the moving truck touches a person or vehicle
+/// (critical: it is the verdict whatever else the trial did).
+pub const PERSON_CONTACT: &str = "person_contact";
 pub use crate::step_criteria::{
     STEP_CRITERIA, StepCriterion, StepView, step_criterion_name, step_measures,
 };
@@ -154,12 +160,14 @@ pub(crate) async fn run_stages<R: Recorder + ?Sized>(
         rec.event(trial.world.sim.time_s(), Level::Error, &why);
         trial.measure();
         trial.verdict.out.fail(Failure::Error, why);
+        trial.judge_safety();
         return trial.verdict.out;
     }
     trial.conclude();
     if !pick_only {
         trial.run_phases(rec).await;
     }
+    trial.judge_safety();
     trial.verdict.out
 }
 
@@ -178,6 +186,7 @@ async fn prepare<'a, R: Recorder + ?Sized>(
     let end = |mut trial: Trial<'a>, failure: Failure, why: String| {
         trial.measure_time();
         trial.verdict.out.fail(failure, why);
+        trial.judge_safety();
         Err::<Trial<'a>, _>(Box::new(trial.verdict.out))
     };
     if let Some(m) = &scn.mission {

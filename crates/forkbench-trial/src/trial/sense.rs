@@ -4,10 +4,11 @@ use forkbench_core::signal::Scan;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, Signal, Style};
 use forkbench_sensors::detector::detect_in;
-use forkbench_sensors::scan::{Errors, scan};
+use forkbench_sensors::scan::{Errors, WorldView, scan};
 use rand_chacha::ChaCha8Rng;
 
 use super::error::StageError;
+use super::movers_view::WithMovers;
 use super::setup::Trial;
 use crate::recorder::Recorder;
 use crate::scenario::sensors::{NamedScanner, PalletSensing};
@@ -64,15 +65,27 @@ impl Trial<'_> {
 
     /// One scan from `sensor` (its true pose), placed at `placed` (its believed pose).
     fn scan_from(&mut self, k: usize, s: &NamedScanner, sensor: Pose2, placed: Pose2) -> Scan {
+        // People and vehicles stand in the scanners' way (they occlude the pallet).
+        let with_movers;
+        let view: &dyn WorldView = match &self.safety {
+            Some(safety) if !safety.movers.is_empty() => {
+                with_movers = WithMovers {
+                    sim: &self.world.sim,
+                    movers: &safety.movers,
+                };
+                &with_movers
+            }
+            _ => &self.world.sim,
+        };
         let mut out = if self.run.noise {
             let state = &mut self.sense.scanners[k];
             let errors = Errors::Modelled {
                 bias_m: state.bias_m,
                 rng: &mut state.rng,
             };
-            scan(&s.scanner, &self.world.sim, sensor, errors)
+            scan(&s.scanner, view, sensor, errors)
         } else {
-            scan::<ChaCha8Rng>(&s.scanner, &self.world.sim, sensor, Errors::Ideal)
+            scan::<ChaCha8Rng>(&s.scanner, view, sensor, Errors::Ideal)
         };
         out.sensor = placed;
         out

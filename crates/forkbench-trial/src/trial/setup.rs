@@ -50,6 +50,8 @@ pub struct Trial<'a> {
     pub(super) link: Option<super::engine::Link>,
     /// The part of the cycle being driven.
     pub(super) stage: super::engine::Stage,
+    /// People, other vehicles and the safety function, when the scenario has them.
+    pub(super) safety: Option<super::safety::SafetyRun>,
 }
 
 impl std::fmt::Debug for Trial<'_> {
@@ -244,6 +246,13 @@ impl<'a> Trial<'a> {
                 return Err(Box::new(out));
             }
         };
+        let safety = match super::safety::SafetyRun::new(scn, run.seed) {
+            Ok(s) => s,
+            Err(e) => {
+                fail(&mut out, format!("the safety function: {e}"));
+                return Err(Box::new(out));
+            }
+        };
         record_scene(rec, scn, case, run, (start, true_pallet), &obstacles);
         let pallet0 = sim.pallet_pose();
         let mut trial = Trial {
@@ -276,6 +285,7 @@ impl<'a> Trial<'a> {
             link: None,
             stage: super::engine::Stage::Leg,
             wall_start: std::time::Instant::now(),
+            safety,
         };
         if scn.mission.is_none()
             && let Err(e) = trial.first_fix_and_estimate(&true_pallet, rec)
@@ -283,6 +293,7 @@ impl<'a> Trial<'a> {
             let why = e.to_string();
             rec.event(0.0, Level::Error, &why);
             trial.verdict.out.fail(Failure::Error, why);
+            trial.judge_safety();
             return Err(Box::new(trial.verdict.out));
         }
         Ok(trial)

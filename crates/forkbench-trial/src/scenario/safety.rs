@@ -1,0 +1,124 @@
+//! A scenario's `[safety]` table: checked at load against its truck, and the protective fields it sizes.
+
+use forkbench_safety::FieldSizing;
+
+use super::checks::at_line;
+use super::file::ScenarioFile;
+use super::{Scenario, World, invalid, invalid_setting};
+use crate::TrialError;
+use forkbench_core::Pose2;
+use forkbench_core::geometry::Obstacle;
+use forkbench_safety::MoverSpec;
+
+/// The `[safety]` settings in range, their speed ranges covering the truck's top speed;
+/// the error names the file, the line of the key and the field.
+pub(super) fn check(f: &ScenarioFile, (file, text): (&str, &str)) -> Result<(), TrialError> {
+    let Some(s) = &f.safety else {
+        return Ok(());
+    };
+    s.validate(f.truck.max_speed_mps).map_err(|e| {
+        let key = e
+            .field
+            .as_deref()
+            .map(|k| k.rsplit('.').next().unwrap_or(k));
+        invalid_setting(&key_line(file, text, key), "safety", &e)
+    })
+}
+
+/// `file:line` of `key` within the `[safety]` tables (else of `[safety]`, else the file).
+fn key_line(file: &str, text: &str, key: Option<&str>) -> String {
+    let Some(start) = text
+        .lines()
+        .position(|l| l.trim_start().starts_with("[safety"))
+    else {
+        return file.to_owned();
+    };
+    let after: String = text.lines().skip(start).collect::<Vec<_>>().join("\n");
+    let at = key.map(|k| at_line("", &after, k)).unwrap_or_default();
+    match at.strip_prefix(':').and_then(|n| n.parse::<usize>().ok()) {
+        Some(n) => format!("{file}:{}", start + n),
+        None => format!("{file}:{}", start + 1),
+    }
+}
+
+/// Each `[[mover]]` in range, its route clear of the world's racks and walls (a person's
+/// body, a vehicle's outline, along every leg of the route); errors name the line of
+/// the mover's table and the field.
+pub(super) fn check_movers(
+    f: &ScenarioFile,
+    world: &World,
+    (file, text): (&str, &str),
+) -> Result<(), TrialError> {
+    let tables: Vec<usize> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.trim_start().starts_with("[[mover]]"))
+        .map(|(i, _)| i + 1)
+        .collect();
+    let obstacles = world.obstacles();
+    // The same racks and walls, in the same order, by name.
+    let labels = world.footprint_obstacles().1;
+    for (k, m) in f.mover.iter().enumerate() {
+        let at = tables
+            .get(k)
+            .map_or_else(|| file.to_owned(), |n| format!("{file}:{n}"));
+        let prefix = format!("mover[{k}]");
+        m.validate()
+            .map_err(|e| invalid_setting(&at, &prefix, &e))?;
+        if let Some(why) = route_blocked(m, &obstacles, &labels) {
+            return Err(invalid(&at, &format!("{prefix}.route"), &why));
+        }
+    }
+    Ok(())
+}
+
+/// Where a mover's route runs through an obstacle, if it does.
+fn route_blocked(m: &MoverSpec, obstacles: &[Obstacle], labels: &[String]) -> Option<String> {
+    let (l, w) = m.body_m();
+    for leg in m.route.windows(2) {
+        let (a, b) = (leg[0], leg[1]);
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+        let steps = (len / ROUTE_CHECK_STEP_M).ceil().max(1.0) as usize;
+        for i in 0..=steps {
+            let u = i as f64 / steps as f64;
+            let p = Pose2::new(a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]), heading);
+            let hit = obstacles.iter().position(|o| {
+                forkbench_safety::rect_gap_m(&(o.centre, o.length_m, o.width_m), &(p, l, w)) <= 0.0
+            });
+            if let Some(o) = hit {
+                let name = labels.get(o).map_or("a rack or wall", String::as_str);
+                return Some(format!(
+                    "runs through {name} near ({:.2}, {:.2}) m",
+                    p.x_m, p.y_m
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// Spacing of the poses a route is checked at (less than a leg's width).
+const ROUTE_CHECK_STEP_M: f64 = 0.05;
+
+impl Scenario {
+    /// The protective field of each of the scenario's speed ranges, empty and at rated
+    /// load, braking on its floor (`[sim] tyre_friction`); Z_R follows the world's
+    /// reflectors unless `[safety] reflectors_near` says otherwise. Without `[safety]`,
+    /// its defaults.
+    pub fn safety_fields(&self) -> Result<FieldSizing, TrialError> {
+        let cfg = self.safety.clone().unwrap_or_default();
+        forkbench_safety::size_fields(
+            &cfg,
+            &self.truck,
+            &self.sim,
+            &self.pallet,
+            !self.world.reflector.is_empty(),
+        )
+        .map_err(|e| TrialError::Invalid {
+            file: self.file.clone(),
+            field: "safety".to_owned(),
+            reason: e.to_string(),
+        })
+    }
+}

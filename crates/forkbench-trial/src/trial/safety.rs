@@ -1,0 +1,499 @@
+//! People and the safety function in a trial: movers walk their routes every step, the safety scanners watch the field set the speed selects, the truck is stopped or slowed, and contacts with people are judged.
+
+use forkbench_core::{ForkliftSpec, PalletSpec, Pose2, Signal, Style};
+use forkbench_safety::{
+    Eye, FieldSets, Fields, Mover, MoverKind, Outline, Reading, Rect, STANDING_MPS, SafetyConfig,
+    SafetyFunction, YIELD_GAP_M, detect, rect_gap_lower_bound_m, rect_gap_m,
+};
+use forkbench_sensors::scan::WorldView as _;
+use forkbench_sim::Sim;
+use rand::RngExt as _;
+use rand_chacha::ChaCha8Rng;
+
+use super::engine::Stage;
+use super::movers_view::WithMovers;
+use super::setup::{Trial, stream};
+use crate::outcome::SafetyOutcome;
+use crate::recorder::{Level, Recorder};
+use crate::scenario::Scenario;
+
+/// Safety scans per scanner response time (an S300's default double sampling).
+const SCANS_PER_RESPONSE: f64 = 2.0;
+
+const CLEAR: Style = Style::rgba([60, 200, 90, 255]).width(0.03);
+const WARNED: Style = Style::rgba([250, 200, 40, 255]).width(0.03);
+const STOPPED: Style = Style::rgba([240, 50, 50, 255]).width(0.05);
+const PERSON: Style = Style::rgba([255, 120, 200, 255]).width(0.04);
+
+/// The people and vehicles of a trial and, when the scenario monitors, its safety
+/// function.
+#[derive(Debug)]
+pub(crate) struct SafetyRun {
+    pub(super) movers: Vec<Mover>,
+    monitor: Option<Monitor>,
+    /// Each mover's least gap to the moving truck so far.
+    closest_m: Vec<f64>,
+    touching: Vec<bool>,
+    contacts: u32,
+    first_contact: Option<String>,
+    /// The speed the truck's controller asked for this step, before the safety function.
+    requested_mps: f64,
+}
+
+#[derive(Debug)]
+struct Monitor {
+    fields: FieldSets,
+    function: SafetyFunction,
+    /// The scanners: at the fork root facing forward, at the chassis' rear facing back.
+    eyes: [Eye; 2],
+    resolution_m: f64,
+    reach_m: f64,
+    period_s: f64,
+    next_scan_s: f64,
+    mute_near_target_m: f64,
+    /// The part of the cycle whose entry muted the fields.
+    muted: Option<Stage>,
+    /// The last scan found the protective field broken (an event marks each new break).
+    broken: bool,
+    /// When the current protective stop began.
+    stop_began_s: Option<f64>,
+}
+
+impl SafetyRun {
+    /// The scenario's movers (their starts drawn from the trial's seed, a stream per
+    /// mover) and its safety function; `None` when it has neither.
+    pub(super) fn new(scn: &Scenario, seed: u64) -> Result<Option<Self>, String> {
+        let cfg = scn.safety.as_ref().filter(|c| c.monitor);
+        if scn.movers.is_empty() && cfg.is_none() {
+            return Ok(None);
+        }
+        let movers: Vec<Mover> = scn
+            .movers
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let mut rng = mover_stream(seed, i);
+                let [a, b] = m.start_s;
+                let start = if b > a { rng.random_range(a..=b) } else { a };
+                Mover::new(m.clone(), start)
+            })
+            .collect();
+        let monitor = match cfg {
+            Some(c) => Some(Monitor::new(scn, c)?),
+            None => None,
+        };
+        let n = movers.len();
+        Ok(Some(SafetyRun {
+            movers,
+            monitor,
+            closest_m: vec![f64::INFINITY; n],
+            touching: vec![false; n],
+            contacts: 0,
+            first_contact: None,
+            requested_mps: 0.0,
+        }))
+    }
+
+    /// What the trial's outcome reports.
+    pub(super) fn outcome(&self) -> SafetyOutcome {
+        let stats = self.monitor.as_ref().map(|m| m.function.stats);
+        SafetyOutcome {
+            monitored: self.monitor.is_some(),
+            stops: stats.map_or(0, |s| s.stops),
+            false_trips: stats.map_or(0, |s| s.false_trips),
+            stop_time_s: stats.map_or(0.0, |s| s.stop_time_s),
+            slowdowns: stats.map_or(0, |s| s.slowdowns),
+            slowdown_time_s: stats.map_or(0.0, |s| s.slowdown_time_s),
+            person_contacts: self.contacts,
+            first_contact: self.first_contact.clone(),
+            closest_m: self
+                .closest_m
+                .iter()
+                .map(|d| d.is_finite().then_some(*d))
+                .collect(),
+        }
+    }
+}
+
+/// A mover's own random stream: keyed by what it is for and by the mover's place.
+fn mover_stream(seed: u64, i: usize) -> ChaCha8Rng {
+    let key = forkbench_core::hash::fnv1a(format!("mover start {i}").bytes());
+    stream(seed, key)
+}
+
+impl Monitor {
+    fn new(scn: &Scenario, c: &SafetyConfig) -> Result<Self, String> {
+        let sizing = scn.safety_fields().map_err(|e| e.to_string())?;
+        let outline = Outline {
+            front_m: scn.truck.fork_length_m,
+            rear_m: scn.truck.body_length_m,
+            axle_behind_m: scn.truck.fork_root_ahead_of_front_axle_m,
+            wheelbase_m: scn.truck.wheelbase_m,
+            body_width_m: scn.truck.body_width_m + 2.0 * c.scanner.tolerance_m,
+        };
+        let fields =
+            FieldSets::from_sizing(&sizing, outline, c.field_length_scale, c.warning_margin_m);
+        let reach_m = fields.reach_m();
+        let fov_rad = c.scanner.fov_deg.to_radians();
+        let period_s = c.scanner.response_time_s / SCANS_PER_RESPONSE;
+        let rear = Pose2::new(-scn.truck.body_length_m, 0.0, std::f64::consts::PI);
+        Ok(Monitor {
+            fields,
+            function: SafetyFunction::new(
+                c.scanner.response_time_s + c.controller_response_s,
+                c.resume_dwell_s,
+                c.warning_speed_mps,
+            ),
+            eyes: [Pose2::new(0.0, 0.0, 0.0), rear].map(|mount| Eye { mount, fov_rad }),
+            resolution_m: c.scanner.resolution_m,
+            reach_m,
+            period_s,
+            next_scan_s: 0.0,
+            mute_near_target_m: c.mute_near_target_m,
+            muted: None,
+            broken: false,
+            stop_began_s: None,
+        })
+    }
+}
+
+/// The truck's parts a person can touch, in the map: the chassis, each fork and a
+/// carried pallet.
+fn truck_parts(sim: &Sim, truck: &ForkliftSpec, pallet: &PalletSpec) -> Vec<Rect> {
+    let root = sim.fork_root_pose();
+    let at = |x: f64, y: f64| root.to_world(&Pose2::new(x, y, 0.0));
+    let (l, w) = (truck.body_length_m, truck.body_width_m);
+    let fork = |side: f64| {
+        (
+            at(truck.fork_length_m / 2.0, side * truck.fork_spacing_m / 2.0),
+            truck.fork_length_m,
+            truck.fork_width_m,
+        )
+    };
+    let mut parts = vec![(at(-l / 2.0, 0.0), l, w), fork(1.0), fork(-1.0)];
+    if sim.carrying() {
+        let face = sim.pallet_pose();
+        let centre = face.to_world(&Pose2::new(pallet.depth_m / 2.0, 0.0, 0.0));
+        parts.push((centre, pallet.depth_m, pallet.width_m));
+    }
+    parts
+}
+
+/// The least gap from `body` to the truck's parts, exact below `care_m` (beyond it, any
+/// value at least `care_m`: the callers only ask whether it is small).
+fn gap_to(parts: &[Rect], body: &Rect, care_m: f64) -> f64 {
+    parts
+        .iter()
+        .map(|p| {
+            let bound = rect_gap_lower_bound_m(p, body);
+            if bound >= care_m {
+                bound
+            } else {
+                rect_gap_m(p, body)
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+impl Trial<'_> {
+    /// The speed the safety function lets the truck drive at, for the controller's
+    /// `speed_mps` this step.
+    pub(super) fn safety_gate<R: Recorder + ?Sized>(&mut self, speed_mps: f64, rec: &mut R) -> f64 {
+        let (t, dt) = (self.world.sim.time_s(), self.world.sim.dt_s());
+        let Some(s) = self.safety.as_mut() else {
+            return speed_mps;
+        };
+        s.requested_mps = speed_mps;
+        let Some(m) = s.monitor.as_mut() else {
+            return speed_mps;
+        };
+        let (was, held) = (m.function.stopped(), m.function.stats.stop_time_s);
+        let standing = self.world.sim.speed_mps().abs() < STANDING_MPS;
+        let v = m.function.gate(t, dt, speed_mps, standing);
+        if was && !m.function.stopped() {
+            m.stop_began_s = None;
+            let why = format!(
+                "safety: fields clear, driving on ({:.1} s stopped in all)",
+                held
+            );
+            rec.event(t, Level::Info, &why);
+        } else if !was && m.function.stopped() {
+            m.stop_began_s = Some(t);
+            rec.event(t, Level::Warn, "safety: protective stop (braking)");
+        }
+        v
+    }
+
+    /// After a physics step: the movers walk on, contacts and closest approaches are
+    /// judged, and at each safety scan the fields are read.
+    pub(super) fn safety_step<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
+        let Some(mut s) = self.safety.take() else {
+            return;
+        };
+        self.move_and_judge(&mut s, rec);
+        if let Some(mut m) = s.monitor.take() {
+            if self.world.sim.time_s() + 1e-9 >= m.next_scan_s {
+                m.next_scan_s += m.period_s;
+                self.read_fields(&mut m, &s, rec);
+            }
+            s.monitor = Some(m);
+        }
+        self.safety = Some(s);
+    }
+
+    fn move_and_judge<R: Recorder + ?Sized>(&self, s: &mut SafetyRun, rec: &mut R) {
+        let sim = &self.world.sim;
+        let (t, dt, speed) = (sim.time_s(), sim.dt_s(), sim.speed_mps());
+        let truck = &self.scn.truck;
+        // One circle round the whole truck (a carried pallet included): most movers are
+        // far outside it, and then no part's corners are needed.
+        let (front, rear) = (
+            truck.fork_length_m.max(self.scn.pallet.depth_m),
+            truck.body_length_m,
+        );
+        let centre = sim
+            .fork_root_pose()
+            .to_world(&Pose2::new((front - rear) / 2.0, 0.0, 0.0));
+        let reach = (front + rear).hypot(truck.body_width_m.max(self.scn.pallet.width_m)) / 2.0;
+        let coarse = |body: &Rect| {
+            let (dx, dy) = (body.0.x_m - centre.x_m, body.0.y_m - centre.y_m);
+            ((dx * dx + dy * dy).sqrt() - reach - body.1.hypot(body.2) / 2.0).max(0.0)
+        };
+        let mut parts: Option<Vec<Rect>> = None;
+        let mut gap = |body: &Rect, care_m: f64| {
+            let far = coarse(body);
+            if far >= care_m {
+                return far;
+            }
+            let parts = parts.get_or_insert_with(|| truck_parts(sim, truck, &self.scn.pallet));
+            gap_to(parts, body, care_m)
+        };
+        let moving = speed.abs() >= STANDING_MPS;
+        for (i, m) in s.movers.iter_mut().enumerate() {
+            let (l, w) = m.spec.body_m();
+            // People yield to a moving truck, and walk round a standing one (passing
+            // through it here: only the moving truck coming into touch is a contact).
+            m.advance(t, dt, |next| {
+                moving && gap(&(*next, l, w), YIELD_GAP_M) < YIELD_GAP_M
+            });
+            if m.gone() {
+                s.touching[i] = false;
+                continue;
+            }
+            // Exact where it may lower the closest approach or be a touch.
+            let gap = gap(&m.body(), s.closest_m[i].max(1e-3));
+            let touching = gap <= 0.0;
+            // An overlap begun while the truck stood is someone walking round it, not an
+            // approach of the moving truck.
+            let passing = touching && s.touching[i];
+            if moving && !passing {
+                s.closest_m[i] = s.closest_m[i].min(gap);
+            }
+            if touching && moving && !s.touching[i] {
+                s.contacts += 1;
+                let who = match m.spec.kind {
+                    MoverKind::Person => "person",
+                    MoverKind::Vehicle => "vehicle",
+                };
+                let why = format!(
+                    "the truck touched {who} {} at {:.2} m/s (t = {t:.2} s)",
+                    i + 1,
+                    speed.abs()
+                );
+                rec.event(t, Level::Error, &why);
+                s.first_contact.get_or_insert(why);
+            }
+            s.touching[i] = touching;
+        }
+        if ((t / dt).round() as u64).is_multiple_of(super::drive::SIGNAL_EVERY_STEPS) {
+            for (i, m) in s.movers.iter().enumerate().filter(|(_, m)| !m.gone()) {
+                let (p, l, w) = m.body();
+                let outline = forkbench_core::geometry::rect_outline(&p, l, w);
+                rec.signal(
+                    t,
+                    &format!("people/{}", i + 1),
+                    &Signal::Path(&outline),
+                    PERSON,
+                );
+            }
+        }
+    }
+
+    /// Whether the fields are muted now: in the pick's or the place's entry, once the
+    /// fork tips came near the target (the pallet face the truck aims at; where the
+    /// place's path leaves the tips), until that part of the cycle ends (the caller
+    /// watches reversing out regardless).
+    fn muted(&self, m: &mut Monitor) -> bool {
+        if m.muted.is_some_and(|st| st != self.stage) {
+            m.muted = None;
+        }
+        if m.muted.is_some() {
+            return true;
+        }
+        let fork = Pose2::new(self.scn.truck.fork_length_m, 0.0, 0.0);
+        let target = match self.stage {
+            Stage::Pick => Some(self.sense.pallet_est),
+            Stage::Phase(k) => self
+                .scn
+                .phases
+                .get(usize::from(k).wrapping_sub(1))
+                .filter(|p| p.name == "place")
+                .and_then(|_| self.path.samples.last())
+                .map(|end| end.pose().to_world(&fork)),
+            Stage::Leg | Stage::Staging => None,
+        };
+        let tips = self.world.sim.fork_root_pose().to_world(&fork);
+        if target.is_some_and(|t| t.distance_to(&tips) <= m.mute_near_target_m) {
+            m.muted = Some(self.stage);
+        }
+        m.muted.is_some()
+    }
+
+    /// One safety scan of the field set the requested speed selects.
+    fn read_fields<R: Recorder + ?Sized>(&self, m: &mut Monitor, s: &SafetyRun, rec: &mut R) {
+        let t = self.world.sim.time_s();
+        // Muting covers the entry (driving forwards); backing out is watched again.
+        let muted = self.muted(m) && s.requested_mps >= 0.0;
+        let set = if muted {
+            None
+        } else {
+            m.fields.active(s.requested_mps)
+        };
+        let Some(set) = set.copied() else {
+            m.broken = false;
+            m.function.read(Reading {
+                t_s: t,
+                protective: false,
+                warning: false,
+                mover_in_protective: false,
+            });
+            return;
+        };
+        let root = self.world.sim.fork_root_pose();
+        let fields = m
+            .fields
+            .fields(&set, s.requested_mps, self.world.sim.steer_rad());
+        let view = WithMovers {
+            sim: &self.world.sim,
+            movers: &s.movers,
+        };
+        let mut surfaces = Vec::new();
+        view.surfaces_near([root.x_m, root.y_m], m.reach_m, &mut surfaces);
+        let segments: Vec<[[f64; 2]; 2]> = surfaces
+            .iter()
+            .map(|f| [local(&root, f.a), local(&root, f.b)])
+            .collect();
+        let seen = detect(&fields, &segments, &m.eyes, m.resolution_m);
+        let intruder = seen.protective.map(|p| {
+            let q = root.to_world(&Pose2::new(p[0], p[1], 0.0));
+            [q.x_m, q.y_m]
+        });
+        let reading = Reading {
+            t_s: t,
+            protective: intruder.is_some(),
+            warning: seen.warning,
+            mover_in_protective: intruder.is_some()
+                && s.movers.iter().any(|mv| {
+                    mv.seen().iter().any(|(p, l, w)| {
+                        let corners = forkbench_core::geometry::rect_corners(p, *l, *w);
+                        corners
+                            .iter()
+                            .chain([[p.x_m, p.y_m]].iter())
+                            .any(|c| fields.hit(local(&root, *c)).0)
+                    })
+                }),
+        };
+        let new_break = intruder.is_some() && !m.broken && !m.function.stopped();
+        m.broken = intruder.is_some();
+        if let Some(p) = intruder.filter(|_| new_break) {
+            let what = if reading.mover_in_protective {
+                "a person or vehicle"
+            } else {
+                "no person (a false trip: rack, wall or post)"
+            };
+            let why = format!(
+                "safety: protective field broken at ({:.2}, {:.2}) m by {what}; stopping ({:?}, {:.2} m/s asked)",
+                p[0], p[1], self.stage, s.requested_mps
+            );
+            rec.event(t, Level::Warn, &why);
+        }
+        record_reading(rec, t, &root, &fields, &reading, m.function.stopped());
+        if let Some(p) = intruder {
+            rec.signal(t, "safety/intrusion", &Signal::Points(&[p]), STOPPED);
+        }
+        m.function.read(reading);
+    }
+
+    /// What the safety function and the movers did, into the outcome; a contact with a
+    /// person is the verdict.
+    pub(super) fn judge_safety(&mut self) {
+        let Some(s) = &self.safety else {
+            return;
+        };
+        let report = s.outcome();
+        let out = &mut self.verdict.out;
+        if let Some(why) = &report.first_contact {
+            let before = out.failure.map(|f| {
+                let detail = out.failure_detail.clone().unwrap_or_default();
+                format!("{}: {detail}", f.name())
+            });
+            out.also_failed.splice(0..0, before);
+            out.fail(
+                crate::outcome::Failure::Criterion(super::PERSON_CONTACT),
+                why.clone(),
+            );
+        }
+        // A failure while the fields held the truck: say so where a reviewer looks first.
+        let held = report.stop_time_s;
+        if !out.success && report.first_contact.is_none() && held >= 1.0 {
+            let n = report.stops;
+            let stops = format!("{n} protective stop{}", if n == 1 { "" } else { "s" });
+            out.likely_cause = Some(format!(
+                "the safety function held the truck stopped for {held:.1} s ({stops}, {} with nobody in the field)",
+                report.false_trips
+            ));
+        }
+        out.safety = Some(report);
+    }
+}
+
+/// A map point in the fork-root frame.
+fn local(root: &Pose2, p: [f64; 2]) -> [f64; 2] {
+    let q = root.to_local(&Pose2::new(p[0], p[1], 0.0));
+    [q.x_m, q.y_m]
+}
+
+fn record_reading<R: Recorder + ?Sized>(
+    rec: &mut R,
+    t: f64,
+    root: &Pose2,
+    set: &Fields,
+    r: &Reading,
+    stopped: bool,
+) {
+    let world = |poly: &[[f64; 2]]| -> Vec<[f64; 2]> {
+        poly.iter()
+            .chain(poly.first())
+            .map(|p| {
+                let q = root.to_world(&Pose2::new(p[0], p[1], 0.0));
+                [q.x_m, q.y_m]
+            })
+            .collect()
+    };
+    let style = if r.protective || stopped {
+        STOPPED
+    } else if r.warning {
+        WARNED
+    } else {
+        CLEAR
+    };
+    for (name, polys, style) in [
+        ("protective", &set.protective, style),
+        ("warning", &set.warning, WARNED),
+    ] {
+        for (i, poly) in polys.iter().enumerate() {
+            let path = format!("safety/{name}_field/{i}");
+            rec.signal(t, &path, &Signal::Path(&world(poly)), style);
+        }
+    }
+}

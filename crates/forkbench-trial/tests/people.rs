@@ -1,0 +1,166 @@
+//! People and the safety function in trials: a person in the truck's path is touched without fields and not with the fields the formula sizes; a crossing person costs a stop and the pick goes on; routes through racks and overlapping speed ranges are refused at load.
+
+use forkbench_trial::{Scenario, TrialOptions, World, run_trial};
+
+const WORLD: &str = "name = \"w\"\n[[rack]]\nname = \"post\"\nx_m = 4.0\ny_m = 3.0\nlength_m = 0.4\nwidth_m = 0.4\n";
+
+/// A pick 8 m straight ahead with `extra` appended (movers, `[safety]`).
+fn pick(extra: &str) -> Result<Scenario, String> {
+    let text = format!(
+        "name = \"people\"\nplanner = \"bspline\"\nworld = \"w.toml\"\ntimeout_s = 40.0\n\
+         start = {{ x_m = 0, y_m = 0, heading_deg = 0 }}\n\
+         pallet = {{ x_m = 8, y_m = 0, heading_deg = 0 }}\n{extra}"
+    );
+    Scenario::parse(&text, "people.toml", |_| World::parse(WORLD, "w.toml"))
+        .map_err(|e| e.to_string())
+}
+
+/// Someone standing on the truck's way to the pallet for the whole trial, their back to it
+/// (shoulders across its path: sideways on, a person fits between the forks).
+const STANDING: &str = "[[mover]]\nkind = \"person\"\nroute = [[4.5, 0.0], [6.5, 0.0]]\nspeed_mps = 1.2\nstart_s = [3000.0, 3000.0]\n";
+
+fn no_noise() -> TrialOptions {
+    TrialOptions {
+        no_noise: true,
+        ..TrialOptions::default()
+    }
+}
+
+#[test]
+fn without_fields_the_truck_touches_a_person_in_its_way_and_the_verdict_names_it() {
+    let scn = pick(STANDING).expect("loads");
+    let out = run_trial(&scn, &scn.cases[0], &no_noise());
+    assert!(!out.success);
+    assert_eq!(
+        out.failure.map(|f| f.name()),
+        Some("person_contact"),
+        "{out:?}"
+    );
+    let s = out.safety.expect("a safety outcome");
+    assert!(
+        !s.monitored && s.person_contacts == 1 && s.stops == 0,
+        "{s:?}"
+    );
+    assert!(out.failure_detail.is_some_and(|d| d.contains("person 1")));
+}
+
+#[test]
+fn the_sized_fields_stop_the_truck_before_a_standing_person() {
+    let scn = pick(&format!("{STANDING}[safety]\n")).expect("loads");
+    let out = run_trial(&scn, &scn.cases[0], &no_noise());
+    let s = out.safety.clone().expect("a safety outcome");
+    assert_eq!(s.person_contacts, 0, "{out:?}");
+    // Blocked for good: the pick runs out of time in front of the person.
+    assert_eq!(out.failure.map(|f| f.name()), Some("timeout"), "{out:?}");
+    assert!(s.monitored && s.stops >= 1 && s.false_trips == 0, "{s:?}");
+    let gap = s.closest_m[0].expect("measured");
+    let sizing = scn.safety_fields().expect("sized");
+    let longest = sizing.fields.iter().map(|f| f.length_m).fold(0.0, f64::max);
+    assert!(
+        gap > 0.1 && gap < longest,
+        "stopped {gap} m short of the person"
+    );
+    assert!(s.stop_time_s > 20.0, "{s:?}");
+}
+
+#[test]
+fn a_crossing_person_costs_a_stop_and_the_pick_goes_on() {
+    let crossing = "[[mover]]\nkind = \"person\"\nroute = [[4.5, -4.0], [4.5, 4.0]]\nspeed_mps = 1.0\nstart_s = [1.0, 1.0]\n[safety]\n";
+    let scn = pick(crossing).expect("loads");
+    let out = run_trial(&scn, &scn.cases[0], &no_noise());
+    let s = out.safety.clone().expect("a safety outcome");
+    assert!(out.success, "{out:?}");
+    assert!(
+        s.stops >= 1 && s.stop_time_s > 0.5 && s.person_contacts == 0,
+        "{s:?}"
+    );
+    assert_eq!(s.false_trips, 0, "{s:?}");
+    // The same seed, the same trial.
+    let again = run_trial(&scn, &scn.cases[0], &no_noise());
+    assert_eq!(out.safety, again.safety);
+    assert_eq!(out.sim_time_s, again.sim_time_s);
+}
+
+#[test]
+fn bad_movers_and_fields_are_refused_at_load_with_the_line_and_field() {
+    let through =
+        "[[mover]]\nkind = \"person\"\nroute = [[4.0, 1.0], [4.0, 5.0]]\nspeed_mps = 1.2\n";
+    let e = pick(through).expect_err("through the post");
+    assert!(
+        e.contains("people.toml:7") && e.contains("mover[0].route"),
+        "{e}"
+    );
+    assert!(e.contains("post"), "{e}");
+    let e = pick("[safety]\nspeed_ranges_mps = [0.5, 0.4, 0.8]\n").expect_err("overlap");
+    assert!(
+        e.contains("people.toml:8") && e.contains("safety.speed_ranges_mps"),
+        "{e}"
+    );
+    let e = pick("[safety]\nspeed_ranges_mps = [0.3, 0.5]\n").expect_err("a gap to the top speed");
+    assert!(e.contains("top speed"), "{e}");
+    let e = pick("[[mover]]\nkind = \"person\"\nroute = [[1, 5], [2, 5]]\nspeed_mps = 1.2\nstart_s = [-1.0, 2.0]\n")
+        .expect_err("a negative time");
+    assert!(e.contains("mover[0].start_s"), "{e}");
+}
+
+/// The scenario file as the main job's people scenarios are written.
+fn warehouse_people(scale: Option<f64>) -> Scenario {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenarios/warehouse-people.toml");
+    let mut text = std::fs::read_to_string(&file).expect("the scenario");
+    if let Some(s) = scale {
+        text = text.replace(
+            "[safety]\n",
+            &format!("[safety]\nfield_length_scale = {s}\n"),
+        );
+    }
+    let dir = file.parent().expect("a folder").to_owned();
+    Scenario::parse(&text, "warehouse-people.toml", |w| {
+        World::load(&dir.join(w))
+    })
+    .expect("loads")
+}
+
+#[test]
+fn with_the_sized_fields_nobody_is_touched_in_200_cycles_with_people_crossing() {
+    use rayon::prelude::*;
+    let scn = warehouse_people(None);
+    assert_eq!(scn.movers.len(), 5);
+    let outcomes: Vec<_> = (1..=200u64)
+        .into_par_iter()
+        .map(|seed| {
+            let opts = TrialOptions {
+                seed: Some(seed),
+                ..TrialOptions::default()
+            };
+            run_trial(&scn, &scn.cases[0], &opts)
+        })
+        .collect();
+    let safety: Vec<_> = outcomes.iter().filter_map(|o| o.safety.clone()).collect();
+    assert_eq!(safety.len(), 200);
+    let touched: Vec<_> = outcomes
+        .iter()
+        .filter(|o| o.failure.map(|f| f.name()) == Some("person_contact"))
+        .map(|o| (o.seed, o.failure_detail.clone()))
+        .collect();
+    assert!(touched.is_empty(), "{touched:?}");
+    // People were in the way: the fields stopped the truck for them.
+    let stops: u32 = safety.iter().map(|s| s.stops - s.false_trips).sum();
+    assert!(stops >= 100, "{stops} stops for people in 200 cycles");
+}
+
+#[test]
+fn fields_far_shorter_than_the_formula_let_the_truck_touch_a_standing_person() {
+    let short = pick(&format!("{STANDING}[safety]\nfield_length_scale = 0.1\nwarning_margin_m = 0.0\nwarning_speed_mps = 2.0\n")).expect("loads");
+    let out = run_trial(&short, &short.cases[0], &no_noise());
+    assert_eq!(
+        out.failure.map(|f| f.name()),
+        Some("person_contact"),
+        "{out:?}"
+    );
+    let s = out.safety.expect("a safety outcome");
+    assert!(
+        s.monitored && s.stops >= 1 && s.person_contacts == 1,
+        "{s:?}"
+    );
+}
