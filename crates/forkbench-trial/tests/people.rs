@@ -164,3 +164,25 @@ fn fields_far_shorter_than_the_formula_let_the_truck_touch_a_standing_person() {
         "{s:?}"
     );
 }
+
+#[test]
+fn reordering_the_movers_changes_no_draw() {
+    let a = "[[mover]]\nkind = \"person\"\nroute = [[4.5, -4.0], [4.5, 4.0]]\nspeed_mps = 1.0\nstart_s = [0.0, 6.0]\n";
+    let b = "[[mover]]\nkind = \"person\"\nroute = [[2.0, 2.2], [7.0, 2.2]]\nspeed_mps = 1.4\nstart_s = [0.0, 6.0]\n";
+    let run = |text: &str| {
+        let scn = pick(&format!("{text}[safety]\n")).expect("loads");
+        let opts = TrialOptions {
+            seed: Some(11),
+            ..TrialOptions::default()
+        };
+        run_trial(&scn, &scn.cases[0], &opts)
+    };
+    let (ab, ba) = (run(&format!("{a}{b}")), run(&format!("{b}{a}")));
+    let (sa, sb) = (ab.safety.expect("safety"), ba.safety.expect("safety"));
+    assert_eq!(
+        sa.closest_m,
+        sb.closest_m.iter().rev().copied().collect::<Vec<_>>()
+    );
+    assert_eq!((sa.stops, sa.stop_time_s), (sb.stops, sb.stop_time_s));
+    assert_eq!(ab.sim_time_s, ba.sim_time_s);
+}

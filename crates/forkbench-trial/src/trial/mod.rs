@@ -16,6 +16,7 @@ mod options;
 mod phases;
 mod plan;
 mod safety;
+mod safety_record;
 mod sense;
 mod session;
 mod session_view;

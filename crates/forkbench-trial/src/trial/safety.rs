@@ -2,7 +2,7 @@
 
 use forkbench_core::{ForkliftSpec, PalletSpec, Pose2, Signal, Style};
 use forkbench_safety::{
-    Eye, FieldSets, Fields, Mover, MoverKind, Outline, Reading, Rect, STANDING_MPS, SafetyConfig,
+    Eye, FieldSets, Mover, MoverKind, Outline, Reading, Rect, STANDING_MPS, SafetyConfig,
     SafetyFunction, YIELD_GAP_M, detect, rect_gap_lower_bound_m, rect_gap_m,
 };
 use forkbench_sensors::scan::WorldView as _;
@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::engine::Stage;
 use super::movers_view::WithMovers;
+use super::safety_record::{local, record_reading};
 use super::setup::{Trial, stream};
 use crate::outcome::SafetyOutcome;
 use crate::recorder::{Level, Recorder};
@@ -20,9 +21,9 @@ use crate::scenario::Scenario;
 /// Safety scans per scanner response time (an S300's default double sampling).
 const SCANS_PER_RESPONSE: f64 = 2.0;
 
-const CLEAR: Style = Style::rgba([60, 200, 90, 255]).width(0.03);
-const WARNED: Style = Style::rgba([250, 200, 40, 255]).width(0.03);
-const STOPPED: Style = Style::rgba([240, 50, 50, 255]).width(0.05);
+pub(super) const CLEAR: Style = Style::rgba([60, 200, 90, 255]).width(0.03);
+pub(super) const WARNED: Style = Style::rgba([250, 200, 40, 255]).width(0.03);
+pub(super) const STOPPED: Style = Style::rgba([240, 50, 50, 255]).width(0.05);
 const PERSON: Style = Style::rgba([255, 120, 200, 255]).width(0.04);
 
 /// The people and vehicles of a trial and, when the scenario monitors, its safety
@@ -67,12 +68,15 @@ impl SafetyRun {
         if scn.movers.is_empty() && cfg.is_none() {
             return Ok(None);
         }
+        let mut seen: Vec<&forkbench_safety::MoverSpec> = Vec::new();
         let movers: Vec<Mover> = scn
             .movers
             .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let mut rng = mover_stream(seed, i);
+            .map(|m| {
+                // Identical movers are told apart by how many came before.
+                let twin = seen.iter().filter(|o| **o == m).count();
+                seen.push(m);
+                let mut rng = mover_stream(seed, m, twin);
                 let [a, b] = m.start_s;
                 let start = if b > a { rng.random_range(a..=b) } else { a };
                 Mover::new(m.clone(), start)
@@ -115,10 +119,12 @@ impl SafetyRun {
     }
 }
 
-/// A mover's own random stream: keyed by what it is for and by the mover's place.
-fn mover_stream(seed: u64, i: usize) -> ChaCha8Rng {
-    let key = forkbench_core::hash::fnv1a(format!("mover start {i}").bytes());
-    stream(seed, key)
+/// A mover's own random stream, keyed by what it is for and by the mover itself (its
+/// kind, route and timing), not its place in the file: reordering `[[mover]]` tables
+/// changes no draw.
+fn mover_stream(seed: u64, m: &forkbench_safety::MoverSpec, twin: usize) -> ChaCha8Rng {
+    let key = format!("mover start {twin} {m:?}");
+    stream(seed, forkbench_core::hash::fnv1a(key.bytes()))
 }
 
 impl Monitor {
@@ -445,7 +451,11 @@ impl Trial<'_> {
         }
         // A failure while the fields held the truck: say so where a reviewer looks first.
         let held = report.stop_time_s;
-        if !out.success && report.first_contact.is_none() && held >= 1.0 {
+        if !out.success
+            && out.likely_cause.is_none()
+            && report.first_contact.is_none()
+            && held >= 1.0
+        {
             let n = report.stops;
             let stops = format!("{n} protective stop{}", if n == 1 { "" } else { "s" });
             out.likely_cause = Some(format!(
@@ -454,46 +464,5 @@ impl Trial<'_> {
             ));
         }
         out.safety = Some(report);
-    }
-}
-
-/// A map point in the fork-root frame.
-fn local(root: &Pose2, p: [f64; 2]) -> [f64; 2] {
-    let q = root.to_local(&Pose2::new(p[0], p[1], 0.0));
-    [q.x_m, q.y_m]
-}
-
-fn record_reading<R: Recorder + ?Sized>(
-    rec: &mut R,
-    t: f64,
-    root: &Pose2,
-    set: &Fields,
-    r: &Reading,
-    stopped: bool,
-) {
-    let world = |poly: &[[f64; 2]]| -> Vec<[f64; 2]> {
-        poly.iter()
-            .chain(poly.first())
-            .map(|p| {
-                let q = root.to_world(&Pose2::new(p[0], p[1], 0.0));
-                [q.x_m, q.y_m]
-            })
-            .collect()
-    };
-    let style = if r.protective || stopped {
-        STOPPED
-    } else if r.warning {
-        WARNED
-    } else {
-        CLEAR
-    };
-    for (name, polys, style) in [
-        ("protective", &set.protective, style),
-        ("warning", &set.warning, WARNED),
-    ] {
-        for (i, poly) in polys.iter().enumerate() {
-            let path = format!("safety/{name}_field/{i}");
-            rec.signal(t, &path, &Signal::Path(&world(poly)), style);
-        }
     }
 }
