@@ -1,5 +1,6 @@
 //! `forkbench report`: one self-contained HTML page per batch directory (tables, SVG plots, recordings, provenance).
 
+mod safety;
 mod sections;
 mod svg;
 
@@ -78,6 +79,11 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
             "<h2>Phases (a trial counts for a phase once the phases before it succeeded)</h2>",
         );
         h.push_str(&phases);
+    }
+    let safety = safety::safety_table(&summary);
+    if !safety.is_empty() {
+        h.push_str("<h2>Safety: people and safety fields</h2>");
+        h.push_str(&safety);
     }
     h.push_str("<h2>Failures by first failed criterion</h2>");
     h.push_str(&sections::failure_breakdown(&summary));

@@ -217,10 +217,9 @@ impl Trial<'_> {
         let standing = self.world.sim.speed_mps().abs() < STANDING_MPS;
         let v = m.function.gate(t, dt, speed_mps, standing);
         if was && !m.function.stopped() {
-            m.stop_began_s = None;
+            let this_s = m.stop_began_s.take().map_or(0.0, |b| t - b);
             let why = format!(
-                "safety: fields clear, driving on ({:.1} s stopped in all)",
-                held
+                "safety: fields clear, driving on after {this_s:.1} s ({held:.1} s stopped in all)"
             );
             rec.event(t, Level::Info, &why);
         } else if !was && m.function.stopped() {
