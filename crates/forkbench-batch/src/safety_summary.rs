@@ -24,6 +24,25 @@ pub struct SafetySummary {
     pub closest_median_m: Option<f64>,
 }
 
+impl SafetySummary {
+    /// The figures as both the markdown and the HTML tables show them, in their column
+    /// order: trials, with a contact, stops, false trips, stopped, slowdowns, slowed,
+    /// closest min / median.
+    pub fn cells(&self) -> [String; 8] {
+        let m = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{v:.2}"));
+        [
+            self.trials.to_string(),
+            self.trials_with_contact.to_string(),
+            format!("{:.2}", self.stops_per_trial),
+            format!("{:.2}", self.false_trips_per_trial),
+            format!("{:.1}", self.stop_time_per_trial_s),
+            format!("{:.2}", self.slowdowns_per_trial),
+            format!("{:.1}", self.slowdown_time_per_trial_s),
+            format!("{} / {}", m(self.closest_min_m), m(self.closest_median_m)),
+        ]
+    }
+}
+
 /// Tallies while records are read.
 #[derive(Debug, Default)]
 pub(crate) struct SafetyAcc {
@@ -85,22 +104,13 @@ pub(crate) fn markdown(rows: &[crate::SummaryRow]) -> String {
     let mut s = String::from(
         "\nSafety (people and safety fields; per trial: means)\n\n| scenario | planner | mode | trials | with a contact | stops | false trips | stopped (s) | slowdowns | slowed (s) | closest min / median (m) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    let m = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{v:.2}"));
     for (r, x) in with {
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.1} | {:.2} | {:.1} | {} / {} |\n",
+            "| {} | {} | {} | {} |\n",
             forkbench_trial::text::md_cell(&r.scenario),
             forkbench_trial::text::md_cell(&r.planner),
             crate::mode_name(r.replan),
-            x.trials,
-            x.trials_with_contact,
-            x.stops_per_trial,
-            x.false_trips_per_trial,
-            x.stop_time_per_trial_s,
-            x.slowdowns_per_trial,
-            x.slowdown_time_per_trial_s,
-            m(x.closest_min_m),
-            m(x.closest_median_m),
+            x.cells().join(" | "),
         ));
     }
     s
