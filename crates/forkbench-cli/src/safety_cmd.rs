@@ -33,8 +33,9 @@ pub fn run(a: &SafetyFieldsArgs) -> anyhow::Result<()> {
         "the [safety] defaults"
     };
     crate::emit(&format!(
-        "{} ({source}):\n{}",
+        "{} ({source}):\n{}{}",
         scn.name,
-        forkbench_safety::text(&sizing)
+        forkbench_safety::text(&sizing),
+        forkbench_safety::drawn_text(&sizing, &scn.safety_footprint())
     ))
 }

@@ -20,9 +20,25 @@ pub struct SafetyScannerSpec {
     /// Smallest object the protective field detects (70 mm: a leg); with the fields'
     /// reach it sets the angle between beams.
     pub resolution_m: f64,
-    /// Each scanner's field of view (one at the fork root facing forward, one at the
-    /// chassis' rear facing back).
+    /// Each scanner's field of view. The two scanners sit at diagonal corners (the fork
+    /// root's left facing forward-left, the chassis' rear right facing back-right), so at
+    /// 270° they see all round the truck.
     pub fov_deg: f64,
+    /// The range errors the scanner makes, which TZ and Z_R budget for.
+    pub range_error: RangeError,
+}
+
+/// How the safety scanner's ranges err.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RangeError {
+    /// Exact ranges.
+    None,
+    /// The worst case the formula's supplements budget for: every range reads long by the
+    /// tolerance TZ, and by Z_R more where the reflector supplement applies (a
+    /// retroreflector's glare), so an object shows that much further from the scanner.
+    #[default]
+    WorstCase,
 }
 
 impl Default for SafetyScannerSpec {
@@ -32,6 +48,7 @@ impl Default for SafetyScannerSpec {
             response_time_s: 0.08,
             resolution_m: 0.07,
             fov_deg: 270.0,
+            range_error: RangeError::WorstCase,
         }
     }
 }
@@ -84,6 +101,10 @@ pub struct SafetyConfig {
     /// target, not an obstacle. Muted while driving forwards until that part of the
     /// cycle ends; backing out is watched.
     pub mute_near_target_m: f64,
+    /// Field sets drawn by hand (`[[safety.field_set]]`), each replacing the sized fields
+    /// of one speed range and direction.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub field_set: Vec<crate::custom::FieldSetSpec>,
 }
 
 impl Default for SafetyConfig {
@@ -102,6 +123,7 @@ impl Default for SafetyConfig {
             warning_speed_mps: 0.3,
             resume_dwell_s: 1.0,
             mute_near_target_m: 2.0,
+            field_set: Vec::new(),
         }
     }
 }
@@ -136,6 +158,29 @@ impl SafetyConfig {
             ("mute_near_target_m", self.mute_near_target_m, 0.0, 10.0),
         ])?;
         self.check_ranges(truck_max_speed_mps)
+    }
+
+    /// Each drawn field set valid for `truck` and one of the speed ranges, no range and
+    /// direction drawn twice; the error carries the field set's index.
+    pub fn validate_field_sets(
+        &self,
+        truck: &crate::custom::Footprint,
+    ) -> Result<(), (usize, SettingsError)> {
+        for (k, f) in self.field_set.iter().enumerate() {
+            f.validate(&self.speed_ranges_mps, truck)
+                .map_err(|e| (k, e))?;
+            let twice = self.field_set[..k]
+                .iter()
+                .any(|g| g.speed_max_mps == f.speed_max_mps && g.direction == f.direction);
+            if twice {
+                let why = format!(
+                    "the {} m/s range is drawn twice for {:?} travel",
+                    f.speed_max_mps, f.direction
+                );
+                return Err((k, SettingsError::field("speed_max_mps", why)));
+            }
+        }
+        Ok(())
     }
 
     fn check_ranges(&self, truck_max_speed_mps: f64) -> Result<(), SettingsError> {

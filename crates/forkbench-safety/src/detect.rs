@@ -22,13 +22,18 @@ pub struct Seen {
 /// Whether each surface (segments in the fork-root frame) breaks a field: a piece of it
 /// at least the resolution long lies in the field (each field a union of convex
 /// polygons) within some scanner's field of view, so an object narrower than the
-/// resolution is missed as the scanner misses it.
+/// resolution is missed as the scanner misses it. `range_bias_m`: how much further than
+/// true the scanner reads each range (its worst-case error), so a surface is judged
+/// where it is measured.
 pub fn detect(
     fields: &Fields,
     segments: &[[[f64; 2]; 2]],
     eyes: &[Eye],
-    resolution_m: f64,
+    (resolution_m, range_bias_m): (f64, f64),
 ) -> Seen {
+    if range_bias_m > 0.0 {
+        return detect_measured(fields, segments, eyes, resolution_m, range_bias_m);
+    }
     let (lo, hi) = bounds(&fields.warning);
     let mut seen = Seen::default();
     for &[a, b] in segments {
@@ -111,6 +116,99 @@ fn piece_in(
     None
 }
 
+/// [`detect`] with each range read `bias_m` long: the surfaces are sampled at half the
+/// resolution, each sample moved away from the nearest scanner that sees it.
+fn detect_measured(
+    fields: &Fields,
+    segments: &[[[f64; 2]; 2]],
+    eyes: &[Eye],
+    resolution_m: f64,
+    bias_m: f64,
+) -> Seen {
+    let (lo, hi) = bounds(&fields.warning);
+    let step = resolution_m / 2.0;
+    let views: Vec<View> = eyes.iter().map(View::of).collect();
+    let boxed = |polys: &[Vec<[f64; 2]>]| -> Vec<([f64; 2], [f64; 2])> {
+        polys
+            .iter()
+            .map(|p| bounds(std::slice::from_ref(p)))
+            .collect()
+    };
+    let (pboxes, wboxes) = (boxed(&fields.protective), boxed(&fields.warning));
+    let inside = |polys: &[Vec<[f64; 2]>], boxes: &[([f64; 2], [f64; 2])], p: [f64; 2]| {
+        polys.iter().zip(boxes).any(|(poly, (lo, hi))| {
+            (lo[0]..=hi[0]).contains(&p[0]) && (lo[1]..=hi[1]).contains(&p[1]) && contains(poly, p)
+        })
+    };
+    let ignored = |p: [f64; 2]| fields.ignore.as_ref().is_some_and(|i| contains(i, p));
+    let mut seen = Seen::default();
+    // Moving a point away from a scanner inside the (convex) bounds never brings it
+    // inside them, so clipping the true surfaces first loses nothing.
+    for &[a, b] in segments {
+        let Some((a, b)) = clip(a, b, lo, hi) else {
+            continue;
+        };
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let n = ((d[0].hypot(d[1]) / step).ceil()).clamp(1.0, 100_000.0) as usize;
+        let (mut run_p, mut run_w) = (0, 0);
+        for k in 0..=n {
+            let u = k as f64 / n as f64;
+            let m = measured(&views, [a[0] + u * d[0], a[1] + u * d[1]], bias_m)
+                .filter(|m| !ignored(*m));
+            let inw = m.is_some_and(|m| inside(&fields.warning, &wboxes, m));
+            let inp = m.is_some_and(|m| inside(&fields.protective, &pboxes, m));
+            run_p = if inp { run_p + 1 } else { 0 };
+            run_w = if inw { run_w + 1 } else { 0 };
+            // A run of samples as long as the resolution (or the whole of a shorter
+            // surface, as the exact test would not count it).
+            if run_p > 2.min(n) && seen.protective.is_none() {
+                seen.protective = m;
+            }
+            seen.warning |= run_w > 2.min(n);
+        }
+        if seen.warning && seen.protective.is_some() {
+            break;
+        }
+    }
+    seen
+}
+
+/// A scanner's mount and view, ready for many points.
+struct View {
+    at: [f64; 2],
+    facing: [f64; 2],
+    cos_half_fov: f64,
+}
+
+impl View {
+    fn of(e: &Eye) -> Self {
+        let (s, c) = e.mount.heading_rad.sin_cos();
+        View {
+            at: [e.mount.x_m, e.mount.y_m],
+            facing: [c, s],
+            cos_half_fov: (e.fov_rad / 2.0).min(std::f64::consts::PI).cos(),
+        }
+    }
+}
+
+/// Where the nearest scanner that sees `p` measures it, reading `bias_m` long.
+fn measured(views: &[View], p: [f64; 2], bias_m: f64) -> Option<[f64; 2]> {
+    let (r, dx, dy) = views
+        .iter()
+        .filter_map(|v| {
+            let (dx, dy) = (p[0] - v.at[0], p[1] - v.at[1]);
+            let r = dx.hypot(dy);
+            let along = dx * v.facing[0] + dy * v.facing[1];
+            (along >= r * v.cos_half_fov).then_some((r, dx, dy))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    if r == 0.0 {
+        return Some(p);
+    }
+    let k = bias_m / r;
+    Some([p[0] + dx * k, p[1] + dy * k])
+}
+
 fn in_view(eyes: &[Eye], p: [f64; 2]) -> bool {
     eyes.iter().any(|e| {
         let q = e.mount.to_local(&Pose2::new(p[0], p[1], 0.0));
@@ -181,16 +279,53 @@ mod tests {
     fn a_leg_is_found_and_a_thinner_object_than_the_resolution_missed() {
         let f = square_fields();
         let leg = [[2.0, 0.0], [2.0, 0.1]];
-        assert!(detect(&f, &[leg], &front(), 0.07).protective.is_some());
-        assert!(detect(&f, &[leg], &front(), 0.15).protective.is_none());
+        assert!(
+            detect(&f, &[leg], &front(), (0.07, 0.0))
+                .protective
+                .is_some()
+        );
+        assert!(
+            detect(&f, &[leg], &front(), (0.15, 0.0))
+                .protective
+                .is_none()
+        );
         let far = [[4.0, 0.0], [4.0, 0.5]];
-        let s = detect(&f, &[far], &front(), 0.07);
+        let s = detect(&f, &[far], &front(), (0.07, 0.0));
         assert!(s.protective.is_none() && s.warning);
         // Behind a forward scanner with a 90° view: unseen.
         let narrow = [Eye {
             mount: Pose2::new(0.0, 0.0, std::f64::consts::PI),
             fov_rad: 90f64.to_radians(),
         }];
-        assert_eq!(detect(&f, &[leg], &narrow, 0.07), Seen::default());
+        assert_eq!(detect(&f, &[leg], &narrow, (0.07, 0.0)), Seen::default());
+    }
+
+    #[test]
+    fn a_range_read_long_moves_what_is_seen_away_from_the_scanner() {
+        let f = square_fields();
+        // A leg 0.2 m inside the protective field's far edge (x = 3).
+        let leg = [[2.8, -0.05], [2.8, 0.05]];
+        assert!(
+            detect(&f, &[leg], &front(), (0.07, 0.0))
+                .protective
+                .is_some()
+        );
+        assert!(
+            detect(&f, &[leg], &front(), (0.07, 0.1))
+                .protective
+                .is_some()
+        );
+        let s = detect(&f, &[leg], &front(), (0.07, 0.3));
+        assert!(s.protective.is_none() && s.warning, "read at 3.1 m: {s:?}");
+        // The sampled and the exact test agree without a bias worth the name.
+        let near = [[1.5, -0.5], [1.5, 0.5]];
+        assert_eq!(
+            detect(&f, &[near], &front(), (0.07, 1e-9))
+                .protective
+                .is_some(),
+            detect(&f, &[near], &front(), (0.07, 0.0))
+                .protective
+                .is_some()
+        );
     }
 }

@@ -22,8 +22,7 @@ pub struct Outline {
     /// rear axle.
     pub axle_behind_m: f64,
     pub wheelbase_m: f64,
-    /// The truck's width with the scanner's tolerance on each side: its own sweep is
-    /// watched this wide.
+    /// The truck's width.
     pub body_width_m: f64,
 }
 
@@ -35,6 +34,10 @@ pub struct FieldSet {
     /// S_L (the worse of empty and rated load, scaled) and S_B.
     pub length_m: f64,
     pub width_m: f64,
+    /// The supplements for what the scanner misjudges (TZ + Z_R + Z_F): the field reaches
+    /// this far beyond the region the truck's leading end stops in, whichever way a turn
+    /// bends it.
+    pub margin_m: f64,
     /// The warning field's extra reach ahead (and half of it to each side).
     pub warning_margin_m: f64,
 }
@@ -66,6 +69,13 @@ impl Fields {
 pub struct FieldSets {
     pub outline: Outline,
     pub sets: Vec<FieldSet>,
+    /// How far round the truck's own swept outline it is watched: the scanner's
+    /// worst-case range error, so whatever stands in the truck's way is seen there even
+    /// read long (a beam grazing the truck's side reads it behind the truck).
+    pub body_margin_m: f64,
+    /// Drawn field sets, each in force for its speed range and direction instead of the
+    /// sized fields (polygons counter-clockwise).
+    pub drawn: Vec<crate::FieldSetSpec>,
 }
 
 impl FieldSets {
@@ -85,10 +95,31 @@ impl FieldSets {
                 speed_max_mps: pair[0].speed_max_mps,
                 length_m: pair.iter().map(|f| f.length_m).fold(0.0, f64::max) * length_scale,
                 width_m: pair.iter().map(|f| f.width_m).fold(0.0, f64::max),
+                margin_m: pair
+                    .iter()
+                    .map(|f| (f.width_m - f.vehicle_width_m) / 2.0)
+                    .fold(0.0, f64::max),
                 warning_margin_m,
             })
             .collect();
-        FieldSets { outline, sets }
+        FieldSets {
+            outline,
+            sets,
+            body_margin_m: sizing.range_bias_m(),
+            drawn: sizing
+                .config
+                .field_set
+                .iter()
+                .map(|f| {
+                    let (protective, warning) = f.polygons();
+                    crate::FieldSetSpec {
+                        protective,
+                        warning,
+                        ..f.clone()
+                    }
+                })
+                .collect(),
+        }
     }
 
     /// The field set monitored at the commanded speed: the first range whose top is at
@@ -107,12 +138,22 @@ impl FieldSets {
 
     /// The fields of `set` for travel in the direction of `speed_cmd_mps` with the rear
     /// wheel at `steer_rad`: the truck's leading end (the forks' region going forwards,
-    /// the chassis' rear in reverse) S_B wide, and the truck's own outline, each swept
-    /// along the arc it would drive for the field's length, so a turn's swing (the rear
-    /// and sides of a rear-steered truck) stays covered.
+    /// the chassis' rear in reverse) swept along the arc it would drive for the stopping
+    /// part of the field's length and grown by the supplements, and the truck's own
+    /// outline swept as far and grown by `body_margin_m`, so a turn's swing (the rear and
+    /// sides of a rear-steered truck) stays covered.
     pub fn fields(&self, set: &FieldSet, speed_cmd_mps: f64, steer_rad: f64) -> Fields {
         let o = &self.outline;
         let ahead = speed_cmd_mps >= 0.0;
+        let dir = if ahead {
+            crate::Direction::Forward
+        } else {
+            crate::Direction::Reverse
+        };
+        let drawn = self
+            .drawn
+            .iter()
+            .find(|d| d.speed_max_mps == set.speed_max_mps && d.direction == dir);
         let lead = |h: f64| -> Vec<[f64; 2]> {
             if ahead {
                 vec![[0.0, -h], [0.0, h], [o.front_m, -h], [o.front_m, h]]
@@ -128,22 +169,40 @@ impl FieldSets {
             [o.front_m, -hb],
             [o.front_m, hb],
         ];
-        // In reverse the forks draw back out of whatever stands between them now (a
-        // set-down pallet): their own region is not watched.
-        let ignore =
-            (!ahead).then(|| vec![[0.0, -hb], [o.front_m, -hb], [o.front_m, hb], [0.0, hb]]);
         let (l, w, grow) = (set.length_m, set.width_m, set.warning_margin_m);
-        let body_sweep = self.sweep(&body, l + grow, ahead, steer_rad);
+        let r = set.margin_m.min(w / 2.0);
+        // In reverse the forks draw back out of whatever stands round them now (a
+        // set-down pallet, the rack's uprights): their own region, with the supplements
+        // round it, is not watched.
+        let ignore = (!ahead).then(|| {
+            let (x, y) = (o.front_m + r, hb + r);
+            vec![[0.0, -y], [x, -y], [x, y], [0.0, y]]
+        });
+        // The region the truck's leading end crosses while stopping, then the
+        // supplements round it: straight, the formula's S_L × S_B rectangle; in a turn
+        // the supplements still lie beyond the bent region in every direction.
+        let lead_field = |half: f64, len: f64| {
+            dilate(
+                &self.sweep(&lead(half - r), (len - r).max(0.0), ahead, steer_rad),
+                r,
+            )
+        };
+        // The truck's own outline swept as far, grown by what the scanner may misread.
+        let b = self.body_margin_m.min(r);
+        let body_field =
+            |len: f64| dilate(&self.sweep(&body, (len - b).max(0.0), ahead, steer_rad), b);
+        if let Some(d) = drawn {
+            // What the integrator drew, whole.
+            return Fields {
+                ignore: None,
+                protective: vec![d.protective.clone()],
+                warning: vec![d.warning.clone()],
+            };
+        }
         Fields {
             ignore,
-            protective: vec![
-                self.sweep(&lead(w / 2.0), l, ahead, steer_rad),
-                self.sweep(&body, l, ahead, steer_rad),
-            ],
-            warning: vec![
-                self.sweep(&lead((w + grow) / 2.0), l + grow, ahead, steer_rad),
-                body_sweep,
-            ],
+            protective: vec![lead_field(w / 2.0, l), body_field(l)],
+            warning: vec![lead_field((w + grow) / 2.0, l + grow), body_field(l + grow)],
         }
     }
 
@@ -190,6 +249,40 @@ impl Outline {
     }
 }
 
+/// Steering angles closer than this share their fields: the field a scan reads is built
+/// for the nearest multiple, so a straight run or a held turn builds it once.
+pub const FIELD_STEER_STEP_RAD: f64 = 0.005;
+
+/// The fields last built, kept while the field set, the direction and the (rounded)
+/// steering angle stay the same.
+#[derive(Debug, Clone, Default)]
+pub struct FieldCache {
+    kept: Option<((u64, bool, i64), Fields)>,
+}
+
+impl FieldCache {
+    /// [`FieldSets::fields`] at the steering angle rounded to [`FIELD_STEER_STEP_RAD`].
+    pub fn fields(
+        &mut self,
+        sets: &FieldSets,
+        set: &FieldSet,
+        speed_cmd_mps: f64,
+        steer_rad: f64,
+    ) -> &Fields {
+        let step = (steer_rad / FIELD_STEER_STEP_RAD).round();
+        let key = (
+            set.speed_max_mps.to_bits(),
+            speed_cmd_mps >= 0.0,
+            step as i64,
+        );
+        if self.kept.as_ref().is_none_or(|(k, _)| *k != key) {
+            let f = sets.fields(set, speed_cmd_mps, step * FIELD_STEER_STEP_RAD);
+            self.kept = Some((key, f));
+        }
+        &self.kept.as_ref().expect("just built").1
+    }
+}
+
 /// The front axle's pose after `s_m` of signed travel at curvature `kappa`.
 fn along_arc(p: &Pose2, s_m: f64, kappa: f64) -> Pose2 {
     if (kappa * s_m).abs() < 1e-9 {
@@ -198,6 +291,19 @@ fn along_arc(p: &Pose2, s_m: f64, kappa: f64) -> Pose2 {
     let dth = kappa * s_m;
     let (x, y) = (dth.sin() / kappa, (1.0 - dth.cos()) / kappa);
     p.to_world(&Pose2::new(x, y, dth))
+}
+
+/// The convex polygon grown by `r` each way along the truck's axes (its Minkowski sum
+/// with a square of side 2r).
+fn dilate(poly: &[[f64; 2]], r: f64) -> Vec<[f64; 2]> {
+    if r <= 0.0 {
+        return poly.to_vec();
+    }
+    let grown = poly
+        .iter()
+        .flat_map(|p| [[-r, -r], [-r, r], [r, -r], [r, r]].map(|d| [p[0] + d[0], p[1] + d[1]]))
+        .collect();
+    hull(grown)
 }
 
 /// The convex hull, counter-clockwise (Andrew's monotone chain).
@@ -259,10 +365,13 @@ mod tests {
                 wheelbase_m: 1.629,
                 body_width_m: 1.4,
             },
+            body_margin_m: 0.3,
+            drawn: Vec::new(),
             sets: vec![FieldSet {
                 speed_max_mps: 0.8,
                 length_m: 1.0,
                 width_m: 2.0,
+                margin_m: 0.3,
                 warning_margin_m: 1.0,
             }],
         }
@@ -273,7 +382,11 @@ mod tests {
         let s = sets();
         let f = s.fields(&s.sets[0], 0.5, 0.0);
         assert!(f.hit([2.5, 0.9]).0 && !f.hit([2.7, 0.0]).0);
-        assert!(!f.hit([-0.5, 0.8]).0, "not beside the chassis");
+        assert!(
+            f.hit([-0.5, 0.95]).0,
+            "beside the chassis, within the supplements"
+        );
+        assert!(!f.hit([-0.5, 1.05]).0, "not beyond them");
         let r = s.fields(&s.sets[0], -0.5, 0.0);
         assert!(r.hit([-3.3, -0.9]).0 && !r.hit([-3.5, 0.0]).0);
         assert_eq!(r.hit([-4.3, 0.0]), (false, true));
@@ -299,10 +412,38 @@ mod tests {
             "{turned:?}"
         );
         // Beside the chassis, where its side swings.
-        let beside = [-1.8, 0.85];
+        let beside = [-1.8, 1.2];
         assert!(
             !straight.hit(beside).0 && turned.hit(beside).0,
             "{turned:?}"
         );
+    }
+
+    #[test]
+    fn in_a_turn_the_supplements_lie_round_the_bent_stopping_region() {
+        let s = sets();
+        let set = s.sets[0];
+        let steer = 0.82;
+        let f = s.fields(&set, -0.5, steer);
+        // Where the rear's corners stop: the lead swept for the stopping part of S_L.
+        let stop = s.sweep(
+            &[[-2.45, -0.7], [-2.45, 0.7]],
+            set.length_m - set.margin_m,
+            false,
+            steer,
+        );
+        // Every point of that region, moved by just under the supplements any way along
+        // the truck's axes, is still in the protective field.
+        let r = 0.99 * set.margin_m;
+        for p in &stop {
+            for d in [[-r, 0.0], [r, 0.0], [0.0, -r], [0.0, r], [-r, -r], [r, r]] {
+                let q = [p[0] + d[0], p[1] + d[1]];
+                assert!(f.hit(q).0, "{q:?} (from {p:?}) not in {:?}", f.protective);
+            }
+        }
+        // Straight, the field is the formula's rectangle: S_L deep, S_B wide.
+        let straight = s.fields(&set, -0.5, 0.0);
+        assert!(straight.hit([-2.45 - 0.99, 0.99]).0);
+        assert!(!straight.hit([-2.45 - 1.01, 0.0]).0 && !straight.hit([-3.0, 1.01]).0);
     }
 }

@@ -4,8 +4,8 @@ use serde::Serialize;
 
 use crate::config::SafetyConfig;
 
-/// Z_R: a retroreflector within 6 m of the protective field can make the scanner measure
-/// short by this much.
+/// Z_R: a retroreflector within 6 m of the protective field can make the scanner's ranges
+/// err by this much.
 pub const REFLECTOR_SUPPLEMENT_M: f64 = 0.35;
 
 /// Z_F: a foot ahead of the point where a leg is detected, for a truck this low.

@@ -61,3 +61,34 @@ pub fn text(s: &FieldSizing) -> String {
     }
     out
 }
+
+/// Each drawn field set (`[[safety.field_set]]`) against the sizing: how far its
+/// protective field reaches straight beyond the truck's leading edge, and S_L for its
+/// range (the worse of empty and rated).
+pub fn drawn_text(s: &FieldSizing, truck: &crate::Footprint) -> String {
+    let mut out = String::new();
+    for d in &s.config.field_set {
+        let s_l = s
+            .fields
+            .iter()
+            .filter(|f| f.speed_max_mps == d.speed_max_mps)
+            .map(|f| f.length_m)
+            .fold(0.0, f64::max);
+        let reach = d.reach_m(truck);
+        let verdict = if reach + 1e-9 < s_l {
+            format!("SHORTER than S_L by {:.0} mm", (s_l - reach) * 1e3)
+        } else {
+            "at least S_L".to_owned()
+        };
+        let _ = writeln!(
+            out,
+            "drawn field set {:.2} m/s {:?}: protective field reaches {:.0} mm beyond the \
+             leading edge (S_L {:.0} mm): {verdict}",
+            d.speed_max_mps,
+            d.direction,
+            reach * 1e3,
+            s_l * 1e3
+        );
+    }
+    out
+}

@@ -11,7 +11,7 @@ use crate::normal;
 use crate::reflectors::Fix;
 
 /// What a localiser is given each control step.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct LocalizerInput {
     pub t_s: f64,
     /// The true fork-root pose: what the world answers from (never copied into a fix by
@@ -25,6 +25,9 @@ pub struct LocalizerInput {
     /// is arbitrary): how the truck moved between two moments, as a NAV350's speed input
     /// tells it. `None` where the controller has no odometry.
     pub odometry: Option<Pose2>,
+    /// What stands in the scan plane for now and blocks sight (people, other trucks), as
+    /// map segments: a model that looks through the world does not see past them.
+    pub occluders: Vec<[[f64; 2]; 2]>,
 }
 
 /// One measurement as delivered to the controller.
@@ -271,6 +274,7 @@ mod tests {
             truth: *truth,
             predicted: None,
             odometry: None,
+            occluders: Vec::new(),
         };
         nav.update(&input, rng).and_then(|r| r.pose)
     }

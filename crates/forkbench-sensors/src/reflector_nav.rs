@@ -174,7 +174,13 @@ impl ReflectorNav {
 
     /// One sweep ending at `t_s`, from the trail of true poses, matched from the prior
     /// (the controller's prediction, or the truth before any: the integrator's set-pose).
-    fn sweep<R: Rng + ?Sized>(&self, t_s: f64, prior: Option<Pose2>, rng: &mut R) -> Reading {
+    /// `occluders`: map segments that hide a reflector behind them this sweep.
+    fn sweep<R: Rng + ?Sized>(
+        &self,
+        t_s: f64,
+        (prior, occluders): (Option<Pose2>, &[[[f64; 2]; 2]]),
+        rng: &mut R,
+    ) -> Reading {
         let m = &self.settings.mount;
         let Some(&(_, truth, _)) = self.trail.0.back() else {
             return Reading {
@@ -186,8 +192,15 @@ impl ReflectorNav {
         let prior = prior.unwrap_or(truth);
         let sensor = truth.to_world(m);
         let cfg = &self.settings.measurement;
-        let seen =
-            reflectors::visible([sensor.x_m, sensor.y_m], &self.present, &self.blocking, cfg);
+        let at = [sensor.x_m, sensor.y_m];
+        let mut seen = reflectors::visible(at, &self.present, &self.blocking, cfg);
+        // People and other trucks in the way hide a reflector for this sweep.
+        seen.retain(|&i| {
+            let r = [self.present[i].x_m, self.present[i].y_m];
+            !occluders
+                .iter()
+                .any(|&[a, b]| crate::sight::segments_cross(at, r, a, b))
+        });
         let obs: Vec<Observation> = seen
             .iter()
             .map(|&i| self.measure_one(i, (t_s, &sensor), rng))
@@ -265,7 +278,7 @@ impl Localizer for ReflectorNav {
         let mark = (input.t_s, input.truth, input.odometry);
         self.trail.push(mark, 1.5 * self.cadence.period_s());
         if self.cadence.due(input.t_s) {
-            let reading = self.sweep(input.t_s, input.predicted, rng);
+            let reading = self.sweep(input.t_s, (input.predicted, &input.occluders), rng);
             self.cadence.send(input.t_s, reading);
         }
         self.cadence.deliver(input.t_s)

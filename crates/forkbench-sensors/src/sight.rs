@@ -143,13 +143,18 @@ impl Grid {
 
 /// Whether the segment from `a` to `b` crosses the segment `s`.
 pub(crate) fn crosses(a: [f64; 2], b: [f64; 2], s: &Surface) -> bool {
+    segments_cross(a, b, s.a, s.b)
+}
+
+/// Whether the segment `a`–`b` crosses the segment `c`–`e`.
+pub(crate) fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], e: [f64; 2]) -> bool {
     let d = [b[0] - a[0], b[1] - a[1]];
-    let e = [s.b[0] - s.a[0], s.b[1] - s.a[1]];
+    let e = [e[0] - c[0], e[1] - c[1]];
     let den = d[0] * e[1] - d[1] * e[0];
     if den.abs() < 1e-15 {
         return false;
     }
-    let w = [s.a[0] - a[0], s.a[1] - a[1]];
+    let w = [c[0] - a[0], c[1] - a[1]];
     let t = (w[0] * e[1] - w[1] * e[0]) / den;
     let u = (w[0] * d[1] - w[1] * d[0]) / den;
     (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)

@@ -214,9 +214,44 @@ mod localiser {
                 truth.heading_rad,
             )),
             odometry: None,
+            occluders: Vec::new(),
         };
         nav.update(&input, &mut ChaCha8Rng::seed_from_u64(1))
             .expect("a reading at t = 0")
+    }
+
+    #[test]
+    fn a_person_in_the_sight_line_hides_a_reflector_for_that_sweep() {
+        let fresh = || {
+            ReflectorNav::new(
+                ReflectorNavSettings::default(),
+                &room(),
+                &[],
+                (8.0, 0.0),
+                0.0,
+            )
+        };
+        let truth = Pose2::new(4.0, 3.0, 0.0);
+        assert_eq!(sweep_at(&mut fresh(), truth).detected, 4);
+        let mut nav = fresh();
+        let sensor = truth.to_world(&ReflectorNavSettings::default().mount);
+        // A leg's edge across the line to reflector a at (0, 0), halfway.
+        let mid = [sensor.x_m / 2.0, sensor.y_m / 2.0];
+        let leg = [
+            [mid[0] - 0.05, mid[1] + 0.05],
+            [mid[0] + 0.05, mid[1] - 0.05],
+        ];
+        let input = LocalizerInput {
+            t_s: 0.0,
+            truth,
+            predicted: Some(truth),
+            odometry: None,
+            occluders: vec![leg],
+        };
+        let r = nav
+            .update(&input, &mut ChaCha8Rng::seed_from_u64(1))
+            .expect("a reading at t = 0");
+        assert_eq!(r.detected, 3);
     }
 
     #[test]
@@ -293,6 +328,7 @@ mod localiser {
                     truth.y_m + 7.0,
                     truth.heading_rad,
                 )),
+                occluders: Vec::new(),
             };
             if let Some(r) = nav.update(&input, &mut rng)
                 && t > 0.2

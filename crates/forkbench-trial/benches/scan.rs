@@ -63,6 +63,7 @@ fn bench(c: &mut Criterion) {
                 truth,
                 predicted: Some(Pose2::new(truth.x_m + 0.05, truth.y_m - 0.03, 0.01)),
                 odometry: Some(truth),
+                occluders: Vec::new(),
             };
             let r = nav.update(&input, &mut rng).expect("a sweep each call");
             r.pose.expect("a fix in the aisle")

@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::TrialError;
 use crate::scenario::{Scenario, World};
 
-const SCENARIOS: [(&str, &str); 6] = [
+const SCENARIOS: [(&str, &str); 8] = [
     (
         "scenarios/field-test.toml",
         include_str!("../data/scenarios/field-test.toml"),
@@ -29,6 +29,14 @@ const SCENARIOS: [(&str, &str); 6] = [
     (
         "scenarios/warehouse-cycle.toml",
         include_str!("../data/scenarios/warehouse-cycle.toml"),
+    ),
+    (
+        "scenarios/warehouse-people.toml",
+        include_str!("../data/scenarios/warehouse-people.toml"),
+    ),
+    (
+        "scenarios/warehouse-people-short.toml",
+        include_str!("../data/scenarios/warehouse-people-short.toml"),
     ),
 ];
 

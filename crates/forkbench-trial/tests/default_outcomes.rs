@@ -1,7 +1,8 @@
 //! The speed work changed no result at the defaults: every committed trial record of the
 //! main job (the embedded scenarios with their own sensing: TiM561 scans, NAV350
-//! reflector fixes, odometry errors, the warehouse mission; two trials of every scenario
-//! × case × planner × mode), re-run at its own seed, gives the same outcome to the bit.
+//! reflector fixes, odometry errors, the warehouse mission, the handling cycle and the
+//! people cycles; two trials of every scenario × case × planner × mode), re-run at its
+//! own seed, gives the same outcome to the bit.
 
 mod common;
 

@@ -121,12 +121,12 @@ fn warehouse_people(scale: Option<f64>) -> Scenario {
     .expect("loads")
 }
 
-#[test]
-fn with_the_sized_fields_nobody_is_touched_in_200_cycles_with_people_crossing() {
+/// Seeds 1–200 of the people cycle, with the fields scaled by `scale` (`None`: as sized).
+fn cycles(scale: Option<f64>) -> Vec<forkbench_trial::TrialOutcome> {
     use rayon::prelude::*;
-    let scn = warehouse_people(None);
+    let scn = warehouse_people(scale);
     assert_eq!(scn.movers.len(), 5);
-    let outcomes: Vec<_> = (1..=200u64)
+    (1..=200u64)
         .into_par_iter()
         .map(|seed| {
             let opts = TrialOptions {
@@ -135,18 +135,65 @@ fn with_the_sized_fields_nobody_is_touched_in_200_cycles_with_people_crossing() 
             };
             run_trial(&scn, &scn.cases[0], &opts)
         })
-        .collect();
-    let safety: Vec<_> = outcomes.iter().filter_map(|o| o.safety.clone()).collect();
-    assert_eq!(safety.len(), 200);
-    let touched: Vec<_> = outcomes
+        .collect()
+}
+
+fn touched(outcomes: &[forkbench_trial::TrialOutcome]) -> Vec<(u64, Option<String>)> {
+    outcomes
         .iter()
-        .filter(|o| o.failure.map(|f| f.name()) == Some("person_contact"))
+        .filter(|o| o.safety.as_ref().is_some_and(|s| s.person_contacts > 0))
         .map(|o| (o.seed, o.failure_detail.clone()))
-        .collect();
-    assert!(touched.is_empty(), "{touched:?}");
+        .collect()
+}
+
+#[test]
+fn in_200_cycles_the_sized_fields_touch_nobody_and_fields_30_percent_shorter_do() {
+    let sized = cycles(None);
+    let safety: Vec<_> = sized.iter().filter_map(|o| o.safety.clone()).collect();
+    assert_eq!(safety.len(), 200);
+    assert!(touched(&sized).is_empty(), "{:?}", touched(&sized));
     // People were in the way: the fields stopped the truck for them.
     let stops: u32 = safety.iter().map(|s| s.stops - s.false_trips).sum();
     assert!(stops >= 100, "{stops} stops for people in 200 cycles");
+    // And the cycles get done: the fields do not hold the truck for racks and walls.
+    let done = sized.iter().filter(|o| o.success).count();
+    assert!(done >= 190, "{done} of 200 cycles done");
+    // The same cycles, seeds and people with protective fields 0.7 × S_L: the scanner's
+    // worst-case range errors eat the margin the supplements left.
+    let short = cycles(Some(0.7));
+    let hits = touched(&short);
+    assert!(!hits.is_empty(), "no contact in 200 cycles at 0.7 × S_L");
+    for o in short
+        .iter()
+        .filter(|o| o.safety.as_ref().is_some_and(|s| s.person_contacts > 0))
+    {
+        assert_eq!(o.failure.map(|f| f.name()), Some("person_contact"), "{o:?}");
+        let detail = o.failure_detail.as_deref().unwrap_or_default();
+        assert!(detail.contains("the truck touched"), "{detail}");
+    }
+}
+
+#[test]
+fn the_short_field_variant_differs_from_the_people_scenario_only_in_its_fields() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenarios");
+    let read = |f: &str| std::fs::read_to_string(dir.join(f)).expect("the scenario");
+    let body = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| {
+                !(l.starts_with('#')
+                    || l.starts_with("name =")
+                    || l.starts_with("description =")
+                    || l.starts_with("field_length_scale ="))
+            })
+            .map(str::to_owned)
+            .collect()
+    };
+    let (full, short) = (
+        read("warehouse-people.toml"),
+        read("warehouse-people-short.toml"),
+    );
+    assert_eq!(body(&full), body(&short));
+    assert!(short.contains("\n[safety]\nfield_length_scale = 0.5\n"));
 }
 
 #[test]
@@ -185,4 +232,64 @@ fn reordering_the_movers_changes_no_draw() {
     );
     assert_eq!((sa.stops, sa.stop_time_s), (sb.stops, sb.stop_time_s));
     assert_eq!(ab.sim_time_s, ba.sim_time_s);
+}
+
+/// `[safety]` with one speed range and a forward field set drawn `reach_m` beyond the
+/// fork tips (1.6 m ahead of the fork root), 1.6 m wide.
+fn drawn(reach_m: f64) -> String {
+    let x = 1.6 + reach_m;
+    let w = x + 1.0;
+    format!(
+        "[safety]\nspeed_ranges_mps = [0.8]\n\n[[safety.field_set]]\nspeed_max_mps = 0.8\n\
+         direction = \"forward\"\nprotective = [[0.0, -0.8], [{x}, -0.8], [{x}, 0.8], [0.0, 0.8]]\n\
+         warning = [[0.0, -1.2], [{w}, -1.2], [{w}, 1.2], [0.0, 1.2]]\n"
+    )
+}
+
+#[test]
+fn a_drawn_field_set_is_the_one_monitored_and_one_too_short_lets_the_truck_touch() {
+    let long = pick(&format!("{STANDING}{}", drawn(1.5))).expect("loads");
+    let out = run_trial(&long, &long.cases[0], &no_noise());
+    let s = out.safety.clone().expect("a safety outcome");
+    assert_eq!(s.person_contacts, 0, "{out:?}");
+    assert!(s.stops >= 1, "{s:?}");
+    // A drawn field 0.15 m beyond the tips: the scanner reads the person 0.45 m long
+    // (TZ and Z_R), so it stops too late.
+    let short = pick(&format!("{STANDING}{}", drawn(0.15))).expect("loads");
+    let out = run_trial(&short, &short.cases[0], &no_noise());
+    assert_eq!(
+        out.failure.map(|f| f.name()),
+        Some("person_contact"),
+        "{out:?}"
+    );
+    // The sizing says so before any trial.
+    let sizing = short.safety_fields().expect("sized");
+    let text = forkbench_safety::drawn_text(&sizing, &short.safety_footprint());
+    assert!(text.contains("SHORTER than S_L"), "{text}");
+}
+
+#[test]
+fn a_drawn_field_short_of_the_truck_s_footprint_margin_is_refused_with_its_line() {
+    let e = pick(&drawn(0.05)).expect_err("5 cm beyond the tips, inside TZ");
+    assert!(
+        e.contains("people.toml:10") && e.contains("safety.field_set[0].protective"),
+        "{e}"
+    );
+    assert!(e.contains("footprint margin"), "{e}");
+    let concave = drawn(1.0).replace(
+        "[2.6, 0.8], [0.0, 0.8]]",
+        "[2.6, 0.8], [1.0, 0.0], [0.0, 0.8]]",
+    );
+    let e = pick(&concave).expect_err("concave");
+    assert!(e.contains("convex"), "{e}");
+    let twice = format!(
+        "{}{}",
+        drawn(1.0),
+        drawn(1.0).replace("[safety]\nspeed_ranges_mps = [0.8]\n", "")
+    );
+    let e = pick(&twice).expect_err("drawn twice");
+    assert!(
+        e.contains("field_set[1].speed_max_mps") && e.contains("twice"),
+        "{e}"
+    );
 }

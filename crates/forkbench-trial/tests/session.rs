@@ -37,7 +37,8 @@ fn field_test() -> Arc<Scenario> {
 }
 
 /// Every committed main-job record (each scenario × case × planner × mode, the mission
-/// included), run as a session stepped with the tracker, gives the record's outcome.
+/// and the people cycles included), run as a session stepped with the tracker, gives the
+/// record's outcome.
 #[test]
 fn a_session_under_its_tracker_reproduces_the_committed_trials() {
     let want = common::records(include_str!("data/default_outcomes.jsonl"));
@@ -51,8 +52,16 @@ fn a_session_under_its_tracker_reproduces_the_committed_trials() {
         let scn = scenarios.iter().find(|s| s.name == name).expect("scenario");
         let mut opts = options(w["seed"].as_u64().expect("seed"), w["replan"].as_bool());
         opts.planner = Some(common::text(w, "planner"));
-        let mut s = Session::start(scn.clone(), &common::text(w, "case"), &opts).expect("starts");
-        run(&mut s, 1_000_000, |_| Control::Tracker);
+        // A handling cycle's record is the whole cycle: a cycle episode steps it all.
+        let episode = if scn.phases.is_empty() {
+            Episode::Pick
+        } else {
+            Episode::Cycle
+        };
+        let mut s =
+            Session::start_episode(scn.clone(), &common::text(w, "case"), &opts, episode, false)
+                .expect("starts");
+        run(&mut s, 10_000_000, |_| Control::Tracker);
         let out = s.ended().expect("ended").0.without_wall_times();
         let mut v = serde_json::to_value(out).expect("serialises");
         let m = v.as_object_mut().expect("object");

@@ -57,7 +57,11 @@ fn no_table2_case_of_either_paper_ends_pallet_not_found_without_noise() {
                 "{file} {}",
                 case.name
             );
-            if out.legs.iter().any(|l| l.name == "pick start → staging") {
+            if out
+                .legs
+                .iter()
+                .any(|l| l.name == forkbench_trial::trial::STAGING_LEG)
+            {
                 staged += 1;
                 assert!(
                     out.success,
@@ -78,7 +82,7 @@ fn a_truck_facing_away_stages_and_picks_and_fail_keeps_one_look() {
     let out = run_trial(&scn, &scn.cases[0], &no_noise());
     assert!(out.success, "{out:?}");
     assert_eq!(out.legs.len(), 1);
-    assert_eq!(out.legs[0].name, "pick start → staging");
+    assert_eq!(out.legs[0].name, forkbench_trial::trial::STAGING_LEG);
     assert!(out.legs[0].reverse_length_m >= 0.0);
     // One look from the start (missed), one from the staging pose (found).
     assert_eq!((out.estimates, out.estimates_missed), (2, 1));

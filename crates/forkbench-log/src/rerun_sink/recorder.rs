@@ -163,40 +163,7 @@ impl RerunRecorder {
         } else {
             format!("#### ❌ FAILED: {failure}")
         };
-        // The first failed criterion, the likely cause, then every other one broken: a
-        // tight list, so the whole verdict fits its panel.
-        let mut detail = o.failure_detail.clone().unwrap_or_default();
-        if let Some(c) = &o.likely_cause {
-            detail += &format!("\n- **likely cause:** {c}");
-        }
-        if !o.also_failed.is_empty() {
-            detail += &format!("\n- ❌ **also** {}", o.also_failed.join(" · "));
-        }
-        if let Some(leg) = o.legs.iter().find(|l| l.name.ends_with("→ staging")) {
-            detail += &format!(
-                "\n- **staged:** the face was not seen from the start; a {:.1} m manoeuvre ({:.1} m \
-                 backwards) to look again from the staging pose{}",
-                leg.planned_length_m,
-                leg.reverse_length_m,
-                if leg.success {
-                    ""
-                } else {
-                    ", and did not reach it"
-                }
-            );
-        }
-        if o.estimates_missed > 0 {
-            detail += &format!(
-                "\n- {} of {} pallet estimates found no pallet (scans under map/sensors)",
-                o.estimates_missed, o.estimates
-            );
-        }
-        if o.fixes_missed > 0 {
-            detail += &format!(
-                "\n- {} NAV350 sweeps gave no pose; largest gap {:.2} s, own pose off by up to {:.3} m",
-                o.fixes_missed, o.largest_fix_gap_s, o.localization_error_max_m
-            );
-        }
+        let detail = verdict_detail(o);
         let [lat_limit, head_limit, _] = self.limits;
         let num = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map_or("—".to_owned(), f);
         format!(
@@ -204,7 +171,7 @@ impl RerunRecorder {
              | at entry | value | limit |\n|---|---|---|\n\
              | lateral offset | {} | {lat_limit} m |\n\
              | heading | {} | {head_limit}° |\n\
-             | fork depth | {:.3} m | |\n\
+             | fork depth | {} | |\n\
              | max contact force | {:.0} N | |\n{}\n\
              {}**{}** · case `{}` · planner `{}` · tracker `{}` · seed {} · {:.2} s simulated, {} replans\n\n\
              Map (y up, 1 m grid): white arrow start · light-blue arrow goal (pre-entry) · \
@@ -214,13 +181,18 @@ impl RerunRecorder {
              red (thin, on top) pallet estimate · green/red arrows true/measured NAV350 fix · \
              white dots NAV350 reflectors, red ones missing, green rays to those the current \
              fix used · mission legs: grey blocked cells, orange A* polyline, purple backing \
-             out (the PRM roadmap is hidden: add map/nav/roadmap in the blueprint panel)\n\n\
+             out (the PRM roadmap is hidden: add map/nav/roadmap in the blueprint panel) · \
+             with people: pink people, the protective field green when clear, red when broken \
+             or stopping, the warning field yellow\n\n\
              **Events**\n\n```text\n{}\n```\n\n\
              **Outcome**\n\n```json\n{}\n```\n",
             phases_table(o),
             num(o.lateral_error_m, &|v| format!("{v:.3} m")),
             num(o.heading_error_rad, &|v| format!("{:.2}°", v.to_degrees())),
-            o.insertion_depth_m,
+            num(
+                Some(o.insertion_depth_m).filter(|v| v.is_finite()),
+                &|v| format!("{v:.3} m")
+            ),
             o.max_contact_force_n,
             measures_rows(o),
             legs_table(o),
@@ -416,4 +388,47 @@ impl Recorder for RerunRecorder {
         // The outcome is the trial's last call: close now, in parallel with other sinks.
         self.close_async();
     }
+}
+
+/// The verdict's first lines: the first failed criterion, the likely cause, then every
+/// other one broken, staging and missed looks or fixes: a tight list, so the whole
+/// verdict fits its panel.
+fn verdict_detail(o: &TrialOutcome) -> String {
+    let mut detail = o.failure_detail.clone().unwrap_or_default();
+    if let Some(c) = &o.likely_cause {
+        detail += &format!("\n- **likely cause:** {c}");
+    }
+    if !o.also_failed.is_empty() {
+        detail += &format!("\n- ❌ **also** {}", o.also_failed.join(" · "));
+    }
+    if let Some(leg) = o
+        .legs
+        .iter()
+        .find(|l| l.name == forkbench_trial::trial::STAGING_LEG)
+    {
+        detail += &format!(
+            "\n- **staged:** the face was not seen from the start; a {:.1} m manoeuvre ({:.1} m \
+             backwards) to look again from the staging pose{}",
+            leg.planned_length_m,
+            leg.reverse_length_m,
+            if leg.success {
+                ""
+            } else {
+                ", and did not reach it"
+            }
+        );
+    }
+    if o.estimates_missed > 0 {
+        detail += &format!(
+            "\n- {} of {} pallet estimates found no pallet (scans under map/sensors)",
+            o.estimates_missed, o.estimates
+        );
+    }
+    if o.fixes_missed > 0 {
+        detail += &format!(
+            "\n- {} NAV350 sweeps gave no pose; largest gap {:.2} s, own pose off by up to {:.3} m",
+            o.fixes_missed, o.largest_fix_gap_s, o.localization_error_max_m
+        );
+    }
+    detail
 }

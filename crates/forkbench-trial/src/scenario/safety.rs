@@ -1,6 +1,6 @@
 //! A scenario's `[safety]` table: checked at load against its truck, and the protective fields it sizes.
 
-use forkbench_safety::FieldSizing;
+use forkbench_safety::{FieldSizing, Footprint};
 
 use super::checks::at_line;
 use super::file::ScenarioFile;
@@ -22,6 +22,16 @@ pub(super) fn check(f: &ScenarioFile, (file, text): (&str, &str)) -> Result<(), 
             .as_deref()
             .map(|k| k.rsplit('.').next().unwrap_or(k));
         invalid_setting(&key_line(file, text, key), "safety", &e)
+    })?;
+    let truck = Footprint::of(&f.truck, s.scanner.tolerance_m);
+    s.validate_field_sets(&truck).map_err(|(k, e)| {
+        let at = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| l.trim_start().starts_with("[[safety.field_set]]"))
+            .nth(k)
+            .map_or_else(|| file.to_owned(), |(n, _)| format!("{file}:{}", n + 1));
+        invalid_setting(&at, &format!("safety.field_set[{k}]"), &e)
     })
 }
 
@@ -102,6 +112,13 @@ fn route_blocked(m: &MoverSpec, obstacles: &[Obstacle], labels: &[String]) -> Op
 const ROUTE_CHECK_STEP_M: f64 = 0.05;
 
 impl Scenario {
+    /// The truck's outline drawn fields are checked against: fork tips, chassis' rear,
+    /// width, and the scanner's tolerance as the margin.
+    pub fn safety_footprint(&self) -> Footprint {
+        let cfg = self.safety.clone().unwrap_or_default();
+        Footprint::of(&self.truck, cfg.scanner.tolerance_m)
+    }
+
     /// The protective field of each of the scenario's speed ranges, empty and at rated
     /// load, braking on its floor (`[sim] tyre_friction`); Z_R follows the world's
     /// reflectors unless `[safety] reflectors_near` says otherwise. Without `[safety]`,

@@ -105,6 +105,7 @@ impl Trial<'_> {
             truth,
             predicted: self.loc.predictor.pose(),
             odometry: self.loc.odometry.pose(),
+            occluders: self.movers_in_sight(),
         };
         let reading = self.loc.localizer.update(&input, &mut self.loc.nav_rng);
         let fix = reading.as_ref().and_then(|r| r.pose);

@@ -39,6 +39,9 @@ pub use crate::scenario::APPROACH_GAP_M;
 /// The criterion a trial fails when the moving truck touches a person or vehicle
 /// (critical: it is the verdict whatever else the trial did).
 pub const PERSON_CONTACT: &str = "person_contact";
+/// The name of the leg a pick drives to its staging pose when the face is not seen from
+/// where it begins (a mission's own legs may end at a waypoint called "staging").
+pub const STAGING_LEG: &str = "pick start → staging";
 pub use crate::step_criteria::{
     STEP_CRITERIA, StepCriterion, StepView, step_criterion_name, step_measures,
 };

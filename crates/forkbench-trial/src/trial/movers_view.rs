@@ -47,3 +47,22 @@ impl WorldView for WithMovers<'_> {
         self.mover_surfaces(centre, radius_m, out);
     }
 }
+
+impl super::setup::Trial<'_> {
+    /// The movers' legs and outlines as map segments, for sensors that only ask whether
+    /// a sight line is clear (the NAV350's reflectors); none without movers.
+    pub(super) fn movers_in_sight(&self) -> Vec<[[f64; 2]; 2]> {
+        let Some(s) = &self.safety else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for m in &s.movers {
+            for (p, l, w) in m.seen() {
+                for f in Surface::rect(&p, l, w, Seen::Fixed) {
+                    out.push([f.a, f.b]);
+                }
+            }
+        }
+        out
+    }
+}

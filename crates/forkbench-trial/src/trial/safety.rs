@@ -2,8 +2,8 @@
 
 use forkbench_core::{ForkliftSpec, PalletSpec, Pose2, Signal, Style};
 use forkbench_safety::{
-    Eye, FieldSets, Mover, MoverKind, Outline, Reading, Rect, STANDING_MPS, SafetyConfig,
-    SafetyFunction, YIELD_GAP_M, detect, rect_gap_lower_bound_m, rect_gap_m,
+    Eye, FieldCache, FieldSets, Mover, MoverKind, Outline, Reading, Rect, STANDING_MPS,
+    SafetyConfig, SafetyFunction, YIELD_GAP_M, detect, rect_gap_lower_bound_m, rect_gap_m,
 };
 use forkbench_sensors::scan::WorldView as _;
 use forkbench_sim::Sim;
@@ -44,10 +44,14 @@ pub(crate) struct SafetyRun {
 #[derive(Debug)]
 struct Monitor {
     fields: FieldSets,
+    built: FieldCache,
     function: SafetyFunction,
-    /// The scanners: at the fork root facing forward, at the chassis' rear facing back.
+    /// The scanners at two diagonal corners, the fork root's left facing forward-left and
+    /// the chassis' rear right facing back-right, so that together they see all round.
     eyes: [Eye; 2],
     resolution_m: f64,
+    /// How much further than true the scanners read (their worst-case error, if asked).
+    range_bias_m: f64,
     reach_m: f64,
     period_s: f64,
     next_scan_s: f64,
@@ -135,23 +139,27 @@ impl Monitor {
             rear_m: scn.truck.body_length_m,
             axle_behind_m: scn.truck.fork_root_ahead_of_front_axle_m,
             wheelbase_m: scn.truck.wheelbase_m,
-            body_width_m: scn.truck.body_width_m + 2.0 * c.scanner.tolerance_m,
+            body_width_m: scn.truck.body_width_m,
         };
         let fields =
             FieldSets::from_sizing(&sizing, outline, c.field_length_scale, c.warning_margin_m);
         let reach_m = fields.reach_m();
         let fov_rad = c.scanner.fov_deg.to_radians();
         let period_s = c.scanner.response_time_s / SCANS_PER_RESPONSE;
-        let rear = Pose2::new(-scn.truck.body_length_m, 0.0, std::f64::consts::PI);
+        let (hw, q) = (scn.truck.body_width_m / 2.0, std::f64::consts::FRAC_PI_4);
+        let front = Pose2::new(0.0, hw, q);
+        let rear = Pose2::new(-scn.truck.body_length_m, -hw, -3.0 * q);
         Ok(Monitor {
             fields,
+            built: FieldCache::default(),
             function: SafetyFunction::new(
                 c.scanner.response_time_s + c.controller_response_s,
                 c.resume_dwell_s,
                 c.warning_speed_mps,
             ),
-            eyes: [Pose2::new(0.0, 0.0, 0.0), rear].map(|mount| Eye { mount, fov_rad }),
+            eyes: [front, rear].map(|mount| Eye { mount, fov_rad }),
             resolution_m: c.scanner.resolution_m,
+            range_bias_m: sizing.range_bias_m(),
             reach_m,
             period_s,
             next_scan_s: 0.0,
@@ -376,8 +384,8 @@ impl Trial<'_> {
         };
         let root = self.world.sim.fork_root_pose();
         let fields = m
-            .fields
-            .fields(&set, s.requested_mps, self.world.sim.steer_rad());
+            .built
+            .fields(&m.fields, &set, s.requested_mps, self.world.sim.steer_rad());
         let view = WithMovers {
             sim: &self.world.sim,
             movers: &s.movers,
@@ -388,7 +396,7 @@ impl Trial<'_> {
             .iter()
             .map(|f| [local(&root, f.a), local(&root, f.b)])
             .collect();
-        let seen = detect(&fields, &segments, &m.eyes, m.resolution_m);
+        let seen = detect(fields, &segments, &m.eyes, (m.resolution_m, m.range_bias_m));
         let intruder = seen.protective.map(|p| {
             let q = root.to_world(&Pose2::new(p[0], p[1], 0.0));
             [q.x_m, q.y_m]
@@ -422,7 +430,7 @@ impl Trial<'_> {
             );
             rec.event(t, Level::Warn, &why);
         }
-        record_reading(rec, t, &root, &fields, &reading, m.function.stopped());
+        record_reading(rec, t, &root, fields, &reading, m.function.stopped());
         if let Some(p) = intruder {
             rec.signal(t, "safety/intrusion", &Signal::Points(&[p]), STOPPED);
         }
