@@ -174,8 +174,9 @@ impl SafetyConfig {
                 .any(|g| g.speed_max_mps == f.speed_max_mps && g.direction == f.direction);
             if twice {
                 let why = format!(
-                    "the {} m/s range is drawn twice for {:?} travel",
-                    f.speed_max_mps, f.direction
+                    "the {} m/s range is drawn twice for {} travel",
+                    f.speed_max_mps,
+                    f.direction.name()
                 );
                 return Err((k, SettingsError::field("speed_max_mps", why)));
             }

@@ -15,6 +15,16 @@ pub enum Direction {
     Reverse,
 }
 
+impl Direction {
+    /// As the scenario file writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Direction::Forward => "forward",
+            Direction::Reverse => "reverse",
+        }
+    }
+}
+
 /// One drawn field set: it replaces the sized fields of the speed range ending at
 /// `speed_max_mps` for travel in `direction`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -226,8 +226,8 @@ impl FieldSets {
         hull(points)
     }
 
-    /// The farthest any field reaches from the fork root, straight or turned (what a
-    /// scan must cover).
+    /// The farthest any field reaches from the fork root, straight or turned, drawn or
+    /// sized (what a scan must cover).
     pub fn reach_m(&self) -> f64 {
         let o = &self.outline;
         self.sets
@@ -239,6 +239,12 @@ impl FieldSets {
                 );
                 (o.front_m.max(o.rear_m) + l).hypot(w / 2.0)
             })
+            .chain(
+                self.drawn
+                    .iter()
+                    .flat_map(|d| d.protective.iter().chain(&d.warning))
+                    .map(|p| p[0].hypot(p[1])),
+            )
             .fold(0.0, f64::max)
     }
 }
@@ -445,5 +451,22 @@ mod tests {
         let straight = s.fields(&set, -0.5, 0.0);
         assert!(straight.hit([-2.45 - 0.99, 0.99]).0);
         assert!(!straight.hit([-2.45 - 1.01, 0.0]).0 && !straight.hit([-3.0, 1.01]).0);
+    }
+
+    #[test]
+    fn a_drawn_field_set_is_used_whole_and_its_reach_scanned() {
+        let mut s = sets();
+        let far = vec![[0.0, -1.0], [9.0, -1.0], [9.0, 1.0], [0.0, 1.0]];
+        s.drawn.push(crate::FieldSetSpec {
+            speed_max_mps: 0.8,
+            direction: crate::Direction::Forward,
+            protective: far.clone(),
+            warning: far.clone(),
+        });
+        assert!(s.reach_m() >= 9.0, "{}", s.reach_m());
+        let f = s.fields(&s.sets[0], 0.5, 0.4);
+        assert_eq!((f.protective, f.ignore), (vec![far], None));
+        // Reverse keeps the sized fields.
+        assert!(s.fields(&s.sets[0], -0.5, 0.0).ignore.is_some());
     }
 }

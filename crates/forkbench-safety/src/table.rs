@@ -82,10 +82,10 @@ pub fn drawn_text(s: &FieldSizing, truck: &crate::Footprint) -> String {
         };
         let _ = writeln!(
             out,
-            "drawn field set {:.2} m/s {:?}: protective field reaches {:.0} mm beyond the \
+            "drawn field set {:.2} m/s {}: protective field reaches {:.0} mm beyond the \
              leading edge (S_L {:.0} mm): {verdict}",
             d.speed_max_mps,
-            d.direction,
+            d.direction.name(),
             reach * 1e3,
             s_l * 1e3
         );
