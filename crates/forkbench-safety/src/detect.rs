@@ -34,6 +34,7 @@ pub fn detect(
     if range_bias_m > 0.0 {
         return detect_measured(fields, segments, eyes, resolution_m, range_bias_m);
     }
+    let views: Vec<View> = eyes.iter().map(View::of).collect();
     let (lo, hi) = bounds(&fields.warning);
     let mut seen = Seen::default();
     for &[a, b] in segments {
@@ -44,13 +45,13 @@ pub fn detect(
             seen.protective = fields
                 .protective
                 .iter()
-                .find_map(|poly| piece_in(poly, a, b, (eyes, fields), resolution_m));
+                .find_map(|poly| piece_in(poly, a, b, (&views, fields), resolution_m));
         }
         if !seen.warning {
             seen.warning = fields
                 .warning
                 .iter()
-                .any(|poly| piece_in(poly, a, b, (eyes, fields), resolution_m).is_some());
+                .any(|poly| piece_in(poly, a, b, (&views, fields), resolution_m).is_some());
         }
         if seen.warning && seen.protective.is_some() {
             break;
@@ -65,7 +66,7 @@ fn piece_in(
     poly: &[[f64; 2]],
     a: [f64; 2],
     b: [f64; 2],
-    (eyes, fields): (&[Eye], &Fields),
+    (views, fields): (&[View], &Fields),
     resolution_m: f64,
 ) -> Option<[f64; 2]> {
     let d = [b[0] - a[0], b[1] - a[1]];
@@ -104,7 +105,7 @@ fn piece_in(
     for k in 0..=samples {
         let p = at(t0 + (t1 - t0) * k as f64 / samples as f64);
         let ignored = fields.ignore.as_ref().is_some_and(|poly| contains(poly, p));
-        run = if in_view(eyes, p) && !ignored {
+        run = if views.iter().any(|v| v.sees(p).is_some()) && !ignored {
             run + 1
         } else {
             0
@@ -191,29 +192,27 @@ impl View {
     }
 }
 
+impl View {
+    /// Where `p` lies from the scanner (range, and its offsets), if within its view.
+    fn sees(&self, p: [f64; 2]) -> Option<(f64, f64, f64)> {
+        let (dx, dy) = (p[0] - self.at[0], p[1] - self.at[1]);
+        let r = dx.hypot(dy);
+        let along = dx * self.facing[0] + dy * self.facing[1];
+        (along >= r * self.cos_half_fov).then_some((r, dx, dy))
+    }
+}
+
 /// Where the nearest scanner that sees `p` measures it, reading `bias_m` long.
 fn measured(views: &[View], p: [f64; 2], bias_m: f64) -> Option<[f64; 2]> {
     let (r, dx, dy) = views
         .iter()
-        .filter_map(|v| {
-            let (dx, dy) = (p[0] - v.at[0], p[1] - v.at[1]);
-            let r = dx.hypot(dy);
-            let along = dx * v.facing[0] + dy * v.facing[1];
-            (along >= r * v.cos_half_fov).then_some((r, dx, dy))
-        })
+        .filter_map(|v| v.sees(p))
         .min_by(|a, b| a.0.total_cmp(&b.0))?;
     if r == 0.0 {
         return Some(p);
     }
     let k = bias_m / r;
     Some([p[0] + dx * k, p[1] + dy * k])
-}
-
-fn in_view(eyes: &[Eye], p: [f64; 2]) -> bool {
-    eyes.iter().any(|e| {
-        let q = e.mount.to_local(&Pose2::new(p[0], p[1], 0.0));
-        q.y_m.atan2(q.x_m).abs() <= e.fov_rad / 2.0
-    })
 }
 
 fn bounds(polys: &[Vec<[f64; 2]>]) -> ([f64; 2], [f64; 2]) {
