@@ -365,7 +365,7 @@ fn trial_input_errors_are_clear() {
     let scn = repo_root().join("scenarios/bspline-table2.toml");
     let out = forkbench(&["trial", scn.to_str().expect("utf8")]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("choose one with --case"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cases; name one (`--case`"));
     let out = forkbench(&["trial", scn.to_str().expect("utf8"), "--case", "42"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no case named \"42\""));

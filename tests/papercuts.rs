@@ -1,6 +1,7 @@
 //! What costs a new user an hour, checked through the binary: a file scenario's records
 //! replay without naming the file, rows below --floor are named, an embedded scenario by
-//! name, a radians slip and a key swallowed by a table are pointed out.
+//! name, a radians slip and a key swallowed by a table are pointed out, and the report draws
+//! each scenario's entry errors against its own limits.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -101,4 +102,42 @@ fn embedded_names_slips_and_swallowed_keys() {
         "{}",
         text(&out)
     );
+}
+
+#[test]
+fn every_scenario_s_entry_errors_are_drawn_against_its_own_limits() {
+    let scn = tmp("tight.toml");
+    let original =
+        std::fs::read_to_string(repo_root().join("scenarios/field-test.toml")).expect("field test");
+    let tight = original.replace("name = \"field-test\"", "name = \"tight\"")
+        + "\n[tolerances]\nlateral_m = 0.04\nheading_deg = 1.5\n";
+    std::fs::write(&scn, tight).expect("write");
+    let out_dir = tmp("limits");
+    let out = forkbench(&[
+        "batch",
+        "field-test",
+        scn.to_str().expect("utf8"),
+        "--trials",
+        "2",
+        "--record",
+        "none",
+        "--out",
+        out_dir.to_str().expect("utf8"),
+        "--report",
+    ]);
+    assert!(matches!(out.status.code(), Some(0 | 3)), "{}", text(&out));
+    let page = std::fs::read_to_string(out_dir.join("report.html")).expect("report");
+    // One pair of histograms per pair of limits, each titled with its scenarios and
+    // drawn with its own limit line.
+    for needle in [
+        "data-plot=\"errors-lateral-0\"",
+        "data-plot=\"errors-lateral-1\"",
+        "data-plot=\"errors-heading-1\"",
+        "<h3>Limits ±100 mm, ±3°: field-test</h3>",
+        "<h3>Limits ±40 mm, ±1.5°: tight</h3>",
+        "tolerance 40 mm",
+        "tolerance 1.5 °",
+    ] {
+        assert!(page.contains(needle), "{needle} missing");
+    }
 }

@@ -22,6 +22,8 @@ from ._forkbench import (
     ScenarioError,
     __version__,
     default_scenarios,
+    replay,
+    report,
     run_batch,
     run_trial,
 )
@@ -38,6 +40,8 @@ __all__ = [
     "__version__",
     "default_scenarios",
     "load",
+    "replay",
+    "report",
     "run_batch",
     "run_trial",
     "to_dataframe",

@@ -1,6 +1,7 @@
 """Typed stubs of forkbench's Rust extension (see the functions' docstrings)."""
 
 import os
+import pathlib
 from collections.abc import Sequence
 from typing import Any
 
@@ -90,6 +91,20 @@ def run_batch(
     jobs: int | None = None,
     out: str | os.PathLike[str] | None = None,
 ) -> list[Outcome]: ...
+def report(
+    dir: str | os.PathLike[str],
+    *,
+    baseline: str | os.PathLike[str] | None = None,
+    out: str | os.PathLike[str] | None = None,
+) -> pathlib.Path: ...
+def replay(
+    record: str | os.PathLike[str] | Outcome,
+    line: int = 1,
+    *,
+    scenario: Scenario | None = None,
+    mcap: str | os.PathLike[str] | None = None,
+    force: bool = False,
+) -> dict[str, Any]: ...
 
 Reward: TypeAlias = tuple[float, float, float, float]
 Step: TypeAlias = tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]

@@ -1,13 +1,11 @@
 //! `run_trial` and `run_batch`: one trial (optionally recorded to MCAP) or a parallel batch, with the CLI's seeds and outcomes, as Python dicts.
 
-use std::collections::HashMap;
 use std::path::PathBuf;
 
-use forkbench_batch::{BatchSpec, ReplanModes, TrialRecord};
+use forkbench_batch::{BatchSpec, ReplanModes};
+use forkbench_trial::TrialOptions;
 use forkbench_trial::trial::Overrides;
-use forkbench_trial::{Recorder, TrialOptions, run_trial_recorded};
 use pyo3::prelude::*;
-use rayon::prelude::*;
 
 use crate::convert::{BatchError, RecordingError, scenario_error, serde_to_py};
 use crate::scenario::Scenario;
@@ -40,22 +38,7 @@ pub fn run_trial<'py>(
     force: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let scn = &scenario.inner;
-    let case = match case {
-        Some(name) => scn.case(name).map_err(|e| scenario_error(py, &e))?,
-        None if scn.cases.len() == 1 => &scn.cases[0],
-        None => {
-            let e = forkbench_trial::TrialError::Invalid {
-                file: scn.file.clone(),
-                field: "case".into(),
-                reason: format!(
-                    "{} cases; choose one (cases: {})",
-                    scn.cases.len(),
-                    scenario.cases_text()
-                ),
-            };
-            return Err(scenario_error(py, &e));
-        }
-    };
+    let case = scn.pick_case(case).map_err(|e| scenario_error(py, &e))?;
     let opts = TrialOptions {
         seed,
         planner,
@@ -73,41 +56,29 @@ pub fn run_trial<'py>(
         wall_budget_s: None,
     };
     // The CLI's own check: values in range, and every override acting on this scenario.
-    let run = scn
-        .check_options(&opts)
+    scn.check_options(&opts)
         .map_err(|e| scenario_error(py, &e))?;
     let out = match mcap {
         None => py.detach(|| forkbench_trial::run_trial(scn, case, &opts)),
         Some(path) => {
-            let meta = forkbench_log::mcap_metadata(
-                [&scn.name, &case.name, &run.planner.name, &run.tracker.name],
-                run.seed,
-                env!("CARGO_PKG_VERSION"),
-            );
-            let fail = |e: forkbench_log::LogError| RecordingError::new_err(e.to_string());
             // As the CLI: an existing file is replaced only when asked (`force=True`).
-            forkbench_log::check_writable(&path, force).map_err(fail)?;
-            let mut rec = forkbench_log::McapRecorder::create(&path, meta).map_err(fail)?;
-            let out = py.detach(|| {
-                let r: &mut dyn Recorder = &mut rec;
-                run_trial_recorded(scn, case, &opts, r)
-            });
-            rec.finish().map_err(fail)?;
-            out
+            let targets = forkbench_log::RecordTargets {
+                mcap: Some(path),
+                force,
+                ..Default::default()
+            };
+            let r = py
+                .detach(|| forkbench_log::run_recorded(scn, case, &opts, &targets))
+                .map_err(|e| match e {
+                    forkbench_log::RecordError::Trial(t) => scenario_error(py, &t),
+                    e => RecordingError::new_err(e.to_string()),
+                })?;
+            r.written
+                .map_err(|e| RecordingError::new_err(e.to_string()))?;
+            r.outcome
         }
     };
     serde_to_py(py, &out)
-}
-
-impl Scenario {
-    fn cases_text(&self) -> String {
-        self.inner
-            .cases
-            .iter()
-            .map(|c| c.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    }
 }
 
 /// Most memory the records a batch returns to Python may take, as dicts.
@@ -167,17 +138,10 @@ pub fn run_batch<'py>(
             .map(|s| (*s.inner).clone())
             .collect(),
     };
-    let asked = match modes {
-        None => None,
-        Some("scenario") => Some(ReplanModes::Scenario),
-        Some("replan") => Some(ReplanModes::Replan),
-        Some("both") => Some(ReplanModes::Both),
-        Some(other) => {
-            return Err(BatchError::new_err(format!(
-                "modes {other:?}: expected \"scenario\", \"replan\" or \"both\""
-            )));
-        }
-    };
+    let asked = modes
+        .map(str::parse::<ReplanModes>)
+        .transpose()
+        .map_err(|e| BatchError::new_err(format!("modes {e}")))?;
     let (replan, compare_replanning) = ReplanModes::choose(false, asked, embedded).spec_fields();
     let spec = BatchSpec {
         scenarios,
@@ -216,39 +180,7 @@ pub fn run_batch<'py>(
     }
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let records = py
-        .detach(|| run(&spec, jobs, out.as_deref()))
+        .detach(|| forkbench_batch::run_records(&spec, jobs, out.as_deref()))
         .map_err(|e| BatchError::new_err(e.to_string()))?;
     records.iter().map(|r| serde_to_py(py, r)).collect()
-}
-
-/// The batch's records in job order: run here, or through the CLI's batch directory.
-fn run(
-    spec: &BatchSpec,
-    jobs: usize,
-    out: Option<&std::path::Path>,
-) -> Result<Vec<TrialRecord>, forkbench_batch::BatchError> {
-    spec.check(jobs)?;
-    let todo = spec.jobs();
-    let Some(dir) = out else {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs)
-            .build()
-            .map_err(|e| forkbench_batch::BatchError::Invalid(format!("thread pool: {e}")))?;
-        return Ok(pool.install(|| {
-            todo.par_iter()
-                .with_max_len(1)
-                .map(|j| spec.run_job(j))
-                .collect()
-        }));
-    };
-    forkbench_batch::run_batch(spec, dir, jobs, &|_| {})?;
-    let order: HashMap<_, usize> = todo
-        .iter()
-        .enumerate()
-        .map(|(i, j)| (spec.key(j), i))
-        .collect();
-    let mut records = forkbench_batch::read_records(&dir.join("trials.jsonl"))?;
-    records.retain(|r| order.contains_key(&r.key()));
-    records.sort_by_key(|r| order[&r.key()]);
-    Ok(records)
 }

@@ -37,6 +37,11 @@ pub fn scenario_error(py: Python<'_>, e: &TrialError) -> PyErr {
             field,
             reason,
         } => (file.clone(), Some(field.clone()), reason.clone()),
+        TrialError::CaseNeeded { file, count, known } => (
+            file.clone(),
+            Some("case".to_owned()),
+            format!("{count} cases; choose one (cases: {known})"),
+        ),
         TrialError::UnknownCase { file, case, known } => (
             file.clone(),
             Some("case".to_owned()),

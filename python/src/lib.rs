@@ -5,6 +5,7 @@ mod convert;
 mod env;
 mod obs;
 mod render;
+mod report;
 mod scenario;
 mod vec_env;
 
@@ -24,6 +25,8 @@ fn _forkbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scenario::default_scenarios, m)?)?;
     m.add_function(wrap_pyfunction!(batch::run_trial, m)?)?;
     m.add_function(wrap_pyfunction!(batch::run_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(report::report, m)?)?;
+    m.add_function(wrap_pyfunction!(report::replay, m)?)?;
     m.add("OBSERVATION_FIELDS", obs::FIELDS.to_vec())?;
     m.add("STAGE_FIELD", obs::STAGE_FIELD)?;
     Ok(())

@@ -1,5 +1,7 @@
 //! JUnit XML (the schema GitLab, GitHub Actions and Jenkins read): one test case per result row.
 
+use forkbench_trial::text::markup as escape;
+
 use super::{GateReport, Provenance, Summary, Verdict};
 
 /// One test case: a result row, failed with a message or passed.
@@ -9,23 +11,6 @@ pub struct Case {
     pub classname: String,
     /// (short message, full text) of a failure.
     pub failure: Option<(String, String)>,
-}
-
-fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            // XML 1.0 has no other control characters.
-            c if (c as u32) < 0x20 && !matches!(c, '\t' | '\n' | '\r') => out.push(' '),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 /// A `<testsuites>` document with one suite of `cases`, and provenance as properties.

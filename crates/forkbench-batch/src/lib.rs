@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod baseline;
+mod case_grid;
 mod checks;
 mod compare;
 pub mod detect_eval;
@@ -24,6 +25,8 @@ mod modes;
 mod order;
 mod outdir;
 mod provenance;
+mod records_run;
+mod replay;
 mod safety_summary;
 mod seed;
 mod shard;
@@ -31,8 +34,10 @@ pub mod stats;
 mod store;
 mod summary;
 mod sweep;
+mod verdicts;
 
 pub use baseline::{Baseline, BaselineRow, BaselineTrial, MAX_BASELINE_BYTES};
+pub use case_grid::{CaseCells, ErrorGroup, case_grids, error_groups};
 pub use compare::{CompareOptions, CompareReport, CompareRow, Discordant, compare};
 pub use export::write_csv;
 pub use gate::{
@@ -44,6 +49,8 @@ pub use manifest::{DirLock, Manifest};
 pub use mode_pairs::{ModePairs, mode_pairs, mode_pairs_markdown};
 pub use modes::ReplanModes;
 pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};
+pub use records_run::run_records;
+pub use replay::Replay;
 pub use safety_summary::SafetySummary;
 pub use seed::{SEED_SCHEME, trial_seed};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
@@ -107,6 +114,9 @@ pub enum BatchError {
     Invalid(String),
     #[error(transparent)]
     File(#[from] forkbench_core::files::FileError),
+    /// A scenario the batch names could not be loaded or has no such case.
+    #[error(transparent)]
+    Trial(#[from] forkbench_trial::TrialError),
 }
 
 /// Writes an output file atomically (see [`forkbench_core::files::write_atomic`]).

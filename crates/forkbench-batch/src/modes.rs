@@ -33,6 +33,22 @@ impl ReplanModes {
     }
 }
 
+impl std::str::FromStr for ReplanModes {
+    type Err = String;
+
+    /// `scenario`, `replan` or `both`; the error quotes the text and names the three.
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "scenario" => Ok(Self::Scenario),
+            "replan" => Ok(Self::Replan),
+            "both" => Ok(Self::Both),
+            other => Err(format!(
+                "{other:?}: expected \"scenario\", \"replan\" or \"both\""
+            )),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -46,5 +62,7 @@ mod tests {
         assert_eq!(ReplanModes::choose(false, None, false), Scenario);
         assert_eq!(Both.spec_fields(), (None, true));
         assert_eq!(Replan.spec_fields(), (Some(true), false));
+        assert_eq!("both".parse::<ReplanModes>(), Ok(Both));
+        assert!("Both".parse::<ReplanModes>().is_err());
     }
 }

@@ -260,14 +260,8 @@ pub fn trials_needed(max_n: u64, power: impl Fn(u64) -> f64) -> Option<u64> {
     Some(hi)
 }
 
-/// Nearest-rank percentile of already sorted values.
-pub fn percentile_sorted(sorted: &[f64], q: f64) -> Option<f64> {
-    if sorted.is_empty() {
-        return None;
-    }
-    let rank = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
-    Some(sorted[rank - 1])
-}
+/// Nearest-rank percentile of already sorted values (the one convention, in core).
+pub use forkbench_core::quantile::percentile_sorted;
 
 #[cfg(test)]
 mod tests {
@@ -292,14 +286,6 @@ mod tests {
         // 90/100 → 70/100 is a clear drop; 90/100 → 92/100 is not.
         assert!(drop_p_value(90, 100, 70, 100) < 0.001);
         assert!(drop_p_value(90, 100, 92, 100) > 0.5);
-    }
-
-    #[test]
-    fn percentiles() {
-        let v = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0];
-        assert_eq!(percentile_sorted(&v, 0.95), Some(10.0));
-        assert_eq!(percentile_sorted(&v, 0.5), Some(5.0));
-        assert_eq!(percentile_sorted(&[], 0.5), None);
     }
 
     #[test]

@@ -276,15 +276,10 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
         );
     }
     shown?;
-    warn_dead_rows(&summary);
-    let below: Vec<String> = a.floor.map_or_else(Vec::new, |f| {
-        summary
-            .rows
-            .iter()
-            .filter(|r| r.success_rate < f)
-            .map(|r| format!("{} ({:.1} %)", row_name(r), 100.0 * r.success_rate))
-            .collect()
-    });
+    for w in summary.dead_rows() {
+        eprintln!("warning: {w}");
+    }
+    let below = summary.below_floor(a.floor);
     if !below.is_empty() {
         eprintln!(
             "below the floor of {:.1} %: {}",
@@ -293,36 +288,6 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
         );
     }
     Ok(below.is_empty())
-}
-
-fn row_name(r: &batch::SummaryRow) -> String {
-    forkbench_trial::text::one_line(&format!(
-        "{} / {} / {} / {}",
-        r.scenario,
-        r.planner,
-        r.tracker,
-        batch::mode_name(r.replan)
-    ))
-}
-
-/// A row none of whose trials succeeded, all for one reason, is more often a broken setup
-/// (an external planner's traceback, a missing interpreter) than a result: say so.
-fn warn_dead_rows(summary: &Summary) {
-    for r in &summary.rows {
-        if r.successes == 0 && r.failures.len() == 1 {
-            let (failure, n) = r
-                .failures
-                .iter()
-                .next()
-                .map_or(("?", 0), |(f, n)| (f.as_str(), *n));
-            eprintln!(
-                "warning: every trial of {} failed with {failure} ({n} of {}); see a trial's \
-                 failure_detail in trials.jsonl or replay one",
-                row_name(r),
-                r.trials
-            );
-        }
-    }
 }
 
 /// The outputs asked for beside the results (CSV, JUnit, HTML report), each attempted,
@@ -346,7 +311,7 @@ fn write_extras(summary: &Summary, a: &BatchArgs, failed: &mut Vec<String>) -> S
         }
     }
     if a.report {
-        match crate::report::write(&a.out, None) {
+        match forkbench_report::html::write(&a.out, None) {
             Ok(_) => written.push_str(", report.html"),
             Err(e) => failed.push(format!("report.html: {e:#}")),
         }
@@ -374,18 +339,9 @@ fn run_sweep(spec: &BatchSpec, a: &BatchArgs, sweep: &str) -> anyhow::Result<()>
         points.push((p.value, run_one(&p.spec, &p.dir, a.jobs)?));
     }
     let text = batch::write_sweep(&a.out, &sweep.knob, &points)?;
-    let mut planners: Vec<String> = points
-        .iter()
-        .flat_map(|(_, s)| s.rows.iter().map(|r| r.planner.clone()))
-        .collect();
-    planners.sort();
-    planners.dedup();
-    for p in &planners {
-        let file = a.out.join(format!("sweep-{p}.png"));
-        crate::plot::draw_sweep(&file, (p, &sweep.knob), &points)?;
-    }
+    forkbench_report::sweep::draw_sweeps(&a.out, &sweep.knob, &points)?;
     if a.report {
-        crate::report::write(&a.out, None)?;
+        forkbench_report::html::write(&a.out, None)?;
     }
     if a.json {
         let results: Vec<batch::SweepResult> = points
@@ -428,7 +384,7 @@ fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
     let dir = a.out.join("recordings");
     for j in &jobs {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        crate::record::record_trial(j.scenario, j.case, &j.options, &dir, a.ros2)?;
+        forkbench_log::record_trial(j.scenario, j.case, &j.options, &dir, a.ros2)?;
     }
     Ok(jobs.len())
 }

@@ -138,7 +138,7 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     check_topics(a, &summary)?;
     let scores = labels.as_ref().map(|l| score(&tally.results, l, gate));
     if let (Some(file), Some(l)) = (&a.plot, &labels) {
-        crate::detect_plot::draw(file, &tally.results, l)?;
+        forkbench_report::detect::draw(file, &tally.results, l)?;
     }
     report(a, &name, &summary, &tally, scores.as_ref())?;
     if !tally.errors.is_empty() {
@@ -291,7 +291,7 @@ fn report(
         t.seconds,
     );
     if let Some(sc) = scores {
-        s += &crate::detect_plot::scores_text(sc);
+        s += &forkbench_report::detect::scores_text(sc);
     }
     crate::emit(&s)
 }

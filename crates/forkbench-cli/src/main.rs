@@ -6,17 +6,11 @@ mod check_cmd;
 mod corridor_cmd;
 mod coverage_cmd;
 mod detect_cmd;
-mod detect_plot;
 mod gate_cmd;
 mod map_cmd;
-mod map_plot;
 mod mission_report;
 mod plan_cmd;
-mod plot;
-mod prm_plot;
-mod record;
 mod replay_cmd;
-mod report;
 mod reproduce_cmd;
 mod route_cmd;
 mod safety_cmd;
@@ -79,8 +73,8 @@ struct RecordFlags {
 }
 
 impl RecordFlags {
-    fn args(self) -> record::RecordArgs {
-        record::RecordArgs {
+    fn args(self) -> forkbench_log::RecordTargets {
+        forkbench_log::RecordTargets {
             rrd: self.rrd,
             mcap: self.mcap,
             ros2: self.ros2,
@@ -329,7 +323,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         }
         Command::Report { dir, baseline, out } => {
             let out = out.unwrap_or_else(|| dir.join("report.html"));
-            let page = report::write_to(&dir, baseline.as_deref(), &out)?;
+            let page = forkbench_report::html::write_to(&dir, baseline.as_deref(), &out)?;
             emit(&format!("report written to {}\n", page.display())).map(|()| Done::Ok)
         }
         Command::Merge { dirs, out, json } => {

@@ -42,7 +42,7 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         None => grid,
     };
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    let name = crate::record::safe_file_stem(&world.name);
+    let name = forkbench_trial::text::safe_file_stem(&world.name);
     let yaml = write_map(&grid, &a.out, &name)?;
     let (free, occupied, unknown) = grid.counts();
     crate::emit(&format!(

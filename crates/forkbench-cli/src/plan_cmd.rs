@@ -10,7 +10,7 @@ use forkbench_plan::{PlanParams, PlanRequest};
 use forkbench_trial::{ComponentSpec, Registry, Role};
 use serde_json::json;
 
-use crate::plot;
+use forkbench_report::plans as plot;
 
 /// `forkbench plan`, as parsed.
 #[derive(Debug, clap::Args)]

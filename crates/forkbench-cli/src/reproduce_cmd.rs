@@ -8,15 +8,10 @@ use forkbench_plan::reproduce::{BsplineTable, SpiralTable, reproduce_bspline, re
 use forkbench_plan::{BsplineConfig, Plan, SpiralConfig};
 use serde_json::json;
 
-use crate::plot;
+use forkbench_report::plans as plot;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => v[n / 2],
-        n => (v[n / 2 - 1] + v[n / 2]) / 2.0,
-    }
+fn median(v: Vec<f64>) -> f64 {
+    forkbench_core::quantile::quantile(v, 0.5).unwrap_or(f64::NAN)
 }
 
 pub fn run(

@@ -1,15 +1,12 @@
 //! `forkbench plan prm|rrt|rrt-connect --map …`: one global plan on an occupancy grid (Luo's PRM + A*, RRT baselines).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::Context as _;
 use forkbench_core::ForkliftSpec;
 use forkbench_core::Pose2;
-use forkbench_nav::simplify::simplify as simplify_in;
 use forkbench_nav::{
-    CollisionModel, FootprintSpace, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap,
-    OccupancyGrid, plan_global, read_map,
+    CollisionModel, GlobalPlan, GlobalPlannerKind, GlobalQuery, OccupancyGrid, plan_global,
 };
 use serde_json::json;
 
@@ -59,16 +56,6 @@ pub fn parse_connect(text: &str) -> Result<f64, String> {
     }
 }
 
-/// The map: a ROS map_server YAML, or a world TOML rasterised at `resolution_m`.
-pub fn load_map(map: &Path, resolution_m: f64) -> anyhow::Result<NavMap> {
-    if map.extension().is_some_and(|e| e == "yaml" || e == "yml") {
-        return Ok(NavMap::from_grid(read_map(map)?));
-    }
-    let world = forkbench_trial::World::load(map)?;
-    NavMap::from_world(&world.obstacles(), resolution_m)
-        .with_context(|| format!("{}: rasterising", map.display()))
-}
-
 impl RouteArgs {
     fn query(&self) -> GlobalQuery {
         let mut algorithm = self
@@ -99,113 +86,24 @@ impl RouteArgs {
 }
 
 pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
-    let map = load_map(&a.map, a.resolution_m)?;
+    let map = forkbench_trial::prm_study::load_map(&a.map, a.resolution_m)?;
     let mut a = a.clone();
     for run in 0..a.runs.max(1) {
         let q = a.query();
         let plan = plan_global(&map, &q)
             .with_context(|| format!("plan {} on {}", a.planner.name(), a.map.display()))?;
         if let (Some(file), 0) = (&a.plot, run) {
-            plot(&a, &map, &q, &plan, file)?;
+            forkbench_report::map::draw_route(file, a.planner, &a.map, &map, &q, &plan)?;
         }
         let simplified = if q.smooth || a.planner.kinodynamic() {
             None
         } else {
-            simplify(&map, &q, &plan, a.seed)
+            forkbench_nav::simplify::simplify_plan(&map, &q, &plan, a.seed)
         };
         crate::emit(&report(&a, &map.grid, &q, &plan, simplified.as_ref()))?;
         a.seed = a.seed.wrapping_add(1);
     }
     Ok(())
-}
-
-/// A route after simplification, its length, and the time simplifying took.
-struct Simplified {
-    points: Vec<[f64; 2]>,
-    length_m: f64,
-    time_s: f64,
-}
-
-/// The route simplified ([`forkbench_nav::simplify::simplify`], seeded with the plan's
-/// seed) in the space it was planned in; `None` without a route.
-fn simplify(map: &NavMap, q: &GlobalQuery, plan: &GlobalPlan, seed: u64) -> Option<Simplified> {
-    let points = plan.route.points.as_ref()?;
-    let t0 = Instant::now();
-    let short = match q.collision {
-        CollisionModel::Inflate => simplify_in(&*map.inflated(q.inflate_m), points, seed),
-        CollisionModel::Footprint => {
-            simplify_in(&FootprintSpace::on(map, &q.truck, q.margin_m), points, seed)
-        }
-    };
-    let time_s = t0.elapsed().as_secs_f64();
-    Some(Simplified {
-        length_m: forkbench_nav::polyline_length_m(&short),
-        points: short,
-        time_s,
-    })
-}
-
-fn plot(
-    a: &RouteArgs,
-    map: &NavMap,
-    q: &GlobalQuery,
-    plan: &GlobalPlan,
-    file: &Path,
-) -> anyhow::Result<()> {
-    let route = &plan.route;
-    // The length the truck would drive: the smoothed path's when there is one.
-    let drivable = match &plan.smoothed {
-        Some(Ok(s)) => format!(
-            "{:.1} m smoothed ({:.1} m A* polyline)",
-            s.path.length_m(),
-            route.length_m
-        ),
-        _ => format!("{:.1} m A* polyline", route.length_m),
-    };
-    let drivable = match &plan.manoeuvre {
-        Some(m) => format!(
-            "{:.1} m manoeuvre, {} cusps{}",
-            m.length_m,
-            m.cusps().len(),
-            if plan.fallback.is_some() {
-                " (Hybrid-A* fallback)"
-            } else {
-                ""
-            }
-        ),
-        None => drivable,
-    };
-    let title = match &route.points {
-        Some(_) => format!("{} on {}: {drivable}", a.planner.name(), a.map.display()),
-        None => format!("{} on {}: no path", a.planner.name(), a.map.display()),
-    };
-    let band = match q.collision {
-        CollisionModel::Inflate => q.inflate_m,
-        CollisionModel::Footprint => q.truck.body_width_m / 2.0 + q.margin_m,
-    };
-    let inflated = map.grid.inflated(band);
-    let smoothed = match &plan.smoothed {
-        Some(Ok(s)) => Some(s),
-        _ => None,
-    };
-    let line: Option<Vec<[f64; 2]>> =
-        smoothed.map(|s| s.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect());
-    let fig = crate::map_plot::MapFigure {
-        title,
-        grid: &map.grid,
-        inflated: &inflated,
-        roadmap: plan.roadmap.as_ref(),
-        // A manoeuvre's own route is the manoeuvre: the point route is drawn only when
-        // the manoeuvre replaced it.
-        path: route.points.as_deref().filter(|_| !a.planner.kinodynamic()),
-        smoothed: line.as_deref(),
-        strike: smoothed.and_then(|s| s.hit).map(|h| [h.x_m, h.y_m]),
-        manoeuvre: plan.manoeuvre.as_ref(),
-        truck: &q.truck,
-        start: [a.start.x_m, a.start.y_m],
-        goal: [a.goal.x_m, a.goal.y_m],
-    };
-    crate::map_plot::draw_map(file, &fig)
 }
 
 /// The smoothing result as JSON: the samples, or why there are none.
@@ -250,7 +148,7 @@ fn report(
     grid: &OccupancyGrid,
     q: &GlobalQuery,
     plan: &GlobalPlan,
-    simplified: Option<&Simplified>,
+    simplified: Option<&forkbench_nav::simplify::Simplified>,
 ) -> String {
     let r = &plan.route;
     let t = &r.timing;
@@ -372,33 +270,15 @@ fn manoeuvre_text(plan: &GlobalPlan) -> String {
     out
 }
 
-/// The warehouse leg the reproduction plans: charging station to the aisle in front of a
-/// far rack bay (the paper's longest leg, station to shelf).
-fn study_leg(world: &forkbench_trial::World) -> anyhow::Result<([f64; 2], [f64; 2])> {
-    let place = |list: &[forkbench_trial::scenario::PalletSlot], name: &str| {
-        list.iter()
-            .find(|p| p.name == name)
-            .map(|p| [p.x_m, p.y_m])
-            .ok_or_else(|| anyhow::anyhow!("worlds/warehouse.toml: no place {name:?}"))
-    };
-    let start = place(&world.station, "charging")?;
-    let slot = place(&world.pallet_slot, "row2b-bay3-south")?;
-    // 1.5 m in front of the slot's face, in the aisle.
-    Ok((start, [slot[0], slot[1] - 1.5]))
-}
-
 /// `reproduce prm`: Luo's studies on the embedded warehouse over `runs` seeds.
 pub fn reproduce(runs: u64, json: bool, plot: Option<&Path>) -> anyhow::Result<()> {
-    let world = forkbench_trial::defaults::embedded_world("warehouse.toml")?;
-    let truck = ForkliftSpec::default();
-    let inflate_m = forkbench_nav::luo_inflation_m(&truck);
-    let grid = NavMap::from_world(&world.obstacles(), 0.05)?
-        .grid
-        .inflated(inflate_m);
-    let ends = study_leg(&world)?;
-    let rows = forkbench_nav::reproduce::studies(&grid, ends, runs)?;
+    let forkbench_trial::prm_study::PrmStudy {
+        ends,
+        inflate_m,
+        rows,
+    } = forkbench_trial::prm_study::run(runs)?;
     if let Some(file) = plot {
-        crate::prm_plot::draw(file, &rows)?;
+        forkbench_report::prm::draw(file, &rows)?;
     }
     if json {
         let rows: Vec<_> = rows

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use anyhow::Context as _;
 use forkbench_trial::text::one_line;
-use forkbench_trial::{Scenario, TrialOptions, TrialOutcome};
+use forkbench_trial::{TrialOptions, TrialOutcome};
 
 /// `trial` (a pick, or a whole mission when the scenario has one) and `mission` (which
 /// requires one and prints each leg): runs, records, prints; Ok(success).
@@ -13,7 +13,7 @@ pub fn run(
     case: Option<&str>,
     opts: &TrialOptions,
     (json, mission): (bool, bool),
-    rec: &crate::record::RecordArgs,
+    rec: &forkbench_log::RecordTargets,
 ) -> anyhow::Result<bool> {
     let scn = forkbench_trial::defaults::load_scenario(file)?;
     crate::warn_slips(&scn);
@@ -23,16 +23,17 @@ pub fn run(
             file.display()
         );
     }
-    let case = pick_case(&scn, file, case)?;
+    let case = scn.pick_case(case)?;
     // Unknown planner or tracker names, and overrides that cannot act, stop here, before
     // any recording file is made.
-    let run = scn.check_options(opts)?;
+    scn.check_options(opts)?;
     // File targets are checked before the run; a viewer that cannot be reached is
     // reported and the trial runs anyway.
-    let mut sinks =
-        crate::record::Sinks::open(rec, crate::record::metadata(&scn.name, &case.name, &run))?;
-    let (out, written) = sinks.record(|r| forkbench_trial::run_trial_recorded(&scn, case, opts, r));
-    let viewer_error = sinks.viewer_error.take();
+    let forkbench_log::Recorded {
+        outcome: out,
+        written,
+        viewer_error,
+    } = forkbench_log::run_recorded(&scn, case, opts, rec)?;
     if let Some(e) = &viewer_error {
         eprintln!("error: {e} (the trial ran without the viewer)");
     }
@@ -49,28 +50,6 @@ pub fn run(
         anyhow::bail!("the requested rerun viewer could not be reached");
     }
     Ok(out.success)
-}
-
-/// The case to run: the one named, or the only one.
-pub(crate) fn pick_case<'a>(
-    scn: &'a Scenario,
-    file: &Path,
-    case: Option<&str>,
-) -> anyhow::Result<&'a forkbench_trial::Case> {
-    Ok(match case {
-        Some(name) => scn.case(name)?,
-        None if scn.cases.len() == 1 => &scn.cases[0],
-        None => anyhow::bail!(
-            "{}: has {} cases; choose one with --case (cases: {})",
-            file.display(),
-            scn.cases.len(),
-            scn.cases
-                .iter()
-                .map(|c| c.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    })
 }
 
 /// The outcome as one JSON object; a mission's also carries its `overall` figures.

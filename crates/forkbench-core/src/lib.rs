@@ -6,6 +6,7 @@ pub mod hash;
 pub mod pallet;
 pub mod path;
 pub mod pose;
+pub mod quantile;
 pub mod settings;
 pub mod signal;
 pub mod units;

@@ -7,5 +7,5 @@ pub mod search;
 
 pub use analysis::{Comparison, CorridorError, Validation, check_inputs, compare, validate};
 pub use bend::{Bend, Junction, MARGIN_M, Vehicle, oblique_min_width_m};
-pub use reproduce::{CorridorQuery, CorridorRun, WidthRow, amv, analyse};
+pub use reproduce::{CorridorQuery, CorridorRun, WidthRow, amv, analyse, check_regions};
 pub use search::{GRegion, Mode, Resolution, Space, min_width_m, passes};

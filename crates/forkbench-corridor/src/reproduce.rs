@@ -92,6 +92,26 @@ pub fn analyse(q: &CorridorQuery) -> Result<CorridorRun, CorridorError> {
     Ok(CorridorRun { rows, regions })
 }
 
+/// Positions [`crate::validate`] sweeps per G region when a run is checked.
+pub const VALIDATION_SAMPLES: usize = 100;
+
+/// Each G region against circle inflation ([`crate::compare`]) and its positions swept
+/// with parry2d ([`crate::validate`], [`VALIDATION_SAMPLES`] of them), with its angle.
+pub fn check_regions(
+    regions: &[(f64, GRegion)],
+) -> Vec<(f64, crate::Comparison, crate::Validation)> {
+    regions
+        .iter()
+        .map(|(deg, g)| {
+            (
+                *deg,
+                crate::compare(g),
+                crate::validate(g, VALIDATION_SAMPLES),
+            )
+        })
+        .collect()
+}
+
 /// Oblique translation's worst bend angle: arctan(Lc / Wc).
 pub fn worst_oblique_angle_deg(v: &Vehicle) -> f64 {
     (v.length_m / v.width_m).atan().to_degrees()

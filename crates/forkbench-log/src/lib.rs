@@ -6,6 +6,7 @@ pub mod mcap_sink;
 #[cfg(feature = "rerun")]
 pub mod rerun_sink;
 pub mod ros2;
+pub mod sinks;
 mod writer;
 
 use std::path::Path;
@@ -16,6 +17,7 @@ pub use mcap_sink::McapRecorder;
 #[cfg(feature = "rerun")]
 pub use rerun_sink::{RerunRecorder, RerunTarget};
 pub use ros2::Ros2Recorder;
+pub use sinks::{RecordError, RecordTargets, Recorded, Sinks, record_trial, run_recorded};
 
 /// The rerun SDK this crate is built against (pinned with `=` in the workspace; a test
 /// checks this against Cargo.lock), for the recordings' metadata.

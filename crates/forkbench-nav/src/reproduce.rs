@@ -23,10 +23,8 @@ pub const NODE_STUDY: [usize; 5] = [15, 50, 100, 150, 500];
 pub const GRID_NODES: [usize; 3] = [500, 100, 50];
 pub const GRID_CONNECT_M: [Option<f64>; 3] = [Some(5.0), Some(30.0), None];
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.retain(|x| !x.is_nan());
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+fn median(v: Vec<f64>) -> f64 {
+    forkbench_core::quantile::quantile(v, 0.5).unwrap_or(f64::NAN)
 }
 
 fn row(

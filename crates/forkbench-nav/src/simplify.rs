@@ -11,6 +11,40 @@ const MAX_FAILS_IN_A_ROW: usize = 100;
 /// Most random shortcuts tried in all.
 const MAX_TRIES: usize = 2000;
 
+/// A plan's route after simplification, its length, and the time simplifying took.
+#[derive(Debug, Clone)]
+pub struct Simplified {
+    pub points: Vec<[f64; 2]>,
+    pub length_m: f64,
+    pub time_s: f64,
+}
+
+/// A plan's route simplified ([`simplify`], seeded with `seed`) in the space it was
+/// planned in (inflated grid or footprint); `None` without a route.
+pub fn simplify_plan(
+    map: &crate::NavMap,
+    q: &crate::GlobalQuery,
+    plan: &crate::GlobalPlan,
+    seed: u64,
+) -> Option<Simplified> {
+    let points = plan.route.points.as_ref()?;
+    let t0 = std::time::Instant::now();
+    let short = match q.collision {
+        crate::CollisionModel::Inflate => simplify(&*map.inflated(q.inflate_m), points, seed),
+        crate::CollisionModel::Footprint => simplify(
+            &crate::FootprintSpace::on(map, &q.truck, q.margin_m),
+            points,
+            seed,
+        ),
+    };
+    let time_s = t0.elapsed().as_secs_f64();
+    Some(Simplified {
+        length_m: crate::polyline_length_m(&short),
+        points: short,
+        time_s,
+    })
+}
+
 /// `points` shortened by shortcuts that stay in free space; the ends are kept.
 pub fn simplify<S: FreeSpace + ?Sized>(space: &S, points: &[[f64; 2]], seed: u64) -> Vec<[f64; 2]> {
     let mut path = shortcut(space, points, &[]);

@@ -5,6 +5,7 @@ pub mod coverage;
 pub mod defaults;
 pub mod mission_summary;
 pub mod outcome;
+pub mod prm_study;
 pub mod recorder;
 pub mod scenario;
 pub mod step_criteria;
@@ -32,6 +33,15 @@ pub enum TrialError {
         file: String,
         field: String,
         reason: String,
+    },
+    /// A scenario of several cases run without naming one (`--case`, or `case=`).
+    #[error(
+        "{file}: has {count} cases; name one (`--case` on the command line, `case=` in Python; cases: {known})"
+    )]
+    CaseNeeded {
+        file: String,
+        count: usize,
+        known: String,
     },
     #[error("{file}: no case named {case:?} (cases: {known})")]
     UnknownCase {

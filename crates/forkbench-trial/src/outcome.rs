@@ -392,6 +392,14 @@ impl TrialOutcome {
         }
     }
 
+    /// The file stem of this trial's recordings, `<scenario>-<case>-<planner>-<tracker>-seed<seed>`
+    /// (`-replan` for a trial that replans), safe as a file name ([`crate::text::safe_file_stem`]).
+    pub fn recording_stem(&self, replan: bool) -> String {
+        let mode = if replan { "-replan" } else { "" };
+        let (s, c, p, t) = (&self.scenario, &self.case, &self.planner, &self.tracker);
+        crate::text::safe_file_stem(&format!("{s}-{c}-{p}-{t}-seed{}{mode}", self.seed))
+    }
+
     /// A not-yet-judged outcome: nothing measured (NaN where a value would be), no failure.
     pub fn blank(
         scenario: &str,

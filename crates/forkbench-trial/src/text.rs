@@ -19,6 +19,17 @@ pub fn one_line(text: &str) -> String {
     visible(&text.replace(['\n', '\r', '\t'], " "))
 }
 
+/// Text inside HTML or XML (an element's text or a double-quoted attribute): control
+/// characters as visible escapes ([`visible`], so nothing XML 1.0 forbids remains), and
+/// `&`, `<`, `>` and `"` as entities. The one escaping of the report, SVG and JUnit.
+pub fn markup(text: &str) -> String {
+    visible(text)
+        .replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
 /// A Markdown table cell: one line, `|` escaped, and HTML's special characters as
 /// entities (Markdown renderers pass raw HTML through).
 pub fn md_cell(text: &str) -> String {
@@ -91,6 +102,20 @@ fn short_sci(v: f64) -> String {
     }
 }
 
+/// `text` with every character other than ASCII letters, digits, '-' and '_' replaced by
+/// '_': a name that can neither leave its folder nor fail a write as a file name.
+pub fn safe_file_stem(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -103,6 +128,10 @@ mod tests {
         }
         assert_eq!(csv_text("bspline"), "bspline");
         assert_eq!(visible("a\u{1b}[2Kb\u{7}\0"), "a\\u{1b}[2Kb\\u{7}\\u{0}");
+        assert_eq!(
+            markup("<a href=\"x\">R&D</a>\u{1b}"),
+            "&lt;a href=&quot;x&quot;&gt;R&amp;D&lt;/a&gt;\\u{1b}"
+        );
         assert_eq!(
             md_cell("a|b\n# head <script>"),
             "a\\|b # head &lt;script&gt;"

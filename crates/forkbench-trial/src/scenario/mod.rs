@@ -379,13 +379,31 @@ impl Scenario {
             .ok_or_else(|| TrialError::UnknownCase {
                 file: self.file.clone(),
                 case: name.to_owned(),
-                known: self
-                    .cases
-                    .iter()
-                    .map(|c| c.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                known: self.case_names(),
             })
+    }
+
+    /// The case a run asked for: the one named, or the only one (naming none of several
+    /// is [`TrialError::CaseNeeded`]).
+    pub fn pick_case(&self, name: Option<&str>) -> Result<&Case, TrialError> {
+        match (name, self.cases.as_slice()) {
+            (Some(n), _) => self.case(n),
+            (None, [only]) => Ok(only),
+            (None, all) => Err(TrialError::CaseNeeded {
+                file: self.file.clone(),
+                count: all.len(),
+                known: self.case_names(),
+            }),
+        }
+    }
+
+    /// The cases' names, comma-separated.
+    fn case_names(&self) -> String {
+        self.cases
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 

@@ -7,7 +7,8 @@ use forkbench_sensors::scan::{Errors, scan};
 use serde::Serialize;
 
 use super::error::StageError;
-use super::setup::{build_world, stream};
+use super::setup::build_world;
+use super::streams::{ACCURACY, stream};
 use crate::TrialError;
 use crate::scenario::sensors::{NamedScanner, PalletSensing};
 use crate::scenario::{Case, Scenario};
@@ -114,7 +115,7 @@ fn study_cell(
     let (mut lat, mut along, mut head) = (Vec::new(), Vec::new(), Vec::new());
     let mut by_sensor = vec![0u32; sensors.len()];
     for k in 0..u64::from(draws) {
-        let mut rng = stream(seed ^ k.wrapping_mul(0xA24B_AED4_963E_E407), 7);
+        let mut rng = stream(seed ^ k.wrapping_mul(0xA24B_AED4_963E_E407), ACCURACY);
         let scans: Vec<(&str, forkbench_core::signal::Scan)> = sensors
             .iter()
             .filter(|s| s.scanner.reaches(&s.scanner.sensor_pose(&root), &truth))

@@ -41,7 +41,7 @@ pub fn scan_once(
     let (sim, root, truth, _) = build_world(scn, case, seed, at)?;
     let pose = cfg.sensor_pose(&root);
     // Its own stream, so a scan does not shift the trial's other draws.
-    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5CA7_5CA7_5CA7_5CA7);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ super::streams::SCAN_ONCE);
     let s = if ideal {
         scan::<ChaCha8Rng>(cfg, &sim, pose, Errors::Ideal)
     } else {

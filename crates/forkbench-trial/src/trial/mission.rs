@@ -168,7 +168,7 @@ impl Trial<'_> {
             m,
             (&here, &to.pose),
             &self.scn.truck,
-            self.run.seed ^ ((i as u64 + 1) << 32),
+            super::streams::leg_seed(self.run.seed, i),
         );
         leg.planning_time_s = secs;
         leg.planning_attempts = attempts;

@@ -23,6 +23,7 @@ mod session_view;
 mod setup;
 mod staging;
 mod state;
+mod streams;
 
 use std::time::Instant;
 

@@ -6,25 +6,19 @@ use forkbench_plan::Planner;
 use forkbench_sensors::Localizer;
 use forkbench_sim::Sim;
 use forkbench_track::{PosePredictor, Tracker};
-use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::error::StageError;
 use super::judge::jitter;
 use super::localize::{LocStats, record_reflectors};
 use super::state::{Localisation, Perception, Verdict, WorldState};
+use super::streams::{self, stream};
 use super::{Resolved, target_insertion_m};
 use crate::components::LocalizerContext;
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, Recorder, SceneInfo};
 use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Case, Scenario};
-
-/// Independent random streams per sensor, so changing one sensor's settings does not
-/// change the other's draws.
-pub(super) fn stream(seed: u64, salt: u64) -> ChaCha8Rng {
-    ChaCha8Rng::seed_from_u64(seed ^ salt.wrapping_mul(0x9E37_79B9_7F4A_7C15))
-}
 
 /// A trial in progress: its scenario and run, the controllers and the plan they follow,
 /// and its state by concern (the world, the localisation, the perception, the verdict
@@ -71,7 +65,11 @@ pub(super) fn build_world(
     seed: u64,
     start_at: Option<Pose2>,
 ) -> Result<(Sim, Pose2, Pose2, Vec<forkbench_sim::Obstacle>), StageError> {
-    let true_pallet = jitter(&case.pallet, &scn.pallet_jitter, &mut stream(seed, 3));
+    let true_pallet = jitter(
+        &case.pallet,
+        &scn.pallet_jitter,
+        &mut stream(seed, streams::PALLET_JITTER),
+    );
     let obstacles = scn.world.obstacles();
     let start =
         start_at.unwrap_or_else(|| scn.mission.as_ref().map_or(case.start, |m| m.start.pose));
@@ -92,8 +90,8 @@ pub(super) fn build_world(
 /// adding a sensor, or listing them in another order, leaves every other draw unchanged.
 fn scanner_salt(name: &str, what: &str) -> u64 {
     match (name, what) {
-        ("tim561", "bias") => 4,
-        ("tim561", "noise") => 2,
+        ("tim561", "bias") => streams::TIM561_BIAS,
+        ("tim561", "noise") => streams::ESTIMATE,
         // The bias salt predates the keyed noise streams; kept so outcomes stay paired.
         (_, "bias") => fnv1a(name.bytes()),
         _ => fnv1a(name.bytes().chain(b"/".iter().copied()).chain(what.bytes())),
@@ -174,7 +172,7 @@ fn odometry_from(start: Pose2) -> PosePredictor {
 /// their own (none with noise off).
 fn odometry_error(run: &Resolved) -> (f64, f64) {
     if run.noise {
-        run.odometry.draw(&mut stream(run.seed, 6))
+        run.odometry.draw(&mut stream(run.seed, streams::ODOMETRY))
     } else {
         (0.0, 0.0)
     }
@@ -330,7 +328,7 @@ impl<'a> Trial<'a> {
 fn localisation(localizer: Box<dyn Localizer>, run: &Resolved, start: Pose2) -> Localisation {
     Localisation {
         localizer,
-        nav_rng: stream(run.seed, 1),
+        nav_rng: stream(run.seed, streams::LOCALISATION),
         predictor: PosePredictor::new(),
         odometry: odometry_from(start),
         first_fix: start,
@@ -351,7 +349,7 @@ fn perception(
 ) -> Perception {
     Perception {
         estimator: scn.registry.estimator(&run.pallet_estimate),
-        est_rng: stream(run.seed, 2),
+        est_rng: stream(run.seed, streams::ESTIMATE),
         scanners: scanner_streams(run),
         detector,
         pallet_est,

@@ -6,8 +6,9 @@ mod svg;
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
 use forkbench_batch::{self as batch, Baseline, GateOptions, Manifest, Summary};
+
+use crate::Result;
 
 const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1300px;color:#222}\
 h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccc}\
@@ -17,11 +18,11 @@ pre{font-size:11px;background:#f7f7f7;padding:6px;overflow:auto}svg{display:bloc
 
 /// Writes `dir/report.html` (or `out`) for a batch directory or a sweep's; with a
 /// baseline, the comparison and its verdicts. Returns the page's path.
-pub fn write(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<PathBuf> {
+pub fn write(dir: &Path, baseline: Option<&Path>) -> Result<PathBuf> {
     write_to(dir, baseline, &dir.join("report.html"))
 }
 
-pub fn write_to(dir: &Path, baseline: Option<&Path>, out: &Path) -> anyhow::Result<PathBuf> {
+pub fn write_to(dir: &Path, baseline: Option<&Path>, out: &Path) -> Result<PathBuf> {
     let body = if dir.join("sweep.json").is_file() {
         sweep_body(dir)?
     } else {
@@ -35,11 +36,13 @@ pub fn write_to(dir: &Path, baseline: Option<&Path>, out: &Path) -> anyhow::Resu
     Ok(out.to_path_buf())
 }
 
-fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
+fn batch_body(dir: &Path, baseline: Option<&Path>) -> Result<String> {
     let summary: Summary = batch::load_results(dir)?;
     let numbered = batch::read_numbered(&dir.join("trials.jsonl"))?;
     let records: Vec<batch::TrialRecord> = numbered.iter().map(|(_, r)| r.clone()).collect();
-    let manifest = Manifest::read(dir)?.context("no manifest.json")?;
+    let manifest = Manifest::read(dir)?.ok_or_else(|| crate::ReportError::NoManifest {
+        dir: dir.to_path_buf(),
+    })?;
     let mut h = format!(
         "<p><b>{} trials, {} successes ({:.1} %)</b></p>",
         summary.trials,
@@ -101,7 +104,7 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> anyhow::Result<String> {
     Ok(h)
 }
 
-fn sweep_body(dir: &Path) -> anyhow::Result<String> {
+fn sweep_body(dir: &Path) -> Result<String> {
     let (knob, points) = batch::read_sweep(dir)?;
     let words = knob.replace('_', " ");
     let mut h = format!("<h2>Success vs {}</h2>", svg::esc(&words));

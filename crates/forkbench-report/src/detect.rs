@@ -7,6 +7,8 @@ use forkbench_core::Pose2;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::Result;
+
 fn spread_text(name: &str, s: Option<&Spread>, unit: &str, scale: f64) -> String {
     match s {
         Some(s) => format!(
@@ -50,8 +52,8 @@ pub fn draw(
     file: &std::path::Path,
     found: &[Option<Pose2>],
     labels: &BTreeMap<usize, Label>,
-) -> anyhow::Result<()> {
-    crate::plot::to_file(
+) -> Result<()> {
+    crate::figure::to_file(
         file,
         (1100, 700),
         |a| draw_on(a, found, labels),
@@ -63,11 +65,11 @@ fn draw_on<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     found: &[Option<Pose2>],
     labels: &BTreeMap<usize, Label>,
-) -> anyhow::Result<()>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
-    use crate::plot::err;
+    use crate::figure::err;
     root.fill(&WHITE).map_err(err)?;
     let (mut lateral, mut heading, mut missed, mut false_det) = (vec![], vec![], vec![], vec![]);
     for (i, l) in labels {

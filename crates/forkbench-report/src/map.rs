@@ -2,14 +2,18 @@
 
 use std::path::Path;
 
-use forkbench_nav::{OccupancyGrid, Roadmap};
+use forkbench_nav::{
+    CollisionModel, GlobalPlan, GlobalPlannerKind, GlobalQuery, NavMap, OccupancyGrid, Roadmap,
+};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use crate::plot::{err, to_file};
+use crate::Result;
+use crate::figure::{err, to_file};
 
 /// What one figure shows.
+#[derive(Debug)]
 pub struct MapFigure<'a> {
     pub title: String,
     /// The map as loaded, and the one the planner searched (obstacles inflated).
@@ -29,7 +33,7 @@ pub struct MapFigure<'a> {
 }
 
 /// Draws `fig` to FILE (.svg or .png), 1 m on the map the same on both axes.
-pub fn draw_map(file: &Path, fig: &MapFigure) -> anyhow::Result<()> {
+pub fn draw_map(file: &Path, fig: &MapFigure) -> Result<()> {
     let (lo, hi) = fig.grid.extent();
     let (w_m, h_m) = (hi[0] - lo[0], hi[1] - lo[1]);
     let width = 1400u32;
@@ -37,7 +41,7 @@ pub fn draw_map(file: &Path, fig: &MapFigure) -> anyhow::Result<()> {
     to_file(file, (width, height), |a| draw(a, fig), |a| draw(a, fig))
 }
 
-fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> anyhow::Result<()> {
+fn draw<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, fig: &MapFigure) -> Result<()> {
     area.fill(&WHITE).map_err(err)?;
     let (lo, hi) = fig.grid.extent();
     let mut chart = ChartBuilder::on(&area)
@@ -116,7 +120,7 @@ fn draw_line<DB: DrawingBackend>(
     points: &[[f64; 2]],
     name: &str,
     style: ShapeStyle,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     chart
         .draw_series(std::iter::once(PathElement::new(
             points.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>(),
@@ -132,7 +136,7 @@ fn draw_line<DB: DrawingBackend>(
 fn draw_roadmap<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     map: &Roadmap,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     let edge = RGBColor(150, 185, 235).stroke_width(1);
     let edges = map.edges.iter().enumerate().flat_map(|(i, e)| {
         e.iter()
@@ -156,7 +160,7 @@ fn draw_roadmap<DB: DrawingBackend>(
 fn draw_strike<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     strike: Option<[f64; 2]>,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     if let Some(at) = strike {
         chart
             .draw_series(std::iter::once(Cross::new(
@@ -177,7 +181,7 @@ fn draw_manoeuvre<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     m: &forkbench_nav::hybrid::Manoeuvre,
     truck: &forkbench_core::ForkliftSpec,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     let forward = RGBColor(30, 90, 220).stroke_width(3);
     let backward = RGBColor(150, 40, 170).stroke_width(3);
     let (mut fwd_label, mut back_label) = (false, false);
@@ -228,4 +232,70 @@ fn draw_manoeuvre<DB: DrawingBackend>(
             .legend(|(x, y)| TriangleMarker::new((x + 10, y), 5, RED.filled()));
     }
     Ok(())
+}
+
+/// Draws one global plan on its map to FILE (.svg or .png): the grid, the inflated band,
+/// the roadmap, the route, its smoothing or manoeuvre, start and goal.
+pub fn draw_route(
+    file: &Path,
+    planner: GlobalPlannerKind,
+    map_file: &Path,
+    map: &NavMap,
+    q: &GlobalQuery,
+    plan: &GlobalPlan,
+) -> Result<()> {
+    let route = &plan.route;
+    // The length the truck would drive: the smoothed path's when there is one.
+    let drivable = match &plan.smoothed {
+        Some(Ok(s)) => format!(
+            "{:.1} m smoothed ({:.1} m A* polyline)",
+            s.path.length_m(),
+            route.length_m
+        ),
+        _ => format!("{:.1} m A* polyline", route.length_m),
+    };
+    let drivable = match &plan.manoeuvre {
+        Some(m) => format!(
+            "{:.1} m manoeuvre, {} cusps{}",
+            m.length_m,
+            m.cusps().len(),
+            if plan.fallback.is_some() {
+                " (Hybrid-A* fallback)"
+            } else {
+                ""
+            }
+        ),
+        None => drivable,
+    };
+    let title = match &route.points {
+        Some(_) => format!("{} on {}: {drivable}", planner.name(), map_file.display()),
+        None => format!("{} on {}: no path", planner.name(), map_file.display()),
+    };
+    let band = match q.collision {
+        CollisionModel::Inflate => q.inflate_m,
+        CollisionModel::Footprint => q.truck.body_width_m / 2.0 + q.margin_m,
+    };
+    let inflated = map.grid.inflated(band);
+    let smoothed = match &plan.smoothed {
+        Some(Ok(s)) => Some(s),
+        _ => None,
+    };
+    let line: Option<Vec<[f64; 2]>> =
+        smoothed.map(|s| s.path.samples.iter().map(|p| [p.x_m, p.y_m]).collect());
+    let fig = MapFigure {
+        title,
+        grid: &map.grid,
+        inflated: &inflated,
+        roadmap: plan.roadmap.as_ref(),
+        // A manoeuvre's own route is the manoeuvre: the point route is drawn only when
+        // the manoeuvre replaced it.
+        path: route.points.as_deref().filter(|_| !planner.kinodynamic()),
+        smoothed: line.as_deref(),
+        strike: smoothed.and_then(|s| s.hit).map(|h| [h.x_m, h.y_m]),
+        manoeuvre: plan.manoeuvre.as_ref(),
+        truck: &q.truck,
+        start: [q.start.x_m, q.start.y_m],
+        goal: [q.goal.x_m, q.goal.y_m],
+    };
+    draw_map(file, &fig)
 }

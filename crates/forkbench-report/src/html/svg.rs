@@ -8,13 +8,7 @@ pub const PALETTE: [&str; 10] = [
     "#bcbd22", "#17becf",
 ];
 
-pub fn esc(text: &str) -> String {
-    forkbench_trial::text::visible(text)
-        .replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
+pub use forkbench_trial::text::markup as esc;
 
 fn open(id: &str, w: f64, h: f64) -> String {
     format!(

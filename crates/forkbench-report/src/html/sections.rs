@@ -7,7 +7,6 @@ use std::path::Path;
 use forkbench_batch::{
     self as batch, GateReport, Manifest, Provenance, Summary, TrialRecord, Verdict,
 };
-use serde_json::Value;
 
 use super::svg::{self, esc};
 
@@ -110,147 +109,84 @@ pub fn failure_breakdown(s: &Summary) -> String {
     svg::stacked_bars("failures", &rows, &kinds)
 }
 
-/// (goal lateral offset D in cm, right positive; pallet angle θ in °) of each case, as the
-/// papers' Table 2 gives them: the pre-entry goal (fork tips 0.3 m before the face) in
-/// the start pose's frame, from the manifest's resolved cases and truck.
-fn case_geometry(settings: &Value) -> BTreeMap<String, (f64, f64)> {
-    let pose = |v: &Value| {
-        let g = |k: &str| v.get(k).and_then(Value::as_f64).unwrap_or(0.0);
-        forkbench_core::Pose2::new(g("x_m"), g("y_m"), g("heading_rad"))
-    };
-    let fork_m = settings["truck"]["fork_length_m"].as_f64().unwrap_or(0.0);
-    let gap = settings["pick"]["pre_entry_gap_m"].as_f64(); // none before `[pick]`
-    let gap_m = gap.unwrap_or(forkbench_trial::trial::APPROACH_GAP_M);
-    let cases = settings
-        .get("cases")
-        .and_then(Value::as_array)
-        .cloned()
-        .unwrap_or_default();
-    cases
-        .iter()
-        .map(|c| {
-            let (start, face) = (pose(&c["start"]), pose(&c["pallet"]));
-            let back = fork_m + gap_m;
-            let goal = face.to_world(&forkbench_core::Pose2::new(-back, 0.0, 0.0));
-            let local = start.to_local(&goal);
-            let name = c["name"].as_str().unwrap_or("").to_owned();
-            let lateral_cm = (-local.y_m * 100.0).round();
-            let angle_deg = (local.heading_rad.to_degrees() * 10.0).round() / 10.0;
-            (name, (lateral_cm, angle_deg))
-        })
-        .collect()
-}
-
-/// (successes, trials) per (lateral offset cm, angle in 0.1°) cell.
-type Grid = BTreeMap<(i64, i64), (u64, u64)>;
-
 /// Success over lateral offset × pallet angle, per scenario (with at least 4 cases) and
-/// planner × tracker.
+/// planner × tracker × mode ([`batch::case_grids`]).
 pub fn heatmaps(manifest: &Manifest, records: &[TrialRecord]) -> String {
     let mut h = String::new();
-    for sc in manifest.scenarios.iter().filter(|s| {
-        s.settings
-            .get("cases")
-            .and_then(Value::as_array)
-            .is_some_and(|c| c.len() >= 4)
-    }) {
-        let geo = case_geometry(&sc.settings);
-        let mut cells: BTreeMap<(String, String, bool), Grid> = BTreeMap::new();
-        for r in records.iter().filter(|r| r.outcome.scenario == sc.name) {
-            let Some(&(lat, ang)) = geo.get(&r.outcome.case) else {
-                continue;
-            };
-            let key = ((lat) as i64, (ang * 10.0) as i64);
-            let c = cells
-                .entry((
-                    r.outcome.planner.clone(),
-                    r.outcome.tracker.clone(),
-                    r.replan.unwrap_or(false),
-                ))
-                .or_default()
-                .entry(key)
-                .or_default();
-            c.0 += u64::from(r.outcome.success);
-            c.1 += 1;
-        }
-        for ((planner, tracker, replan), grid) in &cells {
-            let xs: Vec<i64> = grid
-                .keys()
-                .map(|k| k.0)
-                .collect::<BTreeSet<_>>()
-                .into_iter()
-                .collect();
-            let ys: Vec<i64> = grid
-                .keys()
-                .map(|k| k.1)
-                .collect::<BTreeSet<_>>()
-                .into_iter()
-                .collect();
-            let xf: Vec<f64> = xs.iter().map(|x| *x as f64).collect();
-            let yf: Vec<f64> = ys.iter().map(|y| *y as f64 / 10.0).collect();
-            let cell = |i: usize, j: usize| grid.get(&(xs[i], ys[j])).copied();
-            let mode = batch::mode_name(*replan);
-            let id = format!(
-                "heatmap-{}-{planner}-{tracker}-{}",
-                sc.name,
-                mode.replace(' ', "-")
-            );
-            let title = format!("{}: {planner} / {tracker} / {mode}", sc.name);
-            h.push_str(&svg::heatmap(
-                &id,
-                &title,
-                &xf,
-                &yf,
-                &cell,
-                ("goal lateral offset D (cm, right +)", "pallet angle θ (°)"),
-            ));
-        }
+    for ((scenario, planner, tracker, replan), grid) in batch::case_grids(manifest, records, 4) {
+        let xs: Vec<i64> = grid
+            .keys()
+            .map(|k| k.0)
+            .collect::<BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        let ys: Vec<i64> = grid
+            .keys()
+            .map(|k| k.1)
+            .collect::<BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        let xf: Vec<f64> = xs.iter().map(|x| *x as f64).collect();
+        let yf: Vec<f64> = ys.iter().map(|y| *y as f64 / 10.0).collect();
+        let cell = |i: usize, j: usize| grid.get(&(xs[i], ys[j])).copied();
+        let mode = batch::mode_name(replan);
+        let id = format!(
+            "heatmap-{scenario}-{planner}-{tracker}-{}",
+            mode.replace(' ', "-")
+        );
+        let title = format!("{scenario}: {planner} / {tracker} / {mode}");
+        h.push_str(&svg::heatmap(
+            &id,
+            &title,
+            &xf,
+            &yf,
+            &cell,
+            ("goal lateral offset D (cm, right +)", "pallet angle θ (°)"),
+        ));
     }
     h
 }
 
-/// |lateral| and |heading| error at entry per planner × tracker, with the tolerances.
+/// |lateral| and |heading| error at entry per planner × tracker × mode, with the limits
+/// that judged them: a pair of histograms per distinct pair of limits (each scenario's
+/// own), titled with its scenarios when there is more than one pair.
 pub fn error_distributions(manifest: &Manifest, records: &[TrialRecord]) -> String {
-    let tol = |k: &str| {
-        manifest
-            .scenarios
-            .first()
-            .and_then(|s| s.settings.get("tolerances"))
-            .and_then(|t| t.get(k))
-            .and_then(Value::as_f64)
-            .unwrap_or(0.0)
-    };
-    let mut lat: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    let mut head: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    for r in records {
-        let key = format!(
-            "{} / {} / {}",
-            r.outcome.planner,
-            r.outcome.tracker,
-            batch::mode_name(r.replan.unwrap_or(false))
+    let groups = batch::error_groups(manifest, records);
+    let several = groups.len() > 1;
+    let mut h = String::new();
+    for (k, g) in groups.iter().enumerate() {
+        let (lat_m, head_deg) = g.limits.unwrap_or((0.0, 0.0));
+        let suffix = if several {
+            format!("-{k}")
+        } else {
+            String::new()
+        };
+        if several {
+            let _ = write!(
+                h,
+                "<h3>Limits ±{:.0} mm, ±{head_deg}°: {}</h3>",
+                lat_m * 1e3,
+                esc(&g.scenarios.join(", "))
+            );
+        }
+        let lat: Vec<_> = g.lateral_mm.clone().into_iter().collect();
+        let head: Vec<_> = g.heading_deg.clone().into_iter().collect();
+        h += &svg::histogram(
+            &format!("errors-lateral{suffix}"),
+            "|lateral error| at entry",
+            &lat,
+            (lat_m * 1e3, "mm"),
+            "|lateral error| (mm)",
         );
-        if let Some(v) = r.outcome.lateral_error_m {
-            lat.entry(key.clone()).or_default().push(v.abs() * 1e3);
-        }
-        if let Some(v) = r.outcome.heading_error_rad {
-            head.entry(key).or_default().push(v.abs().to_degrees());
-        }
+        h += &svg::histogram(
+            &format!("errors-heading{suffix}"),
+            "|heading error| at entry",
+            &head,
+            (head_deg, "°"),
+            "|heading error| (°)",
+        );
     }
-    let lat: Vec<_> = lat.into_iter().collect();
-    let head: Vec<_> = head.into_iter().collect();
-    svg::histogram(
-        "errors-lateral",
-        "|lateral error| at entry",
-        &lat,
-        (tol("lateral_m") * 1e3, "mm"),
-        "|lateral error| (mm)",
-    ) + &svg::histogram(
-        "errors-heading",
-        "|heading error| at entry",
-        &head,
-        (tol("heading_deg"), "°"),
-        "|heading error| (°)",
-    )
+    h
 }
 
 /// Failed trials: reason, and links to their recordings where the batch wrote them.
@@ -267,7 +203,7 @@ pub fn failed_trials(dir: &Path, records: &[(usize, TrialRecord)]) -> String {
     let shown = failed.len().min(MAX_ROWS);
     for (line, r) in &failed[..shown] {
         let o = &r.outcome;
-        let stem = crate::record::recording_stem(o, r.replan == Some(true));
+        let stem = o.recording_stem(r.replan == Some(true));
         let links: Vec<String> = ["rrd", "mcap"]
             .iter()
             .filter(|ext| rec_dir.join(format!("{stem}.{ext}")).is_file())
@@ -494,6 +430,6 @@ pub fn sweep(knob: &str, points: &[(f64, Summary)]) -> String {
         "sweep",
         &format!("fork-entry success vs {}", knob.replace('_', " ")),
         &series,
-        &crate::plot::knob_axis(knob),
+        &crate::knob_axis(knob),
     )
 }

@@ -1,13 +1,14 @@
 //! Path figures like the papers' figures 6–8: the path (with control polygon), curvature and steering vs s.
 
 use std::path::Path as FsPath;
-use std::sync::Once;
 
-use anyhow::{Context as _, bail};
 use forkbench_core::{ForkliftSpec, Path};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
+
+use crate::Result;
+use crate::figure::{err, series_colour, to_file};
 
 /// One path to draw.
 #[derive(Debug)]
@@ -17,75 +18,13 @@ pub struct Series<'a> {
     pub control_polygon: Option<Vec<[f64; 2]>>,
 }
 
-/// The bitmap backend needs a font; the embedded DejaVu Sans avoids a system font lookup.
-fn register_font() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // The embedded font is a valid TTF; a failure would only lose text, never data.
-        let _ = plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            dejavu::sans::regular(),
-        );
-    });
-}
-
-/// Draws to FILE with the backend its extension names (.svg or .png). The two closures
-/// are the same drawing code, one per backend type.
-pub fn to_file(
-    file: &FsPath,
-    size: (u32, u32),
-    svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> anyhow::Result<()>,
-    png: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    register_font();
-    let ext = file
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !matches!(ext.as_deref(), Some("svg" | "png")) {
-        bail!("{}: plot file must end in .svg or .png", file.display());
-    }
-    if std::fs::symlink_metadata(file).is_ok_and(|m| !m.is_file()) {
-        bail!(
-            "{}: exists and is not a regular file; give a file's path for the plot",
-            file.display()
-        );
-    }
-    // Drawn to a temporary file beside the target and presented explicitly (plotters
-    // only logs a failed write when a backend is dropped), then renamed over it: a full
-    // disk or a missing folder is an error naming the file, never a truncated plot.
-    // Beside the target, keeping its extension (the backend picks the format by it).
-    let name = file
-        .file_name()
-        .map_or_else(|| "plot".into(), |n| n.to_string_lossy());
-    let tmp = file.with_file_name(format!(".tmp-{}-{name}", std::process::id()));
-    let result = if ext.as_deref() == Some("svg") {
-        let area = SVGBackend::new(&tmp, size).into_drawing_area();
-        svg(area.clone()).and_then(|()| area.present().map_err(|e| anyhow::anyhow!("{e}")))
-    } else {
-        let area = BitMapBackend::new(&tmp, size).into_drawing_area();
-        png(area.clone()).and_then(|()| area.present().map_err(|e| anyhow::anyhow!("{e}")))
-    };
-    let result = result.and_then(|()| {
-        std::fs::File::open(&tmp)
-            .and_then(|f| f.sync_all())
-            .and_then(|()| std::fs::rename(&tmp, file))
-            .map_err(anyhow::Error::from)
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.with_context(|| format!("drawing {}", file.display()))
-}
-
 /// Draws to FILE; the format follows the extension (.svg or .png).
 pub fn draw_plans(
     file: &FsPath,
     title: &str,
     series: &[Series],
     truck: &ForkliftSpec,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     to_file(
         file,
         (1400, 800),
@@ -94,40 +33,15 @@ pub fn draw_plans(
     )
 }
 
-pub fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow::anyhow!("{e:?}")
-}
-
 /// One curvature-derived panel: caption, y label, limit line, and κ ↦ plotted value.
 type Panel<'a> = (&'a str, &'a str, f64, Box<dyn Fn(f64) -> f64 + 'a>);
-
-pub const COLORS: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(23, 190, 207),
-];
-
-/// The colour of series `i` of `n`: the palette's up to its size, else evenly spaced
-/// hues, so no two series share one.
-pub fn series_colour(i: usize, n: usize) -> RGBColor {
-    if n <= COLORS.len() {
-        return COLORS[i % COLORS.len()];
-    }
-    let c = HSLColor(i as f64 / n as f64, 0.7, 0.42).to_rgba();
-    RGBColor(c.0, c.1, c.2)
-}
 
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
     series: &[Series],
     truck: &ForkliftSpec,
-) -> anyhow::Result<()>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -163,7 +77,7 @@ fn arrow(at: [f64; 2], heading: f64, len: f64) -> (Polyline, Polyline) {
 fn draw_path_panel<DB: DrawingBackend>(
     left: &DrawingArea<DB, Shift>,
     series: &[Series],
-) -> anyhow::Result<()>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -234,7 +148,7 @@ fn draw_curvature_panels<DB: DrawingBackend>(
     right_parts: &[DrawingArea<DB, Shift>],
     series: &[Series],
     truck: &ForkliftSpec,
-) -> anyhow::Result<()>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -302,139 +216,6 @@ where
     Ok(())
 }
 
-/// Success rate against the pallet-noise scale, one line per scenario, Wilson 95 % bars.
-pub fn draw_sweep(
-    file: &FsPath,
-    (planner, knob): (&str, &str),
-    points: &[(f64, forkbench_batch::Summary)],
-) -> anyhow::Result<()> {
-    to_file(
-        file,
-        (900, 600),
-        |a| draw_sweep_on(a, (planner, knob), points),
-        |a| draw_sweep_on(a, (planner, knob), points),
-    )
-}
-
-/// What a knob's scale of 1 means, for the sweep's axis.
-pub fn knob_axis(knob: &str) -> String {
-    let what = match knob {
-        "pallet_noise" => "pallet-sensing error (estimate σ, scanner noise and bias)",
-        "localization_noise" => "localisation error (NAV350 or Gaussian σ)",
-        "odometry_noise" => "odometry error (speed scale and steering σ)",
-        other => other,
-    };
-    format!("scale of the {what}; 1 = the scenario's own")
-}
-
-fn draw_sweep_on<DB: DrawingBackend>(
-    root: DrawingArea<DB, Shift>,
-    (planner, knob): (&str, &str),
-    points: &[(f64, forkbench_batch::Summary)],
-) -> anyhow::Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE).map_err(err)?;
-    let x_max = points.iter().map(|p| p.0).fold(0.0, f64::max).max(0.1);
-    let mut chart = ChartBuilder::on(&root)
-        .margin(20)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .caption(
-            format!(
-                "{planner}: fork-entry success vs {}",
-                knob.replace('_', " ")
-            ),
-            ("sans-serif", 20),
-        )
-        .build_cartesian_2d(-0.05 * x_max..1.05 * x_max, 0.0..100.0)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(knob_axis(knob))
-        .y_desc("success rate (%)")
-        .draw()
-        .map_err(err)?;
-    let series = sweep_series(points, planner);
-    let several_trackers = series.iter().any(|(_, t)| *t != series[0].1);
-    for (i, (sc, tr)) in series.iter().enumerate() {
-        let color = COLORS[i % COLORS.len()];
-        let pts = sweep_points(points, (sc, tr), planner);
-        chart
-            .draw_series(LineSeries::new(
-                pts.iter().map(|p| (p.0, p.1)),
-                color.stroke_width(2),
-            ))
-            .map_err(err)?
-            .label(if several_trackers {
-                format!("{sc} / {tr}")
-            } else {
-                sc.clone()
-            })
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
-            });
-        chart
-            .draw_series(
-                pts.iter()
-                    .map(|p| ErrorBar::new_vertical(p.0, p.2, p.1, p.3, color.filled(), 6)),
-            )
-            .map_err(err)?;
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
-}
-
-/// The (scenario, tracker) pairs of `planner` in a sweep, sorted.
-fn sweep_series(
-    points: &[(f64, forkbench_batch::Summary)],
-    planner: &str,
-) -> Vec<(String, String)> {
-    let mut series: Vec<(String, String)> = points
-        .iter()
-        .flat_map(|(_, s)| {
-            s.rows
-                .iter()
-                .filter(|r| r.planner == planner)
-                .map(|r| (r.scenario.clone(), r.tracker.clone()))
-        })
-        .collect();
-    series.sort();
-    series.dedup();
-    series
-}
-
-/// One series' points: (sweep value, success %, Wilson 95 % low, high).
-fn sweep_points(
-    points: &[(f64, forkbench_batch::Summary)],
-    (sc, tr): (&str, &str),
-    planner: &str,
-) -> Vec<(f64, f64, f64, f64)> {
-    points
-        .iter()
-        .filter_map(|(v, s)| {
-            s.rows
-                .iter()
-                .find(|r| r.scenario == sc && r.tracker == tr && r.planner == planner)
-                .map(|r| {
-                    (
-                        *v,
-                        100.0 * r.success_rate,
-                        100.0 * r.ci95_low,
-                        100.0 * r.ci95_high,
-                    )
-                })
-        })
-        .collect()
-}
-
 /// Centre and half-side of a square around every path sample and control point, with a margin.
 fn square_bounds(series: &[Series]) -> (f64, f64, f64) {
     let pts = series.iter().flat_map(|s| {
@@ -464,7 +245,7 @@ fn draw_end_arrows<'a, DB: DrawingBackend + 'a>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     series: &[Series],
     half: f64,
-) -> anyhow::Result<()>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {

@@ -6,20 +6,19 @@ use forkbench_nav::reproduce::StudyRow;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::plot::{COLORS, err, to_file};
+use crate::Result;
+
+use crate::figure::{COLORS, err, to_file};
 
 /// The paper's success rates at 10 m (Luo, Table 2; 50 nodes: 93 %, or 80 % in a rerun).
 const PAPER_SUCCESS: [(usize, f64); 4] = [(15, 35.0), (50, 93.0), (100, 100.0), (500, 100.0)];
 
 /// Draws both panels to FILE (.svg or .png).
-pub fn draw(file: &Path, rows: &[StudyRow]) -> anyhow::Result<()> {
+pub fn draw(file: &Path, rows: &[StudyRow]) -> Result<()> {
     to_file(file, (1400, 560), |a| panels(a, rows), |a| panels(a, rows))
 }
 
-fn panels<DB: DrawingBackend>(
-    area: DrawingArea<DB, Shift>,
-    rows: &[StudyRow],
-) -> anyhow::Result<()> {
+fn panels<DB: DrawingBackend>(area: DrawingArea<DB, Shift>, rows: &[StudyRow]) -> Result<()> {
     area.fill(&WHITE).map_err(err)?;
     let (left, right) = area.split_horizontally(700);
     success(&left, rows)?;
@@ -38,10 +37,7 @@ fn series(rows: &[StudyRow], connect_m: Option<f64>) -> Vec<&StudyRow> {
     v
 }
 
-fn success<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    rows: &[StudyRow],
-) -> anyhow::Result<()> {
+fn success<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, rows: &[StudyRow]) -> Result<()> {
     let mut chart = ChartBuilder::on(area)
         .caption("PRM + A* success rate, 10 m connection", ("sans-serif", 20))
         .margin(12)
@@ -96,10 +92,7 @@ fn success<DB: DrawingBackend>(
     Ok(())
 }
 
-fn times<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    rows: &[StudyRow],
-) -> anyhow::Result<()> {
+fn times<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, rows: &[StudyRow]) -> Result<()> {
     let ms = |r: &StudyRow| (1e3 * r.median_time_s).max(1e-3);
     let top = rows.iter().map(ms).fold(1.0, f64::max) * 2.0;
     let mut chart = ChartBuilder::on(area)
