@@ -1,7 +1,7 @@
 //! What costs a new user an hour, checked through the binary: a file scenario's records
 //! replay without naming the file, rows below --floor are named, an embedded scenario by
 //! name, a radians slip and a key swallowed by a table are pointed out, and the report draws
-//! each scenario's entry errors against its own limits.
+//! each scenario's entry errors against its own limits, linking the recorded failures.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -119,14 +119,19 @@ fn every_scenario_s_entry_errors_are_drawn_against_its_own_limits() {
         scn.to_str().expect("utf8"),
         "--trials",
         "2",
-        "--record",
-        "none",
+        "--max-recordings",
+        "1",
         "--out",
         out_dir.to_str().expect("utf8"),
         "--report",
     ]);
     assert!(matches!(out.status.code(), Some(0 | 3)), "{}", text(&out));
     let page = std::fs::read_to_string(out_dir.join("report.html")).expect("report");
+    // The batch records a failed trial before it writes the report, so the page links it.
+    assert!(
+        page.contains("<a href=\"recordings/"),
+        "no recording linked"
+    );
     // One pair of histograms per pair of limits, each titled with its scenarios and
     // drawn with its own limit line.
     for needle in [

@@ -246,12 +246,13 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     let elapsed = t0.elapsed().as_secs_f64();
     // Every output is attempted, whatever failed before it (a full disk while recording
     // must not cost the table, JUnit, CSV or report); the failures are reported together.
+    // The recordings first: the report links the failed trials' recordings it finds.
     let mut failed: Vec<String> = Vec::new();
-    let extras = write_extras(&summary, &a, &mut failed);
     let recorded = record_batch(&spec, &a).unwrap_or_else(|e| {
         failed.push(format!("recordings: {e:#}"));
         0
     });
+    let extras = write_extras(&summary, &a, &mut failed);
     let shown = if a.json {
         crate::emit(&format!("{}\n", serde_json::to_string(&summary)?))
     } else {

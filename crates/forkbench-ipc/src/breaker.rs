@@ -14,13 +14,13 @@ pub struct Breaker {
 
 impl Breaker {
     /// Refuses a request of `command` when its breaker is open, saying why.
-    pub fn check(&self, command: &str) -> Result<(), String> {
+    pub fn check(&self, command: &str) -> Result<(), crate::ExchangeError> {
         let map = self.timeouts.lock().unwrap_or_else(PoisonError::into_inner);
         match map.get(command) {
-            Some(&n) if n >= BREAKER_THRESHOLD => Err(format!(
+            Some(&n) if n >= BREAKER_THRESHOLD => Err(crate::ExchangeError::other(format!(
                 "not started: {command} timed out {n} times in a row, so its remaining \
                  requests fail at once (circuit breaker)"
-            )),
+            ))),
             _ => Ok(()),
         }
     }
@@ -51,7 +51,7 @@ mod tests {
         b.record("p", true);
         b.record("p", true);
         let e = b.check("p").expect_err("open");
-        assert!(e.contains("timed out 3 times in a row"), "{e}");
+        assert!(e.message.contains("timed out 3 times in a row"), "{e}");
         assert!(b.check("q").is_ok());
     }
 }

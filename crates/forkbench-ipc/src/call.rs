@@ -28,7 +28,7 @@ impl CommandConfig {
         callee: Callee<'_>,
         message: impl FnOnce(u64) -> M,
         id_of: impl FnOnce(&T) -> u64,
-    ) -> Result<T, String> {
+    ) -> Result<T, ExchangeError> {
         let request = |id| {
             serde_json::to_string(&message(id)).map_err(|e| ExchangeError::other(e.to_string()))
         };
@@ -48,14 +48,14 @@ impl CommandConfig {
         callee: Callee<'_>,
         request: impl FnOnce(u64) -> Result<String, ExchangeError>,
         read: impl FnOnce(&str) -> Result<(u64, T), ExchangeError>,
-    ) -> Result<T, String> {
+    ) -> Result<T, ExchangeError> {
         let key = self.breaker_key(callee.dir);
         callee.breaker.check(&key)?;
         let r = self.exchange(callee, request, read);
         callee
             .breaker
             .record(&key, r.as_ref().is_err_and(|e| e.timed_out));
-        r.map_err(String::from)
+        r
     }
 
     fn exchange<T>(

@@ -12,7 +12,7 @@ pub(crate) fn start_with_hello(
     version: u64,
     timeout: Duration,
 ) -> Result<Process, ExchangeError> {
-    let mut p = Process::start(s).map_err(ExchangeError::other)?;
+    let mut p = Process::start(s)?;
     let ours = serde_json::json!({
         "type": "hello",
         "protocol": protocol,

@@ -62,7 +62,8 @@ pub struct Spawn<'a> {
 
 /// Why an exchange failed: the message (exit status and stderr included), and whether it
 /// was the deadline (what the circuit breaker counts).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{message}")]
 pub struct ExchangeError {
     pub timed_out: bool,
     pub message: String,
@@ -75,18 +76,6 @@ impl ExchangeError {
             timed_out: false,
             message: message.into(),
         }
-    }
-}
-
-impl std::fmt::Display for ExchangeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.message)
-    }
-}
-
-impl From<ExchangeError> for String {
-    fn from(e: ExchangeError) -> String {
-        e.message
     }
 }
 
@@ -106,11 +95,11 @@ pub struct Process {
 
 impl Process {
     /// Starts the child in a process group of its own.
-    pub fn start(s: Spawn) -> Result<Self, String> {
+    pub fn start(s: Spawn) -> Result<Self, ExchangeError> {
         let (program, args) = s
             .command
             .split_first()
-            .ok_or_else(|| "the command is empty".to_owned())?;
+            .ok_or_else(|| ExchangeError::other("the command is empty"))?;
         let mut cmd = Command::new(program);
         cmd.args(args)
             .current_dir(s.dir)
@@ -126,9 +115,12 @@ impl Process {
                 }
             }
         }
-        let mut child = cmd
-            .spawn()
-            .map_err(|e| format!("could not start {program:?} in {}: {e}", s.dir.display()))?;
+        let mut child = cmd.spawn().map_err(|e| {
+            ExchangeError::other(format!(
+                "could not start {program:?} in {}: {e}",
+                s.dir.display()
+            ))
+        })?;
         let pgid = i32::try_from(child.id()).unwrap_or(i32::MAX);
         LIVE.lock()
             .unwrap_or_else(PoisonError::into_inner)
@@ -138,7 +130,10 @@ impl Process {
         else {
             let _ = killpg(Pid::from_raw(pgid), Signal::SIGKILL);
             let _ = child.wait();
-            return Err(format!("the {}'s pipes could not be opened", s.what));
+            return Err(ExchangeError::other(format!(
+                "the {}'s pipes could not be opened",
+                s.what
+            )));
         };
         let write_error = Arc::new(Mutex::new(None));
         let (stderr, stderr_done) = spawn_stderr_tail(stderr);

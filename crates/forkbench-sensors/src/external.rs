@@ -144,7 +144,10 @@ impl ExternalDetector {
 
     /// One request on this thread's pooled detector (a new one when none waits), counted
     /// by the circuit breaker.
-    fn request(&self, req: &DetectRequest<'_>) -> Result<ResponseMsg, String> {
+    fn request(
+        &self,
+        req: &DetectRequest<'_>,
+    ) -> Result<ResponseMsg, forkbench_ipc::ExchangeError> {
         let callee = Callee {
             dir: &self.dir,
             protocol: PROTOCOL,
@@ -200,7 +203,7 @@ impl PalletDetector for ExternalDetector {
             detector: self.name.clone(),
             reason,
         };
-        match self.request(req).map_err(fail)? {
+        match self.request(req).map_err(|e| fail(e.message))? {
             ResponseMsg::None { .. } => Ok(None),
             ResponseMsg::Error { message, .. } => {
                 Err(fail(format!("it reported: {}", clip(&message))))

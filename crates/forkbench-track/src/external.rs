@@ -124,7 +124,9 @@ impl ExternalTracker {
             what: "tracker",
             breaker: &BREAKER,
         };
-        self.cfg.call_json(callee, msg, ResponseMsg::id)
+        self.cfg
+            .call_json(callee, msg, ResponseMsg::id)
+            .map_err(|e| e.message)
     }
 
     /// The command from an answer, or why the answer cannot steer the truck.

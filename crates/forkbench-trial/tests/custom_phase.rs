@@ -65,9 +65,9 @@ fn creep_kind() -> PhaseKind {
         |table, _cx| {
             let c: Creep = phase_settings(table)?;
             if !(c.speed_mps.is_finite() && (0.0..=1.0).contains(&c.speed_mps)) {
-                return Err(format!(
-                    "speed_mps must lie in 0–1 m/s (got {})",
-                    c.speed_mps
+                return Err(forkbench_core::SettingsError::field(
+                    "speed_mps",
+                    format!("must lie in 0–1 m/s (got {})", c.speed_mps),
                 ));
             }
             Ok(Box::new(c))

@@ -57,7 +57,7 @@ impl ExternalPlanner {
 
     /// One request on this thread's pooled planner (a new one when none waits), counted
     /// by the circuit breaker.
-    fn request(&self, req: &PlanRequest) -> Result<ResponseMsg, String> {
+    fn request(&self, req: &PlanRequest) -> Result<ResponseMsg, ExchangeError> {
         let callee = Callee {
             dir: &self.dir,
             protocol: PROTOCOL,
@@ -107,7 +107,7 @@ impl Planner for ExternalPlanner {
             planner: name.clone(),
             reason,
         };
-        match self.request(req).map_err(rejected)? {
+        match self.request(req).map_err(|e| rejected(e.message))? {
             ResponseMsg::Error { message, .. } => Err(PlanError::Unreachable {
                 planner: name,
                 reason: clip(&message),

@@ -1,5 +1,6 @@
 //! The lift phase: the pallet rises onto the forks (off the floor, its mass on the truck) while the truck stands.
 
+use forkbench_core::SettingsError;
 use serde::{Deserialize, Serialize};
 
 use super::{Context, Phase, PhaseRun, criteria, settings};
@@ -21,10 +22,16 @@ impl Default for Lift {
     }
 }
 
-pub(super) fn build(table: &toml::Table, _cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
+pub(super) fn build(
+    table: &toml::Table,
+    _cx: &Context<'_>,
+) -> Result<Box<dyn Phase>, SettingsError> {
     let lift: Lift = settings(table)?;
     if !(lift.time_s.is_finite() && lift.time_s >= 0.0 && lift.time_s <= 60.0) {
-        return Err(format!("time_s must lie in 0–60 s (got {})", lift.time_s));
+        return Err(SettingsError::field(
+            "time_s",
+            format!("must lie in 0–60 s (got {})", lift.time_s),
+        ));
     }
     Ok(Box::new(lift))
 }

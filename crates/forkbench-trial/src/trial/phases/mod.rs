@@ -9,6 +9,7 @@ mod run;
 
 pub use run::open_loop;
 
+use forkbench_core::SettingsError;
 use std::sync::Arc;
 
 use serde::Serialize;
@@ -67,7 +68,7 @@ pub trait Phase: std::fmt::Debug + Send + Sync {
 
 /// Builds a phase from its settings table, checked against the scenario's context.
 pub type PhaseCtor =
-    Arc<dyn Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, String> + Send + Sync>;
+    Arc<dyn Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, SettingsError> + Send + Sync>;
 
 /// A phase kind: its name, the phases it may follow, the load it needs and leaves, and
 /// how its settings (and the world, for slots) build it. Registered with
@@ -101,7 +102,7 @@ impl PhaseKind {
         name: &str,
         after: &[&str],
         (needs_loaded, leaves_loaded): (Option<bool>, Option<bool>),
-        build: impl Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, String>
+        build: impl Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, SettingsError>
         + Send
         + Sync
         + 'static,
@@ -197,7 +198,8 @@ pub fn resolve(
             Some(_) => return Err((format!("phase.{name}"), "must be a table".into())),
             None => toml::Table::new(),
         };
-        let phase = (kind.build)(&table, cx).map_err(|e| (format!("phase.{name}"), e))?;
+        let phase =
+            (kind.build)(&table, cx).map_err(|e| (format!("phase.{name}"), e.to_string()))?;
         out.push(PhaseSpec {
             name: name.to_owned(),
             settings: table,
@@ -248,11 +250,12 @@ pub fn defaults_of<T: Serialize + Default>() -> toml::Value {
 }
 
 /// Each `(name, value, max)` a positive finite number of at most `max`.
-pub fn positive_at_most(fields: &[(&str, f64, f64)]) -> Result<(), String> {
+pub fn positive_at_most(fields: &[(&str, f64, f64)]) -> Result<(), SettingsError> {
     for &(name, v, max) in fields {
         if !(v.is_finite() && v > 0.0 && v <= max) {
-            return Err(format!(
-                "{name} must be positive and at most {max} (got {v})"
+            return Err(SettingsError::field(
+                name,
+                format!("must be positive and at most {max} (got {v})"),
             ));
         }
     }
@@ -260,7 +263,9 @@ pub fn positive_at_most(fields: &[(&str, f64, f64)]) -> Result<(), String> {
 }
 
 /// A phase's settings from its table, refusing unknown keys; `check` then the values.
-pub fn settings<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T, String> {
-    T::deserialize(toml::Value::Table(table.clone()))
-        .map_err(|e| e.to_string().trim_end().to_owned())
+pub fn settings<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T, SettingsError> {
+    T::deserialize(toml::Value::Table(table.clone())).map_err(|e| SettingsError {
+        field: None,
+        reason: e.to_string().trim_end().to_owned(),
+    })
 }

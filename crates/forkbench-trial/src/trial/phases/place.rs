@@ -1,5 +1,6 @@
 //! The place phase: the truck carries the pallet into a drop slot along a pick planner's path, lowers it, and backs the forks out; judged on where the pallet stands against the slot.
 
+use forkbench_core::SettingsError;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, Signal, Style};
 use serde::{Deserialize, Serialize};
@@ -60,7 +61,10 @@ struct Place {
     cfg: PlaceFile,
 }
 
-pub(super) fn build(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
+pub(super) fn build(
+    table: &toml::Table,
+    cx: &Context<'_>,
+) -> Result<Box<dyn Phase>, SettingsError> {
     let cfg: PlaceFile = settings(table)?;
     positive_at_most(&[
         ("position_m", cfg.position_m, 10.0),
@@ -70,33 +74,36 @@ pub(super) fn build(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Pha
         ("timeout_s", cfg.timeout_s, 600.0),
     ])?;
     if !(cfg.stop_short_m.is_finite() && (0.0..=1.0).contains(&cfg.stop_short_m)) {
-        return Err(format!(
-            "stop_short_m must lie in 0–1 m (got {})",
-            cfg.stop_short_m
+        return Err(SettingsError::field(
+            "stop_short_m",
+            format!("must lie in 0–1 m (got {})", cfg.stop_short_m),
         ));
     }
     let slot = cfg
         .slot
         .clone()
-        .ok_or("slot: name the world's pallet slot to place at")?;
+        .ok_or_else(|| SettingsError::field("slot", "name the world's pallet slot to place at"))?;
     let at = slot_pose(cx.world, &slot)?;
     let (obstacles, labels) = cx.world.footprint_obstacles();
     if let Some(i) = obstacles.hit(&shrunk(pallet_footprint(cx.pallet)), &at) {
-        return Err(format!(
-            "slot {slot:?}: a pallet there overlaps {}",
-            labels[i]
+        return Err(SettingsError::field(
+            "slot",
+            format!("{slot:?}: a pallet there overlaps {}", labels[i]),
         ));
     }
     Ok(Box::new(Place { slot, at, cfg }))
 }
 
 /// The pose of the world's slot `name` (its face centre, heading into the rack).
-fn slot_pose(world: &World, name: &str) -> Result<Pose2, String> {
+fn slot_pose(world: &World, name: &str) -> Result<Pose2, SettingsError> {
     world.slot_pose(name).ok_or_else(|| {
         let known: Vec<_> = world.pallet_slot.iter().map(|s| s.name.as_str()).collect();
-        format!(
-            "slot {name:?}: the world has no such slot (slots: {})",
-            known.join(", ")
+        SettingsError::field(
+            "slot",
+            format!(
+                "{name:?}: the world has no such slot (slots: {})",
+                known.join(", ")
+            ),
         )
     })
 }

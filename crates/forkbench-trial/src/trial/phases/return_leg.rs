@@ -1,5 +1,6 @@
 //! Mission legs inside the cycle: `carry` (the load on the forks, to where a place begins) and `return` (back to a station, the charging station by default), planned and driven as mission legs.
 
+use forkbench_core::SettingsError;
 use forkbench_nav::NavMap;
 use serde::{Deserialize, Serialize};
 
@@ -31,7 +32,10 @@ struct Leg {
 }
 
 /// A `carry`: the destination is required.
-pub(super) fn build_carry(table: &toml::Table, cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
+pub(super) fn build_carry(
+    table: &toml::Table,
+    cx: &Context<'_>,
+) -> Result<Box<dyn Phase>, SettingsError> {
     build(table, cx, None)
 }
 
@@ -39,7 +43,7 @@ pub(super) fn build_carry(table: &toml::Table, cx: &Context<'_>) -> Result<Box<d
 pub(super) fn build_return(
     table: &toml::Table,
     cx: &Context<'_>,
-) -> Result<Box<dyn Phase>, String> {
+) -> Result<Box<dyn Phase>, SettingsError> {
     let start = cx.mission.map(|m| m.start.clone());
     build(table, cx, start)
 }
@@ -48,21 +52,31 @@ fn build(
     table: &toml::Table,
     cx: &Context<'_>,
     default: Option<Waypoint>,
-) -> Result<Box<dyn Phase>, String> {
+) -> Result<Box<dyn Phase>, SettingsError> {
     let cfg: LegFile = settings(table)?;
-    cx.mission
-        .ok_or("needs a [mission] table: its global planner and tracker drive the leg")?;
+    cx.mission.ok_or_else(|| SettingsError {
+        field: None,
+        reason: "needs a [mission] table: its global planner and tracker drive the leg".into(),
+    })?;
     let mut to = match (&cfg.to, &cfg.pose) {
-        (Some(_), Some(_)) => return Err("give `to` (a station) or `pose`, not both".into()),
+        (Some(_), Some(_)) => {
+            return Err(SettingsError::field(
+                "to",
+                "give `to` (a station) or `pose`, not both",
+            ));
+        }
         (Some(name), None) => station(cx, name)?,
         (None, Some(p)) => {
             let pose = p.to_pose();
             let limit = crate::scenario::MAX_WORLD_EXTENT_M;
             let within = |v: f64, lim: f64| v.is_finite() && v.abs() <= lim;
             if !(within(p.x_m, limit) && within(p.y_m, limit) && within(p.heading_deg, 360.0)) {
-                return Err(format!(
-                    "pose must lie within ±{limit} m and ±360° (got x_m {}, y_m {}, heading_deg {})",
-                    p.x_m, p.y_m, p.heading_deg
+                return Err(SettingsError::field(
+                    "pose",
+                    format!(
+                        "must lie within ±{limit} m and ±360° (got x_m {}, y_m {}, heading_deg {})",
+                        p.x_m, p.y_m, p.heading_deg
+                    ),
                 ));
             }
             Waypoint {
@@ -70,11 +84,16 @@ fn build(
                 pose,
             }
         }
-        (None, None) => default.ok_or("name where to drive: `to` (a station) or `pose`")?,
+        (None, None) => default.ok_or_else(|| {
+            SettingsError::field("to", "name where to drive: `to` (a station) or `pose`")
+        })?,
     };
     if let Some(h) = cfg.heading_deg {
         if !(h.is_finite() && h.abs() <= 360.0) {
-            return Err(format!("heading_deg must lie within ±360° (got {h})"));
+            return Err(SettingsError::field(
+                "heading_deg",
+                format!("must lie within ±360° (got {h})"),
+            ));
         }
         to.pose.heading_rad = h.to_radians();
     }
@@ -82,10 +101,13 @@ fn build(
 }
 
 /// The world's station `name` as a waypoint.
-fn station(cx: &Context<'_>, name: &str) -> Result<Waypoint, String> {
+fn station(cx: &Context<'_>, name: &str) -> Result<Waypoint, SettingsError> {
     let pose = cx.world.station_pose(name).ok_or_else(|| {
         let known: Vec<_> = cx.world.station.iter().map(|s| s.name.as_str()).collect();
-        format!("to: no station {name:?} in the world (it has {known:?})")
+        SettingsError::field(
+            "to",
+            format!("no station {name:?} in the world (it has {known:?})"),
+        )
     })?;
     Ok(Waypoint {
         name: name.to_owned(),

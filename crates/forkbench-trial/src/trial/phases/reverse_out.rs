@@ -1,6 +1,7 @@
 //! The reverse-out phase: the truck backs straight out along its own axis for a set distance, with or without the pallet.
 
 use forkbench_core::Pose2;
+use forkbench_core::SettingsError;
 use serde::{Deserialize, Serialize};
 
 use super::run::open_loop;
@@ -30,7 +31,10 @@ impl Default for ReverseOut {
     }
 }
 
-pub(super) fn build(table: &toml::Table, _cx: &Context<'_>) -> Result<Box<dyn Phase>, String> {
+pub(super) fn build(
+    table: &toml::Table,
+    _cx: &Context<'_>,
+) -> Result<Box<dyn Phase>, SettingsError> {
     let r: ReverseOut = settings(table)?;
     positive_at_most(&[
         ("distance_m", r.distance_m, 50.0),
