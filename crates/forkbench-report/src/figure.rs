@@ -87,16 +87,23 @@ pub fn err<E: std::fmt::Debug>(e: E) -> ReportError {
     ReportError::Backend(format!("{e:?}"))
 }
 
-pub const COLORS: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(23, 190, 207),
-];
+/// The figures' series colours: [`crate::TAB10`] without its grey and olive.
+pub const COLORS: [RGBColor; 8] = {
+    const fn rgb(i: usize) -> RGBColor {
+        let (r, g, b) = crate::TAB10[i];
+        RGBColor(r, g, b)
+    }
+    [
+        rgb(0),
+        rgb(1),
+        rgb(2),
+        rgb(3),
+        rgb(4),
+        rgb(5),
+        rgb(6),
+        rgb(9),
+    ]
+};
 
 /// The colour of series `i` of `n`: the palette's up to its size, else evenly spaced
 /// hues, so no two series share one.

@@ -24,6 +24,21 @@ pub mod sweep;
 
 use std::path::PathBuf;
 
+/// The colours of every chart, the HTML report's and the figures' (matplotlib's tab10:
+/// blue, orange, green, red, purple, brown, pink, grey, olive, cyan), readable on white.
+pub const TAB10: [(u8, u8, u8); 10] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (214, 39, 40),
+    (148, 103, 189),
+    (140, 86, 75),
+    (227, 119, 194),
+    (127, 127, 127),
+    (188, 189, 34),
+    (23, 190, 207),
+];
+
 /// What went wrong making a report or a figure.
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {

@@ -2,11 +2,15 @@
 
 use std::fmt::Write as _;
 
-/// Colours fixed by meaning (failure kinds, series), readable on white.
-pub const PALETTE: [&str; 10] = [
-    "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-    "#bcbd22", "#17becf",
-];
+/// The report's order of [`crate::TAB10`] (failure kinds, series): red second, as the
+/// first failure kind reads best in it.
+const ORDER: [usize; 10] = [0, 3, 2, 1, 4, 5, 6, 7, 8, 9];
+
+/// The colour of the `i`-th failure kind or series, as `#rrggbb`.
+fn palette(i: usize) -> String {
+    let (r, g, b) = crate::TAB10[ORDER[i % ORDER.len()]];
+    format!("#{r:02x}{g:02x}{b:02x}")
+}
 
 pub use forkbench_trial::text::markup as esc;
 
@@ -36,7 +40,7 @@ pub fn stacked_bars(id: &str, rows: &[(String, Vec<(String, u64)>)], kinds: &[St
         let mut x = label_w;
         for (kind, n) in segs {
             let w = bar_w * *n as f64 / total;
-            let c = PALETTE[kinds.iter().position(|k| k == kind).unwrap_or(0) % PALETTE.len()];
+            let c = palette(kinds.iter().position(|k| k == kind).unwrap_or(0));
             let _ = write!(
                 s,
                 "<rect x=\"{x:.1}\" y=\"{y}\" width=\"{w:.1}\" height=\"16\" fill=\"{c}\"><title>{}: {n} ({:.1} %)</title></rect>",
@@ -58,7 +62,7 @@ pub fn stacked_bars(id: &str, rows: &[(String, Vec<(String, u64)>)], kinds: &[St
             label_w + 140.0 * (i % 4) as f64 - 200.0,
             y0 + 22.0 * (i / 4) as f64,
         );
-        let c = PALETTE[i % PALETTE.len()];
+        let c = palette(i);
         let _ = write!(
             s,
             "<rect x=\"{x}\" y=\"{y}\" width=\"12\" height=\"12\" fill=\"{c}\"/><text x=\"{}\" y=\"{}\">{}</text>",
@@ -294,7 +298,7 @@ pub fn histogram(
         "fraction of trials",
     );
     for (k, c) in counts.iter().enumerate() {
-        let colour = PALETTE[k % PALETTE.len()];
+        let colour = palette(k);
         let mut d = format!("M{left},{}", top + h);
         for (i, v) in c.iter().enumerate() {
             let (xa, xb, y) = (
@@ -310,7 +314,7 @@ pub fn histogram(
             left + w,
             top + h
         );
-        legend_entry(&mut s, (left + w, top), k, colour, &series[k].0);
+        legend_entry(&mut s, (left + w, top), k, &colour, &series[k].0);
     }
     let xt = left + w * tolerance / x1;
     let _ = write!(
@@ -347,7 +351,7 @@ pub fn lines(id: &str, title: &str, series: &[(String, Vec<Point>)], x_label: &s
     let px = |x: f64| left + w * x / x1;
     let py = |y: f64| top + h * (1.0 - y / 100.0);
     for (k, (label, pts)) in series.iter().enumerate() {
-        let colour = PALETTE[k % PALETTE.len()];
+        let colour = palette(k);
         let d: Vec<String> = pts
             .iter()
             .map(|p| format!("{:.1},{:.1}", px(p.0), py(p.1)))
@@ -367,7 +371,7 @@ pub fn lines(id: &str, title: &str, series: &[(String, Vec<Point>)], x_label: &s
                 py(p.1)
             );
         }
-        legend_entry(&mut s, (left + w, top), k, colour, label);
+        legend_entry(&mut s, (left + w, top), k, &colour, label);
     }
     s + "</svg>"
 }
