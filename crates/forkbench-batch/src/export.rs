@@ -53,8 +53,15 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
     let mut sorted: Vec<&TrialRecord> = records.iter().collect();
     sorted.sort_by_key(|r| r.key());
     let mut w = csv::Writer::from_writer(Vec::new());
-    // The step criteria's measurements follow the fixed columns, one column each.
-    let measures = forkbench_trial::trial::step_measures();
+    // The step criteria's measurements follow the fixed columns, one column each: the
+    // built-in ones, then any a registered criterion wrote, by name.
+    let mut measures: Vec<&str> = forkbench_trial::trial::step_measures();
+    let extra: std::collections::BTreeSet<&str> = sorted
+        .iter()
+        .flat_map(|r| r.outcome.measures.keys().map(String::as_str))
+        .filter(|k| !measures.contains(k))
+        .collect();
+    measures.extend(extra);
     // Safety columns only in batches with people or safety fields, so others keep theirs.
     let safety = sorted.iter().any(|r| r.outcome.safety.is_some());
     let mut header_written = false;

@@ -78,6 +78,8 @@ pub struct Registry {
     estimator: EstimatorCtor,
     /// The phases a scenario may list after the pick, in registration order.
     phases: Vec<crate::trial::PhaseKind>,
+    /// The criteria every pick measures at each step, in the order of blame.
+    step_criteria: Vec<crate::step_criteria::StepCtor>,
 }
 
 impl std::fmt::Debug for Registry {
@@ -142,6 +144,7 @@ impl Registry {
             scaled_localizers: std::collections::BTreeSet::new(),
             estimator: Arc::new(|cfg| Box::new(cfg.clone())),
             phases: crate::trial::builtin_phases(),
+            step_criteria: crate::step_criteria::STEP_CRITERIA.to_vec(),
         }
         .with_scaled_localizer("gaussian", |s, cx| {
             forkbench_core::settings::parse::<Empty>(s)?;
@@ -266,6 +269,20 @@ impl Registry {
         self.phases.retain(|k| k.name != kind.name);
         self.phases.push(kind);
         self
+    }
+
+    /// Adds a criterion every pick of a scenario on this registry measures at each step,
+    /// judged after the ones before it (replacing one of its name).
+    pub fn with_step_criterion(mut self, ctor: crate::step_criteria::StepCtor) -> Self {
+        let name = ctor().name();
+        self.step_criteria.retain(|c| c().name() != name);
+        self.step_criteria.push(ctor);
+        self
+    }
+
+    /// The step criteria, fresh for one trial, in the order of blame.
+    pub fn step_criteria(&self) -> Vec<Box<dyn crate::step_criteria::StepCriterion>> {
+        self.step_criteria.iter().map(|c| c()).collect()
     }
 
     /// The phase kinds, in registration order.

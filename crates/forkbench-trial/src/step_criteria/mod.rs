@@ -17,7 +17,8 @@ pub struct StepView<'a> {
 }
 
 /// A criterion of the pick that measures at every step and judges its measurement at the
-/// end. Adding one is a file here and a row of [`STEP_CRITERIA`].
+/// end. Adding one is a file here and a row of [`STEP_CRITERIA`]; from outside the crate,
+/// [`crate::Registry::with_step_criterion`].
 pub trait StepCriterion: Send + std::fmt::Debug {
     /// The failure's name (snake case): the verdict, `also_failed` and the summaries
     /// count it by this.
@@ -40,15 +41,20 @@ pub trait StepCriterion: Send + std::fmt::Debug {
     }
 }
 
-/// The step criteria in the order of blame, after the pick's fixed criteria.
-pub const STEP_CRITERIA: &[fn() -> Box<dyn StepCriterion>] = &[fork_tip_clearance::build];
+/// Makes a step criterion, fresh for one trial.
+pub type StepCtor = fn() -> Box<dyn StepCriterion>;
 
-/// Each step criterion, fresh for one trial.
-pub(crate) fn build_all() -> Vec<Box<dyn StepCriterion>> {
+/// The built-in step criteria in the order of blame, after the pick's fixed criteria; a
+/// registry adds more ([`crate::Registry::with_step_criterion`]).
+pub const STEP_CRITERIA: &[StepCtor] = &[fork_tip_clearance::build];
+
+/// Each built-in step criterion, fresh.
+fn build_all() -> Vec<Box<dyn StepCriterion>> {
     STEP_CRITERIA.iter().map(|b| b()).collect()
 }
 
-/// The measurement keys of every step criterion, in order (the CSV's extra columns).
+/// The measurement keys of every built-in step criterion, in order (the CSV's first extra
+/// columns; a registered criterion's follow them).
 pub fn step_measures() -> Vec<&'static str> {
     build_all().iter().map(|c| c.measure()).collect()
 }

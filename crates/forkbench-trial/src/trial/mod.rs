@@ -44,7 +44,7 @@ pub const PERSON_CONTACT: &str = "person_contact";
 /// where it begins (a mission's own legs may end at a waypoint called "staging").
 pub const STAGING_LEG: &str = "pick start → staging";
 pub use crate::step_criteria::{
-    STEP_CRITERIA, StepCriterion, StepView, step_criterion_name, step_measures,
+    STEP_CRITERIA, StepCriterion, StepCtor, StepView, step_criterion_name, step_measures,
 };
 pub use criteria::{Criterion, PICK_CRITERIA};
 pub use engine::{Episode, Stage};

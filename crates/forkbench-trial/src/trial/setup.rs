@@ -270,7 +270,7 @@ impl<'a> Trial<'a> {
             sense: perception(scn, run, detector, true_pallet),
             verdict: Verdict {
                 out,
-                step_criteria: crate::step_criteria::build_all(),
+                step_criteria: scn.registry.step_criteria(),
                 timed_out: true,
                 pick_started: (0.0, 0.0),
                 phase_measures: std::collections::BTreeMap::new(),
