@@ -56,7 +56,8 @@ pub fn run_trial<'py>(
         wall_budget_s: None,
     };
     // The CLI's own check: values in range, and every override acting on this scenario.
-    scn.check_options(&opts)
+    let run = scn
+        .check_options(&opts)
         .map_err(|e| scenario_error(py, &e))?;
     let out = match mcap {
         None => py.detach(|| forkbench_trial::run_trial(scn, case, &opts)),
@@ -68,11 +69,8 @@ pub fn run_trial<'py>(
                 ..Default::default()
             };
             let r = py
-                .detach(|| forkbench_log::run_recorded(scn, case, &opts, &targets))
-                .map_err(|e| match e {
-                    forkbench_log::RecordError::Trial(t) => scenario_error(py, &t),
-                    e => RecordingError::new_err(e.to_string()),
-                })?;
+                .detach(|| forkbench_log::run_recorded((scn, case), (&opts, &run), &targets))
+                .map_err(|e| RecordingError::new_err(e.to_string()))?;
             r.written
                 .map_err(|e| RecordingError::new_err(e.to_string()))?;
             r.outcome

@@ -45,16 +45,10 @@ pub fn replay<'py>(
         forkbench_batch::BatchError::Trial(t) => scenario_error(py, &t),
         e => BatchError::new_err(e.to_string()),
     };
-    let job = if let Ok(path) = record.extract::<PathBuf>() {
-        if line == 0 {
-            return Err(BatchError::new_err("line 0: lines are numbered from 1"));
-        }
-        let file = path.clone();
+    let job = if let Ok(file) = record.extract::<PathBuf>() {
         py.detach(|| {
-            Replay::load(&file, line, None).and_then(|j| match given {
-                Some(s) => Replay::find(j.record, Some(s), Some(&file)),
-                None => Ok(j),
-            })
+            let rec = Replay::read_record(&file, line)?;
+            Replay::find(rec, given, Some(&file))
         })
         .map_err(fail)?
     } else {
@@ -68,17 +62,18 @@ pub fn replay<'py>(
     };
     let case = job.case().map_err(fail)?;
     let opts = job.options();
+    let run = job
+        .scenario
+        .resolve(&opts)
+        .map_err(|e| scenario_error(py, &e))?;
     let targets = forkbench_log::RecordTargets {
         mcap,
         force,
         ..Default::default()
     };
     let recorded = py
-        .detach(|| forkbench_log::run_recorded(&job.scenario, case, &opts, &targets))
-        .map_err(|e| match e {
-            forkbench_log::RecordError::Trial(t) => scenario_error(py, &t),
-            e => RecordingError::new_err(e.to_string()),
-        })?;
+        .detach(|| forkbench_log::run_recorded((&job.scenario, case), (&opts, &run), &targets))
+        .map_err(|e| RecordingError::new_err(e.to_string()))?;
     recorded
         .written
         .map_err(|e| RecordingError::new_err(e.to_string()))?;

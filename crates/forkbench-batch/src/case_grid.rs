@@ -39,7 +39,7 @@ impl ScenarioEntry {
     /// with the fork tips the pick's gap before the face) in the start pose's frame. `None`
     /// when the settings do not hold a truck and posed cases.
     pub fn case_geometry(&self) -> Option<BTreeMap<String, (f64, f64)>> {
-        let s: GeometrySettings = serde_json::from_value(self.settings.clone()).ok()?;
+        let s = GeometrySettings::deserialize(&self.settings).ok()?;
         let gap_m = s.pick.map_or(forkbench_trial::trial::APPROACH_GAP_M, |p| {
             p.pre_entry_gap_m
         });

@@ -16,25 +16,30 @@ pub struct Replay {
 impl Replay {
     /// Reads line `line` (1-based) of `file` and finds its scenario ([`Replay::find`]).
     pub fn load(file: &Path, line: usize, scenario: Option<&Path>) -> Result<Self, BatchError> {
-        let text = crate::read_regular(file, crate::MAX_RECORDS_BYTES)?;
+        let record = Self::read_record(file, line)?;
+        let scenario = scenario.map(Scenario::load).transpose()?;
+        Self::find(record, scenario, Some(file))
+    }
+
+    /// The trial record on line `line` (1-based) of `file`.
+    pub fn read_record(file: &Path, line: usize) -> Result<TrialRecord, BatchError> {
         if line == 0 {
             return Err(BatchError::Invalid(
                 "line 0: lines are numbered from 1".into(),
             ));
         }
+        let text = crate::read_regular(file, crate::MAX_RECORDS_BYTES)?;
         let Some(raw) = text.lines().nth(line - 1) else {
             return Err(BatchError::Invalid(format!(
                 "{}: has no line {line}",
                 file.display()
             )));
         };
-        let record: TrialRecord = serde_json::from_str(raw).map_err(|e| BatchError::Record {
+        serde_json::from_str(raw).map_err(|e| BatchError::Record {
             path: file.display().to_string(),
             line,
             message: format!("not a trial record: {e}"),
-        })?;
-        let scenario = scenario.map(Scenario::load).transpose()?;
-        Self::find(record, scenario, Some(file))
+        })
     }
 
     /// A record and its scenario: `scenario` when given, else the file the batch's

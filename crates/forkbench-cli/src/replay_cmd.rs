@@ -16,7 +16,9 @@ pub fn replay(
         bail!("--line 0: lines are numbered from 1");
     }
     let job = forkbench_batch::Replay::load(file, line, scenario)?;
-    let r = forkbench_log::run_recorded(&job.scenario, job.case()?, &job.options(), rec)?;
+    let opts = job.options();
+    let run = job.scenario.resolve(&opts)?;
+    let r = forkbench_log::run_recorded((&job.scenario, job.case()?), (&opts, &run), rec)?;
     if let Some(e) = &r.viewer_error {
         eprintln!("error: {e} (the trial ran without the viewer)");
     }

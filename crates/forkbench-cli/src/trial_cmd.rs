@@ -26,14 +26,14 @@ pub fn run(
     let case = scn.pick_case(case)?;
     // Unknown planner or tracker names, and overrides that cannot act, stop here, before
     // any recording file is made.
-    scn.check_options(opts)?;
+    let run = scn.check_options(opts)?;
     // File targets are checked before the run; a viewer that cannot be reached is
     // reported and the trial runs anyway.
     let forkbench_log::Recorded {
         outcome: out,
         written,
         viewer_error,
-    } = forkbench_log::run_recorded(&scn, case, opts, rec)?;
+    } = forkbench_log::run_recorded((&scn, case), (opts, &run), rec)?;
     if let Some(e) = &viewer_error {
         eprintln!("error: {e} (the trial ran without the viewer)");
     }

@@ -187,15 +187,14 @@ pub struct Recorded {
     pub viewer_error: Option<LogError>,
 }
 
-/// Opens `targets` (file targets checked before the run) and runs one trial into them.
+/// Opens `targets` (file targets checked before the run) and runs one trial into them;
+/// `run` is `opts` resolved against `scn` (what the MCAP's metadata names).
 pub fn run_recorded(
-    scn: &Scenario,
-    case: &Case,
-    opts: &TrialOptions,
+    (scn, case): (&Scenario, &Case),
+    (opts, run): (&TrialOptions, &Resolved),
     targets: &RecordTargets,
-) -> Result<Recorded, RecordError> {
-    let run = scn.resolve(opts)?;
-    let mut sinks = Sinks::open(targets, metadata(&scn.name, &case.name, &run))?;
+) -> Result<Recorded, LogError> {
+    let mut sinks = Sinks::open(targets, metadata(&scn.name, &case.name, run))?;
     let (outcome, written) =
         sinks.record(|rec| forkbench_trial::run_trial_recorded(scn, case, opts, rec));
     Ok(Recorded {
@@ -229,7 +228,7 @@ pub fn record_trial(
         force: true,
         ..RecordTargets::default()
     };
-    let r = run_recorded(scn, case, opts, &targets)?;
+    let r = run_recorded((scn, case), (opts, &run), &targets)?;
     r.written?;
     Ok((r.outcome, rrd))
 }
