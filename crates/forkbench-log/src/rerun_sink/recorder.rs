@@ -49,6 +49,28 @@ fn legs_table(o: &TrialOutcome) -> String {
     s + "\n"
 }
 
+/// The pick's criteria that keep a measurement, each as a row of the verdict's table
+/// (`criterion | value | limit`), the broken ones in bold.
+fn criteria_rows(o: &TrialOutcome, tol: &forkbench_trial::Limits) -> String {
+    forkbench_trial::trial::PICK_CRITERIA
+        .iter()
+        .filter_map(|c| {
+            let r = c.reading(o, tol)?;
+            let name = c.failure.name();
+            let broken = o.failure == Some(c.failure)
+                || o.also_failed
+                    .iter()
+                    .any(|a| a.split(':').next() == Some(name));
+            let value = if broken {
+                format!("**{}** ❌", r.value)
+            } else {
+                r.value
+            };
+            Some(format!("| {} | {value} | {} |\n", r.label, r.limit))
+        })
+        .collect()
+}
+
 /// The step criteria's measurements as rows of the verdict's table (`measure | value`).
 fn measures_rows(o: &TrialOutcome) -> String {
     o.measures
@@ -164,15 +186,9 @@ impl RerunRecorder {
             format!("#### ❌ FAILED: {failure}")
         };
         let detail = verdict_detail(o);
-        let [lat_limit, head_limit, _] = self.limits;
-        let num = |v: Option<f64>, f: &dyn Fn(f64) -> String| v.map_or("—".to_owned(), f);
         format!(
             "{head}\n\n{detail}\n\n{}\
-             | at entry | value | limit |\n|---|---|---|\n\
-             | lateral offset | {} | {lat_limit} m |\n\
-             | heading | {} | {head_limit}° |\n\
-             | fork depth | {} | |\n\
-             | max contact force | {:.0} N | |\n{}\n\
+             | criterion | value | limit |\n|---|---|---|\n{}{}\n\
              {}**{}** · case `{}` · planner `{}` · tracker `{}` · seed {} · {:.2} s simulated, {} replans\n\n\
              Map (y up, 1 m grid): white arrow start · light-blue arrow goal (pre-entry) · \
              blue plan being driven (thin: its control polygon), faded plans superseded · \
@@ -187,13 +203,7 @@ impl RerunRecorder {
              **Events**\n\n```text\n{}\n```\n\n\
              **Outcome**\n\n```json\n{}\n```\n",
             phases_table(o),
-            num(o.lateral_error_m, &|v| format!("{v:.3} m")),
-            num(o.heading_error_rad, &|v| format!("{:.2}°", v.to_degrees())),
-            num(
-                Some(o.insertion_depth_m).filter(|v| v.is_finite()),
-                &|v| format!("{v:.3} m")
-            ),
-            o.max_contact_force_n,
+            criteria_rows(o, &self.tolerances),
             measures_rows(o),
             legs_table(o),
             o.scenario,
@@ -217,6 +227,7 @@ impl RerunRecorder {
 
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
+        self.tolerances = s.tolerances.clone();
         self.limits = [
             s.tolerances.lateral_m,
             s.tolerances.heading_deg(),
@@ -431,4 +442,38 @@ fn verdict_detail(o: &TrialOutcome) -> String {
         );
     }
     detail
+}
+
+#[cfg(test)]
+mod tests {
+    use forkbench_trial::{Failure, Limits, TrialOutcome};
+
+    /// The verdict's table has a row per pick criterion that keeps its measurement, with
+    /// the scenario's limit, and marks the broken ones.
+    #[test]
+    fn the_verdict_table_comes_from_the_criteria() {
+        let mut o = TrialOutcome::blank("s", "c", ("p", "t"), 1, true);
+        o.lateral_error_m = Some(0.244);
+        o.heading_error_rad = Some(0.01);
+        o.max_contact_force_n = 50.0;
+        o.insertion_depth_m = 0.0;
+        o.fail(Failure::LateralError, "off".into());
+        o.also_failed = vec!["insertion_depth: forks 0 m deep".into()];
+        let rows = super::criteria_rows(&o, &Limits::default());
+        let shown = forkbench_trial::trial::PICK_CRITERIA
+            .iter()
+            .filter(|c| c.reading(&o, &Limits::default()).is_some())
+            .count();
+        assert_eq!(rows.lines().count(), shown);
+        assert!(
+            rows.contains("| lateral offset at entry | **0.244 m** ❌ | 0.1 m |"),
+            "{rows}"
+        );
+        assert!(
+            rows.contains("| fork depth | **0.000 m** ❌ | ≥ 1 m |"),
+            "{rows}"
+        );
+        assert!(rows.contains("| heading at entry | 0.57° | 3° |"), "{rows}");
+        assert!(rows.contains("| max contact force | 50 N |"), "{rows}");
+    }
 }

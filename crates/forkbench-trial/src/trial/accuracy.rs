@@ -7,8 +7,8 @@ use forkbench_sensors::scan::{Errors, scan};
 use serde::Serialize;
 
 use super::error::StageError;
-use super::setup::build_world;
 use super::streams::{ACCURACY, stream};
+use super::world::build_world;
 use crate::TrialError;
 use crate::scenario::sensors::{NamedScanner, PalletSensing};
 use crate::scenario::{Case, Scenario};

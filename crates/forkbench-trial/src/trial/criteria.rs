@@ -1,76 +1,163 @@
-//! The pick's criteria, each once: its failure, what it measures, and its check against its limit, in the order of blame.
+//! The pick's criteria, each once: its failure, what it measures, whether a breach is final, the verdict's row, and its check against its limit, in the order of blame.
 
 use forkbench_core::{ForkliftSpec, PalletSpec};
 
 use crate::outcome::{Failure, TrialOutcome};
 use crate::scenario::Limits;
 
-/// What the pick's criteria read: the outcome's measurements, the limits, the truck and
-/// pallet, and what the drive saw.
+/// The pick's measurements the criteria judge: at the end of the drive, or as they stand
+/// at a step (a caller-driven pick ends on the first final breach).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Judged<'a> {
-    pub out: &'a TrialOutcome,
-    pub tol: &'a Limits,
-    pub truck: &'a ForkliftSpec,
-    pub pallet: &'a PalletSpec,
+pub(super) struct PickMeasures {
     pub collision: bool,
     pub timed_out: bool,
-    /// The scenario's time limit.
-    pub timeout_s: f64,
+    pub max_contact_force_n: f64,
+    pub pallet_displacement_m: f64,
+    pub pallet_rotation_rad: f64,
+    /// At entry (`None`: the tips have not reached the face).
+    pub lateral_error_m: Option<f64>,
+    pub heading_error_rad: Option<f64>,
+    pub insertion_depth_m: f64,
     /// The fork middle farthest from its pocket's centre line, laterally.
     pub worst_pocket_miss_m: f64,
 }
 
+/// What the pick's criteria read: the measurements, the limits, the truck and pallet.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Judged<'a> {
+    pub m: PickMeasures,
+    pub tol: &'a Limits,
+    pub truck: &'a ForkliftSpec,
+    pub pallet: &'a PalletSpec,
+    /// The scenario's time limit.
+    pub timeout_s: f64,
+}
+
+/// One line of a verdict's table: what a criterion measured against its limit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reading {
+    pub label: &'static str,
+    /// The value with its unit (`—` when nothing was measured).
+    pub value: String,
+    /// The limit with its unit.
+    pub limit: String,
+}
+
 /// One criterion of the pick: the failure it names, what it measures (for documents and
-/// listings), and its check (the value against the limit when broken).
+/// listings), whether a breach is final, the verdict's row (from a judged outcome), and
+/// its check (the value against the limit when broken).
 #[derive(Debug, Clone, Copy)]
 pub struct Criterion {
     pub failure: Failure,
     pub measures: &'static str,
+    /// No later step can undo a breach (the truck touched a rack, the entry is past), so
+    /// a pick a caller drives ends on it; a breach that is not final may still mend
+    /// (the forks not deep yet).
+    pub irreversible: bool,
+    reading: Option<fn(&TrialOutcome, &Limits) -> Reading>,
     check: fn(&Judged<'_>) -> Option<String>,
 }
 
+impl Criterion {
+    /// What it measured in `out` against `tol`, for a verdict's table (`None`: its
+    /// measurement is not kept in the outcome).
+    pub fn reading(&self, out: &TrialOutcome, tol: &Limits) -> Option<Reading> {
+        self.reading.map(|r| r(out, tol))
+    }
+}
+
 /// The pick's criteria in the order of blame: the first broken one is the verdict.
-/// Adding one is a `Failure` variant and a row here.
+/// Adding one is a `Failure` variant and a row here (a criterion that measures at each
+/// step is a [`crate::StepCriterion`] instead).
 pub const PICK_CRITERIA: &[Criterion] = &[
     Criterion {
         failure: Failure::Collision,
         measures: "the truck touched a rack or wall",
+        irreversible: true,
+        reading: None,
         check: collision,
     },
     Criterion {
         failure: Failure::ContactForce,
         measures: "the largest fork–pallet force before full depth",
+        irreversible: true,
+        reading: Some(|o, t| Reading {
+            label: "max contact force",
+            value: format!("{:.0} N", o.max_contact_force_n),
+            limit: format!("{:.0} N", t.contact_force_n),
+        }),
         check: contact_force,
     },
     Criterion {
         failure: Failure::PalletDisplaced,
         measures: "how far the pallet was pushed and turned",
+        irreversible: true,
+        reading: Some(|o, t| Reading {
+            label: "pallet moved, turned",
+            value: format!(
+                "{:.3} m, {:.2}°",
+                o.pallet_displacement_m,
+                o.pallet_rotation_rad.to_degrees()
+            ),
+            limit: format!(
+                "{} m, {}°",
+                t.pallet_displacement_m,
+                t.pallet_rotation_deg()
+            ),
+        }),
         check: pallet_displaced,
     },
     Criterion {
         failure: Failure::LateralError,
         measures: "the fork root's offset from the pocket centre line at entry",
+        irreversible: true,
+        reading: Some(|o, t| Reading {
+            label: "lateral offset at entry",
+            value: o
+                .lateral_error_m
+                .map_or("—".into(), |v| format!("{v:.3} m")),
+            limit: format!("{} m", t.lateral_m),
+        }),
         check: lateral_error,
     },
     Criterion {
         failure: Failure::HeadingError,
         measures: "the heading off the pallet axis at entry",
+        irreversible: true,
+        reading: Some(|o, t| Reading {
+            label: "heading at entry",
+            value: o
+                .heading_error_rad
+                .map_or("—".into(), |v| format!("{:.2}°", v.to_degrees())),
+            limit: format!("{}°", t.heading_deg()),
+        }),
         check: heading_error,
     },
     Criterion {
         failure: Failure::Timeout,
         measures: "whether the truck stood at the goal within the time limit",
+        irreversible: false,
+        reading: None,
         check: timeout,
     },
     Criterion {
         failure: Failure::InsertionDepth,
         measures: "how deep the fork tips went past the pallet face",
+        irreversible: false,
+        reading: Some(|o, t| Reading {
+            label: "fork depth",
+            value: Some(o.insertion_depth_m)
+                .filter(|v| v.is_finite())
+                .map_or("—".into(), |v| format!("{v:.3} m")),
+            limit: format!("≥ {} m", t.insertion_depth_m),
+        }),
         check: insertion_depth,
     },
     Criterion {
         failure: Failure::ForkOutsidePocket,
         measures: "the fork middle's lateral distance from its pocket centre",
+        irreversible: false,
+        reading: None,
         check: fork_outside_pocket,
     },
 ];
@@ -83,29 +170,36 @@ pub(super) fn broken(j: &Judged<'_>) -> Vec<(Failure, String)> {
         .collect()
 }
 
+/// Whether a criterion whose breach is final is broken by the measurements now.
+pub(super) fn broken_for_good(j: &Judged<'_>) -> bool {
+    PICK_CRITERIA
+        .iter()
+        .any(|c| c.irreversible && (c.check)(j).is_some())
+}
+
 fn collision(j: &Judged<'_>) -> Option<String> {
-    j.collision
+    j.m.collision
         .then(|| "truck touched a rack or wall".to_owned())
 }
 
 fn contact_force(j: &Judged<'_>) -> Option<String> {
-    (j.out.max_contact_force_n > j.tol.contact_force_n).then(|| {
+    (j.m.max_contact_force_n > j.tol.contact_force_n).then(|| {
         format!(
             "fork–pallet contact {:.0} N > {:.0} N before full depth",
-            j.out.max_contact_force_n, j.tol.contact_force_n
+            j.m.max_contact_force_n, j.tol.contact_force_n
         )
     })
 }
 
 fn pallet_displaced(j: &Judged<'_>) -> Option<String> {
-    let (out, tol) = (j.out, j.tol);
-    (out.pallet_displacement_m > tol.pallet_displacement_m
-        || out.pallet_rotation_rad.abs() > tol.pallet_rotation_rad)
+    let (m, tol) = (&j.m, j.tol);
+    (m.pallet_displacement_m > tol.pallet_displacement_m
+        || m.pallet_rotation_rad.abs() > tol.pallet_rotation_rad)
         .then(|| {
             format!(
                 "pallet moved {:.3} m and turned {:.2}° (limits {} m, {}°)",
-                out.pallet_displacement_m,
-                out.pallet_rotation_rad.to_degrees(),
+                m.pallet_displacement_m,
+                m.pallet_rotation_rad.to_degrees(),
                 tol.pallet_displacement_m,
                 tol.pallet_rotation_deg()
             )
@@ -114,16 +208,14 @@ fn pallet_displaced(j: &Judged<'_>) -> Option<String> {
 
 fn lateral_error(j: &Judged<'_>) -> Option<String> {
     let limit = j.tol.lateral_m;
-    j.out
-        .lateral_error_m
+    j.m.lateral_error_m
         .filter(|e| e.abs() > limit)
         .map(|e| format!("{e:.3} m off the pocket centre line at entry (limit {limit} m)"))
 }
 
 fn heading_error(j: &Judged<'_>) -> Option<String> {
     let tol = j.tol;
-    j.out
-        .heading_error_rad
+    j.m.heading_error_rad
         .filter(|e| e.abs() > tol.heading_rad)
         .map(|e| {
             format!(
@@ -135,22 +227,22 @@ fn heading_error(j: &Judged<'_>) -> Option<String> {
 }
 
 fn timeout(j: &Judged<'_>) -> Option<String> {
-    j.timed_out
+    j.m.timed_out
         .then(|| format!("not stopped at the goal after {} s", j.timeout_s))
 }
 
 fn insertion_depth(j: &Judged<'_>) -> Option<String> {
-    (j.out.insertion_depth_m < j.tol.insertion_depth_m).then(|| {
+    (j.m.insertion_depth_m < j.tol.insertion_depth_m).then(|| {
         format!(
             "forks {:.3} m deep (required {} m)",
-            j.out.insertion_depth_m, j.tol.insertion_depth_m
+            j.m.insertion_depth_m, j.tol.insertion_depth_m
         )
     })
 }
 
 fn fork_outside_pocket(j: &Judged<'_>) -> Option<String> {
     let clearance = (j.pallet.pocket_width_m - j.truck.fork_width_m) / 2.0;
-    let miss = j.worst_pocket_miss_m;
+    let miss = j.m.worst_pocket_miss_m;
     (miss > clearance).then(|| {
         format!("a fork is {miss:.3} m from its pocket centre (clearance {clearance:.4} m)")
     })
@@ -177,5 +269,89 @@ mod tests {
                 "fork_outside_pocket"
             ]
         );
+    }
+
+    /// Measurements of a pick well inside every limit, mid-approach: standing off the
+    /// face, nothing touched.
+    fn clean() -> PickMeasures {
+        PickMeasures {
+            collision: false,
+            timed_out: false,
+            max_contact_force_n: 0.0,
+            pallet_displacement_m: 0.0,
+            pallet_rotation_rad: 0.0,
+            lateral_error_m: Some(0.0),
+            heading_error_rad: Some(0.0),
+            insertion_depth_m: -1.0,
+            worst_pocket_miss_m: 0.0,
+        }
+    }
+
+    /// A caller-driven pick ends on a breach no later step can mend (a touched rack, a
+    /// pushed pallet, an entry off the line) and not on one that may still mend (the
+    /// forks short of their depth, out of time).
+    #[test]
+    fn only_final_breaches_end_a_pick_early() {
+        let (tol, truck, pallet) = (
+            Limits::default(),
+            ForkliftSpec::default(),
+            PalletSpec::field_1200(),
+        );
+        let judged = |m| Judged {
+            m,
+            tol: &tol,
+            truck: &truck,
+            pallet: &pallet,
+            timeout_s: 60.0,
+        };
+        let m = clean();
+        // Short of depth: broken, but not for good.
+        assert_eq!(broken(&judged(m))[0].0, Failure::InsertionDepth);
+        assert!(!broken_for_good(&judged(m)));
+        let timed_out = PickMeasures {
+            timed_out: true,
+            ..m
+        };
+        assert!(!broken_for_good(&judged(timed_out)));
+        for (name, breach) in [
+            (
+                "collision",
+                PickMeasures {
+                    collision: true,
+                    ..m
+                },
+            ),
+            (
+                "contact_force",
+                PickMeasures {
+                    max_contact_force_n: 1e6,
+                    ..m
+                },
+            ),
+            (
+                "pallet_displaced",
+                PickMeasures {
+                    pallet_rotation_rad: 1.0,
+                    ..m
+                },
+            ),
+            (
+                "lateral_error",
+                PickMeasures {
+                    lateral_error_m: Some(1.0),
+                    ..m
+                },
+            ),
+            (
+                "heading_error",
+                PickMeasures {
+                    heading_error_rad: Some(1.0),
+                    ..m
+                },
+            ),
+        ] {
+            assert_eq!(broken(&judged(breach))[0].0.name(), name);
+            assert!(broken_for_good(&judged(breach)), "{name}");
+        }
     }
 }

@@ -8,7 +8,7 @@ use super::engine::{Stage, Steering};
 use super::error::StageError;
 use super::judge::in_pallet_frame;
 use super::session::Control;
-use super::setup::Trial;
+use super::state::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
 use forkbench_core::{Signal, Style};
 
@@ -347,32 +347,18 @@ impl<'a> Trial<'a> {
 }
 
 impl Trial<'_> {
-    /// A caller-driven pick is over: the truck stands with the forks at the required
-    /// depth, or a criterion has failed in a way later ticks cannot undo.
+    /// A caller-driven pick is over: a criterion whose breach is final is broken (the
+    /// pick's own or a step criterion), or the truck stands with the forks at the
+    /// required depth.
     fn settled(&self) -> bool {
-        let (tol, out) = (&self.scn.tolerances, &self.verdict.out);
-        let pallet = self.world.sim.pallet_pose();
-        let moved = pallet.distance_to(&self.world.pallet0) > tol.pallet_displacement_m
-            || wrap_angle(pallet.heading_rad - self.world.pallet0.heading_rad).abs()
-                > tol.pallet_rotation_rad;
-        let entry_off = out.lateral_error_m.is_some_and(|e| e.abs() > tol.lateral_m)
-            || out
-                .heading_error_rad
-                .is_some_and(|e| e.abs() > tol.heading_rad);
-        let depth = self
-            .scn
-            .truck
-            .insertion_depth_m(&pallet, &self.world.sim.fork_root_pose());
+        let (m, now) = self.measures_now();
         let step_broken = self
             .verdict
             .step_criteria
             .iter()
             .any(|c| c.irreversible() && c.broken().is_some());
-        self.world.collision
+        super::criteria::broken_for_good(&self.judged(m))
             || step_broken
-            || out.max_contact_force_n > tol.contact_force_n
-            || moved
-            || entry_off
-            || (self.stands() && depth >= tol.insertion_depth_m)
+            || (self.stands() && now.insertion_depth_m >= self.scn.tolerances.insertion_depth_m)
     }
 }

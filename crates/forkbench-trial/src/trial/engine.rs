@@ -12,7 +12,7 @@ use super::error::StageError;
 use super::goal_for;
 use super::session::{Control, Observation, Truth};
 use super::session_view::ScanKeeper;
-use super::setup::Trial;
+use super::state::Trial;
 use crate::recorder::Recorder;
 
 /// Which part of the cycle a drive belongs to (what a caller's observation names).

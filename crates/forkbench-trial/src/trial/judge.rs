@@ -2,46 +2,45 @@
 
 use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
-use rand_chacha::ChaCha8Rng;
 
-use super::criteria::Judged;
-use super::setup::Trial;
+use super::criteria::{Judged, PickMeasures};
+use super::state::Trial;
 use crate::outcome::Failure;
 use crate::text::compact_numbers;
-
-/// The pallet pose moved by a draw of N(0, σ) per axis in its own frame, truncated at 3σ.
-pub(super) fn jitter(pallet: &Pose2, sigma: &Pose2, rng: &mut ChaCha8Rng) -> Pose2 {
-    if sigma.x_m == 0.0 && sigma.y_m == 0.0 && sigma.heading_rad == 0.0 {
-        return *pallet;
-    }
-    let mut draw = |s: f64| {
-        let z: f64 = rand::RngExt::sample(rng, rand_distr::StandardNormal);
-        s * z.clamp(-3.0, 3.0)
-    };
-    let d = Pose2::new(draw(sigma.x_m), draw(sigma.y_m), draw(sigma.heading_rad));
-    pallet.to_world(&d)
-}
 
 /// Fork-root pose in the pallet frame: x < 0 before the face, y the lateral offset.
 pub(super) fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
     pallet.to_local(root)
 }
 
+/// Where the forks stand against the pallet now: the fork root in the pallet frame, the
+/// insertion depth, how far the pallet moved and turned, the worst fork's lateral miss of
+/// its pocket.
+pub(super) struct Standing {
+    pub local: Pose2,
+    pub insertion_depth_m: f64,
+    pub pallet_displacement_m: f64,
+    pub pallet_rotation_rad: f64,
+    pub worst_pocket_miss_m: f64,
+}
+
 impl Trial<'_> {
     /// Writes the final measurements and the verdict into the outcome.
     pub(super) fn conclude(&mut self) {
-        let worst_pocket_miss = self.measure();
-        let judged = Judged {
-            out: &self.verdict.out,
-            tol: &self.scn.tolerances,
-            truck: &self.scn.truck,
-            pallet: &self.scn.pallet,
+        let worst_pocket_miss_m = self.measure();
+        let out = &self.verdict.out;
+        let m = PickMeasures {
             collision: self.world.collision,
             timed_out: self.verdict.timed_out,
-            timeout_s: self.scn.timeout_s,
-            worst_pocket_miss_m: worst_pocket_miss,
+            max_contact_force_n: out.max_contact_force_n,
+            pallet_displacement_m: out.pallet_displacement_m,
+            pallet_rotation_rad: out.pallet_rotation_rad,
+            lateral_error_m: out.lateral_error_m,
+            heading_error_rad: out.heading_error_rad,
+            insertion_depth_m: out.insertion_depth_m,
+            worst_pocket_miss_m,
         };
-        let mut broken = super::criteria::broken(&judged);
+        let mut broken = super::criteria::broken(&self.judged(m));
         for c in &self.verdict.step_criteria {
             if let Some(v) = c.value() {
                 self.verdict.out.measures.insert(c.measure().to_owned(), v);
@@ -63,6 +62,36 @@ impl Trial<'_> {
         }
     }
 
+    /// The pick's measurements with the scenario's limits, truck and pallet.
+    pub(super) fn judged(&self, m: PickMeasures) -> Judged<'_> {
+        Judged {
+            m,
+            tol: &self.scn.tolerances,
+            truck: &self.scn.truck,
+            pallet: &self.scn.pallet,
+            timeout_s: self.scn.timeout_s,
+        }
+    }
+
+    /// The pick's measurements as they stand at this step (nothing written to the
+    /// outcome): what a caller-driven pick is judged on before it ends.
+    pub(super) fn measures_now(&self) -> (PickMeasures, Standing) {
+        let now = self.standing();
+        let out = &self.verdict.out;
+        let m = PickMeasures {
+            collision: self.world.collision,
+            timed_out: false,
+            max_contact_force_n: out.max_contact_force_n,
+            pallet_displacement_m: now.pallet_displacement_m,
+            pallet_rotation_rad: now.pallet_rotation_rad,
+            lateral_error_m: out.lateral_error_m,
+            heading_error_rad: out.heading_error_rad,
+            insertion_depth_m: now.insertion_depth_m,
+            worst_pocket_miss_m: now.worst_pocket_miss_m,
+        };
+        (m, now)
+    }
+
     /// The simulated time and the localisation so far: all a trial that ended before its
     /// drive to the pallet measured (the forks were never brought to it).
     pub(crate) fn measure_time(&mut self) {
@@ -78,25 +107,38 @@ impl Trial<'_> {
     /// returns the worst fork's lateral miss of its pocket.
     pub(crate) fn measure(&mut self) -> f64 {
         self.measure_time();
-        let truck = &self.scn.truck;
+        let now = self.standing();
         let out = &mut self.verdict.out;
+        out.final_lateral_error_m = now.local.y_m;
+        out.final_heading_error_rad = now.local.heading_rad;
+        out.insertion_depth_m = now.insertion_depth_m;
+        out.pallet_displacement_m = now.pallet_displacement_m;
+        out.pallet_rotation_rad = now.pallet_rotation_rad;
+        now.worst_pocket_miss_m
+    }
+
+    /// Where the forks stand against the pallet now, and how far it moved.
+    fn standing(&self) -> Standing {
+        let truck = &self.scn.truck;
         let root = self.world.sim.fork_root_pose();
         let pallet_now = self.world.sim.pallet_pose();
-        let local = in_pallet_frame(&pallet_now, &root);
-        out.final_lateral_error_m = local.y_m;
-        out.final_heading_error_rad = local.heading_rad;
-        out.insertion_depth_m = truck.insertion_depth_m(&pallet_now, &root);
-        out.pallet_displacement_m = pallet_now.distance_to(&self.world.pallet0);
-        out.pallet_rotation_rad =
-            wrap_angle(pallet_now.heading_rad - self.world.pallet0.heading_rad);
         let pockets = self.scn.pallet.pocket_offsets_m();
-        truck
+        let worst_pocket_miss_m = truck
             .fork_points(&root, truck.fork_length_m / 2.0)
             .iter()
             .zip(pockets)
             // Lateral position of the fork's middle in the pallet frame, against its pocket.
             .map(|(mid, py)| (pallet_now.to_local(mid).y_m - py).abs())
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max);
+        Standing {
+            local: in_pallet_frame(&pallet_now, &root),
+            insertion_depth_m: truck.insertion_depth_m(&pallet_now, &root),
+            pallet_displacement_m: pallet_now.distance_to(&self.world.pallet0),
+            pallet_rotation_rad: wrap_angle(
+                pallet_now.heading_rad - self.world.pallet0.heading_rad,
+            ),
+            worst_pocket_miss_m,
+        }
     }
 }
 

@@ -7,7 +7,7 @@ use super::engine::Steering;
 use super::error::LegError;
 use super::mission::DriveStats;
 use super::session::Control;
-use super::setup::Trial;
+use super::state::Trial;
 use crate::recorder::Recorder;
 use crate::scenario::mission::MissionSpec;
 

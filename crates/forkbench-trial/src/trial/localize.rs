@@ -4,7 +4,7 @@ use forkbench_core::{Pose2, Signal, Style};
 use forkbench_sensors::{LocalizerInput, Reading};
 
 use super::error::StageError;
-use super::setup::Trial;
+use super::state::Trial;
 use crate::outcome::{LegOutcome, TrialOutcome};
 use crate::recorder::{Level, Recorder};
 

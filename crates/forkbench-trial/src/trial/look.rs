@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use super::error::StageError;
-use super::setup::build_world;
+use super::world::build_world;
 use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Case, Scenario};
 

@@ -9,7 +9,7 @@ use forkbench_track::SegmentFollower;
 
 use super::error::LegError;
 use super::mission::{DriveStats, REVERSE, SMOOTHED, path_points};
-use super::setup::Trial;
+use super::state::Trial;
 use crate::outcome::LegOutcome;
 use crate::recorder::Recorder;
 use crate::scenario::mission::{MissionSpec, Waypoint};

@@ -8,7 +8,7 @@ use forkbench_nav::smooth::{SmoothParams, smooth};
 use forkbench_nav::{GlobalPlan, GlobalQuery, NavMap, plan_global, truck_parts};
 
 use super::error::{LegError, StageError};
-use super::setup::Trial;
+use super::state::Trial;
 use crate::outcome::LegOutcome;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::mission::{GlobalPlannerKind, MissionSpec, Waypoint};

@@ -24,6 +24,7 @@ mod setup;
 mod staging;
 mod state;
 mod streams;
+mod world;
 
 use std::time::Instant;
 
@@ -46,7 +47,7 @@ pub const STAGING_LEG: &str = "pick start → staging";
 pub use crate::step_criteria::{
     STEP_CRITERIA, StepCriterion, StepCtor, StepView, step_criterion_name, step_measures,
 };
-pub use criteria::{Criterion, PICK_CRITERIA};
+pub use criteria::{Criterion, PICK_CRITERIA, Reading};
 pub use engine::{Episode, Stage};
 pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
@@ -57,7 +58,7 @@ pub use phases::{
 };
 pub use session::{Control, Observation, Session, SessionEnd, Truth};
 pub use session_view::SceneView;
-pub use setup::Trial;
+pub use state::Trial;
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
 /// (negative: before it).

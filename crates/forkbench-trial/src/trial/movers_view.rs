@@ -48,7 +48,7 @@ impl WorldView for WithMovers<'_> {
     }
 }
 
-impl super::setup::Trial<'_> {
+impl super::state::Trial<'_> {
     /// The movers' legs and outlines as map segments, for sensors that only ask whether
     /// a sight line is clear (the NAV350's reflectors); none without movers.
     pub(super) fn movers_in_sight(&self) -> Vec<[[f64; 2]; 2]> {

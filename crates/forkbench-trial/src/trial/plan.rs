@@ -5,7 +5,7 @@ use forkbench_plan::{Plan, PlanRequest};
 
 use super::error::StageError;
 use super::goal_for;
-use super::setup::Trial;
+use super::state::Trial;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{ReplanMethod, truck_footprint};
@@ -25,6 +25,12 @@ const BLEND_BEFORE_M: f64 = 0.5;
 const BLEND_MIN_M: f64 = 0.5;
 
 impl Trial<'_> {
+    /// Follows `path` from now on (the first plan, a replan, a phase's plan).
+    pub(super) fn set_path(&mut self, path: forkbench_core::Path) {
+        self.path = path;
+        self.path_version += 1;
+    }
+
     /// Plans from `pose` (path curvature `curvature`) to the pre-entry pose of `est`. The
     /// planner's curve ends aligned with the pockets, tips just short of the face (the
     /// papers' P_dest); the forks then go in straight to the target depth.

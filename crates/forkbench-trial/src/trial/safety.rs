@@ -13,7 +13,7 @@ use rand_chacha::ChaCha8Rng;
 use super::engine::Stage;
 use super::movers_view::WithMovers;
 use super::safety_record::{local, record_reading};
-use super::setup::Trial;
+use super::state::Trial;
 use super::streams::stream;
 use crate::outcome::SafetyOutcome;
 use crate::recorder::{Level, Recorder};

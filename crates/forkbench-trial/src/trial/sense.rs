@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::error::StageError;
 use super::movers_view::WithMovers;
-use super::setup::Trial;
+use super::state::Trial;
 use crate::recorder::Recorder;
 use crate::scenario::sensors::{NamedScanner, PalletSensing};
 
@@ -23,6 +23,26 @@ const SCAN_STYLES: [Style; 3] = [
 const DETECTION_STYLE: Style = Style::rgb(255, 60, 60).width(0.03);
 
 impl Trial<'_> {
+    /// The fix the pick plans from (the odometry-predicted pose when no fix is due) and
+    /// the first pallet estimate.
+    pub(super) fn first_fix_and_estimate<R: Recorder + ?Sized>(
+        &mut self,
+        true_pallet: &Pose2,
+        rec: &mut R,
+    ) -> Result<(), StageError> {
+        let (fix, _) = self.sense(rec)?;
+        self.loc.first_fix = fix
+            .or(self.loc.predictor.pose())
+            .unwrap_or(self.loc.first_fix);
+        self.loc.predictor.fix(self.loc.first_fix);
+        let range = self.loc.first_fix.distance_to(true_pallet);
+        let believed = self.loc.first_fix;
+        if let Some(est) = self.estimate(true_pallet, range, &believed, rec)? {
+            self.adopt_estimate(est, true_pallet);
+        }
+        Ok(())
+    }
+
     /// A pallet estimate when the fork root is `range_m` from the face: the scenario's
     /// fixed bias on top of the sensing's own error. `believed` is the fork-root pose
     /// the truck thinks it has: scans are placed in the map with it, so a detection is

@@ -1,88 +1,21 @@
-//! Setup stage: the simulated world, sensors with their own random streams, the components, the first fix and estimate.
+//! Setup stage: a trial built once from its scenario and run: the world, the components, the sensors with their own random streams; then the first fix and estimate.
 
 use forkbench_core::hash::fnv1a;
 use forkbench_core::{Pose2, SettingsError};
 use forkbench_plan::Planner;
 use forkbench_sensors::Localizer;
-use forkbench_sim::Sim;
 use forkbench_track::{PosePredictor, Tracker};
-use rand_chacha::ChaCha8Rng;
 
-use super::error::StageError;
-use super::judge::jitter;
 use super::localize::{LocStats, record_reflectors};
-use super::state::{Localisation, Perception, Verdict, WorldState};
+use super::state::{Localisation, Perception, ScannerState, Trial, Verdict, WorldState};
 use super::streams::{self, stream};
+use super::world::build_world;
 use super::{Resolved, target_insertion_m};
 use crate::components::LocalizerContext;
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, Recorder, SceneInfo};
 use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Case, Scenario};
-
-/// A trial in progress: its scenario and run, the controllers and the plan they follow,
-/// and its state by concern (the world, the localisation, the perception, the verdict
-/// being built).
-pub struct Trial<'a> {
-    /// When the trial began, for its wall-time budget.
-    pub(super) wall_start: std::time::Instant,
-    pub(super) scn: &'a Scenario,
-    pub(super) run: &'a Resolved,
-    pub(super) world: WorldState,
-    pub(super) loc: Localisation,
-    pub(super) sense: Perception,
-    pub(super) verdict: Verdict,
-    pub(super) planner: Box<dyn Planner>,
-    pub(super) tracker: Box<dyn Tracker>,
-    /// The path the tracker follows now (the first plan, the last replan, a phase's).
-    pub(super) path: forkbench_core::Path,
-    /// Counts the changes of `path`, so a session copies it only when it changed.
-    pub(super) path_version: u64,
-    /// Depth the forks are driven to past the face.
-    pub(super) insertion_m: f64,
-    /// The session whose caller takes the ticks, if one does.
-    pub(super) link: Option<super::engine::Link>,
-    /// The part of the cycle being driven.
-    pub(super) stage: super::engine::Stage,
-    /// People, other vehicles and the safety function, when the scenario has them.
-    pub(super) safety: Option<super::safety::SafetyRun>,
-}
-
-impl std::fmt::Debug for Trial<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Trial")
-            .field("out", &self.verdict.out)
-            .finish_non_exhaustive()
-    }
-}
-
-/// The physics world of a trial: the truck at its start (a mission's first place, else the
-/// case's start, or `start_at`), the pallet where it really stands (jittered on its own
-/// random stream).
-pub(super) fn build_world(
-    scn: &Scenario,
-    case: &Case,
-    seed: u64,
-    start_at: Option<Pose2>,
-) -> Result<(Sim, Pose2, Pose2, Vec<forkbench_sim::Obstacle>), StageError> {
-    let true_pallet = jitter(
-        &case.pallet,
-        &scn.pallet_jitter,
-        &mut stream(seed, streams::PALLET_JITTER),
-    );
-    let obstacles = scn.world.obstacles();
-    let start =
-        start_at.unwrap_or_else(|| scn.mission.as_ref().map_or(case.start, |m| m.start.pose));
-    let sim = Sim::new(
-        &scn.truck,
-        &start,
-        &scn.pallet,
-        &true_pallet,
-        &obstacles,
-        &scn.sim,
-    )?;
-    Ok((sim, start, true_pallet, obstacles))
-}
 
 /// A scanner model's stream salt for `what` (its bias, its per-beam noise): for the first
 /// model the bench had, the salts it always used (bias 4, noise 2, the estimate's stream);
@@ -101,15 +34,6 @@ fn scanner_salt(name: &str, what: &str) -> u64 {
 /// Each scanner's systematic range error for one trial and the stream of its per-beam
 /// noise, each keyed by the scanner's name (nothing for the Gaussian model; no bias with
 /// noise off, where scans draw nothing).
-/// One pallet scanner through a trial: its range bias (the systematic error), the stream
-/// its per-beam noise draws from, and when its next frame is ready.
-pub(super) struct ScannerState {
-    pub(super) bias_m: f64,
-    pub(super) rng: ChaCha8Rng,
-    /// A look before this time gets no new frame from this scanner (its `rate_hz`).
-    pub(super) next_frame_s: f64,
-}
-
 fn scanner_streams(run: &Resolved) -> Vec<ScannerState> {
     match &run.pallet_sensing {
         PalletSensing::Scanner { sensors, .. } => sensors
@@ -295,32 +219,6 @@ impl<'a> Trial<'a> {
             return Err(Box::new(trial.verdict.out));
         }
         Ok(trial)
-    }
-
-    /// Follows `path` from now on (the first plan, a replan, a phase's plan).
-    pub(super) fn set_path(&mut self, path: forkbench_core::Path) {
-        self.path = path;
-        self.path_version += 1;
-    }
-
-    /// The fix the pick plans from (the odometry-predicted pose when no fix is due) and
-    /// the first pallet estimate.
-    pub(super) fn first_fix_and_estimate<R: Recorder + ?Sized>(
-        &mut self,
-        true_pallet: &Pose2,
-        rec: &mut R,
-    ) -> Result<(), StageError> {
-        let (fix, _) = self.sense(rec)?;
-        self.loc.first_fix = fix
-            .or(self.loc.predictor.pose())
-            .unwrap_or(self.loc.first_fix);
-        self.loc.predictor.fix(self.loc.first_fix);
-        let range = self.loc.first_fix.distance_to(true_pallet);
-        let believed = self.loc.first_fix;
-        if let Some(est) = self.estimate(true_pallet, range, &believed, rec)? {
-            self.adopt_estimate(est, true_pallet);
-        }
-        Ok(())
     }
 }
 

@@ -8,7 +8,7 @@ use forkbench_track::SegmentFollower;
 
 use super::error::StageError;
 use super::mission::DriveStats;
-use super::setup::Trial;
+use super::state::Trial;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::mission::{GlobalFile, MissionSpec, Waypoint, mission_tracker};

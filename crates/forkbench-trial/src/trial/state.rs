@@ -1,17 +1,20 @@
-//! A trial's state by concern: the physical world, the localisation, the perception of the pallet, and the verdict being built.
+//! A trial in progress and its state by concern: the physical world, the localisation, the perception of the pallet, and the verdict being built.
 
 use std::collections::BTreeMap;
 
 use forkbench_core::Pose2;
+use forkbench_plan::Planner;
 use forkbench_sensors::detector::PalletDetector;
 use forkbench_sensors::{Localizer, PalletEstimator};
 use forkbench_sim::Sim;
 use forkbench_track::PosePredictor;
+use forkbench_track::Tracker;
 use rand_chacha::ChaCha8Rng;
 
+use super::Resolved;
 use super::localize::LocStats;
-use super::setup::ScannerState;
 use crate::outcome::TrialOutcome;
+use crate::scenario::Scenario;
 use crate::step_criteria::StepCriterion;
 
 /// The physical world and what happened in it.
@@ -78,4 +81,49 @@ pub(crate) struct Verdict {
     pub(crate) pick_started: (f64, f64),
     /// What the running phase measured, by name (see `PhaseOutcome::measures`).
     pub(crate) phase_measures: BTreeMap<String, f64>,
+}
+
+/// A trial in progress: its scenario and run, the controllers and the plan they follow,
+/// and its state by concern (the world, the localisation, the perception, the verdict
+/// being built).
+pub struct Trial<'a> {
+    /// When the trial began, for its wall-time budget.
+    pub(super) wall_start: std::time::Instant,
+    pub(super) scn: &'a Scenario,
+    pub(super) run: &'a Resolved,
+    pub(super) world: WorldState,
+    pub(super) loc: Localisation,
+    pub(super) sense: Perception,
+    pub(super) verdict: Verdict,
+    pub(super) planner: Box<dyn Planner>,
+    pub(super) tracker: Box<dyn Tracker>,
+    /// The path the tracker follows now (the first plan, the last replan, a phase's).
+    pub(super) path: forkbench_core::Path,
+    /// Counts the changes of `path`, so a session copies it only when it changed.
+    pub(super) path_version: u64,
+    /// Depth the forks are driven to past the face.
+    pub(super) insertion_m: f64,
+    /// The session whose caller takes the ticks, if one does.
+    pub(super) link: Option<super::engine::Link>,
+    /// The part of the cycle being driven.
+    pub(super) stage: super::engine::Stage,
+    /// People, other vehicles and the safety function, when the scenario has them.
+    pub(super) safety: Option<super::safety::SafetyRun>,
+}
+
+impl std::fmt::Debug for Trial<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Trial")
+            .field("out", &self.verdict.out)
+            .finish_non_exhaustive()
+    }
+}
+
+/// One pallet scanner through a trial: its range bias (the systematic error), the stream
+/// its per-beam noise draws from, and when its next frame is ready.
+pub(super) struct ScannerState {
+    pub(super) bias_m: f64,
+    pub(super) rng: ChaCha8Rng,
+    /// A look before this time gets no new frame from this scanner (its `rate_hz`).
+    pub(super) next_frame_s: f64,
 }

@@ -5,7 +5,7 @@ use forkbench_core::units::wrap_angle;
 
 use super::Failed;
 use crate::outcome::Failure;
-use crate::trial::setup::Trial;
+use crate::trial::state::Trial;
 
 /// What every phase holds at every step: no rack or wall touched, the load still on the
 /// forks.

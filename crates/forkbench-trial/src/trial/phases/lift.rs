@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::{Context, Phase, PhaseRun, criteria, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
-use crate::trial::setup::Trial;
+use crate::trial::state::Trial;
 
 /// `[phase.lift]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]

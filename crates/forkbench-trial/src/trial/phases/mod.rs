@@ -14,7 +14,7 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
-use super::setup::Trial;
+use super::state::Trial;
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 use crate::scenario::World;

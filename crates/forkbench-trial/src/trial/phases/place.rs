@@ -10,7 +10,7 @@ use super::{Context, Failed, Phase, PhaseRun, criteria, positive_at_most, settin
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{World, pallet_footprint, shrunk};
-use crate::trial::setup::Trial;
+use crate::trial::state::Trial;
 
 /// The slot's outline in recordings: cyan, so the placed (orange) pallet reads against it.
 const SLOT: Style = Style {

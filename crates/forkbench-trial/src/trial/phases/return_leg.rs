@@ -9,7 +9,7 @@ use crate::outcome::Failure;
 use crate::recorder::Recorder;
 use crate::scenario::PoseDeg;
 use crate::scenario::mission::Waypoint;
-use crate::trial::setup::Trial;
+use crate::trial::state::Trial;
 
 /// `[phase.carry]` and `[phase.return]`: where the leg goes.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]

@@ -8,7 +8,7 @@ use super::run::open_loop;
 use super::{Context, Failed, Phase, PhaseRun, criteria, positive_at_most, settings};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
-use crate::trial::setup::Trial;
+use crate::trial::state::Trial;
 
 /// `[phase.reverse_out]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]

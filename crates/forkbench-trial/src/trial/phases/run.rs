@@ -10,7 +10,7 @@ use crate::outcome::PhaseOutcome;
 use crate::recorder::{Level, Recorder};
 use crate::trial::engine::{Stage, Steering};
 use crate::trial::session::Control;
-use crate::trial::setup::Trial;
+use crate::trial::state::Trial;
 
 /// A command holding `speed_mps` and `steer_rad`, for phases that drive without a path.
 pub fn open_loop(speed_mps: f64, steer_rad: f64, pose: &Pose2) -> Command {
