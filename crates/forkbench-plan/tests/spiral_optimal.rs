@@ -1,9 +1,6 @@
 //! The spiral planner's cost against an independent optimiser (scipy SLSQP over all five coefficients and the length, `tools/spiral_reference.py`): within 1 % on every goal the reference solves, in the paper's window and the wide one.
 
-#[path = "common/reference.rs"]
-mod common;
-
-use common::reference;
+use crate::common::reference;
 use forkbench_core::ForkliftSpec;
 use forkbench_plan::spiral::{self, SpiralConfig, SpiralProblem, window_bound};
 

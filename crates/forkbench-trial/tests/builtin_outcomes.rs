@@ -3,7 +3,7 @@
 //! gives the same outcome. Seeds are taken from the records, so the check does not depend
 //! on how a batch derives them.
 
-mod common;
+use crate::common;
 
 use forkbench_trial::defaults::default_scenarios;
 use forkbench_trial::{TrialOptions, run_trial};

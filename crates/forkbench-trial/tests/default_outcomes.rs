@@ -4,7 +4,7 @@
 //! people cycles; two trials of every scenario × case × planner × mode), re-run at its
 //! own seed, gives the same outcome to the bit.
 
-mod common;
+use crate::common;
 
 use forkbench_trial::defaults::default_scenarios;
 use forkbench_trial::{TrialOptions, run_trial};

@@ -1,6 +1,6 @@
 //! A session stepped tick by tick: under its own tracker it reproduces a batch trial to the bit; under a caller's commands it ends on the criteria, the time limit, and the same way twice.
 
-mod common;
+use crate::common;
 
 use std::sync::Arc;
 

@@ -1,0 +1,8 @@
+//! The crate's integration tests as one test binary: each file a module, built and linked once (a binary per file repeats the release build of everything they share).
+
+#[path = "common/reference.rs"]
+mod common;
+
+mod paper_tables;
+mod properties;
+mod spiral_optimal;

@@ -1,0 +1,24 @@
+//! The crate's integration tests as one test binary: each file a module, built and linked once (a binary per file repeats the release build of everything they share).
+
+mod common;
+
+mod builtin_outcomes;
+mod components;
+mod coverage;
+mod custom_phase;
+mod default_outcomes;
+mod external_detector;
+mod external_tracker;
+mod file_layout;
+mod format_doc;
+mod localization;
+mod missions;
+mod pallet_kinds;
+mod people;
+mod phases;
+mod replanning;
+mod sensing;
+mod session;
+mod settings_ranges;
+mod staging;
+mod trial;

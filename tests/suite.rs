@@ -1,0 +1,11 @@
+//! The end-to-end tests of the `forkbench` binary as one test binary: each file a module, built and linked once (a binary per file repeats the release build of everything they share).
+
+mod cli;
+mod external_planner;
+mod external_tracker;
+mod hostile_input;
+mod navigation;
+mod papercuts;
+mod ros2;
+mod scenario_fuzz;
+mod shards;
