@@ -45,7 +45,7 @@ pub use gate::{
     paired_trials_needed, regress,
 };
 pub use guard::guarded;
-pub use manifest::{DirLock, Manifest};
+pub use manifest::{DirLock, Manifest, build_commit};
 pub use mode_pairs::{ModePairs, mode_pairs, mode_pairs_markdown};
 pub use modes::ReplanModes;
 pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};

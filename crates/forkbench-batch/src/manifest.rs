@@ -15,6 +15,10 @@ use super::{BatchError, BatchSpec, io};
 #[serde(deny_unknown_fields)]
 pub struct Manifest {
     pub forkbench_version: String,
+    /// The git commit forkbench was built from (`None` when built outside a checkout):
+    /// a directory's trials all come from one build, so resuming with another is refused.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub build: Option<String>,
     pub seed: u64,
     /// How trial seeds derive from `seed` ([`super::SEED_SCHEME`]); manifests written
     /// before the scheme was named used scheme 1.
@@ -62,6 +66,22 @@ pub struct ScenarioEntry {
 
 pub(super) const FILE: &str = "manifest.json";
 
+/// The git commit this forkbench was built from, when it was built from a checkout.
+pub fn build_commit() -> Option<String> {
+    let commit = env!("FORKBENCH_GIT_COMMIT");
+    (!commit.is_empty()).then(|| commit.to_owned())
+}
+
+/// A build as a message names it.
+pub(super) fn build_name(build: Option<&str>) -> String {
+    match build {
+        Some(c) => format!("the forkbench built from commit {}", &c[..c.len().min(12)]),
+        None => "a forkbench that recorded no commit (built outside a git checkout, or \
+                 before batches recorded it)"
+            .to_owned(),
+    }
+}
+
 fn scheme_one() -> u32 {
     1
 }
@@ -91,6 +111,7 @@ impl Manifest {
             .collect::<Result<_, BatchError>>()?;
         Ok(Manifest {
             forkbench_version: env!("CARGO_PKG_VERSION").to_owned(),
+            build: build_commit(),
             seed: spec.seed,
             seed_scheme: super::SEED_SCHEME,
             trials: spec.trials,

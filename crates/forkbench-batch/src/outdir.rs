@@ -65,11 +65,22 @@ impl BatchSpec {
         }
         match Manifest::read(dir)? {
             Some(have) => {
+                if have.build != want.build {
+                    return Err(BatchError::Invalid(format!(
+                        "{}: its trials were run by {}, and this run is {}: a directory's \
+                         results come from one build, so they are not resumed; start over with \
+                         `batch --force-new`, or choose another output directory",
+                        dir.display(),
+                        manifest::build_name(have.build.as_deref()),
+                        manifest::build_name(want.build.as_deref()),
+                    )));
+                }
                 let diff = have.differences(&want);
                 if !diff.is_empty() {
                     return Err(BatchError::Invalid(format!(
                         "{}: holds trials of a different batch ({} differences, directory → \
-                         this run: {}); set force_new to discard them, or choose another output directory",
+                         this run: {}); start over with `batch --force-new`, or choose \
+                         another output directory",
                         dir.display(),
                         diff.len(),
                         diff.iter().take(8).cloned().collect::<Vec<_>>().join("; ")

@@ -98,10 +98,9 @@ pub(super) fn finish_runs(dir: &std::path::Path) -> Vec<RunEntry> {
 impl Provenance {
     /// This process's provenance for a batch that ran from `started` until now.
     pub fn collect(manifest: Manifest, jobs: usize, started: SystemTime) -> Self {
-        let commit = env!("FORKBENCH_GIT_COMMIT");
         Self {
             forkbench_version: env!("CARGO_PKG_VERSION").to_owned(),
-            git_commit: (!commit.is_empty()).then(|| commit.to_owned()),
+            git_commit: super::manifest::build_commit(),
             host: host_name(),
             cpu_model: cpu_model(),
             cores: std::thread::available_parallelism().map_or(1, usize::from),

@@ -176,7 +176,7 @@ fn resume_refuses_other_settings_and_force_new_starts_over() {
     quiet.overrides.pallet_noise_scale = Some(0.0);
     let e = err(batch::run_batch(&quiet, &d, 2, &|_| {}));
     assert!(
-        e.contains("pallet_noise_scale: null → 0.0") && e.contains("force_new"),
+        e.contains("pallet_noise_scale: null → 0.0") && e.contains("--force-new"),
         "{e}"
     );
     let mut seed = base.clone();
@@ -201,6 +201,40 @@ fn resume_refuses_other_settings_and_force_new_starts_over() {
     })
     .expect("resumes");
     assert_eq!(seen.into_inner(), 0);
+}
+
+/// Trials a directory holds from another build are not resumed: one verdict would mix
+/// two versions of the code (a commit the directory names, or none recorded).
+#[test]
+fn resume_refuses_trials_of_another_build() {
+    let d = tmp("resume-build");
+    let base = spec(vec![scenario("field-test.toml")], 2, 3);
+    batch::run_batch(&base, &d, 2, &|_| {}).expect("runs");
+    let file = d.join("manifest.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).expect("reads")).expect("json");
+    let ours = batch::build_commit();
+    assert_eq!(m.get("build").and_then(|b| b.as_str()), ours.as_deref());
+    let Some(ours) = ours else {
+        // Built outside a git checkout: there is no build to tell apart.
+        return;
+    };
+    m["build"] = "0123456789abcdef0123456789abcdef01234567".into();
+    std::fs::write(&file, m.to_string()).expect("writes");
+    let e = err(batch::run_batch(&base, &d, 2, &|_| {}));
+    assert!(
+        e.contains("commit 0123456789ab") && e.contains(&ours[..12]) && e.contains("--force-new"),
+        "{e}"
+    );
+    m.as_object_mut().expect("object").remove("build");
+    std::fs::write(&file, m.to_string()).expect("writes");
+    let e = err(batch::run_batch(&base, &d, 2, &|_| {}));
+    assert!(e.contains("recorded no commit"), "{e}");
+    // The trials are still there, and starting over is the way out.
+    assert_eq!(records(&d).len(), 2);
+    let mut again = base.clone();
+    again.force_new = true;
+    batch::run_batch(&again, &d, 2, &|_| {}).expect("starts over");
 }
 
 /// Defect 2: merge combined shards of different batches, duplicates, missing shards,
