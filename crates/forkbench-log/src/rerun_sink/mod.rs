@@ -66,10 +66,9 @@ pub struct RerunRecorder {
     rec: rerun::RecordingStream,
     sink: Sink,
     send_every: usize,
-    /// Limits drawn on the plots: lateral (m) and heading (°) at entry, contact force (N).
-    limits: [f64; 3],
-    /// The scenario's limits, for the verdict's table of the pick's criteria.
-    tolerances: forkbench_trial::Limits,
+    /// The scenario's limits (from its scene): drawn on the plots (lateral and heading at
+    /// entry, contact force) and the verdict's table of the pick's criteria.
+    tolerances: Option<forkbench_trial::Limits>,
     /// Fork length and the pallet's half width: where the tips reach the face plane
     /// (the judged entry), and the approach window the entry plots cover.
     entry_geometry: [f64; 2],
@@ -200,8 +199,7 @@ impl RerunRecorder {
             rec,
             sink,
             send_every,
-            limits: [f64::NAN; 3],
-            tolerances: forkbench_trial::Limits::default(),
+            tolerances: None,
             entry_geometry: [0.0; 2],
             entry_at: None,
             plans: 0,

@@ -2,7 +2,7 @@
 
 use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
-use forkbench_trial::{Level, Recorder, SceneInfo, StepRecord, TrialOutcome};
+use forkbench_trial::{Level, Limits, Recorder, SceneInfo, StepRecord, TrialOutcome};
 
 use super::RerunRecorder;
 use super::columns::{color, rgba, strip};
@@ -51,17 +51,12 @@ fn legs_table(o: &TrialOutcome) -> String {
 
 /// The pick's criteria that keep a measurement, each as a row of the verdict's table
 /// (`criterion | value | limit`), the broken ones in bold.
-fn criteria_rows(o: &TrialOutcome, tol: &forkbench_trial::Limits) -> String {
+fn criteria_rows(o: &TrialOutcome, tol: &Limits) -> String {
     forkbench_trial::trial::PICK_CRITERIA
         .iter()
         .filter_map(|c| {
             let r = c.reading(o, tol)?;
-            let name = c.failure.name();
-            let broken = o.failure == Some(c.failure)
-                || o.also_failed
-                    .iter()
-                    .any(|a| a.split(':').next() == Some(name));
-            let value = if broken {
+            let value = if o.broke(c.failure) {
                 format!("**{}** ❌", r.value)
             } else {
                 r.value
@@ -203,7 +198,7 @@ impl RerunRecorder {
              **Events**\n\n```text\n{}\n```\n\n\
              **Outcome**\n\n```json\n{}\n```\n",
             phases_table(o),
-            criteria_rows(o, &self.tolerances),
+            criteria_rows(o, self.tolerances.as_ref().unwrap_or(&Limits::default())),
             measures_rows(o),
             legs_table(o),
             o.scenario,
@@ -227,12 +222,7 @@ impl RerunRecorder {
 
 impl Recorder for RerunRecorder {
     fn scene(&mut self, s: &SceneInfo<'_>) {
-        self.tolerances = s.tolerances.clone();
-        self.limits = [
-            s.tolerances.lateral_m,
-            s.tolerances.heading_deg(),
-            s.tolerances.contact_force_n,
-        ];
+        self.tolerances = Some(s.tolerances.clone());
         self.entry_geometry = [s.truck.fork_length_m, s.pallet.width_m / 2.0];
         let name = format!(
             "{} / {} / {} / {} / seed {}",
@@ -333,7 +323,9 @@ impl Recorder for RerunRecorder {
         // Against the pallet where it is now, as the judge measures the entry.
         let local = s.pallet.to_local(&s.truth);
         let heading_deg = wrap_angle(local.heading_rad).to_degrees();
-        let [lat, head, contact] = self.limits;
+        let [lat, head, contact] = self.tolerances.as_ref().map_or([f64::NAN; 3], |t| {
+            [t.lateral_m, t.heading_deg(), t.contact_force_n]
+        });
         // The fork tips' last metres before the face, the entry and the insertion.
         let approach = local.x_m + self.entry_geometry[0] >= -APPROACH_M;
         self.mark_entry(s, &local);

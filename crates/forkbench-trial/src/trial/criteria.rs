@@ -66,6 +66,18 @@ impl Criterion {
     }
 }
 
+impl TrialOutcome {
+    /// Whether the trial broke `failure`: its verdict, or one of `also_failed`.
+    pub fn broke(&self, failure: Failure) -> bool {
+        let name = failure.name();
+        self.failure == Some(failure)
+            || self
+                .also_failed
+                .iter()
+                .any(|a| a.split(':').next() == Some(name))
+    }
+}
+
 /// The pick's criteria in the order of blame: the first broken one is the verdict.
 /// Adding one is a `Failure` variant and a row here (a criterion that measures at each
 /// step is a [`crate::StepCriterion`] instead).

@@ -351,7 +351,8 @@ impl Trial<'_> {
     /// pick's own or a step criterion), or the truck stands with the forks at the
     /// required depth.
     fn settled(&self) -> bool {
-        let (m, now) = self.measures_now();
+        let now = self.standing();
+        let m = self.pick_measures(&now, false);
         let step_broken = self
             .verdict
             .step_criteria

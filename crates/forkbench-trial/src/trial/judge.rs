@@ -16,7 +16,7 @@ pub(super) fn in_pallet_frame(pallet: &Pose2, root: &Pose2) -> Pose2 {
 /// Where the forks stand against the pallet now: the fork root in the pallet frame, the
 /// insertion depth, how far the pallet moved and turned, the worst fork's lateral miss of
 /// its pocket.
-pub(super) struct Standing {
+pub(crate) struct Standing {
     pub local: Pose2,
     pub insertion_depth_m: f64,
     pub pallet_displacement_m: f64,
@@ -27,19 +27,8 @@ pub(super) struct Standing {
 impl Trial<'_> {
     /// Writes the final measurements and the verdict into the outcome.
     pub(super) fn conclude(&mut self) {
-        let worst_pocket_miss_m = self.measure();
-        let out = &self.verdict.out;
-        let m = PickMeasures {
-            collision: self.world.collision,
-            timed_out: self.verdict.timed_out,
-            max_contact_force_n: out.max_contact_force_n,
-            pallet_displacement_m: out.pallet_displacement_m,
-            pallet_rotation_rad: out.pallet_rotation_rad,
-            lateral_error_m: out.lateral_error_m,
-            heading_error_rad: out.heading_error_rad,
-            insertion_depth_m: out.insertion_depth_m,
-            worst_pocket_miss_m,
-        };
+        let now = self.measure();
+        let m = self.pick_measures(&now, self.verdict.timed_out);
         let mut broken = super::criteria::broken(&self.judged(m));
         for c in &self.verdict.step_criteria {
             if let Some(v) = c.value() {
@@ -73,14 +62,15 @@ impl Trial<'_> {
         }
     }
 
-    /// The pick's measurements as they stand at this step (nothing written to the
-    /// outcome): what a caller-driven pick is judged on before it ends.
-    pub(super) fn measures_now(&self) -> (PickMeasures, Standing) {
-        let now = self.standing();
+    /// The pick's measurements: where the forks stand `now`, what the drive recorded
+    /// (contact force, the entry errors), whether it ran out of time. Before the pick
+    /// ends, `now` is this step's standing (nothing written to the outcome): what a
+    /// caller-driven pick is judged on.
+    pub(super) fn pick_measures(&self, now: &Standing, timed_out: bool) -> PickMeasures {
         let out = &self.verdict.out;
-        let m = PickMeasures {
+        PickMeasures {
             collision: self.world.collision,
-            timed_out: false,
+            timed_out,
             max_contact_force_n: out.max_contact_force_n,
             pallet_displacement_m: now.pallet_displacement_m,
             pallet_rotation_rad: now.pallet_rotation_rad,
@@ -88,8 +78,7 @@ impl Trial<'_> {
             heading_error_rad: out.heading_error_rad,
             insertion_depth_m: now.insertion_depth_m,
             worst_pocket_miss_m: now.worst_pocket_miss_m,
-        };
-        (m, now)
+        }
     }
 
     /// The simulated time and the localisation so far: all a trial that ended before its
@@ -104,8 +93,8 @@ impl Trial<'_> {
 
     /// The trial's measurements as it stands now (time, localisation, where the forks are
     /// against the pallet, how far the pallet moved), kept also when it ends in an error;
-    /// returns the worst fork's lateral miss of its pocket.
-    pub(crate) fn measure(&mut self) -> f64 {
+    /// returns where the forks stand.
+    pub(crate) fn measure(&mut self) -> Standing {
         self.measure_time();
         let now = self.standing();
         let out = &mut self.verdict.out;
@@ -114,11 +103,11 @@ impl Trial<'_> {
         out.insertion_depth_m = now.insertion_depth_m;
         out.pallet_displacement_m = now.pallet_displacement_m;
         out.pallet_rotation_rad = now.pallet_rotation_rad;
-        now.worst_pocket_miss_m
+        now
     }
 
     /// Where the forks stand against the pallet now, and how far it moved.
-    fn standing(&self) -> Standing {
+    pub(super) fn standing(&self) -> Standing {
         let truck = &self.scn.truck;
         let root = self.world.sim.fork_root_pose();
         let pallet_now = self.world.sim.pallet_pose();
