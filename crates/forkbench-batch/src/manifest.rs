@@ -75,7 +75,11 @@ pub fn build_commit() -> Option<String> {
 /// A build as a message names it.
 pub(super) fn build_name(build: Option<&str>) -> String {
     match build {
-        Some(c) => format!("the forkbench built from commit {}", &c[..c.len().min(12)]),
+        // A manifest is a file anyone may edit: cut at a character, shown escaped.
+        Some(c) => format!(
+            "the forkbench built from commit {}",
+            forkbench_trial::text::visible(&c.chars().take(12).collect::<String>())
+        ),
         None => "a forkbench that recorded no commit (built outside a git checkout, or \
                  before batches recorded it)"
             .to_owned(),

@@ -226,6 +226,12 @@ fn resume_refuses_trials_of_another_build() {
         e.contains("commit 0123456789ab") && e.contains(&ours[..12]) && e.contains("--force-new"),
         "{e}"
     );
+    // An edited commit of a control character and two-byte characters (its twelfth byte
+    // inside one) is named, cut at a character and escaped, not a panic.
+    m["build"] = "\u{7}éééééééééééééé".into();
+    std::fs::write(&file, m.to_string()).expect("writes");
+    let e = err(batch::run_batch(&base, &d, 2, &|_| {}));
+    assert!(e.contains("commit \\u{7}ééééééééééé, and"), "{e}");
     m.as_object_mut().expect("object").remove("build");
     std::fs::write(&file, m.to_string()).expect("writes");
     let e = err(batch::run_batch(&base, &d, 2, &|_| {}));
