@@ -3,13 +3,17 @@
 pub mod components;
 pub mod coverage;
 pub mod defaults;
+pub mod footprints;
 pub mod mission_summary;
 pub mod outcome;
+pub mod phase;
+pub mod pose_deg;
 pub mod prm_study;
 pub mod recorder;
 pub mod scenario;
 pub mod step_criteria;
 pub mod text;
+pub mod tolerances;
 pub mod trial;
 
 pub use components::{ComponentSpec, Registry, Role};

@@ -21,7 +21,7 @@ pub struct SceneInfo<'a> {
     /// Fork-root start pose.
     pub start: Pose2,
     /// What the judge checks, for drawing the limits beside the errors.
-    pub tolerances: &'a crate::Limits,
+    pub tolerances: &'a crate::tolerances::Limits,
 }
 
 /// One control step: truth, what the controller saw, what it commanded.

@@ -3,8 +3,8 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use forkbench_trial::trial::{
-    Failed, Phase, PhaseKind, PhaseRun, Trial, open_loop, phase_settings, phase_settings_defaults,
+use forkbench_trial::phase::{
+    Failed, Phase, PhaseHost, PhaseKind, PhaseRun, defaults_of, open_loop, settings,
 };
 use forkbench_trial::{Failure, Recorder, Registry, Scenario, TrialOptions, World, run_trial};
 use serde::{Deserialize, Serialize};
@@ -30,16 +30,16 @@ impl Default for Creep {
 }
 
 impl Phase for Creep {
-    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+    fn run<'t>(&'t self, t: &'t mut dyn PhaseHost, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
         Box::pin(async move {
-            let on_forks = |t: &Trial<'_>| {
+            let on_forks = |t: &dyn PhaseHost| {
                 let root = t.sim().fork_root_pose();
                 root.to_local(&t.sim().pallet_pose())
             };
             let (before, start) = (on_forks(t), t.sim().fork_root_pose());
             let end_s = t.sim().time_s() + self.time_s;
             let speed = self.speed_mps;
-            t.drive_under(self.time_s + 1.0, rec, |t, pose| {
+            t.drive_under(self.time_s + 1.0, rec, &mut |t, pose| {
                 Ok((t.sim().time_s() < end_s).then(|| open_loop(speed, 0.0, &pose)))
             })
             .await?;
@@ -63,7 +63,7 @@ fn creep_kind() -> PhaseKind {
         &["lift", "reverse_out"],
         (Some(true), None),
         |table, _cx| {
-            let c: Creep = phase_settings(table)?;
+            let c: Creep = settings(table)?;
             if !(c.speed_mps.is_finite() && (0.0..=1.0).contains(&c.speed_mps)) {
                 return Err(forkbench_core::SettingsError::field(
                     "speed_mps",
@@ -72,7 +72,7 @@ fn creep_kind() -> PhaseKind {
             }
             Ok(Box::new(c))
         },
-        phase_settings_defaults::<Creep>(),
+        defaults_of::<Creep>(),
     )
 }
 

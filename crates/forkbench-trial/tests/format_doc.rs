@@ -33,7 +33,7 @@ fn truck_defaults() -> toml::Value {
 
 /// Each table with defaults, by the heading it has in the document.
 fn defaulted() -> Vec<(String, toml::Value)> {
-    let phases = forkbench_trial::trial::phase_defaults()
+    let phases = forkbench_trial::phase::phase_defaults()
         .into_iter()
         .map(|(name, v)| (format!("[phase.{name}]"), v));
     defaulted_tables()

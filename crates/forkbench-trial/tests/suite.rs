@@ -11,6 +11,7 @@ mod external_detector;
 mod external_tracker;
 mod file_layout;
 mod format_doc;
+mod layering;
 mod localization;
 mod missions;
 mod pallet_kinds;

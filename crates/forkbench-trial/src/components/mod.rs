@@ -77,7 +77,7 @@ pub struct Registry {
     scaled_localizers: std::collections::BTreeSet<String>,
     estimator: EstimatorCtor,
     /// The phases a scenario may list after the pick, in registration order.
-    phases: Vec<crate::trial::PhaseKind>,
+    phases: Vec<crate::phase::PhaseKind>,
     /// The criteria every pick measures at each step, in the order of blame.
     step_criteria: Vec<crate::step_criteria::StepCtor>,
 }
@@ -143,7 +143,7 @@ impl Registry {
             localizers: BTreeMap::new(),
             scaled_localizers: std::collections::BTreeSet::new(),
             estimator: Arc::new(|cfg| Box::new(cfg.clone())),
-            phases: crate::trial::builtin_phases(),
+            phases: crate::phase::builtin_phases(),
             step_criteria: crate::step_criteria::STEP_CRITERIA.to_vec(),
         }
         .with_scaled_localizer("gaussian", |s, cx| {
@@ -265,7 +265,7 @@ impl Registry {
 
     /// Replaces the pallet-estimate model.
     /// Adds a phase kind a scenario may list after the pick (replacing one of its name).
-    pub fn with_phase(mut self, kind: crate::trial::PhaseKind) -> Self {
+    pub fn with_phase(mut self, kind: crate::phase::PhaseKind) -> Self {
         self.phases.retain(|k| k.name != kind.name);
         self.phases.push(kind);
         self
@@ -286,7 +286,7 @@ impl Registry {
     }
 
     /// The phase kinds, in registration order.
-    pub fn phase_kinds(&self) -> &[crate::trial::PhaseKind] {
+    pub fn phase_kinds(&self) -> &[crate::phase::PhaseKind] {
         &self.phases
     }
 

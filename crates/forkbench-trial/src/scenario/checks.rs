@@ -1,43 +1,13 @@
 //! Checks of a scenario at load: run settings, value ranges, and the layout of every case (no overlaps at the start).
 
 use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
-use forkbench_geom::{Footprint, Obstacles};
+use forkbench_geom::Obstacles;
+
+use crate::footprints::{pallet_footprint, shrunk, truck_footprint};
 
 use super::file::{CaseFile, PalletPlacement, ScenarioFile};
 use super::{Case, MAX_CASES, MAX_TIMEOUT_S, World, invalid, invalid_setting};
 use crate::TrialError;
-
-/// The truck body's footprint referenced to the fork root: the chassis ends there (forks
-/// excluded, since they are meant to enter the pallet).
-pub fn truck_footprint(truck: &ForkliftSpec) -> Footprint {
-    Footprint {
-        length_m: truck.body_length_m,
-        width_m: truck.body_width_m,
-        centre_ahead_m: -truck.body_length_m / 2.0,
-    }
-}
-
-/// The pallet's footprint referenced to its face centre.
-pub fn pallet_footprint(pallet: &PalletSpec) -> Footprint {
-    Footprint {
-        length_m: pallet.depth_m,
-        width_m: pallet.width_m,
-        centre_ahead_m: pallet.depth_m / 2.0,
-    }
-}
-
-/// Layouts may touch (a pallet against a rack's back, a truck parked flush to a wall):
-/// footprints are shrunk by this on every side before the overlap test.
-const LAYOUT_TOLERANCE_M: f64 = 1e-3;
-
-/// `fp` shrunk by the layout tolerance on every side, for overlap tests that let shapes touch.
-pub(crate) fn shrunk(fp: Footprint) -> Footprint {
-    Footprint {
-        length_m: fp.length_m - 2.0 * LAYOUT_TOLERANCE_M,
-        width_m: fp.width_m - 2.0 * LAYOUT_TOLERANCE_M,
-        ..fp
-    }
-}
 
 fn check_layout(
     case: &Case,
@@ -195,19 +165,19 @@ pub(super) fn resolve_phases(
     f: &ScenarioFile,
     (world, pallet, mission): (&World, &PalletSpec, Option<&super::mission::MissionSpec>),
     (text, file): (&str, &str),
-    kinds: &[crate::trial::PhaseKind],
-) -> Result<Vec<crate::trial::PhaseSpec>, TrialError> {
+    kinds: &[crate::phase::PhaseKind],
+) -> Result<Vec<crate::phase::PhaseSpec>, TrialError> {
     let names = f.phases.as_ref();
     let list = names.map_or_else(
-        || vec![crate::trial::PICK.to_owned()],
+        || vec![crate::phase::PICK.to_owned()],
         |n| n.get_ref().clone(),
     );
-    let cx = crate::trial::PhaseContext {
+    let cx = Site {
         world,
         pallet,
         mission,
     };
-    crate::trial::phases_resolve(&list, &f.phase, &cx, kinds).map_err(|(field, reason)| {
+    crate::phase::resolve(&list, &f.phase, &cx, kinds).map_err(|(field, reason)| {
         // A phase's settings are at their table's header; the list's errors, and those of
         // a phase without a table, at the list.
         let list_at = || {
@@ -450,7 +420,7 @@ pub(super) fn check_geometry(
         ));
     }
     let depth = f.tolerances.insertion_depth_m;
-    let default_depth = super::file::Tolerances::default().insertion_depth_m;
+    let default_depth = crate::tolerances::Tolerances::default().insertion_depth_m;
     let note = if depth == default_depth {
         " (the default)"
     } else {
@@ -477,4 +447,37 @@ pub(super) fn check_geometry(
         ));
     }
     Ok(())
+}
+
+/// The scenario's world, pallet and mission, as a phase's settings are checked against them.
+struct Site<'a> {
+    world: &'a World,
+    pallet: &'a PalletSpec,
+    mission: Option<&'a super::mission::MissionSpec>,
+}
+
+impl crate::phase::Context for Site<'_> {
+    fn pallet(&self) -> &PalletSpec {
+        self.pallet
+    }
+
+    fn slots(&self) -> Vec<(String, Pose2)> {
+        let slots = self.world.pallet_slot.iter();
+        slots.map(|s| (s.name.clone(), s.pose())).collect()
+    }
+
+    fn stations(&self) -> Vec<(String, Pose2)> {
+        let stations = self.world.station.iter();
+        stations.map(|s| (s.name.clone(), s.pose())).collect()
+    }
+
+    fn pallet_overlaps(&self, at: &Pose2) -> Option<String> {
+        let (obstacles, mut labels) = self.world.footprint_obstacles();
+        let hit = obstacles.hit(&shrunk(pallet_footprint(self.pallet)), at)?;
+        Some(labels.swap_remove(hit))
+    }
+
+    fn mission_start(&self) -> Option<(String, Pose2)> {
+        self.mission.map(|m| (m.start.name.clone(), m.start.pose))
+    }
 }

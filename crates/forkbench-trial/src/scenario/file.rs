@@ -8,6 +8,7 @@ use forkbench_sim::SimConfig;
 use serde::{Deserialize, Serialize};
 
 use super::PoseDeg;
+use crate::tolerances::Tolerances;
 
 /// Gap between the fork tips and the pallet face at the end of the approach curve: the
 /// default of `[pick] pre_entry_gap_m`.
@@ -49,36 +50,6 @@ impl PalletKind {
             Self::Epal1 => "epal-1",
             Self::Iso1200x1000 => "iso-1200x1000",
             Self::Gma48x40 => "gma-48x40",
-        }
-    }
-}
-
-/// Success tolerances of a pick.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Tolerances {
-    /// Fork-root offset from the pocket centre line at entry.
-    pub lateral_m: f64,
-    pub heading_deg: f64,
-    /// Required fork insertion (tips past the pallet face).
-    pub insertion_depth_m: f64,
-    /// Fork–pallet contact force allowed before full depth.
-    pub contact_force_n: f64,
-    pub pallet_displacement_m: f64,
-    pub pallet_rotation_deg: f64,
-}
-
-impl Default for Tolerances {
-    fn default() -> Self {
-        Self {
-            // 0.15 m forks in 0.405 m pockets leave ±0.1275 m; keep a margin for the
-            // heading error's contribution along the fork.
-            lateral_m: 0.10,
-            heading_deg: 3.0,
-            insertion_depth_m: 1.0,
-            contact_force_n: 200.0,
-            pallet_displacement_m: 0.02,
-            pallet_rotation_deg: 1.0,
         }
     }
 }

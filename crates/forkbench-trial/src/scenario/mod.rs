@@ -20,14 +20,16 @@ use serde::Serialize;
 use crate::TrialError;
 use crate::components::{ComponentSpec, Registry, Role};
 
-pub(crate) use checks::shrunk;
-pub use checks::{ForkFit, fork_fit, pallet_footprint, truck_footprint};
+pub use crate::footprints::{pallet_footprint, shrunk, truck_footprint};
+pub use crate::pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
+pub use crate::tolerances::{Limits, Tolerances};
+pub use checks::{ForkFit, fork_fit};
 pub use file::{
     APPROACH_GAP_M, BetweenLooks, NoiseFile, PalletKind, PalletPlacement, PickFile, ReplanFile,
-    ReplanMethod, Tolerances, WhenNotSeen,
+    ReplanMethod, WhenNotSeen,
 };
-pub use limits::{Limits, Replan};
-pub use world::{MAX_WORLD_EXTENT_M, PalletSlot, PoseDeg, RectFile, World};
+pub use limits::Replan;
+pub use world::{PalletSlot, RectFile, World};
 
 use checks::{check_values, resolve_cases};
 use file::ScenarioFile;
@@ -153,7 +155,7 @@ pub struct Scenario {
     pub mission: Option<mission::MissionSpec>,
     /// The phases after the pick, in order (none: the trial is the pick).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub phases: Vec<crate::trial::PhaseSpec>,
+    pub phases: Vec<crate::phase::PhaseSpec>,
     /// How the truck's safety fields are sized (`[safety]`; none: the defaults, and the
     /// settings hash of scenarios without it is kept).
     #[serde(skip_serializing_if = "Option::is_none")]

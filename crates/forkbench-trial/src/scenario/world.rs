@@ -1,4 +1,4 @@
-//! World files (racks, walls, pallet slots) and poses as files write them (metres, degrees).
+//! World files (racks, walls, pallet slots), and the checks of poses as files write them (metres, degrees).
 
 use std::path::Path as FsPath;
 
@@ -9,21 +9,10 @@ use serde::{Deserialize, Serialize};
 
 use super::{invalid, parse, read};
 use crate::TrialError;
-
-/// A pose as written in files: metres and degrees.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PoseDeg {
-    pub x_m: f64,
-    pub y_m: f64,
-    pub heading_deg: f64,
-}
+use crate::pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
 
 impl PoseDeg {
-    pub fn to_pose(self) -> Pose2 {
-        Pose2::new(self.x_m, self.y_m, self.heading_deg.to_radians())
-    }
-
+    /// Each value finite and within the world's extent; errors name `file` and `field`.
     pub(super) fn check(&self, file: &str, field: &str) -> Result<(), TrialError> {
         for (name, v) in [
             ("x_m", self.x_m),
@@ -58,8 +47,6 @@ impl PoseDeg {
     }
 }
 
-/// Largest |x| or |y| anywhere in a world or scenario file.
-pub const MAX_WORLD_EXTENT_M: f64 = 1e4;
 /// How far inside an obstacle a reflector may lie and still count as on its face.
 const ON_FACE_TOLERANCE_M: f64 = 1e-9;
 

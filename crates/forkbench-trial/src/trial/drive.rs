@@ -4,10 +4,11 @@ use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 use forkbench_track::{Command, TrackerInput};
 
-use super::engine::{Stage, Steering};
+use super::engine::Steering;
 use super::error::StageError;
 use super::judge::in_pallet_frame;
-use super::session::Control;
+use super::link::Control;
+use super::link::Stage;
 use super::state::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
 use forkbench_core::{Signal, Style};
@@ -58,7 +59,7 @@ impl<'a> Steering<'a, StageError> for PickDrive {
     ) -> Result<Option<Command>, StageError> {
         if let Control::Command { .. } = control {
             // The caller steers; the scenario's tracker is not asked.
-            return Ok(Some(super::phases::open_loop(0.0, 0.0, &pose)));
+            return Ok(Some(crate::phase::open_loop(0.0, 0.0, &pose)));
         }
         let cmd = t.tracker_command(pose)?;
         if t.docked(&cmd) {

@@ -2,32 +2,16 @@
 
 use std::future::Future;
 use std::pin::Pin;
-use std::sync::{Arc, Mutex, PoisonError};
-use std::task::{Context, Poll, Waker};
+use std::task::{Context, Poll};
 
 use forkbench_core::Pose2;
 use forkbench_track::Command;
 
 use super::error::StageError;
 use super::goal_for;
-use super::session::{Control, Observation, Truth};
-use super::session_view::ScanKeeper;
+use super::link::{Control, Link, Observation, Truth};
 use super::state::Trial;
 use crate::recorder::Recorder;
-
-/// Which part of the cycle a drive belongs to (what a caller's observation names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stage {
-    /// A mission leg before the pick.
-    Leg,
-    /// The drive to a staging pose and the moves between looks.
-    Staging,
-    /// The approach and insertion.
-    Pick,
-    /// A phase after the pick, by its index in the scenario's `phases` list (1 is the
-    /// first after the pick).
-    Phase(u16),
-}
 
 /// A drive's command source, its stop condition and its per-step criteria.
 pub(crate) trait Steering<'a, E> {
@@ -237,110 +221,6 @@ impl Future for Yield {
         } else {
             self.0 = true;
             Poll::Pending
-        }
-    }
-}
-
-/// Polls `fut` once: `Some` once it has finished.
-pub(crate) fn poll_once<T>(fut: Pin<&mut (dyn Future<Output = T> + Send + '_)>) -> Option<T> {
-    match fut.poll(&mut Context::from_waker(Waker::noop())) {
-        Poll::Ready(v) => Some(v),
-        Poll::Pending => None,
-    }
-}
-
-/// Runs a trial with no caller to its end (it never yields without a link).
-pub(crate) fn run_to_end<T>(fut: impl Future<Output = T>) -> T {
-    let mut fut = std::pin::pin!(fut);
-    loop {
-        if let Poll::Ready(v) = fut.as_mut().poll(&mut Context::from_waker(Waker::noop())) {
-            return v;
-        }
-    }
-}
-
-/// Which stages a session's caller takes the ticks of.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Episode {
-    /// The pick alone (the legs and staging before it run on their own; the episode ends
-    /// at the pick's verdict).
-    Pick,
-    /// The whole cycle: every leg, the staging, the pick and each phase.
-    Cycle,
-}
-
-/// What a session and its trial share: the caller's control in, the view out.
-#[derive(Debug, Clone)]
-pub(crate) struct Link {
-    episode: Episode,
-    slot: Arc<Mutex<Slot>>,
-}
-
-/// The shared state behind a [`Link`].
-#[derive(Debug, Default)]
-pub(crate) struct Slot {
-    pub(crate) control: Option<Control>,
-    pub(crate) obs: Option<Observation>,
-    pub(crate) truth: Option<Truth>,
-    /// The path the trial follows, when it changed since the session took it.
-    pub(crate) path: Option<forkbench_core::Path>,
-    path_version: Option<u64>,
-    /// The session draws its scene: the racks' outlines (once) and the last scans.
-    pub(crate) viewed: bool,
-    pub(crate) obstacles: Option<Vec<[[f64; 2]; 5]>>,
-    obstacles_sent: bool,
-    pub(crate) scans: ScanKeeper,
-    /// The last drive the caller stepped ended at its time limit.
-    pub(crate) deadline_hit: bool,
-}
-
-impl Link {
-    pub(crate) fn new(episode: Episode, viewed: bool) -> Self {
-        let slot = Slot {
-            viewed,
-            ..Slot::default()
-        };
-        Link {
-            episode,
-            slot: Arc::new(Mutex::new(slot)),
-        }
-    }
-
-    pub(crate) fn lock(&self) -> std::sync::MutexGuard<'_, Slot> {
-        self.slot.lock().unwrap_or_else(PoisonError::into_inner)
-    }
-
-    /// The session ends at the pick's verdict.
-    pub(crate) fn pick_only(&self) -> bool {
-        self.episode == Episode::Pick
-    }
-
-    fn covers(&self, stage: Stage) -> bool {
-        self.episode == Episode::Cycle || stage == Stage::Pick
-    }
-
-    fn control(&self) -> Control {
-        self.lock().control.unwrap_or(Control::Tracker)
-    }
-}
-
-/// A session's recorder: keeps the last scans for its view, when it is drawn.
-#[derive(Debug)]
-pub(crate) struct LinkRecorder(pub(crate) Link);
-
-impl Recorder for LinkRecorder {
-    fn signal(
-        &mut self,
-        t_s: f64,
-        path: &str,
-        signal: &forkbench_core::Signal<'_>,
-        style: forkbench_core::Style,
-    ) {
-        if matches!(signal, forkbench_core::Signal::Scan(_)) {
-            let mut slot = self.0.lock();
-            if slot.viewed {
-                slot.scans.signal(t_s, path, signal, style);
-            }
         }
     }
 }

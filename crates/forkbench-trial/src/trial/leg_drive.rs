@@ -5,8 +5,8 @@ use forkbench_track::{Command, PurePursuit, Tracker, TrackerInput};
 
 use super::engine::Steering;
 use super::error::LegError;
+use super::link::Control;
 use super::mission::DriveStats;
-use super::session::Control;
 use super::state::Trial;
 use crate::recorder::Recorder;
 use crate::scenario::mission::MissionSpec;

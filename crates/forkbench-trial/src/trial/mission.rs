@@ -128,7 +128,7 @@ impl Trial<'_> {
         rec: &mut R,
     ) -> LegOutcome {
         let t0 = self.world.sim.time_s();
-        self.loc.leg_stats = super::localize::LocStats::new(t0);
+        self.loc.leg_stats = super::loc_stats::LocStats::new(t0);
         let mut leg = blank_leg(format!("{} → {}", from.name, to.name));
         let mut stats = DriveStats::default();
         let result = self

@@ -7,16 +7,20 @@ mod engine;
 mod error;
 mod judge;
 mod leg_drive;
+mod link;
+mod loc_stats;
 mod localize;
 mod look;
 mod manoeuvre_leg;
 mod mission;
 mod movers_view;
 mod options;
+mod phase_host;
 mod phases;
 mod plan;
 mod safety;
 mod safety_record;
+mod safety_run;
 mod sense;
 mod session;
 mod session_view;
@@ -48,15 +52,10 @@ pub use crate::step_criteria::{
     STEP_CRITERIA, StepCriterion, StepCtor, StepView, step_criterion_name, step_measures,
 };
 pub use criteria::{Criterion, PICK_CRITERIA, Reading};
-pub use engine::{Episode, Stage};
+pub use link::{Control, Episode, Observation, Stage, Truth};
 pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
-pub use phases::{
-    Context as PhaseContext, Failed, PICK, Phase, PhaseCtor, PhaseKind, PhaseRun, PhaseSpec,
-    builtin_phases, defaults_of as phase_settings_defaults, open_loop, phase_defaults,
-    positive_at_most, resolve as phases_resolve, settings as phase_settings,
-};
-pub use session::{Control, Observation, Session, SessionEnd, Truth};
+pub use session::{Session, SessionEnd};
 pub use session_view::SceneView;
 pub use state::Trial;
 
@@ -127,7 +126,7 @@ pub fn run_trial_recorded<R: Recorder + ?Sized>(
 ) -> TrialOutcome {
     let wall = Instant::now();
     let mut out = match scn.resolve(opts) {
-        Ok(run) => engine::run_to_end(run_stages(scn, case, &run, None, rec)),
+        Ok(run) => link::run_to_end(run_stages(scn, case, &run, None, rec)),
         Err(e) => unresolved(scn, case, opts, &e),
     };
     out.wall_time_ms = wall.elapsed().as_secs_f64() * 1e3;
@@ -153,10 +152,10 @@ pub(crate) async fn run_stages<R: Recorder + ?Sized>(
     scn: &Scenario,
     case: &Case,
     run: &Resolved,
-    link: Option<engine::Link>,
+    link: Option<link::Link>,
     rec: &mut R,
 ) -> TrialOutcome {
-    let pick_only = link.as_ref().is_some_and(engine::Link::pick_only);
+    let pick_only = link.as_ref().is_some_and(link::Link::pick_only);
     let mut trial = match prepare(scn, case, run, link, rec).await {
         Ok(t) => t,
         Err(out) => return *out,
@@ -184,7 +183,7 @@ async fn prepare<'a, R: Recorder + ?Sized>(
     scn: &'a Scenario,
     case: &Case,
     run: &'a Resolved,
-    link: Option<engine::Link>,
+    link: Option<link::Link>,
     rec: &mut R,
 ) -> Result<Trial<'a>, Box<TrialOutcome>> {
     let mut trial = Trial::setup(scn, case, run, rec)?;

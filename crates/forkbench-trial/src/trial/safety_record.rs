@@ -1,10 +1,13 @@
 //! How a safety scan is recorded: the fields in force, drawn in the map and coloured by the function's state.
 
-use forkbench_core::{Pose2, Signal};
+use forkbench_core::{Pose2, Signal, Style};
 use forkbench_safety::{Fields, Reading};
 
-use super::safety::{CLEAR, STOPPED, WARNED};
 use crate::recorder::Recorder;
+
+pub(super) const CLEAR: Style = Style::rgba([60, 200, 90, 255]).width(0.03);
+pub(super) const WARNED: Style = Style::rgba([250, 200, 40, 255]).width(0.03);
+pub(super) const STOPPED: Style = Style::rgba([240, 50, 50, 255]).width(0.05);
 
 /// A map point in the fork-root frame.
 pub(super) fn local(root: &Pose2, p: [f64; 2]) -> [f64; 2] {

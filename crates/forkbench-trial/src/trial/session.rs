@@ -4,9 +4,9 @@ use std::future::Future;
 use std::pin::Pin;
 use std::sync::Arc;
 
-use forkbench_core::{Path, Pose2};
+use forkbench_core::Path;
 
-use super::engine::{Episode, Link, LinkRecorder, Stage, poll_once};
+use super::link::{Control, Episode, Link, LinkRecorder, Observation, Stage, Truth, poll_once};
 use super::session_view::SceneView;
 use super::{Resolved, TrialOptions, run_stages};
 use crate::TrialError;
@@ -38,56 +38,6 @@ self_cell::self_cell!(
     }
     impl {Debug}
 );
-
-/// Where each tick's command comes from.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Control {
-    /// The scenario's tracker, as in a batch: the episode ends when it reports the goal
-    /// reached and the truck stands.
-    Tracker,
-    /// The caller's speed and steering commands, clamped to the truck's limits. The
-    /// episode ends when the truck stands with the forks at the required depth, or as
-    /// soon as a criterion has failed for good (a collision, contact force, pallet moved,
-    /// entry outside the limits).
-    Command { speed_mps: f64, steer_rad: f64 },
-    /// The scenario's tracker's command plus the caller's correction (speed m/s,
-    /// steering rad), clamped to the truck's limits; the episode ends as under
-    /// [`Control::Tracker`], so a zero correction is the tracker's own trial.
-    Residual { speed_mps: f64, steer_rad: f64 },
-}
-
-/// What the truck's controller knows at a tick (never the truth).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Observation {
-    pub t_s: f64,
-    /// Time left before the current drive's time limit (the pick's is the scenario's).
-    pub time_left_s: f64,
-    /// The controller's fork-root pose: the localiser's fix, or odometry between fixes.
-    pub pose: Pose2,
-    /// This tick brought a localiser fix.
-    pub fix: bool,
-    /// The pallet face pose the current plan aims at.
-    pub pallet_estimate: Pose2,
-    /// The fork-root pose that puts the forks at their target depth in the estimate.
-    pub goal: Pose2,
-    /// Measured speed (forward positive) and equivalent steering angle.
-    pub speed_mps: f64,
-    pub steer_rad: f64,
-    /// The part of the cycle being driven.
-    pub stage: Stage,
-}
-
-/// The truth a reward may use (a judge's view, not the controller's).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Truth {
-    pub fork_root: Pose2,
-    /// The fork-root pose at the target depth in the real pallet.
-    pub goal: Pose2,
-    /// Depth of the shallower fork tip past the real pallet face.
-    pub insertion_depth_m: f64,
-    /// The real pallet face pose.
-    pub pallet: Pose2,
-}
 
 /// How a session's episode ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -6,7 +6,8 @@ use forkbench_plan::Planner;
 use forkbench_sensors::Localizer;
 use forkbench_track::{PosePredictor, Tracker};
 
-use super::localize::{LocStats, record_reflectors};
+use super::loc_stats::LocStats;
+use super::localize::record_reflectors;
 use super::state::{Localisation, Perception, ScannerState, Trial, Verdict, WorldState};
 use super::streams::{self, stream};
 use super::world::build_world;
@@ -168,7 +169,7 @@ impl<'a> Trial<'a> {
                 return Err(Box::new(out));
             }
         };
-        let safety = match super::safety::SafetyRun::new(scn, run.seed) {
+        let safety = match super::safety_run::SafetyRun::new(scn, run.seed) {
             Ok(s) => s,
             Err(e) => {
                 fail(&mut out, format!("the safety function: {e}"));
@@ -205,7 +206,7 @@ impl<'a> Trial<'a> {
             path_version: 0,
             insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
             link: None,
-            stage: super::engine::Stage::Leg,
+            stage: super::link::Stage::Leg,
             wall_start: std::time::Instant::now(),
             safety,
         };

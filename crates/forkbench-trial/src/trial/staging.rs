@@ -64,7 +64,7 @@ impl Trial<'_> {
                 pick.staging_distance_m
             ),
         );
-        self.stage = super::engine::Stage::Staging;
+        self.stage = super::link::Stage::Staging;
         self.staging_leg(staging, rec)
             .await
             .map_err(|why| (Failure::StagingUnreachable, why))?;

@@ -12,7 +12,7 @@ use forkbench_track::Tracker;
 use rand_chacha::ChaCha8Rng;
 
 use super::Resolved;
-use super::localize::LocStats;
+use super::loc_stats::LocStats;
 use crate::outcome::TrialOutcome;
 use crate::scenario::Scenario;
 use crate::step_criteria::StepCriterion;
@@ -104,11 +104,11 @@ pub struct Trial<'a> {
     /// Depth the forks are driven to past the face.
     pub(super) insertion_m: f64,
     /// The session whose caller takes the ticks, if one does.
-    pub(super) link: Option<super::engine::Link>,
+    pub(super) link: Option<super::link::Link>,
     /// The part of the cycle being driven.
-    pub(super) stage: super::engine::Stage,
+    pub(super) stage: super::link::Stage,
     /// People, other vehicles and the safety function, when the scenario has them.
-    pub(super) safety: Option<super::safety::SafetyRun>,
+    pub(super) safety: Option<super::safety_run::SafetyRun>,
 }
 
 impl std::fmt::Debug for Trial<'_> {

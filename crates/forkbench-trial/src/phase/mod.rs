@@ -1,33 +1,22 @@
-//! The phases after the pick (lift, reverse out, carry, place, return): each a unit with its own settings and criteria, built by name from a scenario's `phases` list.
+//! The phases after the pick (lift, reverse out, carry, place, return): each a unit with its own settings and criteria, built by name from a scenario's `phases` list and driven through a [`PhaseHost`].
 
 mod criteria;
+mod host;
 mod lift;
 mod place;
 mod return_leg;
 mod reverse_out;
-mod run;
 
-pub use run::open_loop;
+pub use criteria::load_held;
+pub use host::{Context, DriveRun, LegRun, PalletLimits, PhaseHost, Steer, open_loop, stand_for};
 
 use forkbench_core::SettingsError;
 use std::sync::Arc;
 
 use serde::Serialize;
 
-use super::state::Trial;
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
-use crate::scenario::World;
-use forkbench_core::PalletSpec;
-
-/// What a phase's settings are checked against: the world (its slots) and the pallet.
-#[derive(Debug, Clone, Copy)]
-pub struct Context<'a> {
-    pub world: &'a World,
-    pub pallet: &'a PalletSpec,
-    /// The scenario's mission: its global planner, tracker and stations drive a return.
-    pub mission: Option<&'a crate::scenario::mission::MissionSpec>,
-}
 
 /// A phase after the pick as a scenario lists it: its name and its `[phase.NAME]` settings,
 /// and the phase they build (built once, when the scenario loads).
@@ -54,21 +43,18 @@ pub type Failed = (Failure, String);
 pub type PhaseRun<'t> =
     std::pin::Pin<Box<dyn std::future::Future<Output = Result<(), Failed>> + Send + 't>>;
 
-/// One phase after the pick. A phase drives the truck with [`Trial::drive_under`] and
-/// [`Trial::stand_for`] (the one drive loop), measures with [`Trial::record_measure`]
-/// and judges with its own criteria; `run` returns `Box::pin(async move { … })`.
+/// One phase after the pick. A phase drives the truck with [`PhaseHost::drive_under`] and
+/// [`stand_for`] (the trial's one drive loop), measures with
+/// [`PhaseHost::record_measure`] and judges with its own criteria; `run` returns
+/// `Box::pin(async move { … })`.
 pub trait Phase: std::fmt::Debug + Send + Sync {
     /// Drives the trial through the phase. Err: its first failed criterion.
-    fn run<'t, 'a: 't>(
-        &'t self,
-        trial: &'t mut Trial<'a>,
-        rec: &'t mut dyn Recorder,
-    ) -> PhaseRun<'t>;
+    fn run<'t>(&'t self, host: &'t mut dyn PhaseHost, rec: &'t mut dyn Recorder) -> PhaseRun<'t>;
 }
 
 /// Builds a phase from its settings table, checked against the scenario's context.
 pub type PhaseCtor =
-    Arc<dyn Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, SettingsError> + Send + Sync>;
+    Arc<dyn Fn(&toml::Table, &dyn Context) -> Result<Box<dyn Phase>, SettingsError> + Send + Sync>;
 
 /// A phase kind: its name, the phases it may follow, the load it needs and leaves, and
 /// how its settings (and the world, for slots) build it. Registered with
@@ -102,7 +88,7 @@ impl PhaseKind {
         name: &str,
         after: &[&str],
         (needs_loaded, leaves_loaded): (Option<bool>, Option<bool>),
-        build: impl Fn(&toml::Table, &Context<'_>) -> Result<Box<dyn Phase>, SettingsError>
+        build: impl Fn(&toml::Table, &dyn Context) -> Result<Box<dyn Phase>, SettingsError>
         + Send
         + Sync
         + 'static,
@@ -177,7 +163,7 @@ pub const PICK: &str = "pick";
 pub fn resolve(
     names: &[String],
     settings: &toml::Table,
-    cx: &Context<'_>,
+    cx: &dyn Context,
     kinds: &[PhaseKind],
 ) -> Result<Vec<PhaseSpec>, (String, String)> {
     if names.first().map(String::as_str) != Some(PICK) {

@@ -3,32 +3,21 @@
 use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 
-use super::Failed;
-use crate::outcome::Failure;
-use crate::trial::state::Trial;
+use forkbench_sim::Sim;
 
-/// What every phase holds at every step: no rack or wall touched, the load still on the
-/// forks.
-pub(super) fn every_step(t: &Trial<'_>) -> Result<(), Failed> {
-    if t.world.collision {
-        return Err((
-            Failure::Collision,
-            "truck touched a rack or wall".to_owned(),
-        ));
-    }
-    load_held(t)
-}
+use super::{Failed, PhaseHost};
+use crate::outcome::Failure;
 
 /// The carried load stayed on the forks: the truck never accelerated it harder than its
 /// friction on them holds (μ g).
-pub(super) fn load_held(t: &Trial<'_>) -> Result<(), Failed> {
-    if t.world.sim.load_shifted() {
-        let limit = t.world.sim.load_grip_mps2();
+pub fn load_held(sim: &Sim) -> Result<(), Failed> {
+    if sim.load_shifted() {
+        let limit = sim.load_grip_mps2();
         return Err((
             Failure::LoadShifted,
             format!(
                 "the load was accelerated at {:.2} m/s² (its friction on the forks holds {limit:.2} m/s²)",
-                t.world.sim.peak_load_accel_mps2()
+                sim.peak_load_accel_mps2()
             ),
         ));
     }
@@ -37,21 +26,21 @@ pub(super) fn load_held(t: &Trial<'_>) -> Result<(), Failed> {
 
 /// A pallet left standing stayed where it stood (the forks did not drag it) within the
 /// pick's displacement and rotation limits.
-pub(super) fn pallet_stayed(t: &Trial<'_>, from: &Pose2) -> Result<(), Failed> {
-    let now = t.world.sim.pallet_pose();
+pub(super) fn pallet_stayed(host: &dyn PhaseHost, from: &Pose2) -> Result<(), Failed> {
+    let now = host.sim().pallet_pose();
     let (moved, turned) = (
         now.distance_to(from),
         wrap_angle(now.heading_rad - from.heading_rad),
     );
-    let tol = &t.scn.tolerances;
-    if moved > tol.pallet_displacement_m || turned.abs() > tol.pallet_rotation_rad {
+    let tol = host.pallet_limits();
+    if moved > tol.displacement_m || turned.abs() > tol.rotation_rad {
         return Err((
             Failure::PalletDisplaced,
             format!(
                 "the forks dragged the pallet {moved:.3} m and turned it {:.2}° (limits {} m, {}°)",
                 turned.to_degrees(),
-                tol.pallet_displacement_m,
-                tol.pallet_rotation_deg()
+                tol.displacement_m,
+                tol.rotation_deg
             ),
         ));
     }

@@ -3,10 +3,9 @@
 use forkbench_core::SettingsError;
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Phase, PhaseRun, criteria, settings};
+use super::{Context, Phase, PhaseHost, PhaseRun, criteria, settings, stand_for};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
-use crate::trial::state::Trial;
 
 /// `[phase.lift]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -24,7 +23,7 @@ impl Default for Lift {
 
 pub(super) fn build(
     table: &toml::Table,
-    _cx: &Context<'_>,
+    _cx: &dyn Context,
 ) -> Result<Box<dyn Phase>, SettingsError> {
     let lift: Lift = settings(table)?;
     if !(lift.time_s.is_finite() && lift.time_s >= 0.0 && lift.time_s <= 60.0) {
@@ -37,14 +36,13 @@ pub(super) fn build(
 }
 
 impl Phase for Lift {
-    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+    fn run<'t>(&'t self, t: &'t mut dyn PhaseHost, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
         Box::pin(async move {
-            t.world
-                .sim
+            t.sim_mut()
                 .lift()
                 .map_err(|e| (Failure::LiftFailed, e.to_string()))?;
-            t.stand_for(self.time_s, rec).await?;
-            criteria::load_held(t)
+            stand_for(t, self.time_s, rec).await?;
+            criteria::load_held(t.sim())
         })
     }
 }

@@ -1,15 +1,12 @@
 //! Mission legs inside the cycle: `carry` (the load on the forks, to where a place begins) and `return` (back to a station, the charging station by default), planned and driven as mission legs.
 
-use forkbench_core::SettingsError;
-use forkbench_nav::NavMap;
+use forkbench_core::{Pose2, SettingsError};
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Phase, PhaseRun, settings};
+use super::{Context, Phase, PhaseHost, PhaseRun, settings};
 use crate::outcome::Failure;
+use crate::pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
 use crate::recorder::Recorder;
-use crate::scenario::PoseDeg;
-use crate::scenario::mission::Waypoint;
-use crate::trial::state::Trial;
 
 /// `[phase.carry]` and `[phase.return]`: where the leg goes.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -25,16 +22,16 @@ pub(super) struct LegFile {
     heading_deg: Option<f64>,
 }
 
-/// A resolved leg phase: where it goes.
+/// A resolved leg phase: where it goes (a name, and the fork root's pose there).
 #[derive(Debug)]
 struct Leg {
-    to: Waypoint,
+    to: (String, Pose2),
 }
 
 /// A `carry`: the destination is required.
 pub(super) fn build_carry(
     table: &toml::Table,
-    cx: &Context<'_>,
+    cx: &dyn Context,
 ) -> Result<Box<dyn Phase>, SettingsError> {
     build(table, cx, None)
 }
@@ -42,19 +39,18 @@ pub(super) fn build_carry(
 /// A `return`: by default to the mission's start (the charging station).
 pub(super) fn build_return(
     table: &toml::Table,
-    cx: &Context<'_>,
+    cx: &dyn Context,
 ) -> Result<Box<dyn Phase>, SettingsError> {
-    let start = cx.mission.map(|m| m.start.clone());
-    build(table, cx, start)
+    build(table, cx, cx.mission_start())
 }
 
 fn build(
     table: &toml::Table,
-    cx: &Context<'_>,
-    default: Option<Waypoint>,
+    cx: &dyn Context,
+    default: Option<(String, Pose2)>,
 ) -> Result<Box<dyn Phase>, SettingsError> {
     let cfg: LegFile = settings(table)?;
-    cx.mission.ok_or_else(|| SettingsError {
+    cx.mission_start().ok_or_else(|| SettingsError {
         field: None,
         reason: "needs a [mission] table: its global planner and tracker drive the leg".into(),
     })?;
@@ -68,7 +64,7 @@ fn build(
         (Some(name), None) => station(cx, name)?,
         (None, Some(p)) => {
             let pose = p.to_pose();
-            let limit = crate::scenario::MAX_WORLD_EXTENT_M;
+            let limit = MAX_WORLD_EXTENT_M;
             let within = |v: f64, lim: f64| v.is_finite() && v.abs() <= lim;
             if !(within(p.x_m, limit) && within(p.y_m, limit) && within(p.heading_deg, 360.0)) {
                 return Err(SettingsError::field(
@@ -79,10 +75,7 @@ fn build(
                     ),
                 ));
             }
-            Waypoint {
-                name: format!("({:.1}, {:.1})", p.x_m, p.y_m),
-                pose,
-            }
+            (format!("({:.1}, {:.1})", p.x_m, p.y_m), pose)
         }
         (None, None) => default.ok_or_else(|| {
             SettingsError::field("to", "name where to drive: `to` (a station) or `pose`")
@@ -95,63 +88,39 @@ fn build(
                 format!("must lie within ±360° (got {h})"),
             ));
         }
-        to.pose.heading_rad = h.to_radians();
+        to.1.heading_rad = h.to_radians();
     }
     Ok(Box::new(Leg { to }))
 }
 
-/// The world's station `name` as a waypoint.
-fn station(cx: &Context<'_>, name: &str) -> Result<Waypoint, SettingsError> {
-    let pose = cx.world.station_pose(name).ok_or_else(|| {
-        let known: Vec<_> = cx.world.station.iter().map(|s| s.name.as_str()).collect();
+/// The world's station `name`, named.
+fn station(cx: &dyn Context, name: &str) -> Result<(String, Pose2), SettingsError> {
+    let stations = cx.stations();
+    let pose = stations.iter().find(|(n, _)| n == name).map(|(_, p)| *p);
+    let pose = pose.ok_or_else(|| {
+        let known: Vec<_> = stations.iter().map(|(n, _)| n.as_str()).collect();
         SettingsError::field(
             "to",
             format!("no station {name:?} in the world (it has {known:?})"),
         )
     })?;
-    Ok(Waypoint {
-        name: name.to_owned(),
-        pose,
-    })
+    Ok((name.to_owned(), pose))
 }
 
 impl Phase for Leg {
-    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+    fn run<'t>(&'t self, t: &'t mut dyn PhaseHost, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
         Box::pin(async move {
-            let scn = t.scn;
-            let m = scn
-                .mission
-                .as_ref()
-                .ok_or((Failure::Error, "no [mission]".to_owned()))?;
-            let map = NavMap::shared_from_world(&t.world.obstacles, m.global.resolution_m)
-                .map_err(|e| (Failure::Error, e.to_string()))?;
-            let here = Waypoint {
-                name: "here".to_owned(),
-                pose: t.world.sim.fork_root_pose(),
-            };
-            // Numbered after the mission's legs and the cycle's earlier ones (its seed and
-            // recorded route are its own); a leg after the first backs out of where it
-            // starts, as from a station.
-            let number = m.via.len() + 1 + t.verdict.out.phases.len();
-            let leg = t.leg(&map, m, (number, &here, &self.to), rec).await;
-            let measures = [
-                ("planned_length_m", leg.planned_length_m),
-                ("final_position_error_m", leg.final_position_error_m),
-                ("cross_track_max_m", leg.cross_track_max_m),
-            ];
-            t.verdict
-                .phase_measures
-                .extend(measures.map(|(k, v)| (k.to_owned(), v)));
+            let (name, pose) = (&self.to.0, self.to.1);
+            let leg = t.drive_leg((name, pose), rec).await?;
+            t.record_measure("planned_length_m", leg.planned_length_m);
+            t.record_measure("final_position_error_m", leg.final_position_error_m);
+            t.record_measure("cross_track_max_m", leg.cross_track_max_m);
             if leg.success {
                 Ok(())
             } else {
                 Err((
                     Failure::LegFailed,
-                    format!(
-                        "to {}: {}",
-                        self.to.name,
-                        leg.failure_detail.unwrap_or_default()
-                    ),
+                    format!("to {name}: {}", leg.failure_detail.unwrap_or_default()),
                 ))
             }
         })

@@ -4,11 +4,11 @@ use forkbench_core::Pose2;
 use forkbench_core::SettingsError;
 use serde::{Deserialize, Serialize};
 
-use super::run::open_loop;
-use super::{Context, Failed, Phase, PhaseRun, criteria, positive_at_most, settings};
+use super::{
+    Context, Failed, Phase, PhaseHost, PhaseRun, criteria, open_loop, positive_at_most, settings,
+};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
-use crate::trial::state::Trial;
 
 /// `[phase.reverse_out]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -33,7 +33,7 @@ impl Default for ReverseOut {
 
 pub(super) fn build(
     table: &toml::Table,
-    _cx: &Context<'_>,
+    _cx: &dyn Context,
 ) -> Result<Box<dyn Phase>, SettingsError> {
     let r: ReverseOut = settings(table)?;
     positive_at_most(&[
@@ -45,12 +45,12 @@ pub(super) fn build(
 }
 
 impl Phase for ReverseOut {
-    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+    fn run<'t>(&'t self, t: &'t mut dyn PhaseHost, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
         Box::pin(async move {
-            let (pallet0, carrying) = (t.world.sim.pallet_pose(), t.world.sim.carrying());
+            let (pallet0, carrying) = (t.sim().pallet_pose(), t.sim().carrying());
             back_straight(t, (self.distance_m, self.speed_mps, self.timeout_s), rec).await?;
             if carrying {
-                criteria::load_held(t)
+                criteria::load_held(t.sim())
             } else {
                 criteria::pallet_stayed(t, &pallet0)
             }
@@ -62,14 +62,14 @@ impl Phase for ReverseOut {
 /// controller's pose, is `distance_m` back and the truck stands; `timeout` if it is not
 /// within `timeout_s`.
 pub(super) async fn back_straight(
-    t: &mut Trial<'_>,
+    t: &mut dyn PhaseHost,
     (distance_m, speed_mps, timeout_s): (f64, f64, f64),
     rec: &mut dyn Recorder,
 ) -> Result<(), Failed> {
     let mut from: Option<Pose2> = None;
     let mut backed_m = 0.0;
     let finished = t
-        .drive_under(timeout_s, rec, |t, pose| {
+        .drive_under(timeout_s, rec, &mut |t, pose| {
             let start = *from.get_or_insert(pose);
             backed_m = start.distance_to(&pose);
             let left_m = distance_m - backed_m;

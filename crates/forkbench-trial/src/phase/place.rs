@@ -6,11 +6,12 @@ use forkbench_core::{Pose2, Signal, Style};
 use serde::{Deserialize, Serialize};
 
 use super::reverse_out::back_straight;
-use super::{Context, Failed, Phase, PhaseRun, criteria, positive_at_most, settings};
+use super::{
+    Context, Failed, Phase, PhaseHost, PhaseRun, criteria, positive_at_most, settings, stand_for,
+};
+use crate::footprints::pallet_footprint;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
-use crate::scenario::{World, pallet_footprint, shrunk};
-use crate::trial::state::Trial;
 
 /// The slot's outline in recordings: cyan, so the placed (orange) pallet reads against it.
 const SLOT: Style = Style {
@@ -63,7 +64,7 @@ struct Place {
 
 pub(super) fn build(
     table: &toml::Table,
-    cx: &Context<'_>,
+    cx: &dyn Context,
 ) -> Result<Box<dyn Phase>, SettingsError> {
     let cfg: PlaceFile = settings(table)?;
     positive_at_most(&[
@@ -83,21 +84,22 @@ pub(super) fn build(
         .slot
         .clone()
         .ok_or_else(|| SettingsError::field("slot", "name the world's pallet slot to place at"))?;
-    let at = slot_pose(cx.world, &slot)?;
-    let (obstacles, labels) = cx.world.footprint_obstacles();
-    if let Some(i) = obstacles.hit(&shrunk(pallet_footprint(cx.pallet)), &at) {
+    let at = slot_pose(cx, &slot)?;
+    if let Some(what) = cx.pallet_overlaps(&at) {
         return Err(SettingsError::field(
             "slot",
-            format!("{slot:?}: a pallet there overlaps {}", labels[i]),
+            format!("{slot:?}: a pallet there overlaps {what}"),
         ));
     }
     Ok(Box::new(Place { slot, at, cfg }))
 }
 
 /// The pose of the world's slot `name` (its face centre, heading into the rack).
-fn slot_pose(world: &World, name: &str) -> Result<Pose2, SettingsError> {
-    world.slot_pose(name).ok_or_else(|| {
-        let known: Vec<_> = world.pallet_slot.iter().map(|s| s.name.as_str()).collect();
+fn slot_pose(cx: &dyn Context, name: &str) -> Result<Pose2, SettingsError> {
+    let slots = cx.slots();
+    let found = slots.iter().find(|(n, _)| n == name).map(|(_, pose)| *pose);
+    found.ok_or_else(|| {
+        let known: Vec<_> = slots.iter().map(|(n, _)| n.as_str()).collect();
         SettingsError::field(
             "slot",
             format!(
@@ -109,18 +111,18 @@ fn slot_pose(world: &World, name: &str) -> Result<Pose2, SettingsError> {
 }
 
 impl Phase for Place {
-    fn run<'t, 'a: 't>(&'t self, t: &'t mut Trial<'a>, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
+    fn run<'t>(&'t self, t: &'t mut dyn PhaseHost, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
         Box::pin(async move {
-            if !t.world.sim.carrying() {
+            if !t.sim().carrying() {
                 return Err((Failure::Error, "nothing on the forks to place".into()));
             }
             self.approach(t, rec).await?;
-            t.world.sim.lower();
-            t.stand_for(self.cfg.lower_time_s, rec).await?;
-            let placed = t.world.sim.pallet_pose();
-            self.measure(t, &placed);
+            t.sim_mut().lower();
+            stand_for(t, self.cfg.lower_time_s, rec).await?;
+            let placed = t.sim().pallet_pose();
+            let off = self.measure(t, &placed);
             back_straight(t, (self.cfg.retract_m, 0.5, 30.0), rec).await?;
-            self.placement(t)?;
+            self.placement(off)?;
             criteria::pallet_stayed(t, &placed)
         })
     }
@@ -129,41 +131,35 @@ impl Phase for Place {
 impl Place {
     /// Plans to the fork-root pose that sets the carried pallet's face on the slot (as
     /// if picking a pallet standing there) and drives it with the scenario's tracker.
-    async fn approach(&self, t: &mut Trial<'_>, rec: &mut dyn Recorder) -> Result<(), Failed> {
-        let truck = &t.scn.truck;
-        let root_on_pallet = t
-            .world
-            .sim
-            .pallet_pose()
-            .to_local(&t.world.sim.fork_root_pose());
+    async fn approach(&self, t: &mut dyn PhaseHost, rec: &mut dyn Recorder) -> Result<(), Failed> {
+        let truck = t.truck().clone();
+        let root_on_pallet = t.sim().pallet_pose().to_local(&t.sim().fork_root_pose());
         let aim = self
             .at
             .to_world(&Pose2::new(-self.cfg.stop_short_m, 0.0, 0.0));
         let root_goal = aim.to_world(&root_on_pallet);
         // The face a pick would aim at to end with the fork root at `root_goal`.
-        let face = root_goal.to_world(&Pose2::new(truck.fork_length_m - t.insertion_m, 0.0, 0.0));
-        let pose = t.sense(rec).map_err(|e| (Failure::Error, e.to_string()))?.1;
-        let k0 = t.world.sim.steer_rad().tan() / truck.wheelbase_m;
-        let time = t.world.sim.time_s();
+        let face = root_goal.to_world(&Pose2::new(truck.fork_length_m - t.insertion_m(), 0.0, 0.0));
+        let pose = t.sense(rec).map_err(|e| (Failure::Error, e))?;
+        let k0 = t.sim().steer_rad().tan() / truck.wheelbase_m;
+        let time = t.sim().time_s();
         let refused = |why: String| {
             (
                 Failure::PlanFailed,
                 format!("to slot {:?}: {why}", self.slot),
             )
         };
-        let plan = t
-            .plan_from(pose, k0, &face)
-            .map_err(|e| refused(e.to_string()))?;
+        let plan = t.plan_to_face(pose, k0, &face).map_err(refused)?;
         if let Some(why) = t.clash(&plan.path) {
-            return Err(refused(why.to_string()));
+            return Err(refused(why));
         }
         rec.plan(
             time,
-            t.verdict.out.replans + 1,
+            t.replans() + 1,
             &plan.path,
             plan.control_polygon_m.as_deref(),
         );
-        let corners = pallet_footprint(&t.scn.pallet).corners(&self.at);
+        let corners = pallet_footprint(t.pallet()).corners(&self.at);
         let outline: Vec<[f64; 2]> = corners.iter().chain(&corners[..1]).copied().collect();
         rec.signal(time, "place/slot", &Signal::Path(&outline), SLOT);
         rec.event(
@@ -175,14 +171,11 @@ impl Place {
                 self.slot
             ),
         );
-        t.tracker.reset(&plan.path, truck);
-        t.set_path(plan.path);
+        t.follow(plan.path);
         let timeout_s = self.cfg.timeout_s;
         let arrived = t
-            .drive_under(timeout_s, rec, |t, pose| {
-                let cmd = t
-                    .tracker_command(pose)
-                    .map_err(|e| (Failure::Error, e.to_string()))?;
+            .drive_under(timeout_s, rec, &mut |t, pose| {
+                let cmd = t.tracker_command(pose).map_err(|e| (Failure::Error, e))?;
                 Ok((!(cmd.done && t.stands())).then_some(cmd))
             })
             .await?;
@@ -196,23 +189,23 @@ impl Place {
         }
     }
 
-    /// The placed pallet against the slot, and the room left around it.
-    fn measure(&self, t: &mut Trial<'_>, placed: &Pose2) {
-        let (obstacles, _) = &t.world.footprints;
-        let clearance = obstacles.clearance(&pallet_footprint(&t.scn.pallet), placed, 1.0);
-        let m = &mut t.verdict.phase_measures;
-        m.insert("position_error_m".into(), placed.distance_to(&self.at));
-        m.insert(
-            "heading_error_rad".into(),
+    /// The placed pallet against the slot (recorded, and returned as its distance and
+    /// heading off it), and the room left around it.
+    fn measure(&self, t: &mut dyn PhaseHost, placed: &Pose2) -> (f64, f64) {
+        let clearance = t.clearance_m(&pallet_footprint(t.pallet()), placed, 1.0);
+        let off = (
+            placed.distance_to(&self.at),
             wrap_angle(placed.heading_rad - self.at.heading_rad),
         );
-        m.insert("clearance_m".into(), clearance);
+        t.record_measure("position_error_m", off.0);
+        t.record_measure("heading_error_rad", off.1);
+        t.record_measure("clearance_m", clearance);
+        off
     }
 
-    /// The pallet set down within the place tolerances of its slot.
-    fn placement(&self, t: &Trial<'_>) -> Result<(), Failed> {
-        let m = &t.verdict.phase_measures;
-        let (d, h) = (m["position_error_m"], m["heading_error_rad"]);
+    /// The pallet set down within the place tolerances of its slot (`(d, h)`: its
+    /// distance and heading off it).
+    fn placement(&self, (d, h): (f64, f64)) -> Result<(), Failed> {
         if d > self.cfg.position_m || h.abs() > self.cfg.heading_deg.to_radians() {
             return Err((
                 Failure::PlacementError,

@@ -5,25 +5,13 @@ use std::collections::BTreeMap;
 use forkbench_core::{Pose2, Signal, Style};
 use forkbench_track::Command;
 
-use super::{Failed, PICK, PhaseSpec};
-use crate::outcome::PhaseOutcome;
+use crate::outcome::{Failure, PhaseOutcome};
+use crate::phase::{Failed, PICK, PhaseSpec, Steer};
 use crate::recorder::{Level, Recorder};
-use crate::trial::engine::{Stage, Steering};
-use crate::trial::session::Control;
+use crate::trial::engine::Steering;
+use crate::trial::link::Control;
+use crate::trial::link::Stage;
 use crate::trial::state::Trial;
-
-/// A command holding `speed_mps` and `steer_rad`, for phases that drive without a path.
-pub fn open_loop(speed_mps: f64, steer_rad: f64, pose: &Pose2) -> Command {
-    Command {
-        speed_mps,
-        steer_rad,
-        lookahead_point: [pose.x_m, pose.y_m],
-        cross_track_m: 0.0,
-        remaining_m: 0.0,
-        path_curvature_per_m: 0.0,
-        done: false,
-    }
-}
 
 /// Hands a generic recorder to phases as a trait object.
 struct DynRec<'r, R: ?Sized>(&'r mut R);
@@ -124,28 +112,17 @@ impl<'a> Trial<'a> {
         self.verdict.out.phases.push(done);
     }
 
-    /// Holds the truck standing (steering where it is) for `time_s`, as while the mast
-    /// lifts or lowers; the every-step criteria still hold.
-    pub async fn stand_for(&mut self, time_s: f64, rec: &mut dyn Recorder) -> Result<(), Failed> {
-        let end_s = self.world.sim.time_s() + time_s;
-        self.drive_under(time_s + 1.0, rec, |t, pose| {
-            Ok((t.world.sim.time_s() < end_s)
-                .then(|| open_loop(0.0, t.world.sim.steer_rad(), &pose)))
-        })
-        .await?;
-        Ok(())
-    }
-
-    /// Steps the truck under `command` (from the controller's pose) until it returns
-    /// `None` (Ok(true)), `limit_s` passes (Ok(false)), it fails, or a criterion every
-    /// phase holds at every step breaks (Err).
-    pub async fn drive_under(
+    /// Steps the truck under a phase's `command` (from the controller's pose) until it
+    /// returns `None` (Ok(true)), `limit_s` passes (Ok(false)), it fails, or a criterion
+    /// every phase holds at every step breaks (Err).
+    pub(super) async fn drive_phase<R: Recorder + ?Sized>(
         &mut self,
         limit_s: f64,
-        rec: &mut dyn Recorder,
-        command: impl FnMut(&mut Trial<'a>, Pose2) -> Result<Option<Command>, Failed>,
+        rec: &mut R,
+        command: &mut Steer<'_>,
     ) -> Result<bool, Failed> {
-        self.drive_by(limit_s, &mut PhaseDrive(command), rec).await
+        let mut drive = PhaseDrive(|t: &mut Trial<'a>, pose| command(t, pose));
+        self.drive_by(limit_s, &mut drive, rec).await
     }
 }
 
@@ -173,7 +150,7 @@ where
         _cmd: &Command,
         rec: &mut R,
     ) -> Result<bool, Failed> {
-        super::criteria::every_step(t)?;
+        every_step(t)?;
         let now = t.world.sim.time_s();
         let step = (now / t.world.sim.dt_s()).round() as u64;
         if step.is_multiple_of(crate::trial::drive::SIGNAL_EVERY_STEPS) {
@@ -186,24 +163,14 @@ where
     }
 }
 
-impl Trial<'_> {
-    /// The physics world: the truck, the pallet, the mast (`lift`, `lower`).
-    pub fn sim(&self) -> &forkbench_sim::Sim {
-        &self.world.sim
+/// What every phase holds at every step: no rack or wall touched, the load still on the
+/// forks.
+fn every_step(t: &Trial<'_>) -> Result<(), Failed> {
+    if t.world.collision {
+        return Err((
+            Failure::Collision,
+            "truck touched a rack or wall".to_owned(),
+        ));
     }
-
-    /// The physics world, to lift or lower the pallet.
-    pub fn sim_mut(&mut self) -> &mut forkbench_sim::Sim {
-        &mut self.world.sim
-    }
-
-    /// The scenario the trial runs.
-    pub fn scenario(&self) -> &crate::scenario::Scenario {
-        self.scn
-    }
-
-    /// Records `value` as the running phase's measure `name` (its outcome's `measures`).
-    pub fn record_measure(&mut self, name: &str, value: f64) {
-        self.verdict.phase_measures.insert(name.to_owned(), value);
-    }
+    crate::phase::load_held(&t.world.sim)
 }

@@ -1,0 +1,124 @@
+//! The running trial as the host a phase drives: its physics, the scenario's pick planner and tracker, the one drive loop and the mission's legs.
+
+use forkbench_core::{ForkliftSpec, PalletSpec, Path, Pose2};
+use forkbench_geom::Footprint;
+use forkbench_nav::NavMap;
+use forkbench_plan::Plan;
+use forkbench_sim::Sim;
+use forkbench_track::Command;
+
+use crate::outcome::Failure;
+use crate::phase::{DriveRun, LegRun, PalletLimits, PhaseHost, Steer};
+use crate::recorder::Recorder;
+use crate::scenario::mission::Waypoint;
+use crate::trial::state::Trial;
+
+impl<'a> PhaseHost for Trial<'a> {
+    fn sim(&self) -> &Sim {
+        &self.world.sim
+    }
+
+    fn sim_mut(&mut self) -> &mut Sim {
+        &mut self.world.sim
+    }
+
+    fn truck(&self) -> &ForkliftSpec {
+        &self.scn.truck
+    }
+
+    fn pallet(&self) -> &PalletSpec {
+        &self.scn.pallet
+    }
+
+    fn insertion_m(&self) -> f64 {
+        self.insertion_m
+    }
+
+    fn pallet_limits(&self) -> PalletLimits {
+        let tol = &self.scn.tolerances;
+        PalletLimits {
+            displacement_m: tol.pallet_displacement_m,
+            rotation_rad: tol.pallet_rotation_rad,
+            rotation_deg: tol.pallet_rotation_deg(),
+        }
+    }
+
+    fn record_measure(&mut self, name: &str, value: f64) {
+        self.verdict.phase_measures.insert(name.to_owned(), value);
+    }
+
+    fn stands(&self) -> bool {
+        Trial::stands(self)
+    }
+
+    fn drive_under<'s>(
+        &'s mut self,
+        limit_s: f64,
+        rec: &'s mut dyn Recorder,
+        command: &'s mut Steer<'_>,
+    ) -> DriveRun<'s> {
+        Box::pin(self.drive_phase(limit_s, rec, command))
+    }
+
+    fn sense(&mut self, rec: &mut dyn Recorder) -> Result<Pose2, String> {
+        Trial::sense(self, rec)
+            .map(|(_, pose)| pose)
+            .map_err(|e| e.to_string())
+    }
+
+    fn plan_to_face(&mut self, pose: Pose2, curvature: f64, face: &Pose2) -> Result<Plan, String> {
+        self.plan_from(pose, curvature, face)
+            .map_err(|e| e.to_string())
+    }
+
+    fn clash(&self, path: &Path) -> Option<String> {
+        Trial::clash(self, path).map(|e| e.to_string())
+    }
+
+    fn replans(&self) -> u32 {
+        self.verdict.out.replans
+    }
+
+    fn follow(&mut self, path: Path) {
+        self.tracker.reset(&path, &self.scn.truck);
+        self.set_path(path);
+    }
+
+    fn tracker_command(&mut self, pose: Pose2) -> Result<Command, String> {
+        Trial::tracker_command(self, pose).map_err(|e| e.to_string())
+    }
+
+    fn clearance_m(&self, footprint: &Footprint, at: &Pose2, max_m: f64) -> f64 {
+        let (obstacles, _) = &self.world.footprints;
+        obstacles.clearance(footprint, at, max_m)
+    }
+
+    fn drive_leg<'s>(
+        &'s mut self,
+        (name, pose): (&'s str, Pose2),
+        rec: &'s mut dyn Recorder,
+    ) -> LegRun<'s> {
+        Box::pin(async move {
+            let scn = self.scn;
+            let m = scn
+                .mission
+                .as_ref()
+                .ok_or((Failure::Error, "no [mission]".to_owned()))?;
+            let map = NavMap::shared_from_world(&self.world.obstacles, m.global.resolution_m)
+                .map_err(|e| (Failure::Error, e.to_string()))?;
+            let here = Waypoint {
+                name: "here".to_owned(),
+                pose: self.world.sim.fork_root_pose(),
+            };
+            let to = Waypoint {
+                name: name.to_owned(),
+                pose,
+            };
+            // Numbered after the mission's legs and the cycle's earlier ones (its seed and
+            // recorded route are its own); a leg after the first backs out of where it
+            // starts, as from a station.
+            let number = m.via.len() + 1 + self.verdict.out.phases.len();
+            Ok(self.leg(&map, m, (number, &here, &to), rec).await)
+        })
+    }
+}
