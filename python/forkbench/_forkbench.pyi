@@ -90,6 +90,7 @@ def run_batch(
     odometry_noise_scale: float | None = None,
     jobs: int | None = None,
     out: str | os.PathLike[str] | None = None,
+    force_new: bool = False,
 ) -> list[Outcome]: ...
 def report(
     dir: str | os.PathLike[str],

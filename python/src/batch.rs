@@ -108,11 +108,12 @@ fn records_bytes(spec: &BatchSpec) -> u64 {
 /// trial's identity, so the same outcomes), in parallel on `jobs` threads, and returns
 /// its records (dicts: the lines of `trials.jsonl`) in the batch's job order. Without
 /// `scenarios`, the embedded defaults in both replanning modes (the README's main job).
-/// With `out`, also writes (or resumes) the CLI's batch directory there.
+/// With `out`, also writes (or resumes) the CLI's batch directory there; `force_new`
+/// starts that directory over (a batch's own files only), as the CLI's `--force-new`.
 #[pyfunction]
 #[pyo3(signature = (scenarios=None, *, trials=20, seed=1, planners=None, trackers=None,
                     modes=None, pallet_noise_scale=None, localization_noise_scale=None,
-                    odometry_noise_scale=None, jobs=None, out=None))]
+                    odometry_noise_scale=None, jobs=None, out=None, force_new=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_batch<'py>(
     py: Python<'py>,
@@ -127,6 +128,7 @@ pub fn run_batch<'py>(
     odometry_noise_scale: Option<f64>,
     jobs: Option<usize>,
     out: Option<PathBuf>,
+    force_new: bool,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let embedded = scenarios.is_none();
     let scenarios = match scenarios {
@@ -156,7 +158,7 @@ pub fn run_batch<'py>(
         },
         replan,
         compare_replanning,
-        force_new: false,
+        force_new,
     };
     let bytes = records_bytes(&spec);
     if bytes > MAX_RECORDS_BYTES {
@@ -174,6 +176,12 @@ pub fn run_batch<'py>(
     if out.as_ref().is_some_and(|p| p.as_os_str().is_empty()) {
         return Err(BatchError::new_err(
             "out \"\": name the batch directory (None keeps the records in memory)",
+        ));
+    }
+    if force_new && out.is_none() {
+        return Err(BatchError::new_err(
+            "force_new: starts the batch directory `out` over; name it (without `out` the \
+             records stay in memory and nothing is written)",
         ));
     }
     let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));

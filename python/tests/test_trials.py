@@ -49,6 +49,14 @@ def test_a_batch_equals_the_clis_and_becomes_a_dataframe(cli, tmp_path):
     written = forkbench.run_batch(scenarios, trials=3, seed=7, out=tmp_path / "py")
     assert len(written) == len(want) == len(read_jsonl(tmp_path / "py" / "trials.jsonl"))
     assert (tmp_path / "py" / "summary.json").exists()
+    # Other settings do not resume it; `force_new` starts it over, as the CLI's --force-new.
+    with pytest.raises(forkbench.BatchError, match="force_new=True"):
+        forkbench.run_batch(scenarios, trials=3, seed=8, out=tmp_path / "py")
+    again = forkbench.run_batch(scenarios, trials=3, seed=8, out=tmp_path / "py", force_new=True)
+    assert len(again) == len(read_jsonl(tmp_path / "py" / "trials.jsonl")) == len(want)
+    assert {r["seed"] for r in again}.isdisjoint({r["seed"] for r in written})
+    with pytest.raises(forkbench.BatchError, match="force_new"):
+        forkbench.run_batch(scenarios, trials=1, force_new=True)
     df = forkbench.to_dataframe(got)
     assert len(df) == len(want)
     assert {"scenario", "case", "seed", "success", "failure", "lateral_error_m"} <= set(df.columns)

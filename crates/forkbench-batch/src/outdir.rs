@@ -69,7 +69,8 @@ impl BatchSpec {
                     return Err(BatchError::Invalid(format!(
                         "{}: its trials were run by {}, and this run is {}: a directory's \
                          results come from one build, so they are not resumed; start over with \
-                         `batch --force-new`, or choose another output directory",
+                         `batch --force-new` (`force_new=True` in Python), or choose another \
+                         output directory",
                         dir.display(),
                         manifest::build_name(have.build.as_deref()),
                         manifest::build_name(want.build.as_deref()),
@@ -79,8 +80,8 @@ impl BatchSpec {
                 if !diff.is_empty() {
                     return Err(BatchError::Invalid(format!(
                         "{}: holds trials of a different batch ({} differences, directory → \
-                         this run: {}); start over with `batch --force-new`, or choose \
-                         another output directory",
+                         this run: {}); start over with `batch --force-new` \
+                         (`force_new=True` in Python), or choose another output directory",
                         dir.display(),
                         diff.len(),
                         diff.iter().take(8).cloned().collect::<Vec<_>>().join("; ")
