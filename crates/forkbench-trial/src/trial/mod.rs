@@ -39,6 +39,7 @@ use crate::components::{ComponentSpec, Role};
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
+use state::Trial;
 
 pub use crate::scenario::APPROACH_GAP_M;
 
@@ -57,7 +58,6 @@ pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
 pub use session::{Session, SessionEnd};
 pub use session_view::SceneView;
-pub use state::Trial;
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
 /// (negative: before it).

@@ -86,7 +86,7 @@ pub(crate) struct Verdict {
 /// A trial in progress: its scenario and run, the controllers and the plan they follow,
 /// and its state by concern (the world, the localisation, the perception, the verdict
 /// being built).
-pub struct Trial<'a> {
+pub(crate) struct Trial<'a> {
     /// When the trial began, for its wall-time budget.
     pub(super) wall_start: std::time::Instant,
     pub(super) scn: &'a Scenario,
