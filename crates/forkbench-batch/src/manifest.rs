@@ -66,23 +66,42 @@ pub struct ScenarioEntry {
 
 pub(super) const FILE: &str = "manifest.json";
 
-/// The git commit this forkbench was built from, when it was built from a checkout.
+/// The git commit this forkbench was built from, when it was built from a checkout; with
+/// `-changed-` and a fingerprint of the changes when its sources differed from the commit
+/// (edited or new files under `crates/` or `scenarios/`, or the workspace's manifest or
+/// lock file), so two builds of one commit with different edits are told apart.
 pub fn build_commit() -> Option<String> {
-    let commit = env!("FORKBENCH_GIT_COMMIT");
-    (!commit.is_empty()).then(|| commit.to_owned())
+    build_of(env!("FORKBENCH_GIT_COMMIT"), env!("FORKBENCH_GIT_CHANGES"))
 }
+
+fn build_of(commit: &str, changes: &str) -> Option<String> {
+    match (commit, changes) {
+        ("", _) => None,
+        (c, "") => Some(c.to_owned()),
+        (c, f) => Some(format!("{c}{CHANGED}{f}")),
+    }
+}
+
+/// What separates a commit from the fingerprint of the changes it was built with.
+const CHANGED: &str = "-changed-";
 
 /// A build as a message names it.
 pub(super) fn build_name(build: Option<&str>) -> String {
-    match build {
-        // A manifest is a file anyone may edit: cut at a character, shown escaped.
-        Some(c) => format!(
-            "the forkbench built from commit {}",
-            forkbench_trial::text::visible(&c.chars().take(12).collect::<String>())
+    let Some(build) = build else {
+        return "a forkbench that recorded no commit (built outside a git checkout, or \
+                before batches recorded it)"
+            .to_owned();
+    };
+    // A manifest is a file anyone may edit: cut at a character, shown escaped.
+    let cut =
+        |s: &str, n: usize| forkbench_trial::text::visible(&s.chars().take(n).collect::<String>());
+    match build.split_once(CHANGED) {
+        Some((commit, changes)) => format!(
+            "the forkbench built from commit {} with changed sources (fingerprint {})",
+            cut(commit, 12),
+            cut(changes, 16)
         ),
-        None => "a forkbench that recorded no commit (built outside a git checkout, or \
-                 before batches recorded it)"
-            .to_owned(),
+        None => format!("the forkbench built from commit {}", cut(build, 12)),
     }
 }
 
@@ -324,5 +343,30 @@ impl DirLock {
             ))),
             Err(std::fs::TryLockError::Error(e)) => Err(io(&path)(e)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_build_from_changed_sources_is_named_apart_from_its_commit() {
+        let commit = "0123456789abcdef0123456789abcdef01234567";
+        assert_eq!(build_of("", "ffff"), None);
+        assert_eq!(build_of(commit, "").as_deref(), Some(commit));
+        let changed = build_of(commit, "00c0ffee00c0ffee").expect("a build");
+        assert_ne!(Some(changed.clone()), build_of(commit, ""));
+        assert_ne!(Some(changed.clone()), build_of(commit, "11c0ffee00c0ffee"));
+        assert_eq!(
+            build_name(Some(&changed)),
+            "the forkbench built from commit 0123456789ab with changed sources (fingerprint \
+             00c0ffee00c0ffee)"
+        );
+        assert_eq!(
+            build_name(Some(commit)),
+            "the forkbench built from commit 0123456789ab"
+        );
+        assert!(build_name(None).contains("recorded no commit"));
     }
 }
