@@ -9,8 +9,7 @@ use crate::outcome::{Failure, PhaseOutcome};
 use crate::phase::{Failed, PICK, PhaseSpec, Steer};
 use crate::recorder::{Level, Recorder};
 use crate::trial::engine::Steering;
-use crate::trial::link::Control;
-use crate::trial::link::Stage;
+use crate::trial::link::{Control, Stage};
 use crate::trial::state::Trial;
 
 /// Hands a generic recorder to phases as a trait object.
@@ -72,7 +71,7 @@ impl<'a> Trial<'a> {
         });
     }
 
-    /// One phase: built from its spec, run, timed and judged.
+    /// One phase (built when the scenario loaded): run, timed and judged.
     async fn run_phase(&mut self, spec: &PhaseSpec, rec: &mut dyn Recorder) {
         let (t0, d0, loaded) = (
             self.world.sim.time_s(),
@@ -121,19 +120,15 @@ impl<'a> Trial<'a> {
         rec: &mut R,
         command: &mut Steer<'_>,
     ) -> Result<bool, Failed> {
-        let mut drive = PhaseDrive(|t: &mut Trial<'a>, pose| command(t, pose));
-        self.drive_by(limit_s, &mut drive, rec).await
+        self.drive_by(limit_s, &mut PhaseDrive(command), rec).await
     }
 }
 
 /// A phase's drive: its commands, the criteria every phase holds at every step, and the
 /// axle loads recorded.
-struct PhaseDrive<F>(F);
+struct PhaseDrive<'c, 's>(&'c mut Steer<'s>);
 
-impl<'a, F> Steering<'a, Failed> for PhaseDrive<F>
-where
-    F: FnMut(&mut Trial<'a>, Pose2) -> Result<Option<Command>, Failed>,
-{
+impl<'a> Steering<'a, Failed> for PhaseDrive<'_, '_> {
     fn command(
         &mut self,
         t: &mut Trial<'a>,
