@@ -215,7 +215,7 @@ pub struct Job {
 }
 
 impl BatchSpec {
-    /// Every job of this shard, in a fixed global order ([`order::for_each_job`]).
+    /// Every job of this shard, in a fixed global order (`order::for_each_job`).
     pub fn jobs(&self) -> Vec<Job> {
         let scenarios: Vec<order::ScenarioJobs> = self
             .scenarios

@@ -11,7 +11,7 @@ use nix::unistd::Pid;
 static ADOPTING: AtomicBool = AtomicBool::new(false);
 
 /// Makes this process the reaper of its descendants' orphans (Linux's child subreaper), so
-/// a child's daemonised grandchild is reparented here, not to init, and [`kill_orphans`]
+/// a child's daemonised grandchild is reparented here, not to init, and `kill_orphans`
 /// can find it. For a program whose every child is an external component (the CLI), not
 /// for a host process (Python) that has children of its own.
 pub fn adopt_orphans() {

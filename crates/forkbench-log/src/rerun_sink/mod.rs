@@ -2,7 +2,7 @@
 //!
 //! Everything goes through rerun's public SDK. A file is recorded into a memory sink and
 //! encoded by rerun when the trial ends, on the writer thread the MCAP sink uses too
-//! ([`crate::writer`]), which reports write errors with the file's name.
+//! (`crate::writer`), which reports write errors with the file's name.
 
 mod columns;
 mod layout;

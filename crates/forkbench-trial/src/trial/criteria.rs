@@ -80,7 +80,7 @@ impl TrialOutcome {
 
 /// The pick's criteria in the order of blame: the first broken one is the verdict.
 /// Adding one is a `Failure` variant and a row here (a criterion that measures at each
-/// step is a [`crate::StepCriterion`] instead).
+/// step is a [`crate::step_criteria::StepCriterion`] instead).
 pub const PICK_CRITERIA: &[Criterion] = &[
     Criterion {
         failure: Failure::Collision,

@@ -107,7 +107,7 @@ pub struct TrialOptions {
     /// Noise scales and sensing models.
     pub overrides: Overrides,
     /// Most wall time one trial may take, external components' answers included
-    /// (`None`: [`DEFAULT_WALL_BUDGET_S`]); past it the trial ends as an error.
+    /// (`None`: `DEFAULT_WALL_BUDGET_S`); past it the trial ends as an error.
     pub wall_budget_s: Option<f64>,
 }
 
