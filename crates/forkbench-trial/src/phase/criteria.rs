@@ -32,15 +32,15 @@ pub(super) fn pallet_stayed(host: &dyn PhaseHost, from: &Pose2) -> Result<(), Fa
         now.distance_to(from),
         wrap_angle(now.heading_rad - from.heading_rad),
     );
-    let tol = host.pallet_limits();
-    if moved > tol.displacement_m || turned.abs() > tol.rotation_rad {
+    let tol = host.tolerances();
+    if moved > tol.pallet_displacement_m || turned.abs() > tol.pallet_rotation_rad {
         return Err((
             Failure::PalletDisplaced,
             format!(
                 "the forks dragged the pallet {moved:.3} m and turned it {:.2}° (limits {} m, {}°)",
                 turned.to_degrees(),
-                tol.displacement_m,
-                tol.rotation_deg
+                tol.pallet_displacement_m,
+                tol.pallet_rotation_deg()
             ),
         ));
     }

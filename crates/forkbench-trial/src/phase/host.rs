@@ -12,31 +12,27 @@ use forkbench_track::Command;
 use super::Failed;
 use crate::outcome::LegOutcome;
 use crate::recorder::Recorder;
+use crate::tolerances::Limits;
 
 /// What a phase's settings are checked against when the scenario loads: the world's
 /// slots, stations and fixed obstacles, the pallet, and the mission.
 pub trait Context {
     /// The scenario's pallet.
     fn pallet(&self) -> &PalletSpec;
-    /// The world's pallet slots by name (each pose at its face centre, heading in).
-    fn slots(&self) -> Vec<(String, Pose2)>;
-    /// The world's stations by name.
-    fn stations(&self) -> Vec<(String, Pose2)>;
+    /// The pose of the world's pallet slot `name` (its face centre, heading in).
+    fn slot_pose(&self, name: &str) -> Option<Pose2>;
+    /// The world's pallet slots' names, for messages.
+    fn slot_names(&self) -> Vec<String>;
+    /// The pose of the world's station `name`.
+    fn station_pose(&self, name: &str) -> Option<Pose2>;
+    /// The world's stations' names, for messages.
+    fn station_names(&self) -> Vec<String>;
     /// The rack or wall (its label) a pallet standing with its face centre at `at` would
     /// overlap; shapes may touch.
     fn pallet_overlaps(&self, at: &Pose2) -> Option<String>;
     /// The mission's start, by name and pose (a return's default destination); `None`:
     /// the scenario has no `[mission]`, whose planner and tracker drive legs.
     fn mission_start(&self) -> Option<(String, Pose2)>;
-}
-
-/// The pick's limits on a pallet the forks leave standing.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PalletLimits {
-    pub displacement_m: f64,
-    pub rotation_rad: f64,
-    /// The rotation limit as the scenario wrote it, for messages.
-    pub rotation_deg: f64,
 }
 
 /// A phase's command at the controller's pose each tick: `None` ends the drive.
@@ -62,8 +58,9 @@ pub trait PhaseHost: Send {
     fn pallet(&self) -> &PalletSpec;
     /// How far past the fork root the pick drove the pallet's face (the insertion).
     fn insertion_m(&self) -> f64;
-    /// The pick's limits on dragging a pallet left standing.
-    fn pallet_limits(&self) -> PalletLimits;
+    /// The scenario's tolerances (a pallet left standing may be dragged only within the
+    /// pick's displacement and rotation limits).
+    fn tolerances(&self) -> &Limits;
     /// Records `value` as the running phase's measure `name` (its outcome's `measures`).
     fn record_measure(&mut self, name: &str, value: f64);
     /// The truck stands (how a drive ends).

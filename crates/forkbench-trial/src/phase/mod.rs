@@ -8,7 +8,7 @@ mod return_leg;
 mod reverse_out;
 
 pub use criteria::load_held;
-pub use host::{Context, DriveRun, LegRun, PalletLimits, PhaseHost, Steer, open_loop, stand_for};
+pub use host::{Context, DriveRun, LegRun, PhaseHost, Steer, open_loop, stand_for};
 
 use forkbench_core::SettingsError;
 use std::sync::Arc;

@@ -96,10 +96,8 @@ pub(super) fn build(
 
 /// The pose of the world's slot `name` (its face centre, heading into the rack).
 fn slot_pose(cx: &dyn Context, name: &str) -> Result<Pose2, SettingsError> {
-    let slots = cx.slots();
-    let found = slots.iter().find(|(n, _)| n == name).map(|(_, pose)| *pose);
-    found.ok_or_else(|| {
-        let known: Vec<_> = slots.iter().map(|(n, _)| n.as_str()).collect();
+    cx.slot_pose(name).ok_or_else(|| {
+        let known = cx.slot_names();
         SettingsError::field(
             "slot",
             format!(

@@ -95,10 +95,8 @@ fn build(
 
 /// The world's station `name`, named.
 fn station(cx: &dyn Context, name: &str) -> Result<(String, Pose2), SettingsError> {
-    let stations = cx.stations();
-    let pose = stations.iter().find(|(n, _)| n == name).map(|(_, p)| *p);
-    let pose = pose.ok_or_else(|| {
-        let known: Vec<_> = stations.iter().map(|(n, _)| n.as_str()).collect();
+    let pose = cx.station_pose(name).ok_or_else(|| {
+        let known = cx.station_names();
         SettingsError::field(
             "to",
             format!("no station {name:?} in the world (it has {known:?})"),

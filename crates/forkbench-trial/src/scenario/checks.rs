@@ -461,14 +461,24 @@ impl crate::phase::Context for Site<'_> {
         self.pallet
     }
 
-    fn slots(&self) -> Vec<(String, Pose2)> {
-        let slots = self.world.pallet_slot.iter();
-        slots.map(|s| (s.name.clone(), s.pose())).collect()
+    fn slot_pose(&self, name: &str) -> Option<Pose2> {
+        self.world.slot_pose(name)
     }
 
-    fn stations(&self) -> Vec<(String, Pose2)> {
-        let stations = self.world.station.iter();
-        stations.map(|s| (s.name.clone(), s.pose())).collect()
+    fn slot_names(&self) -> Vec<String> {
+        self.world
+            .pallet_slot
+            .iter()
+            .map(|s| s.name.clone())
+            .collect()
+    }
+
+    fn station_pose(&self, name: &str) -> Option<Pose2> {
+        self.world.station_pose(name)
+    }
+
+    fn station_names(&self) -> Vec<String> {
+        self.world.station.iter().map(|s| s.name.clone()).collect()
     }
 
     fn pallet_overlaps(&self, at: &Pose2) -> Option<String> {

@@ -8,9 +8,10 @@ use forkbench_sim::Sim;
 use forkbench_track::Command;
 
 use crate::outcome::Failure;
-use crate::phase::{DriveRun, LegRun, PalletLimits, PhaseHost, Steer};
+use crate::phase::{DriveRun, LegRun, PhaseHost, Steer};
 use crate::recorder::Recorder;
 use crate::scenario::mission::Waypoint;
+use crate::tolerances::Limits;
 use crate::trial::state::Trial;
 
 impl<'a> PhaseHost for Trial<'a> {
@@ -34,13 +35,8 @@ impl<'a> PhaseHost for Trial<'a> {
         self.insertion_m
     }
 
-    fn pallet_limits(&self) -> PalletLimits {
-        let tol = &self.scn.tolerances;
-        PalletLimits {
-            displacement_m: tol.pallet_displacement_m,
-            rotation_rad: tol.pallet_rotation_rad,
-            rotation_deg: tol.pallet_rotation_deg(),
-        }
+    fn tolerances(&self) -> &Limits {
+        &self.scn.tolerances
     }
 
     fn record_measure(&mut self, name: &str, value: f64) {
