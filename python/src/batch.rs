@@ -52,6 +52,7 @@ pub fn run_trial<'py>(
             localizer,
             pallet_sensing,
             missing_reflectors,
+            ..Overrides::default()
         },
         wall_budget_s: None,
     };

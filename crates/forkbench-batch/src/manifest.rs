@@ -44,6 +44,11 @@ pub struct Manifest {
     pub pallet_sensing: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub missing_reflectors: Option<Vec<String>>,
+    /// The truck's actuators and timing every scenario ran with: a preset, then settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truck_preset: Option<String>,
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub truck: std::collections::BTreeMap<String, f64>,
     pub replan: Option<bool>,
     /// Every trial run planning once and replanning.
     #[serde(default)]
@@ -147,6 +152,8 @@ impl Manifest {
             localizer: spec.overrides.localizer.clone(),
             pallet_sensing: spec.overrides.pallet_sensing.clone(),
             missing_reflectors: spec.overrides.missing_reflectors.clone(),
+            truck_preset: spec.overrides.truck_preset.clone(),
+            truck: spec.overrides.truck.clone(),
             replan: spec.replan,
             compare_replanning: spec.compare_replanning,
             scenarios,
@@ -162,6 +169,8 @@ impl Manifest {
             localizer: self.localizer.clone(),
             pallet_sensing: self.pallet_sensing.clone(),
             missing_reflectors: self.missing_reflectors.clone(),
+            truck_preset: self.truck_preset.clone(),
+            truck: self.truck.clone(),
         }
     }
 

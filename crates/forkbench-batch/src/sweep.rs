@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use super::{BatchSpec, Summary, TrialRecord};
 use forkbench_trial::scenario::{Case, Scenario};
 use forkbench_trial::text::md_cell;
-use forkbench_trial::trial::{NOISE_KNOBS, Overrides, TrialOptions};
+use forkbench_trial::trial::{NOISE_KNOBS, Overrides, TRUCK_KNOBS, TrialOptions, truck_path};
 
 /// One point of a finished sweep as `sweep.json` holds it.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -28,7 +28,8 @@ fn pallet_noise() -> String {
 /// Largest `sweep.json` read.
 const MAX_SWEEP_BYTES: u64 = 256 << 20;
 
-/// A noise sweep: the knob ([`NOISE_KNOBS`]) and the scales it takes, in order.
+/// A sweep: the knob (a noise scale of [`NOISE_KNOBS`], or a truck setting of
+/// [`TRUCK_KNOBS`]) and the values it takes, in order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sweep {
     pub knob: String,
@@ -36,17 +37,19 @@ pub struct Sweep {
 }
 
 impl Sweep {
-    /// `knob=v1,v2,…` as `--sweep` takes it, every value a valid scale.
+    /// `knob=v1,v2,…` as `--sweep` takes it, every value in the knob's range.
     pub fn parse(text: &str) -> Result<Self, super::BatchError> {
         let bad = |why: String| super::BatchError::Invalid(format!("--sweep {text:?}: {why}"));
         let (knob, values) = text
             .split_once('=')
             .ok_or_else(|| bad("expected KNOB=V1,V2,…".into()))?;
         let knob = knob.trim();
-        if !NOISE_KNOBS.contains(&knob) {
+        if !NOISE_KNOBS.contains(&knob) && truck_path(knob).is_none() {
+            let truck: Vec<&str> = TRUCK_KNOBS.iter().map(|(k, _)| *k).collect();
             return Err(bad(format!(
-                "unknown knob {knob:?} (known: {})",
-                NOISE_KNOBS.join(", ")
+                "unknown knob {knob:?} (noise scales: {}; truck settings: {})",
+                NOISE_KNOBS.join(", "),
+                truck.join(", ")
             )));
         }
         let values = values
@@ -138,9 +141,13 @@ pub fn sweep_points(spec: &BatchSpec, out: &Path, sweep: &Sweep) -> Vec<SweepPoi
 /// A sweep's success rates and the errors the knob moves, as markdown: one line per
 /// scenario × planner × tracker × mode × scale.
 pub fn sweep_markdown(knob: &str, points: &[(f64, Summary)]) -> String {
+    let column = if NOISE_KNOBS.contains(&knob) {
+        format!("{} scale", knob.replace('_', " "))
+    } else {
+        knob.to_owned()
+    };
     let mut s = format!(
-        "| scenario | planner | tracker | mode | {} scale | trials | success rate | 95 % CI | estimate error, median (mm) | localisation error, median (mm) |\n|---|---|---|---|---|---|---|---|---|---|\n",
-        knob.replace('_', " ")
+        "| scenario | planner | tracker | mode | {column} | trials | success rate | 95 % CI | estimate error, median (mm) | localisation error, median (mm) |\n|---|---|---|---|---|---|---|---|---|---|\n"
     );
     let mut rows: Vec<(f64, &super::SummaryRow)> = points
         .iter()

@@ -67,6 +67,11 @@ pub struct BatchArgs {
     /// NAV350's map keeps them.
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     pub missing_reflectors: Option<Vec<String>>,
+    /// The truck's actuators and control timing: a preset (`ideal`, `realistic`) or a
+    /// truck file (`[steering]`, `[drive]`, `[control]`, `max_steer_rate_radps`, and an
+    /// optional `preset`), applied over each scenario's `[truck]`.
+    #[arg(long, value_name = "PRESET|FILE")]
+    pub truck: Option<String>,
     /// Batch seed; each trial's seed derives from it and the trial's identity.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -209,6 +214,7 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     let modes =
         batch::ReplanModes::choose(a.replan, a.modes.map(Into::into), a.scenarios.is_empty());
     let (replan, compare_replanning) = modes.spec_fields();
+    let (truck_preset, truck) = crate::truck_cmd::truck_settings(a.truck.as_deref())?;
     let spec = BatchSpec {
         scenarios,
         planners: a.planners.clone(),
@@ -223,6 +229,8 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
             localizer: a.localizer.clone(),
             pallet_sensing: a.pallet_sensing.clone(),
             missing_reflectors: a.missing_reflectors.clone(),
+            truck_preset,
+            truck,
         },
         replan,
         compare_replanning,

@@ -16,6 +16,7 @@ mod route_cmd;
 mod safety_cmd;
 mod scan_cmd;
 mod trial_cmd;
+mod truck_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -130,6 +131,11 @@ struct TrialCli {
     /// keeps them: which legs suffer if they go.
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     missing_reflectors: Option<Vec<String>>,
+    /// The truck's actuators and control timing: a preset (`ideal`, `realistic`) or a
+    /// truck file (`[steering]`, `[drive]`, `[control]`, `max_steer_rate_radps`, and an
+    /// optional `preset`), applied over the scenario's `[truck]`.
+    #[arg(long, value_name = "PRESET|FILE")]
+    truck: Option<String>,
     #[arg(long)]
     json: bool,
     #[command(flatten)]
@@ -138,6 +144,7 @@ struct TrialCli {
 
 impl TrialCli {
     fn run(self, mission: bool) -> anyhow::Result<Done> {
+        let (truck_preset, truck) = truck_cmd::truck_settings(self.truck.as_deref())?;
         let overrides = forkbench_trial::trial::Overrides {
             pallet_noise_scale: self.pallet_noise_scale,
             localization_noise_scale: self.localization_noise_scale,
@@ -145,6 +152,8 @@ impl TrialCli {
             localizer: self.localizer,
             pallet_sensing: self.pallet_sensing,
             missing_reflectors: self.missing_reflectors,
+            truck_preset,
+            truck,
         };
         let opts = trial_cmd::options(
             self.seed,
@@ -243,6 +252,12 @@ enum Command {
     /// detection): each term of the makers' formula, braking measured in the physics
     /// empty and at rated load on the scenario's floor.
     SafetyFields(safety_cmd::SafetyFieldsArgs),
+    /// Fit the truck's steering and drive actuators (dead time, time constant, limits)
+    /// from a CSV log of commands and measured responses, validated on held-out runs.
+    Identify(truck_cmd::IdentifyArgs),
+    /// Drive the simulated truck through seeded steering and speed steps and write the
+    /// actuator log `identify` reads (a round trip with known actuators).
+    StepTest(truck_cmd::StepTestArgs),
     /// Load a scenario as a run would and print what it resolved to: world, components,
     /// how the forks fit the pallet, limits and cases (exit 1 with the file, field and
     /// reason when it does not load).
@@ -368,6 +383,8 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Detect(args) => detect_cmd::run(&args).map(|()| Done::Ok),
         Command::Check(args) => check_cmd::run(&args).map(|()| Done::Ok),
         Command::SafetyFields(args) => safety_cmd::run(&args).map(|()| Done::Ok),
+        Command::Identify(args) => truck_cmd::identify(&args).map(|()| Done::Ok),
+        Command::StepTest(args) => truck_cmd::step_test(&args).map(|()| Done::Ok),
     }
 }
 

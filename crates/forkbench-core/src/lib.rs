@@ -1,5 +1,6 @@
 //! Shared vocabulary of forkbench: poses, units, the forklift and pallet specs, sampled paths.
 
+pub mod actuators;
 pub mod files;
 pub mod geometry;
 pub mod hash;

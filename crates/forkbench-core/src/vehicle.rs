@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::actuators::{Actuators, ControlTiming, DriveActuator, SteeringActuator};
+
 /// Geometry and limits of a rear-steered counterbalance forklift.
 ///
 /// The kinematic origin is the centre of the front (drive) axle; the path reference
@@ -35,6 +37,16 @@ pub struct ForkliftSpec {
     /// Fork blade thickness; when given, a pallet whose pockets are lower is refused.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fork_thickness_m: Option<f64>,
+    /// The steering actuator (`[steering]` in a truck file, `[truck.steering]` in a
+    /// scenario); left out of serialised specs when ideal, so older settings keep their hashes.
+    #[serde(skip_serializing_if = "SteeringActuator::is_ideal")]
+    pub steering: SteeringActuator,
+    /// The traction drive (`[drive]`).
+    #[serde(skip_serializing_if = "DriveActuator::is_ideal")]
+    pub drive: DriveActuator,
+    /// The controller's period and transport delay (`[control]`).
+    #[serde(skip_serializing_if = "ControlTiming::is_ideal")]
+    pub control: ControlTiming,
 }
 
 /// The A30's rating: 3 t.
@@ -64,6 +76,9 @@ impl Default for ForkliftSpec {
             max_steer_rate_radps: 0.8,
             rated_capacity_kg: DEFAULT_RATED_CAPACITY_KG,
             fork_thickness_m: None,
+            steering: SteeringActuator::IDEAL,
+            drive: DriveActuator::IDEAL,
+            control: ControlTiming::IDEAL,
         }
     }
 }
@@ -201,7 +216,25 @@ impl ForkliftSpec {
                 "forks spread far wider than the truck",
             ));
         }
-        Ok(())
+        self.steering.validate()?;
+        self.drive.validate()?;
+        self.control.validate()
+    }
+
+    /// The actuators and timing, together.
+    pub fn actuators(&self) -> Actuators {
+        Actuators {
+            steering: self.steering.clone(),
+            drive: self.drive.clone(),
+            control: self.control.clone(),
+        }
+    }
+
+    /// Takes the actuators and timing of `a` (a preset), keeping the geometry.
+    pub fn set_actuators(&mut self, a: Actuators) {
+        self.steering = a.steering;
+        self.drive = a.drive;
+        self.control = a.control;
     }
 }
 

@@ -68,7 +68,12 @@ pub fn knob_axis(knob: &str) -> String {
         "pallet_noise" => "pallet-sensing error (estimate σ, scanner noise and bias)",
         "localization_noise" => "localisation error (NAV350 or Gaussian σ)",
         "odometry_noise" => "odometry error (speed scale and steering σ)",
-        other => other,
+        other => {
+            if let Some(path) = forkbench_trial::trial::truck_path(other) {
+                return format!("truck {path}, as set");
+            }
+            other
+        }
     };
     format!("scale of the {what}; 1 = the scenario's own")
 }

@@ -42,6 +42,9 @@ pub struct Reading {
     /// Reflectors the device detected this sweep, matched or not (0 for models without
     /// reflectors).
     pub detected: usize,
+    /// When the pose was measured (the sweep's end), on the trial's clock: a reading
+    /// delivered a latency later says how old it is, so the controller can carry it to now.
+    pub measured_s: f64,
 }
 
 /// A localisation sensor: pose fixes of the fork root as the controller receives them.
@@ -250,6 +253,7 @@ impl Localizer for Nav350 {
                 pose: Some(fix),
                 fix: None,
                 detected: 0,
+                measured_s: input.t_s,
             };
             self.cadence.send(input.t_s, reading);
         }

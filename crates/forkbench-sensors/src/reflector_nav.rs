@@ -187,6 +187,7 @@ impl ReflectorNav {
                 pose: None,
                 fix: None,
                 detected: 0,
+                measured_s: t_s,
             };
         };
         let prior = prior.unwrap_or(truth);
@@ -212,6 +213,7 @@ impl ReflectorNav {
             pose: fix.as_ref().map(|f| root_of(&f.pose, m)),
             fix,
             detected: obs.len(),
+            measured_s: t_s,
         }
     }
 

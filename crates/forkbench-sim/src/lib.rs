@@ -1,5 +1,6 @@
 //! The rapier2d world of a pick trial: one rigid-body forklift with tyre impulses, pallets with stringers it can lift and carry, fixed racks.
 
+mod actuator;
 mod bodies;
 mod load;
 mod view;
@@ -72,6 +73,8 @@ pub struct Sim {
     pallet_spec: PalletSpec,
     cfg: SimConfig,
     steer_rad: f64,
+    steering: actuator::Steering,
+    drive: actuator::Drive,
     /// Steps taken; time is steps × dt, so it never drifts from float accumulation.
     steps: u64,
     truck_mass_kg: f64,
@@ -219,6 +222,8 @@ impl Sim {
             pallet_spec: pallet_spec.clone(),
             cfg: cfg.clone(),
             steer_rad: 0.0,
+            steering: actuator::Steering::new(spec, cfg.dt_s),
+            drive: actuator::Drive::new(spec, cfg.dt_s),
             steps: 0,
             truck_mass_kg,
             truck_inertia,
@@ -328,26 +333,12 @@ impl Sim {
         self.last_obstacle_contact
     }
 
-    /// One fixed step with the commanded speed and steering angle.
+    /// One fixed step with the commanded speed and steering angle, as the truck's
+    /// actuators (`ForkliftSpec::steering`, `drive`, `control`) pass them on.
     pub fn step(&mut self, speed_cmd_mps: f64, steer_cmd_rad: f64) {
         let dt = self.cfg.dt_s;
-        // Rate-limited steering actuator.
-        let max = self.spec.max_steer_rad;
-        let target = if steer_cmd_rad.is_finite() {
-            steer_cmd_rad.clamp(-max, max)
-        } else {
-            self.steer_rad
-        };
-        let rate = self.spec.max_steer_rate_radps * dt;
-        self.steer_rad =
-            (self.steer_rad + (target - self.steer_rad).clamp(-rate, rate)).clamp(-max, max);
-        let speed_cmd = if speed_cmd_mps.is_finite() {
-            speed_cmd_mps
-        } else {
-            0.0
-        };
-
-        self.apply_drive(speed_cmd, dt);
+        self.steer_rad = self.steering.step(steer_cmd_rad, dt);
+        self.apply_drive(speed_cmd_mps, dt);
         self.apply_tyres(dt);
         self.apply_pallet_floor_friction(dt);
         self.world.step();
@@ -357,13 +348,17 @@ impl Sim {
         self.check_load(dt);
     }
 
-    /// Drive/brake force at the front axle from a proportional speed controller, at most
-    /// what the drive tyres' grip on the floor can pass (μ times the front axle load).
+    /// Drive/brake force at the front axle from the drive's speed loop, at most what the
+    /// drive tyres' grip on the floor can pass (μ times the front axle load).
     fn apply_drive(&mut self, speed_cmd: f64, dt: f64) {
         let a = self.front_axle_pose();
         let v = self.speed_mps();
-        let accel = (self.cfg.speed_gain_per_s * (speed_cmd - v))
-            .clamp(-self.cfg.max_accel_mps2, self.cfg.max_accel_mps2);
+        let accel = self.drive.accel(
+            speed_cmd,
+            v,
+            self.cfg.speed_gain_per_s,
+            self.cfg.max_accel_mps2,
+        );
         let grip_n = self.cfg.tyre_friction * self.axle_loads_n()[0];
         let j = (self.truck_mass_kg * accel).clamp(-grip_n, grip_n) * dt;
         let (s, c) = a.heading_rad.sin_cos();

@@ -1,5 +1,6 @@
 //! Path tracking for a rear-steered forklift: the `Tracker` trait, pure pursuit, regulated pure pursuit, trackers in other languages (`external`), odometry prediction.
 
+mod compensation;
 pub mod external;
 mod predictor;
 mod pursuit;
@@ -7,8 +8,9 @@ mod regulated;
 mod segments;
 mod tracker;
 
+pub use compensation::DelayCompensated;
 pub use external::ExternalTracker;
-pub use predictor::PosePredictor;
+pub use predictor::{PosePredictor, advance_pose};
 pub use pursuit::{Command, PurePursuit, TrackerConfig};
 pub use regulated::{RegulatedConfig, RegulatedPurePursuit};
 pub use segments::{SegmentFollower, steer_for_root_curvature};

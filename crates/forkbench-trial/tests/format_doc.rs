@@ -49,6 +49,18 @@ fn defaulted_tables() -> Vec<(&'static str, toml::Value)> {
         |m: &str| value(&forkbench_sensors::scan::ScannerConfig::preset(m).expect("preset"));
     vec![
         ("[truck]", truck_defaults()),
+        (
+            "[truck.steering]",
+            value(&forkbench_core::actuators::SteeringActuator::default()),
+        ),
+        (
+            "[truck.drive]",
+            value(&forkbench_core::actuators::DriveActuator::default()),
+        ),
+        (
+            "[truck.control]",
+            value(&forkbench_core::actuators::ControlTiming::default()),
+        ),
         ("[sim]", value(&forkbench_sim::SimConfig::default())),
         ("[noise.nav350]", value(&noise.nav350)),
         ("[noise.pallet_estimate]", value(&noise.pallet_estimate)),

@@ -18,7 +18,9 @@ use forkbench_sensors::{
     Localizer, Nav350, Nav350Config, PalletEstimateConfig, PalletEstimator, ReflectorNav,
     ReflectorNavSettings,
 };
-use forkbench_track::{ExternalTracker, PurePursuit, RegulatedPurePursuit, Tracker};
+use forkbench_track::{
+    DelayCompensated, ExternalTracker, PurePursuit, RegulatedPurePursuit, Tracker,
+};
 
 pub use spec::{ComponentSpec, Role};
 
@@ -117,6 +119,20 @@ impl Registry {
             })
             .with_tracker("regulated_pure_pursuit", |s, _| {
                 Ok(Box::new(RegulatedPurePursuit::from_settings(s)?))
+            })
+            // Delay-compensated: the same trackers steering from the pose predicted over
+            // the truck's actuator delay (a Smith predictor).
+            .with_tracker("pure_pursuit_compensated", |s, _| {
+                let inner = Box::new(PurePursuit::from_settings(s)?);
+                Ok(Box::new(DelayCompensated::new(
+                    inner,
+                    "pure_pursuit_compensated",
+                )))
+            })
+            .with_tracker("regulated_pure_pursuit_compensated", |s, _| {
+                let inner = Box::new(RegulatedPurePursuit::from_settings(s)?);
+                let name = "regulated_pure_pursuit_compensated";
+                Ok(Box::new(DelayCompensated::new(inner, name)))
             })
             .with_tracker("external", |s, cx| {
                 Ok(Box::new(ExternalTracker::from_settings(

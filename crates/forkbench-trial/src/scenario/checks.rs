@@ -258,6 +258,10 @@ pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), TrialErro
         return Err(invalid_setting(file, "noise.odometry", &e));
     }
     check_settings(f, file)?;
+    f.truck
+        .control
+        .steps_per_tick(f.sim.dt_s)
+        .map_err(|e| invalid_setting(file, "truck", &e))?;
     if let Some(b) = &f.estimate_bias {
         b.check(file, "estimate_bias")?;
     }

@@ -141,7 +141,7 @@ impl<'a> Trial<'a> {
             pose,
             speed_mps: self.world.sim.speed_mps(),
             steer_rad: self.world.sim.steer_rad(),
-            truck: &self.scn.truck,
+            truck: &self.run.truck,
         }
     }
 

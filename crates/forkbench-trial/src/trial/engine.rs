@@ -62,10 +62,25 @@ impl<'a> Trial<'a> {
         S: Steering<'a, E>,
     {
         let deadline_s = self.world.sim.time_s() + limit_s;
+        let every = self.control_steps_per_tick();
         let mut last = None;
+        // The tick's command and control, held until the next tick.
+        let mut held: Option<(Command, Control, u32)> = None;
         let ended = loop {
             if self.world.sim.time_s() >= deadline_s {
                 break Ok(false);
+            }
+            if let (Some((cmd, control, since)), Some((_, pose))) = (held.as_mut(), last)
+                && *since < every
+            {
+                *since += 1;
+                let (cmd, control) = (*cmd, *control);
+                self.physics_step(&cmd, None, pose, rec);
+                match steering.stepped(self, control, &cmd, rec) {
+                    Ok(false) => continue,
+                    Ok(true) => break Ok(true),
+                    Err(e) => break Err(e),
+                }
             }
             let (fix, pose) = match self.sense(rec) {
                 Ok(r) => r,
@@ -86,6 +101,7 @@ impl<'a> Trial<'a> {
                 Err(e) => break Err(e),
             };
             self.physics_step(&cmd, fix, pose, rec);
+            held = Some((cmd, control, 1));
             match steering.stepped(self, control, &cmd, rec) {
                 Ok(false) => {}
                 Ok(true) => break Ok(true),
@@ -100,6 +116,15 @@ impl<'a> Trial<'a> {
             link.lock().deadline_hit = matches!(ended, Ok(false));
         }
         ended
+    }
+
+    /// Physics steps per control tick (`[truck.control] period_s`, checked at load).
+    fn control_steps_per_tick(&self) -> u32 {
+        self.run
+            .truck
+            .control
+            .steps_per_tick(self.world.sim.dt_s())
+            .unwrap_or(1)
     }
 
     /// The session whose caller takes this stage's ticks, if one does.

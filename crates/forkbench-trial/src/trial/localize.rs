@@ -36,9 +36,10 @@ impl Trial<'_> {
         let fix = reading.as_ref().and_then(|r| r.pose);
         if let Some(r) = &reading {
             self.take_reading(t_s, r, rec);
-        }
-        if let Some(fix) = fix {
-            self.loc.predictor.fix(fix);
+            if let Some(fix) = r.pose {
+                // Carried from when it was measured: a late fix is not the pose now.
+                self.loc.predictor.fix_measured_ago(fix, t_s - r.measured_s);
+            }
         }
         let pose = self.loc.predictor.pose().unwrap_or(self.loc.first_fix);
         if !(pose.is_finite() && truth.is_finite()) {

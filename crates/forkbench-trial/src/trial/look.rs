@@ -38,7 +38,7 @@ pub fn scan_once(
     seed: u64,
     ideal: bool,
 ) -> Result<ScanReport, StageError> {
-    let (sim, root, truth, _) = build_world(scn, case, seed, at)?;
+    let (sim, root, truth, _) = build_world(scn, &scn.truck, case, seed, at)?;
     let pose = cfg.sensor_pose(&root);
     // Its own stream, so a scan does not shift the trial's other draws.
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ super::streams::SCAN_ONCE);

@@ -1,5 +1,6 @@
 //! A run's choices on top of a scenario file (`TrialOptions`, its `Overrides`), checked once, and their resolution into what a trial runs with.
 
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
@@ -40,6 +41,14 @@ pub struct Overrides {
     /// Reflectors missing from the world while the NAV350's map keeps them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub missing_reflectors: Option<Vec<String>>,
+    /// Take this preset's actuators and control timing (`ideal`, `realistic`) instead
+    /// of the scenario's `[truck]` ones.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truck_preset: Option<String>,
+    /// Actuator and timing settings by dotted path (`steering.dead_time_s`; see
+    /// [`super::TRUCK_KNOBS`]), after the preset: a `--truck` file, a sweep's point.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub truck: BTreeMap<String, f64>,
 }
 
 /// The noise knobs by the names sweeps and messages use, with their source.
@@ -56,8 +65,13 @@ impl Overrides {
         }
     }
 
-    /// Sets a knob's scale; false for a name that is not a knob.
+    /// Sets a knob's scale, or a truck setting by its sweep name or dotted path
+    /// ([`super::TRUCK_KNOBS`]); false for a name that is neither.
     pub fn set_scale(&mut self, knob: &str, v: f64) -> bool {
+        if let Some(path) = super::truck_path(knob) {
+            self.truck.insert(path.to_owned(), v);
+            return true;
+        }
         let slot = match knob {
             "pallet_noise" => &mut self.pallet_noise_scale,
             "localization_noise" => &mut self.localization_noise_scale,
@@ -79,6 +93,15 @@ impl Overrides {
                     &format!("{v} must be a number from 0 to {MAX_NOISE_SCALE}"),
                 ));
             }
+        }
+        if self.truck_preset.is_some() || !self.truck.is_empty() {
+            // Names and ranges, on the bench's own truck: a scenario's truck is checked again.
+            let preset = self.truck_preset.as_deref();
+            super::apply_truck(
+                &forkbench_core::ForkliftSpec::default(),
+                preset,
+                &self.truck,
+            )?;
         }
         if let Some(names) = &self.missing_reflectors
             && let Some(n) = names.iter().find(|n| n.trim().is_empty())
@@ -168,6 +191,8 @@ pub struct Resolved {
     pub odometry: forkbench_sensors::OdometryConfig,
     /// Most wall time the trial may take.
     pub wall_budget_s: f64,
+    /// The scenario's truck with the run's actuator and timing changes.
+    pub truck: forkbench_core::ForkliftSpec,
 }
 
 impl Scenario {
@@ -214,7 +239,22 @@ impl Scenario {
             localization_noise_scale,
             odometry: self.scaled_odometry(o.odometry_noise_scale)?,
             wall_budget_s: opts.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
+            truck: self.truck_for(o)?,
         })
+    }
+
+    /// This scenario's truck with the run's preset and settings, its control period
+    /// checked against the physics step.
+    fn truck_for(&self, o: &Overrides) -> Result<forkbench_core::ForkliftSpec, TrialError> {
+        if o.truck_preset.is_none() && o.truck.is_empty() {
+            return Ok(self.truck.clone());
+        }
+        let truck = super::apply_truck(&self.truck, o.truck_preset.as_deref(), &o.truck)?;
+        truck
+            .control
+            .steps_per_tick(self.sim.dt_s)
+            .map_err(|e| invalid_setting(&self.file, "truck", &e))?;
+        Ok(truck)
     }
 
     /// Resolves and also builds the localiser once in this scenario's world: what a run

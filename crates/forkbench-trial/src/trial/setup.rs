@@ -162,13 +162,14 @@ impl<'a> Trial<'a> {
                 return Err(Box::new(out));
             }
         };
-        let (sim, start, true_pallet, obstacles) = match build_world(scn, case, run.seed, None) {
-            Ok(w) => w,
-            Err(e) => {
-                fail(&mut out, e.to_string());
-                return Err(Box::new(out));
-            }
-        };
+        let (sim, start, true_pallet, obstacles) =
+            match build_world(scn, &run.truck, case, run.seed, None) {
+                Ok(w) => w,
+                Err(e) => {
+                    fail(&mut out, e.to_string());
+                    return Err(Box::new(out));
+                }
+            };
         let safety = match super::safety_run::SafetyRun::new(scn, run.seed) {
             Ok(s) => s,
             Err(e) => {

@@ -13,6 +13,7 @@ use crate::scenario::{Case, Scenario};
 /// random stream).
 pub(super) fn build_world(
     scn: &Scenario,
+    truck: &forkbench_core::ForkliftSpec,
     case: &Case,
     seed: u64,
     start_at: Option<Pose2>,
@@ -26,7 +27,7 @@ pub(super) fn build_world(
     let start =
         start_at.unwrap_or_else(|| scn.mission.as_ref().map_or(case.start, |m| m.start.pose));
     let sim = Sim::new(
-        &scn.truck,
+        truck,
         &start,
         &scn.pallet,
         &true_pallet,

@@ -1,0 +1,108 @@
+//! The truck's actuators from the command line: `--truck PRESET|FILE` for a run.
+
+/// A `--truck` argument as a run's changes to the truck: a preset by name, or a truck
+/// file's preset and settings; refused naming the file and the field.
+pub(crate) fn truck_settings(
+    arg: Option<&str>,
+) -> anyhow::Result<(Option<String>, std::collections::BTreeMap<String, f64>)> {
+    let Some(arg) = arg else {
+        return Ok((None, Default::default()));
+    };
+    if forkbench_core::actuators::Actuators::preset(arg).is_some() {
+        return Ok((Some(arg.to_owned()), Default::default()));
+    }
+    let path = std::path::PathBuf::from(arg);
+    if !path.exists() {
+        let known: Vec<&str> = forkbench_core::actuators::PRESETS
+            .iter()
+            .map(|(n, _)| *n)
+            .collect();
+        anyhow::bail!(
+            "--truck {arg:?}: neither a preset ({}) nor a file",
+            known.join(", ")
+        );
+    }
+    let text = crate::read_input(&path)?;
+    forkbench_trial::trial::truck_file_settings(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// `forkbench identify LOG`: the truck's actuators fitted from a log.
+#[derive(Debug, clap::Args)]
+pub struct IdentifyArgs {
+    /// CSV log with a header naming `t_s`, `steer_cmd_rad`, `steer_rad`, `speed_cmd_mps`,
+    /// `speed_mps` (either channel may be missing; other columns ignored; a `run` column
+    /// separates runs, which are held out whole for validation).
+    log: std::path::PathBuf,
+    /// Print the fit as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Write the fitted settings as a truck file that `--truck` takes.
+    #[arg(long, value_name = "FILE")]
+    truck_out: Option<std::path::PathBuf>,
+}
+
+pub fn identify(a: &IdentifyArgs) -> anyhow::Result<()> {
+    use anyhow::Context as _;
+    let log = forkbench_identify::read_csv(&a.log)?;
+    let fit = forkbench_identify::identify(&log)
+        .with_context(|| format!("identifying {}", a.log.display()))?;
+    if let Some(out) = &a.truck_out {
+        forkbench_core::files::write_atomic(out, fit.truck_toml().as_bytes())
+            .with_context(|| format!("writing {}", out.display()))?;
+    }
+    if a.json {
+        return crate::emit_json_line(&fit);
+    }
+    crate::emit(&fit.text())
+}
+
+/// `forkbench step-test`: drive the simulated truck through seeded steering and speed
+/// steps and write the actuator log `identify` reads.
+#[derive(Debug, clap::Args)]
+pub struct StepTestArgs {
+    /// The truck's actuators (a preset or a truck file) over the A30 defaults.
+    #[arg(long, value_name = "PRESET|FILE")]
+    truck: Option<String>,
+    /// Where the CSV log goes.
+    #[arg(long)]
+    out: std::path::PathBuf,
+    /// Runs (each from rest), 1–1000.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    runs: u32,
+    /// Length of each run in seconds, 2–600.
+    #[arg(long, default_value_t = 20.0)]
+    run_s: f64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+pub fn step_test(a: &StepTestArgs) -> anyhow::Result<()> {
+    use anyhow::Context as _;
+    if !(a.run_s.is_finite() && (2.0..=600.0).contains(&a.run_s)) {
+        anyhow::bail!("--run-s {}: must lie within 2–600 s", a.run_s);
+    }
+    let (preset, settings) = truck_settings(a.truck.as_deref())?;
+    let truck = forkbench_trial::trial::apply_truck(
+        &forkbench_core::ForkliftSpec::default(),
+        preset.as_deref(),
+        &settings,
+    )?;
+    let sim = forkbench_sim::SimConfig::default();
+    truck.control.steps_per_tick(sim.dt_s)?;
+    let test = forkbench_identify::excite::StepTest {
+        runs: a.runs as usize,
+        run_s: a.run_s,
+        seed: a.seed,
+        steering: true,
+    };
+    let log = forkbench_identify::excite::step_test(&truck, &sim, &test)?;
+    forkbench_core::files::write_atomic(&a.out, forkbench_identify::to_csv(&log).as_bytes())
+        .with_context(|| format!("writing {}", a.out.display()))?;
+    crate::emit(&format!(
+        "{} runs of {} s written to {}\n",
+        a.runs,
+        a.run_s,
+        a.out.display()
+    ))
+}

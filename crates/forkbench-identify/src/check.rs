@@ -1,0 +1,52 @@
+//! What a log must show before a fit is worth making: enough samples and time, and commands that move.
+
+use crate::IdentifyError;
+use crate::log::Run;
+use crate::model::{Kind, channel};
+
+/// Fewest samples over a channel's runs.
+const MIN_SAMPLES: usize = 100;
+/// Shortest logged time over a channel's runs.
+const MIN_DURATION_S: f64 = 2.0;
+
+/// Refuses a channel whose log is too short or whose command never moves.
+pub fn enough(kind: Kind, runs: &[&Run]) -> Result<(), IdentifyError> {
+    let name = match kind {
+        Kind::Steering => "steering",
+        Kind::Drive => "drive",
+    };
+    let samples: usize = runs.iter().map(|r| r.t_s.len()).sum();
+    let duration: f64 = runs
+        .iter()
+        .map(|r| r.t_s.last().copied().unwrap_or(0.0) - r.t_s.first().copied().unwrap_or(0.0))
+        .sum();
+    if samples < MIN_SAMPLES || duration < MIN_DURATION_S {
+        return Err(IdentifyError::TooShort {
+            channel: name,
+            samples,
+            duration_s: duration,
+        });
+    }
+    let cmds: Vec<f64> = runs
+        .iter()
+        .filter_map(|r| channel(r, kind))
+        .flat_map(|c| c.cmd.iter().copied())
+        .collect();
+    let (lo, hi) = cmds
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    let threshold = match kind {
+        Kind::Steering => 0.01,
+        Kind::Drive => 0.02,
+    };
+    if !(hi - lo >= threshold) {
+        return Err(IdentifyError::NoExcitation {
+            channel: name,
+            span: (hi - lo).max(0.0),
+            threshold,
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,3 @@
+//! The identification's integration tests, one binary.
+
+mod round_trip;

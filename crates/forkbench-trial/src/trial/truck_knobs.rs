@@ -1,0 +1,185 @@
+//! A run's changes to the truck's actuators and timing: a named preset, single settings by their dotted names (a `--truck` file, a sweep), and their application to a scenario's truck.
+
+use std::collections::BTreeMap;
+
+use forkbench_core::ForkliftSpec;
+use forkbench_core::actuators::{Actuators, PRESETS};
+
+use crate::TrialError;
+use crate::scenario::invalid;
+
+/// The truck settings a run may change, by their names in a sweep and their dotted paths
+/// in a truck file: the actuators and the control timing. The geometry is the scenario's.
+pub const TRUCK_KNOBS: [(&str, &str); 14] = [
+    ("steering_rate_limit_radps", "max_steer_rate_radps"),
+    ("steering_dead_time_s", "steering.dead_time_s"),
+    ("steering_time_constant_s", "steering.time_constant_s"),
+    ("steering_accel_limit_radps2", "steering.accel_limit_radps2"),
+    ("steering_deadband_rad", "steering.deadband_rad"),
+    ("steering_backlash_rad", "steering.backlash_rad"),
+    ("steering_offset_rad", "steering.offset_rad"),
+    ("drive_dead_time_s", "drive.dead_time_s"),
+    ("drive_time_constant_s", "drive.time_constant_s"),
+    ("drive_accel_limit_mps2", "drive.accel_limit_mps2"),
+    ("drive_brake_limit_mps2", "drive.brake_limit_mps2"),
+    ("drive_creep_speed_mps", "drive.creep_speed_mps"),
+    ("control_period_s", "control.period_s"),
+    ("control_transport_delay_s", "control.transport_delay_s"),
+];
+
+/// The dotted path of a sweep knob's name, or of a dotted path itself.
+pub fn truck_path(name: &str) -> Option<&'static str> {
+    TRUCK_KNOBS
+        .iter()
+        .find(|(k, p)| *k == name || *p == name)
+        .map(|(_, p)| *p)
+}
+
+fn bad(field: &str, reason: &str) -> TrialError {
+    invalid("options", field, reason)
+}
+
+/// `truck` with `preset`'s actuators (if any), then each of `settings` (dotted paths of
+/// [`TRUCK_KNOBS`]), checked as a truck file is.
+pub fn apply_truck(
+    truck: &ForkliftSpec,
+    preset: Option<&str>,
+    settings: &BTreeMap<String, f64>,
+) -> Result<ForkliftSpec, TrialError> {
+    let mut out = truck.clone();
+    if let Some(name) = preset {
+        let a = Actuators::preset(name).ok_or_else(|| {
+            let known: Vec<&str> = PRESETS.iter().map(|(n, _)| *n).collect();
+            bad(
+                "truck_preset",
+                &format!("unknown preset {name:?} (known: {})", known.join(", ")),
+            )
+        })?;
+        out.set_actuators(a);
+    }
+    if settings.is_empty() {
+        return Ok(out);
+    }
+    let mut value = toml::Value::try_from(&out)
+        .map_err(|e| bad("truck", &format!("the truck does not serialise: {e}")))?;
+    for (path, v) in settings {
+        if truck_path(path) != Some(path.as_str()) {
+            let known: Vec<&str> = TRUCK_KNOBS.iter().map(|(_, p)| *p).collect();
+            return Err(bad(
+                path,
+                &format!(
+                    "not a setting a run may change (the geometry is the scenario's); known: {}",
+                    known.join(", ")
+                ),
+            ));
+        }
+        set_dotted(&mut value, path, *v);
+    }
+    let spec: ForkliftSpec = value
+        .try_into()
+        .map_err(|e: toml::de::Error| bad("truck", e.message()))?;
+    spec.validate()
+        .map_err(|e| bad(&format!("truck.{}", e.field.unwrap_or_default()), &e.reason))?;
+    Ok(spec)
+}
+
+/// Sets `path` (`a.b`) in a table value, making the inner table when it is missing.
+fn set_dotted(value: &mut toml::Value, path: &str, v: f64) {
+    let mut at = value;
+    let mut parts = path.split('.').peekable();
+    while let Some(part) = parts.next() {
+        let Some(table) = at.as_table_mut() else {
+            return;
+        };
+        if parts.peek().is_none() {
+            table.insert(part.to_owned(), toml::Value::Float(v));
+            return;
+        }
+        at = table
+            .entry(part.to_owned())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    }
+}
+
+/// A truck file (`--truck FILE`) as a run's changes: its `preset`, if it names one, and
+/// every number under the settings a run may change; anything else is refused naming it.
+pub fn truck_file_settings(
+    text: &str,
+) -> Result<(Option<String>, BTreeMap<String, f64>), TrialError> {
+    let table: toml::Table = toml::from_str(text).map_err(|e| bad("truck", e.message()))?;
+    let mut preset = None;
+    let mut settings = BTreeMap::new();
+    for (key, value) in &table {
+        match (key.as_str(), value) {
+            ("preset", toml::Value::String(name)) => preset = Some(name.clone()),
+            (_, toml::Value::Table(inner)) => {
+                for (k, v) in inner {
+                    let path = format!("{key}.{k}");
+                    settings.insert(path.clone(), number(&path, v)?);
+                }
+            }
+            (_, v) => {
+                settings.insert(key.clone(), number(key, v)?);
+            }
+        }
+    }
+    for path in settings.keys() {
+        if truck_path(path) != Some(path.as_str()) {
+            return Err(bad(
+                path,
+                "a truck file for a run changes only the actuators and control timing \
+                 (the geometry is the scenario's [truck])",
+            ));
+        }
+    }
+    Ok((preset, settings))
+}
+
+fn number(path: &str, v: &toml::Value) -> Result<f64, TrialError> {
+    match v {
+        toml::Value::Float(f) => Ok(*f),
+        toml::Value::Integer(i) => Ok(*i as f64),
+        _ => Err(bad(path, "must be a number")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_setting_lands_where_its_path_says_and_bad_ones_are_named() {
+        let truck = ForkliftSpec::default();
+        let mut s = BTreeMap::new();
+        s.insert("steering.dead_time_s".to_owned(), 0.2);
+        s.insert("drive.brake_limit_mps2".to_owned(), 1.5);
+        let t = apply_truck(&truck, None, &s).expect("valid");
+        assert_eq!(t.steering.dead_time_s, 0.2);
+        assert_eq!(t.drive.brake_limit_mps2, Some(1.5));
+        s.insert("steering.dead_time_s".to_owned(), 9.0);
+        let e = apply_truck(&truck, None, &s).expect_err("9 s").to_string();
+        assert!(e.contains("steering.dead_time_s"), "{e}");
+        let mut g = BTreeMap::new();
+        g.insert("wheelbase_m".to_owned(), 2.0);
+        let e = apply_truck(&truck, None, &g)
+            .expect_err("geometry")
+            .to_string();
+        assert!(e.contains("wheelbase_m") && e.contains("geometry"), "{e}");
+    }
+
+    #[test]
+    fn a_preset_then_settings() {
+        let truck = ForkliftSpec::default();
+        let mut s = BTreeMap::new();
+        s.insert("control.period_s".to_owned(), 0.05);
+        let t = apply_truck(&truck, Some("realistic"), &s).expect("valid");
+        assert_eq!(t.steering, Actuators::REALISTIC.steering);
+        assert_eq!(t.control.period_s, Some(0.05));
+        assert!(apply_truck(&truck, Some("sporty"), &s).is_err());
+        let (p, s) = truck_file_settings("preset = \"ideal\"\n[steering]\ndead_time_s = 0.1\n")
+            .expect("valid file");
+        assert_eq!(p.as_deref(), Some("ideal"));
+        assert_eq!(s.get("steering.dead_time_s"), Some(&0.1));
+        assert!(truck_file_settings("wheelbase_m = 2.0").is_err());
+    }
+}
