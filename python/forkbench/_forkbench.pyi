@@ -2,7 +2,7 @@
 
 import os
 import pathlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -76,6 +76,8 @@ def run_trial(
     replan: bool | None = None,
     mcap: str | os.PathLike[str] | None = None,
     force: bool = False,
+    truck_preset: str | None = None,
+    truck: Mapping[str, float] | None = None,
 ) -> Outcome: ...
 def run_batch(
     scenarios: Sequence[Scenario] | None = None,
@@ -91,6 +93,8 @@ def run_batch(
     jobs: int | None = None,
     out: str | os.PathLike[str] | None = None,
     force_new: bool = False,
+    truck_preset: str | None = None,
+    truck: Mapping[str, float] | None = None,
 ) -> list[Outcome]: ...
 def report(
     dir: str | os.PathLike[str],

@@ -1,5 +1,6 @@
 //! `run_trial` and `run_batch`: one trial (optionally recorded to MCAP) or a parallel batch, with the CLI's seeds and outcomes, as Python dicts.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use forkbench_batch::{BatchSpec, ReplanModes};
@@ -12,12 +13,15 @@ use crate::scenario::Scenario;
 
 /// Runs one case of `scenario` to its judged outcome (a dict: the CLI's `trial --json`).
 /// `case` may be omitted when the scenario has one case. `mcap` records the trial to
-/// that file (Foxglove schemas; .rrd recordings come from the CLI).
+/// that file (Foxglove schemas; .rrd recordings come from the CLI). `truck_preset`
+/// (`ideal`, `realistic`) and `truck` (settings by dotted path, `steering.dead_time_s`)
+/// change the truck's actuators and timing, as the CLI's `--truck`.
 #[pyfunction]
 #[pyo3(signature = (scenario, case=None, *, seed=None, planner=None, tracker=None,
                     noise=true, pallet_noise_scale=None, localization_noise_scale=None,
                     odometry_noise_scale=None, pallet_sensing=None, localizer=None,
-                    missing_reflectors=None, replan=None, mcap=None, force=false))]
+                    missing_reflectors=None, replan=None, mcap=None, force=false,
+                    truck_preset=None, truck=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_trial<'py>(
     py: Python<'py>,
@@ -36,6 +40,8 @@ pub fn run_trial<'py>(
     replan: Option<bool>,
     mcap: Option<PathBuf>,
     force: bool,
+    truck_preset: Option<String>,
+    truck: Option<BTreeMap<String, f64>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let scn = &scenario.inner;
     let case = scn.pick_case(case).map_err(|e| scenario_error(py, &e))?;
@@ -52,7 +58,8 @@ pub fn run_trial<'py>(
             localizer,
             pallet_sensing,
             missing_reflectors,
-            ..Overrides::default()
+            truck_preset,
+            truck: truck.unwrap_or_default(),
         },
         wall_budget_s: None,
     };
@@ -114,7 +121,8 @@ fn records_bytes(spec: &BatchSpec) -> u64 {
 #[pyfunction]
 #[pyo3(signature = (scenarios=None, *, trials=20, seed=1, planners=None, trackers=None,
                     modes=None, pallet_noise_scale=None, localization_noise_scale=None,
-                    odometry_noise_scale=None, jobs=None, out=None, force_new=false))]
+                    odometry_noise_scale=None, jobs=None, out=None, force_new=false,
+                    truck_preset=None, truck=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_batch<'py>(
     py: Python<'py>,
@@ -130,6 +138,8 @@ pub fn run_batch<'py>(
     jobs: Option<usize>,
     out: Option<PathBuf>,
     force_new: bool,
+    truck_preset: Option<String>,
+    truck: Option<BTreeMap<String, f64>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let embedded = scenarios.is_none();
     let scenarios = match scenarios {
@@ -155,6 +165,8 @@ pub fn run_batch<'py>(
             pallet_noise_scale,
             localization_noise_scale,
             odometry_noise_scale,
+            truck_preset,
+            truck: truck.unwrap_or_default(),
             ..Overrides::default()
         },
         replan,

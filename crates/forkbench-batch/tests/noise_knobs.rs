@@ -180,6 +180,11 @@ fn records_of_an_overridden_batch_replay_identically() {
         localizer: Some("gaussian".into()),
         pallet_sensing: Some("tim561".into()),
         missing_reflectors: None,
+        // A run's truck too: a preset and a setting over it.
+        truck_preset: Some("ideal".into()),
+        truck: [("steering.dead_time_s".to_owned(), 0.1)]
+            .into_iter()
+            .collect(),
     };
     batch::run_batch(
         &spec(scenarios.clone(), 2, overrides.clone()),

@@ -79,6 +79,8 @@ fn summary(scn: &Scenario) -> String {
             scn.tolerances.contact_force_n,
             scn.tolerances.pallet_displacement_m
         ),
+        steering_line(&scn.truck),
+        drive_line(&scn.truck),
         format!("seed         {}; timeout {} s", scn.seed, scn.timeout_s),
     ];
     if let Some(m) = &scn.mission {
@@ -95,6 +97,44 @@ fn summary(scn: &Scenario) -> String {
     }
     lines.extend(cases(scn));
     lines.join("\n") + "\n"
+}
+
+/// The steering actuator as it will act (docs/truck.md).
+fn steering_line(t: &forkbench_core::ForkliftSpec) -> String {
+    let s = &t.steering;
+    let acc = s
+        .accel_limit_radps2
+        .map_or("unlimited".to_owned(), |a| format!("{a} rad/s²"));
+    format!(
+        "steering     dead time {} s (+ transport {} s), lag {} s, rate {} rad/s, acceleration {acc}, \
+         deadband {} rad, backlash {} rad, offset {} rad",
+        s.dead_time_s,
+        t.control.transport_delay_s,
+        s.time_constant_s,
+        t.max_steer_rate_radps,
+        s.deadband_rad,
+        s.backlash_rad,
+        s.offset_rad
+    )
+}
+
+/// The drive and the controller's period as they will act.
+fn drive_line(t: &forkbench_core::ForkliftSpec) -> String {
+    let d = &t.drive;
+    let or_sim =
+        |v: Option<f64>, unit: &str| v.map_or("[sim]'s".to_owned(), |v| format!("{v} {unit}"));
+    format!(
+        "drive        dead time {} s, speed loop τ {}, acceleration {}, braking {}, creep below {} m/s; \
+         control every {}",
+        d.dead_time_s,
+        or_sim(d.time_constant_s, "s"),
+        or_sim(d.accel_limit_mps2, "m/s²"),
+        or_sim(d.brake_limit_mps2, "m/s²"),
+        d.creep_speed_mps,
+        t.control
+            .period_s
+            .map_or("physics step".to_owned(), |p| format!("{p} s"))
+    )
 }
 
 /// One line per case (the first 20).

@@ -40,16 +40,44 @@ pub struct IdentifyArgs {
     /// Write the fitted settings as a truck file that `--truck` takes.
     #[arg(long, value_name = "FILE")]
     truck_out: Option<std::path::PathBuf>,
+    /// Draw each channel's held-out run, measured against fitted (.svg or .png).
+    #[arg(long, value_name = "FILE")]
+    plot: Option<std::path::PathBuf>,
+    /// For an .mcap log: the topic whose JSON messages hold the samples (forkbench's own
+    /// recordings keep them on /forkbench/telemetry).
+    #[arg(long, default_value = forkbench_identify::mcap_log::TELEMETRY_TOPIC)]
+    topic: String,
+    /// For an .mcap log: the message fields holding t_s, steer_cmd_rad, steer_rad,
+    /// speed_cmd_mps, speed_mps, in that order (an empty name leaves a channel out).
+    #[arg(long, value_delimiter = ',', num_args = 5, value_name = "FIELDS",
+          default_values_t = forkbench_identify::log::COLUMNS.map(str::to_owned))]
+    fields: Vec<String>,
 }
 
 pub fn identify(a: &IdentifyArgs) -> anyhow::Result<()> {
     use anyhow::Context as _;
-    let log = forkbench_identify::read_csv(&a.log)?;
+    let is_mcap = a
+        .log
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
+    let log = if is_mcap {
+        let fields: [String; 5] = a
+            .fields
+            .clone()
+            .try_into()
+            .map_err(|_| anyhow::anyhow!("--fields takes 5 names"))?;
+        forkbench_identify::mcap_log::read_mcap(&a.log, &a.topic, &fields)?
+    } else {
+        forkbench_identify::read_csv(&a.log)?
+    };
     let fit = forkbench_identify::identify(&log)
         .with_context(|| format!("identifying {}", a.log.display()))?;
     if let Some(out) = &a.truck_out {
         forkbench_core::files::write_atomic(out, fit.truck_toml().as_bytes())
             .with_context(|| format!("writing {}", out.display()))?;
+    }
+    if let Some(plot) = &a.plot {
+        forkbench_report::identify::draw(plot, &fit)?;
     }
     if a.json {
         return crate::emit_json_line(&fit);

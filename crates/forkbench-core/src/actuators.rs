@@ -63,18 +63,21 @@ pub struct ControlTiming {
 }
 
 impl Default for SteeringActuator {
+    /// The first truck's: the bench's own controllers are tuned for it (see docs/truck.md).
     fn default() -> Self {
         Self::IDEAL
     }
 }
 
 impl Default for DriveActuator {
+    /// The first truck's: the bench's own controllers are tuned for it (see docs/truck.md).
     fn default() -> Self {
         Self::IDEAL
     }
 }
 
 impl Default for ControlTiming {
+    /// The first truck's: the bench's own controllers are tuned for it (see docs/truck.md).
     fn default() -> Self {
         Self::IDEAL
     }
@@ -199,7 +202,7 @@ pub struct Actuators {
 pub const PRESETS: [(&str, &str); 2] = [
     (
         "ideal",
-        "the bench's first truck: steering a bare rate limit, the speed loop without delay, control every physics step",
+        "the bench's first truck (before forkbench modelled actuators): steering a bare rate limit, the speed loop without delay, control every physics step",
     ),
     (
         "realistic",
@@ -220,7 +223,8 @@ impl Actuators {
         steering: SteeringActuator {
             dead_time_s: 0.06,
             time_constant_s: 0.08,
-            accel_limit_radps2: Some(4.0),
+            // The steepest a first-order lag of 0.08 s climbs to the 0.8 rad/s rate: r / τ.
+            accel_limit_radps2: Some(10.0),
             deadband_rad: 0.002,
             backlash_rad: 0.004,
             offset_rad: 0.0,
@@ -269,6 +273,7 @@ mod tests {
         assert!(SteeringActuator::default().is_ideal());
         assert!(DriveActuator::default().is_ideal());
         assert!(ControlTiming::default().is_ideal());
+        assert!(!Actuators::REALISTIC.steering.is_ideal());
     }
 
     #[test]

@@ -41,10 +41,12 @@ pub fn enough(kind: Kind, runs: &[&Run]) -> Result<(), IdentifyError> {
         Kind::Steering => 0.01,
         Kind::Drive => 0.02,
     };
-    if !(hi - lo >= threshold) {
+    let span = hi - lo;
+    // NaN-safe: an empty or non-finite span is no excitation either.
+    if span.is_nan() || span < threshold {
         return Err(IdentifyError::NoExcitation {
             channel: name,
-            span: (hi - lo).max(0.0),
+            span: span.max(0.0),
             threshold,
         });
     }

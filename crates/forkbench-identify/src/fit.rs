@@ -109,8 +109,13 @@ pub fn fit(kind: Kind, runs: &[&Run]) -> Params {
         Kind::Drive => vec![0.25_f64.ln(), (1.5 * peak).ln(), (1.5 * peak).ln()],
     };
     let search = |d: f64, iters: usize| {
+        // The time constants a truck file takes: the drive's from 0.01 s.
+        let tau_min = match kind {
+            Kind::Steering => 1e-3,
+            Kind::Drive => 0.01,
+        };
         let f = |x: &[f64]| {
-            if x[0].exp() < 1e-3 || x[0].exp() > 10.0 {
+            if x[0].exp() < tau_min || x[0].exp() > 10.0 {
                 return f64::INFINITY;
             }
             sse(kind, &params(kind, d, x), runs)
@@ -132,8 +137,16 @@ pub fn fit(kind: Kind, runs: &[&Run]) -> Params {
     p
 }
 
-/// Drops each limit whose removal changes the error by less than `LIMIT_SEEN`.
+/// Drops each limit whose removal changes the error by less than `LIMIT_SEEN`, and any
+/// beyond what a truck file takes (20 rad/s, 50 m/s²): the log cannot tell those apart
+/// from no limit.
 fn drop_unseen_limits(kind: Kind, p: &mut Params, err: f64, runs: &[&Run]) {
+    let cap = match kind {
+        Kind::Steering => 20.0,
+        Kind::Drive => 50.0,
+    };
+    p.limit_up = p.limit_up.filter(|v| *v <= cap);
+    p.limit_down = p.limit_down.filter(|v| *v <= cap);
     for which in [0, 1] {
         let mut without = *p;
         match which {

@@ -4,6 +4,7 @@ pub mod check;
 pub mod excite;
 pub mod fit;
 pub mod log;
+pub mod mcap_log;
 pub mod model;
 
 use std::collections::BTreeMap;

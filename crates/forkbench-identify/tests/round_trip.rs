@@ -6,6 +6,13 @@ use forkbench_identify::excite::{StepTest, step_test};
 use forkbench_identify::{identify, parse_csv, to_csv};
 use forkbench_sim::SimConfig;
 
+/// The A30 with the first truck's actuators: what a test sets is all there is.
+fn ideal() -> ForkliftSpec {
+    let mut t = ForkliftSpec::default();
+    t.set_actuators(forkbench_core::actuators::Actuators::IDEAL);
+    t
+}
+
 fn truck(dead_s: f64, tau_s: f64, rate: f64) -> ForkliftSpec {
     ForkliftSpec {
         max_steer_rate_radps: rate,
@@ -14,7 +21,7 @@ fn truck(dead_s: f64, tau_s: f64, rate: f64) -> ForkliftSpec {
             time_constant_s: tau_s,
             ..SteeringActuator::IDEAL
         },
-        ..ForkliftSpec::default()
+        ..ideal()
     }
 }
 
@@ -74,7 +81,7 @@ fn the_ideal_drive_fits_its_speed_loop() {
         steering: false,
         ..StepTest::default()
     };
-    let log = step_test(&ForkliftSpec::default(), &SimConfig::default(), &test).expect("valid");
+    let log = step_test(&ideal(), &SimConfig::default(), &test).expect("valid");
     let log = parse_csv(&to_csv(&log), "log.csv").expect("reads back");
     let got = identify(&log).expect("identified");
     assert_eq!(got.channels.len(), 1, "no steering channel");

@@ -12,6 +12,8 @@ pub mod detect;
 pub mod figure;
 pub mod html;
 #[cfg(feature = "figures")]
+pub mod identify;
+#[cfg(feature = "figures")]
 pub mod map;
 #[cfg(feature = "figures")]
 pub mod plans;

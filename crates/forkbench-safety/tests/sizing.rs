@@ -47,10 +47,17 @@ fn braking_in_the_physics_matches_the_controllers_analytic_stop() {
         };
         for load in [Load::Empty, Load::Rated] {
             let grip = mu * 9.81 * front_share(&truck, &cfg, &pallet, load);
-            let decel = cfg.max_accel_mps2.min(grip);
+            // The drive's own braking limit and speed loop (the default truck's), and
+            // the distance run at speed before the stop command reaches the drive.
+            let d = &truck.drive;
+            let decel = d.brake_limit_mps2.unwrap_or(cfg.max_accel_mps2).min(grip);
+            let gain = d
+                .time_constant_s
+                .map_or(cfg.speed_gain_per_s, |tau| 1.0 / tau);
+            let delay_s = d.dead_time_s + truck.control.transport_delay_s;
             for v in [0.3, 0.6, 0.8] {
                 let b = braking_distance(&truck, &cfg, &pallet, v, load).expect("brakes");
-                let want = analytic_stop_m(v, cfg.speed_gain_per_s, decel);
+                let want = v * delay_s + analytic_stop_m(v, gain, decel);
                 let err = (b.distance_m - want).abs();
                 assert!(
                     err <= 0.01 + 0.03 * want,

@@ -121,7 +121,7 @@ pub struct Nav350Config {
     pub position_sigma_m: f64,
     /// Heading σ (the datasheet's ±0.15° read as 2σ).
     pub heading_sigma_rad: f64,
-    /// Time from measurement to delivery.
+    /// Time from measurement (the sweep's end) to delivery; the datasheet gives none.
     pub latency_s: f64,
 }
 

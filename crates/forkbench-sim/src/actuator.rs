@@ -78,8 +78,10 @@ impl Steering {
         };
         delta = delta.clamp(-rate, rate);
         if let Some(acc) = self.cfg.accel_limit_radps2 {
-            // Slow down in time to stop at the target, and change the rate only so fast.
-            let stop = (2.0 * acc * err.abs()).sqrt();
+            // Slow down in time to stop at the target (the discrete braking bound, so the
+            // last steps land on it), and change the rate only so fast.
+            let half_step = 0.5 * acc * dt_s;
+            let stop = ((2.0 * acc * err.abs()) + half_step * half_step).sqrt() - half_step;
             let prev = self.motor_rate_radps;
             let w = (delta / dt_s)
                 .clamp(-stop, stop)
@@ -148,11 +150,18 @@ impl Drive {
 mod tests {
     use super::*;
 
+    /// The A30 with the first truck's actuators.
+    fn ideal() -> ForkliftSpec {
+        let mut t = ForkliftSpec::default();
+        t.set_actuators(forkbench_core::actuators::Actuators::IDEAL);
+        t
+    }
+
     fn truck(steering: SteeringActuator) -> ForkliftSpec {
         ForkliftSpec {
             steering,
             max_steer_rate_radps: 20.0,
-            ..ForkliftSpec::default()
+            ..ideal()
         }
     }
 
@@ -185,7 +194,7 @@ mod tests {
 
     #[test]
     fn the_ideal_actuator_is_the_bare_rate_limit() {
-        let spec = ForkliftSpec::default();
+        let spec = ideal();
         let mut s = Steering::new(&spec, 0.01);
         let mut legacy = 0.0_f64;
         for k in 0..300 {
@@ -256,7 +265,7 @@ mod tests {
                 creep_speed_mps: 0.05,
                 ..DriveActuator::IDEAL
             },
-            ..ForkliftSpec::default()
+            ..ideal()
         };
         let mut d = Drive::new(&spec, 0.01);
         assert_eq!(d.accel(1.0, 0.0, 4.0, 1.0), 0.5);

@@ -99,10 +99,19 @@ fn stopping_distance_m(sim: &mut Sim, speed_mps: f64) -> f64 {
 /// Stopping distance with a speed controller of gain k and accel limit, on drive tyres
 /// that brake at most `grip` m/s²: constant deceleration down to the speed where k v
 /// drops below it, then the controller's exponential tail (v₁/k).
+/// The truck's drive sets the gain and the braking limit, and runs at `v0` until the
+/// stop command reaches it (its dead time and the transport delay).
 fn analytic_stop_m(v0: f64, grip_mps2: f64, cfg: &SimConfig) -> f64 {
-    let a = grip_mps2.min(cfg.max_accel_mps2);
-    let v1 = a / cfg.speed_gain_per_s;
-    (v0 * v0 - v1 * v1) / (2.0 * a) + v1 / cfg.speed_gain_per_s
+    let d = ForkliftSpec::default();
+    let limit = d.drive.brake_limit_mps2.unwrap_or(cfg.max_accel_mps2);
+    let gain = d
+        .drive
+        .time_constant_s
+        .map_or(cfg.speed_gain_per_s, |tau| 1.0 / tau);
+    let delay_s = d.drive.dead_time_s + d.control.transport_delay_s;
+    let a = grip_mps2.min(limit);
+    let v1 = a / gain;
+    v0 * delay_s + (v0 * v0 - v1 * v1) / (2.0 * a) + v1 / gain
 }
 
 /// On a wet floor the drive tyres limit braking; the load pressing on the front (drive)

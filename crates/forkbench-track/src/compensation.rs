@@ -128,10 +128,17 @@ mod tests {
     use super::*;
     use crate::PurePursuit;
 
+    /// The A30 with the first truck's actuators.
+    fn ideal() -> ForkliftSpec {
+        let mut t = ForkliftSpec::default();
+        t.set_actuators(forkbench_core::actuators::Actuators::IDEAL);
+        t
+    }
+
     /// Without delays the prediction is the measured state: the compensation is a no-op.
     #[test]
     fn no_delay_no_prediction() {
-        let truck = ForkliftSpec::default();
+        let truck = ideal();
         let c = DelayCompensated::new(Box::new(PurePursuit::with_config(Default::default())), "x");
         let input = TrackerInput {
             t_s: 1.0,
@@ -146,7 +153,7 @@ mod tests {
     /// Driving straight at 0.8 m/s with 0.2 s of dead time: the pose is predicted 0.16 m on.
     #[test]
     fn a_dead_time_carries_the_pose_forward() {
-        let mut truck = ForkliftSpec::default();
+        let mut truck = ideal();
         truck.steering.dead_time_s = 0.2;
         truck.drive.dead_time_s = 0.2;
         let c = DelayCompensated::new(Box::new(PurePursuit::with_config(Default::default())), "x");

@@ -32,6 +32,9 @@ fn rerun(want: &Value) -> Value {
                 speed_scale_sigma: 0.0,
                 steer_offset_sigma_rad: 0.0,
             };
+            // …and before actuators and the NAV350's latency were modelled (both at 0 by
+            // default; set here so a change of default does not move these records).
+            s.noise.nav350.latency_s = 0.0;
             s
         })
         .collect();
@@ -42,7 +45,10 @@ fn rerun(want: &Value) -> Value {
         planner: Some(common::text(want, "planner")),
         tracker: None,
         no_noise: false,
-        overrides: Default::default(),
+        overrides: forkbench_trial::trial::Overrides {
+            truck_preset: Some("ideal".to_owned()),
+            ..Default::default()
+        },
         // The records of plan-once came from the scenario's own setting.
         replan: replan.then_some(true),
         wall_budget_s: None,

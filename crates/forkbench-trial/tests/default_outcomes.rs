@@ -1,8 +1,9 @@
-//! The speed work changed no result at the defaults: every committed trial record of the
-//! main job (the embedded scenarios with their own sensing: TiM561 scans, NAV350
-//! reflector fixes, odometry errors, the warehouse mission, the handling cycle and the
-//! people cycles; two trials of every scenario × case × planner × mode), re-run at its
-//! own seed, gives the same outcome to the bit.
+//! Committed trial records of the main job (the embedded scenarios with their own sensing:
+//! TiM561 scans, NAV350 reflector fixes, odometry errors, the warehouse mission, the
+//! handling cycle and the people cycles; two trials of every scenario × case × planner ×
+//! mode), re-run at their own seeds, give the same outcomes to the bit, at the defaults and
+//! with `--truck ideal` named: the records were made before actuators and sensor timing
+//! were modelled, and their defaults leave both out.
 
 use crate::common;
 
@@ -10,8 +11,8 @@ use forkbench_trial::defaults::default_scenarios;
 use forkbench_trial::{TrialOptions, run_trial};
 use serde_json::Value;
 
-/// Records made before the change by `batch --trials 20` (trials 0 and 1 of each row),
-/// with the wall and planning times removed.
+/// Records made by `batch --trials 20` (trials 0 and 1 of each row), with the wall and
+/// planning times removed, before the actuators were modelled.
 fn committed() -> Vec<Value> {
     common::records(include_str!("data/default_outcomes.jsonl"))
 }
@@ -30,7 +31,7 @@ fn without_clock_times(v: &mut Value) {
 }
 
 /// The record re-run at its seed, in the committed records' form.
-fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario]) -> Value {
+fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario], ideal: bool) -> Value {
     let (scn, case) = common::case_of(scenarios, want);
     let replan = want["replan"].as_bool().expect("replan");
     let opts = TrialOptions {
@@ -38,7 +39,10 @@ fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario]) -> Value {
         planner: Some(common::text(want, "planner")),
         tracker: Some(common::text(want, "tracker")),
         no_noise: false,
-        overrides: Default::default(),
+        overrides: forkbench_trial::trial::Overrides {
+            truck_preset: ideal.then(|| "ideal".to_owned()),
+            ..Default::default()
+        },
         replan: Some(replan),
         wall_budget_s: None,
     };
@@ -50,8 +54,7 @@ fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario]) -> Value {
     v
 }
 
-#[test]
-fn default_outcomes_are_identical_to_the_records_before_the_change() {
+fn check(ideal: bool) {
     let want = committed();
     let scenarios = default_scenarios().expect("embedded scenarios");
     let rows: std::collections::BTreeSet<_> = want
@@ -69,5 +72,16 @@ fn default_outcomes_are_identical_to_the_records_before_the_change() {
         want.iter().any(|w| w["scenario"] == "warehouse-mission"),
         "the mission is among the records"
     );
-    common::assert_reruns_equal(&want, |w| rerun(w, &scenarios));
+    common::assert_reruns_equal(&want, |w| rerun(w, &scenarios, ideal));
+}
+
+#[test]
+fn default_outcomes_are_identical_to_the_committed_records() {
+    check(false);
+}
+
+/// Named, the `ideal` preset is the same truck, to the bit.
+#[test]
+fn the_ideal_preset_reproduces_the_committed_records() {
+    check(true);
 }

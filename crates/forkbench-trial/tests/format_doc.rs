@@ -27,6 +27,10 @@ fn truck_defaults() -> toml::Value {
             "rated_capacity_kg".to_owned(),
             toml::Value::Float(spec.rated_capacity_kg),
         );
+        // Tables of their own in the document.
+        for table in ["steering", "drive", "control"] {
+            t.remove(table);
+        }
     }
     v
 }

@@ -53,6 +53,10 @@ pub struct ScannerConfig {
     /// does; nearer ones merge into a mixed range. 0: always merged (a phase-based
     /// time-of-flight camera's flying pixels).
     pub echo_separation_m: f64,
+    /// Time from a frame's first beam to its last: a rotating mirror sweeps its field of
+    /// view in this share of a turn, so beams of a moving truck leave from different
+    /// places (motion distortion); 0: every beam at once (a camera's global shutter).
+    pub sweep_s: f64,
 }
 
 impl Default for ScannerConfig {
@@ -95,6 +99,9 @@ impl ScannerConfig {
             spot_at_cover_m: 0.007,
             max_incidence_rad: 80f64.to_radians(),
             echo_separation_m: 0.3,
+            // Every beam at once by default, as the bench scanned before; the TiM561's
+            // mirror turns once per frame with 270° of it carrying beams: 0.75 / 15 s.
+            sweep_s: 0.0,
         }
     }
 
@@ -120,6 +127,7 @@ impl ScannerConfig {
             spot_at_cover_m: 0.0,
             max_incidence_rad: 80f64.to_radians(),
             echo_separation_m: 0.0,
+            sweep_s: 0.0,
         }
     }
 
@@ -191,10 +199,14 @@ impl ScannerConfig {
             ("spot_divergence_rad", self.spot_divergence_rad),
             ("spot_at_cover_m", self.spot_at_cover_m),
             ("echo_separation_m", self.echo_separation_m),
+            ("sweep_s", self.sweep_s),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(f, "must be a finite number ≥ 0");
             }
+        }
+        if self.sweep_s > 1.0 / self.rate_hz {
+            return bad("sweep_s", "must be at most one frame period (1 / rate_hz)");
         }
         if self.range_min_m >= self.range_max_m {
             return bad("range_min_m", "must be below range_max_m");

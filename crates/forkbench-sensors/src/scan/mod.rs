@@ -96,17 +96,51 @@ pub fn scan<R: Rng + ?Sized>(
     cfg: &ScannerConfig,
     world: &dyn WorldView,
     sensor: Pose2,
+    errors: Errors<'_, R>,
+) -> Scan {
+    scan_swept(cfg, world, &|_| sensor, errors)
+}
+
+/// Segments a moving sweep is cast in: each beam leaves from its segment's pose, within
+/// a sixteenth of the sweep's travel of its own.
+const SWEEP_SEGMENTS: usize = 16;
+
+/// A scan whose beams leave from where the sensor is as the sweep passes them:
+/// `sensor_at(f)` is its true pose a fraction `f` through the sweep (0: the first beam,
+/// 1: the last). The scan is stamped with the pose at its end, as a driver places it.
+pub fn scan_swept<R: Rng + ?Sized>(
+    cfg: &ScannerConfig,
+    world: &dyn WorldView,
+    sensor_at: &dyn Fn(f64) -> Pose2,
     mut errors: Errors<'_, R>,
 ) -> Scan {
     let n = cfg.beams();
     let angle_min_rad = -cfg.fov_rad / 2.0;
-    let caster = Caster::new(world, &sensor, cfg.range_max_m + 1.0);
+    let end = sensor_at(1.0);
+    let segments = if cfg.sweep_s > 0.0 && sensor_at(0.0) != end {
+        SWEEP_SEGMENTS.min(n.max(1))
+    } else {
+        1
+    };
+    let poses: Vec<Pose2> = if segments == 1 {
+        vec![end]
+    } else {
+        (0..segments)
+            .map(|j| sensor_at((j as f64 + 0.5) / segments as f64))
+            .collect()
+    };
+    let casters: Vec<Caster> = poses
+        .iter()
+        .map(|p| Caster::new(world, p, cfg.range_max_m + 1.0))
+        .collect();
     let ranges_m = (0..n)
         .map(|i| {
-            let a = sensor.heading_rad + angle_min_rad + i as f64 * cfg.step_rad;
+            let j = i * segments / n.max(1);
+            let (pose, caster) = (&poses[j], &casters[j]);
+            let a = pose.heading_rad + angle_min_rad + i as f64 * cfg.step_rad;
             let r = match &mut errors {
                 Errors::Ideal => caster.cast(a).map(|h| h.range_m),
-                Errors::Modelled { bias_m, rng } => spot_return(cfg, &caster, a).map(|(r, th)| {
+                Errors::Modelled { bias_m, rng } => spot_return(cfg, caster, a).map(|(r, th)| {
                     let z: f64 = rng.sample(rand_distr::StandardNormal);
                     r + *bias_m + cfg.range_sigma_at(r, th) * z
                 }),
@@ -116,7 +150,7 @@ pub fn scan<R: Rng + ?Sized>(
         })
         .collect();
     Scan {
-        sensor,
+        sensor: end,
         angle_min_rad,
         angle_step_rad: cfg.step_rad,
         range_min_m: cfg.range_min_m,

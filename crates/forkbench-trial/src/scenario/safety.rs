@@ -6,8 +6,8 @@ use super::checks::at_line;
 use super::file::ScenarioFile;
 use super::{Scenario, World, invalid, invalid_setting};
 use crate::TrialError;
-use forkbench_core::Pose2;
 use forkbench_core::geometry::Obstacle;
+use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_safety::MoverSpec;
 
 /// The `[safety]` settings in range, their speed ranges covering the truck's top speed;
@@ -124,10 +124,15 @@ impl Scenario {
     /// reflectors unless `[safety] reflectors_near` says otherwise. Without `[safety]`,
     /// its defaults.
     pub fn safety_fields(&self) -> Result<FieldSizing, TrialError> {
+        self.safety_fields_for(&self.truck)
+    }
+
+    /// The same for `truck` (a run's, whose actuators may differ from the scenario's).
+    pub fn safety_fields_for(&self, truck: &ForkliftSpec) -> Result<FieldSizing, TrialError> {
         let cfg = self.safety.clone().unwrap_or_default();
         forkbench_safety::size_fields(
             &cfg,
-            &self.truck,
+            truck,
             &self.sim,
             &self.pallet,
             !self.world.reflector.is_empty(),

@@ -157,6 +157,7 @@ impl<'a> Trial<'a> {
         let before = self.world.sim.fork_root_pose();
         self.world.sim.step(cmd.speed_mps, cmd.steer_rad);
         let moved_m = before.distance_to(&self.world.sim.fork_root_pose());
+        self.world.mark();
         self.world.travelled_m += moved_m;
         if self.world.sim.carrying() {
             self.world.travelled_loaded_m += moved_m;

@@ -58,7 +58,11 @@ pub(super) struct Monitor {
 impl SafetyRun {
     /// The scenario's movers (their starts drawn from the trial's seed, a stream per
     /// mover) and its safety function; `None` when it has neither.
-    pub(super) fn new(scn: &Scenario, seed: u64) -> Result<Option<Self>, String> {
+    pub(super) fn new(
+        scn: &Scenario,
+        truck: &forkbench_core::ForkliftSpec,
+        seed: u64,
+    ) -> Result<Option<Self>, String> {
         let cfg = scn.safety.as_ref().filter(|c| c.monitor);
         if scn.movers.is_empty() && cfg.is_none() {
             return Ok(None);
@@ -78,7 +82,7 @@ impl SafetyRun {
             })
             .collect();
         let monitor = match cfg {
-            Some(c) => Some(Monitor::new(scn, c)?),
+            Some(c) => Some(Monitor::new(scn, truck, c)?),
             None => None,
         };
         let n = movers.len();
@@ -123,8 +127,13 @@ fn mover_stream(seed: u64, m: &forkbench_safety::MoverSpec, twin: usize) -> ChaC
 }
 
 impl Monitor {
-    fn new(scn: &Scenario, c: &SafetyConfig) -> Result<Self, String> {
-        let sizing = scn.safety_fields().map_err(|e| e.to_string())?;
+    /// Fields sized for `truck`, the run's (its actuators brake it).
+    fn new(
+        scn: &Scenario,
+        truck: &forkbench_core::ForkliftSpec,
+        c: &SafetyConfig,
+    ) -> Result<Self, String> {
+        let sizing = scn.safety_fields_for(truck).map_err(|e| e.to_string())?;
         let outline = Outline {
             front_m: scn.truck.fork_length_m,
             rear_m: scn.truck.body_length_m,

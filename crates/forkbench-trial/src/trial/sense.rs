@@ -4,7 +4,7 @@ use forkbench_core::signal::Scan;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, Signal, Style};
 use forkbench_sensors::detector::detect_in;
-use forkbench_sensors::scan::{Errors, WorldView, scan};
+use forkbench_sensors::scan::{Errors, WorldView, scan_swept};
 use rand_chacha::ChaCha8Rng;
 
 use super::error::StageError;
@@ -30,7 +30,7 @@ impl Trial<'_> {
         true_pallet: &Pose2,
         rec: &mut R,
     ) -> Result<(), StageError> {
-        let (fix, _) = self.sense(rec)?;
+        let fix = self.wait_for_fix(rec)?;
         self.loc.first_fix = fix
             .or(self.loc.predictor.pose())
             .unwrap_or(self.loc.first_fix);
@@ -41,6 +41,26 @@ impl Trial<'_> {
             self.adopt_estimate(est, true_pallet);
         }
         Ok(())
+    }
+
+    /// Before the localiser's first reading ever (a NAV350 delivers it a latency after its
+    /// first sweep), the truck stands until it arrives, at most a period and a second;
+    /// later, a look takes what is there. The fix, if the reading had one.
+    fn wait_for_fix<R: Recorder + ?Sized>(
+        &mut self,
+        rec: &mut R,
+    ) -> Result<Option<Pose2>, StageError> {
+        let until = self.world.sim.time_s() + self.loc.localizer.period_s() + 1.0;
+        let readings = |t: &Self| t.loc.stats.fixes + t.loc.stats.missed;
+        let first = readings(self) == 0;
+        loop {
+            let (fix, pose) = self.sense(rec)?;
+            if !first || readings(self) > 0 || self.world.sim.time_s() >= until {
+                return Ok(fix);
+            }
+            let steer = self.world.sim.steer_rad();
+            self.physics_step(&crate::phase::open_loop(0.0, steer, &pose), None, pose, rec);
+        }
     }
 
     /// A pallet estimate when the fork root is `range_m` from the face: the scenario's
@@ -83,8 +103,15 @@ impl Trial<'_> {
         }
     }
 
-    /// One scan from `sensor` (its true pose), placed at `placed` (its believed pose).
-    fn scan_from(&mut self, k: usize, s: &NamedScanner, sensor: Pose2, placed: Pose2) -> Scan {
+    /// One scan from `sensor` as it truly moved over its sweep (ending now), placed at
+    /// `placed` (its believed pose now).
+    fn scan_from(&mut self, k: usize, s: &NamedScanner, placed: Pose2) -> Scan {
+        let (t, sweep_s) = (self.world.sim.time_s(), s.scanner.sweep_s);
+        let world = &self.world;
+        let sensor_at = |f: f64| {
+            let root = world.root_at(t - sweep_s * (1.0 - f));
+            s.scanner.sensor_pose(&root)
+        };
         // People and vehicles stand in the scanners' way (they occlude the pallet).
         let with_movers;
         let view: &dyn WorldView = match &self.safety {
@@ -103,9 +130,9 @@ impl Trial<'_> {
                 bias_m: state.bias_m,
                 rng: &mut state.rng,
             };
-            scan(&s.scanner, view, sensor, errors)
+            scan_swept(&s.scanner, view, &sensor_at, errors)
         } else {
-            scan::<ChaCha8Rng>(&s.scanner, view, sensor, Errors::Ideal)
+            scan_swept::<ChaCha8Rng>(&s.scanner, view, &sensor_at, Errors::Ideal)
         };
         out.sensor = placed;
         out
@@ -126,7 +153,6 @@ impl Trial<'_> {
         } else {
             self.world.pallet_nominal
         };
-        let root = self.world.sim.fork_root_pose();
         let t = self.world.sim.time_s();
         let mut scans = Vec::with_capacity(sensors.len());
         for (k, s) in sensors.iter().enumerate() {
@@ -137,7 +163,7 @@ impl Trial<'_> {
                 continue;
             }
             self.sense.scanners[k].next_frame_s = t + 1.0 / s.scanner.rate_hz;
-            let sc = self.scan_from(k, s, s.scanner.sensor_pose(&root), placed);
+            let sc = self.scan_from(k, s, placed);
             let style = SCAN_STYLES[k % SCAN_STYLES.len()];
             rec.signal(t, &format!("sensors/{}", s.name), &Signal::Scan(&sc), style);
             scans.push((s.name.as_str(), sc));

@@ -170,7 +170,7 @@ impl<'a> Trial<'a> {
                     return Err(Box::new(out));
                 }
             };
-        let safety = match super::safety_run::SafetyRun::new(scn, run.seed) {
+        let safety = match super::safety_run::SafetyRun::new(scn, &run.truck, run.seed) {
             Ok(s) => s,
             Err(e) => {
                 fail(&mut out, format!("the safety function: {e}"));
@@ -191,6 +191,7 @@ impl<'a> Trial<'a> {
                 collision: false,
                 travelled_m: 0.0,
                 travelled_loaded_m: 0.0,
+                trail: Default::default(),
             },
             loc: localisation(localizer, run, start),
             sense: perception(scn, run, detector, true_pallet),

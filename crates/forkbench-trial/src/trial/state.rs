@@ -34,6 +34,44 @@ pub(crate) struct WorldState {
     /// the pallet on the forks.
     pub(crate) travelled_m: f64,
     pub(crate) travelled_loaded_m: f64,
+    /// The true fork-root pose after each recent physics step: where a scanner's beams
+    /// left from over its sweep.
+    pub(crate) trail: std::collections::VecDeque<(f64, Pose2)>,
+}
+
+/// How far back the trail of true poses reaches: past any scanner's sweep.
+const TRAIL_S: f64 = 1.0;
+
+impl WorldState {
+    /// Keeps the fork root's true pose now in the trail.
+    pub(crate) fn mark(&mut self) {
+        let t = self.sim.time_s();
+        self.trail.push_back((t, self.sim.fork_root_pose()));
+        while self.trail.front().is_some_and(|(t0, _)| *t0 < t - TRAIL_S) {
+            self.trail.pop_front();
+        }
+    }
+
+    /// The fork root's true pose at `t_s`, between the trail's marks (its oldest before
+    /// them, now after them).
+    pub(crate) fn root_at(&self, t_s: f64) -> Pose2 {
+        let now = self.sim.fork_root_pose();
+        let Some(i) = self.trail.iter().position(|(t, _)| *t >= t_s) else {
+            return now;
+        };
+        let (t1, p1) = self.trail[i];
+        if i == 0 || t1 <= t_s {
+            return p1;
+        }
+        let (t0, p0) = self.trail[i - 1];
+        let u = (t_s - t0) / (t1 - t0);
+        let dh = forkbench_core::units::wrap_angle(p1.heading_rad - p0.heading_rad);
+        Pose2::new(
+            p0.x_m + u * (p1.x_m - p0.x_m),
+            p0.y_m + u * (p1.y_m - p0.y_m),
+            p0.heading_rad + u * dh,
+        )
+    }
 }
 
 /// Where the truck believes it is: the localiser, the odometry and their record.

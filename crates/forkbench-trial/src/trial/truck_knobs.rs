@@ -57,13 +57,8 @@ pub fn apply_truck(
         })?;
         out.set_actuators(a);
     }
-    if settings.is_empty() {
-        return Ok(out);
-    }
-    let mut value = toml::Value::try_from(&out)
-        .map_err(|e| bad("truck", &format!("the truck does not serialise: {e}")))?;
     for (path, v) in settings {
-        if truck_path(path) != Some(path.as_str()) {
+        if !set_field(&mut out, path, *v) {
             let known: Vec<&str> = TRUCK_KNOBS.iter().map(|(_, p)| *p).collect();
             return Err(bad(
                 path,
@@ -73,32 +68,35 @@ pub fn apply_truck(
                 ),
             ));
         }
-        set_dotted(&mut value, path, *v);
     }
-    let spec: ForkliftSpec = value
-        .try_into()
-        .map_err(|e: toml::de::Error| bad("truck", e.message()))?;
-    spec.validate()
+    out.validate()
         .map_err(|e| bad(&format!("truck.{}", e.field.unwrap_or_default()), &e.reason))?;
-    Ok(spec)
+    Ok(out)
 }
 
-/// Sets `path` (`a.b`) in a table value, making the inner table when it is missing.
-fn set_dotted(value: &mut toml::Value, path: &str, v: f64) {
-    let mut at = value;
-    let mut parts = path.split('.').peekable();
-    while let Some(part) = parts.next() {
-        let Some(table) = at.as_table_mut() else {
-            return;
-        };
-        if parts.peek().is_none() {
-            table.insert(part.to_owned(), toml::Value::Float(v));
-            return;
-        }
-        at = table
-            .entry(part.to_owned())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+/// Sets the truck's setting at `path` (one of [`TRUCK_KNOBS`]); false for another path.
+/// Set field by field, not through the serialised form, which leaves out what equals
+/// the first truck's.
+fn set_field(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
+    let (st, dr, ct) = (&mut t.steering, &mut t.drive, &mut t.control);
+    match path {
+        "max_steer_rate_radps" => t.max_steer_rate_radps = v,
+        "steering.dead_time_s" => st.dead_time_s = v,
+        "steering.time_constant_s" => st.time_constant_s = v,
+        "steering.accel_limit_radps2" => st.accel_limit_radps2 = Some(v),
+        "steering.deadband_rad" => st.deadband_rad = v,
+        "steering.backlash_rad" => st.backlash_rad = v,
+        "steering.offset_rad" => st.offset_rad = v,
+        "drive.dead_time_s" => dr.dead_time_s = v,
+        "drive.time_constant_s" => dr.time_constant_s = Some(v),
+        "drive.accel_limit_mps2" => dr.accel_limit_mps2 = Some(v),
+        "drive.brake_limit_mps2" => dr.brake_limit_mps2 = Some(v),
+        "drive.creep_speed_mps" => dr.creep_speed_mps = v,
+        "control.period_s" => ct.period_s = Some(v),
+        "control.transport_delay_s" => ct.transport_delay_s = v,
+        _ => return false,
     }
+    true
 }
 
 /// A truck file (`--truck FILE`) as a run's changes: its `preset`, if it names one, and
@@ -165,6 +163,17 @@ mod tests {
             .expect_err("geometry")
             .to_string();
         assert!(e.contains("wheelbase_m") && e.contains("geometry"), "{e}");
+    }
+
+    /// A setting over the first truck keeps the rest of it (its unlimited rates too).
+    #[test]
+    fn a_setting_over_the_ideal_preset_keeps_the_rest_ideal() {
+        let mut s = BTreeMap::new();
+        s.insert("steering.dead_time_s".to_owned(), 0.1);
+        let t = apply_truck(&ForkliftSpec::default(), Some("ideal"), &s).expect("valid");
+        assert_eq!(t.steering.accel_limit_radps2, None);
+        assert!(t.drive.is_ideal() && t.control.is_ideal());
+        assert_eq!(t.steering.time_constant_s, 0.0);
     }
 
     #[test]
