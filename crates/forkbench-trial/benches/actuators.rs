@@ -1,14 +1,15 @@
-//! What the actuator and timing models cost a trial: the same trials with the `ideal` truck and the default one, interleaved trial by trial (alternating which goes first), medians of each and of their per-round ratio.
+//! What the actuator and timing models cost a trial: the same trials with the `ideal` truck and the `realistic` one, interleaved trial by trial (alternating which goes first), medians of each and of their per-round ratio.
 
 use forkbench_trial::trial::Overrides;
 use forkbench_trial::{TrialOptions, run_trial};
 
 fn options(seed: u64, ideal: bool) -> TrialOptions {
+    let preset = if ideal { "ideal" } else { "realistic" };
     TrialOptions {
         seed: Some(seed),
         replan: Some(false),
         overrides: Overrides {
-            truck_preset: ideal.then(|| "ideal".to_owned()),
+            truck_preset: Some(preset.to_owned()),
             ..Overrides::default()
         },
         ..TrialOptions::default()
@@ -58,7 +59,7 @@ fn main() {
             ratio.push(b / a);
         }
         println!(
-            "{name}: ideal {:.2} ms, default {:.2} ms, default / ideal {:.3} (medians of {rounds} interleaved rounds)",
+            "{name}: ideal {:.2} ms, realistic {:.2} ms, realistic / ideal {:.3} (medians of {rounds} interleaved rounds)",
             median(&mut ideal),
             median(&mut real),
             median(&mut ratio)
