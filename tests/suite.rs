@@ -9,3 +9,4 @@ mod papercuts;
 mod ros2;
 mod scenario_fuzz;
 mod shards;
+mod truck;
