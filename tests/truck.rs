@@ -1,4 +1,4 @@
-//! The truck's actuators through the binary: a step-test log identified back into a truck file that `--truck` takes, a run's truck file refused naming the file, and a bad log refused naming its line and column.
+//! The truck's actuators through the binary: a step-test log identified back into a truck file that `--truck` takes, a trial's MCAP identified, a run's truck file refused naming the file, and a bad log refused naming its line and column.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -56,6 +56,35 @@ fn a_step_test_is_identified_into_a_truck_file_a_trial_takes() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/field-test.toml");
     let out = forkbench(&["trial", s(&root), "--no-noise", "--truck", s(&fitted)]);
     assert!(matches!(out.status.code(), Some(0 | 3)), "{}", text(&out));
+}
+
+/// A trial's own MCAP is a log: the realistic truck's steering delay (0.06 s, 0.01 s on
+/// the bus, commands held for a 0.02 s period) and lag come back from one pick.
+#[test]
+fn a_trials_mcap_is_identified() {
+    let mcap = tmp("pick.mcap");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/field-test.toml");
+    let out = forkbench(&[
+        "trial",
+        s(&root),
+        "--truck",
+        "realistic",
+        "--mcap",
+        s(&mcap),
+    ]);
+    assert!(matches!(out.status.code(), Some(0 | 3)), "{}", text(&out));
+    let out = forkbench(&["identify", s(&mcap), "--json"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let steering = &v["channels"][0]["settings"];
+    let d = steering["steering.dead_time_s"]
+        .as_f64()
+        .expect("dead time");
+    let tau = steering["steering.time_constant_s"].as_f64().expect("lag");
+    assert!(
+        (0.06..=0.1).contains(&d) && (tau - 0.08).abs() < 0.016,
+        "{v}"
+    );
 }
 
 #[test]

@@ -123,9 +123,13 @@ impl Identified {
     pub fn text(&self) -> String {
         let mut s = String::new();
         for c in &self.channels {
+            let on = match c.held_out_runs {
+                0 => "on the fitted run itself (one run: none held out)".to_owned(),
+                n => format!("on {n} held-out run(s)"),
+            };
             s.push_str(&format!(
-                "{}: fit {:.1} % on {} held-out run(s) ({} fitted, {} samples)\n",
-                c.channel, c.fit_percent, c.held_out_runs, c.fit_runs, c.samples
+                "{}: fit {:.1} % {on} ({} fitted, {} samples)\n",
+                c.channel, c.fit_percent, c.fit_runs, c.samples
             ));
             for (k, v) in &c.settings {
                 s.push_str(&format!("  {k} = {v:.4}\n"));
