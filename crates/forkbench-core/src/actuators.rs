@@ -190,6 +190,17 @@ impl ControlTiming {
     }
 }
 
+/// The share of the way to its target a first-order lag of `time_constant_s` covers in
+/// `dt_s` (the exact discrete step, so sampled responses match the analytic one); 1 for
+/// no lag.
+pub fn lag_fraction(dt_s: f64, time_constant_s: f64) -> f64 {
+    if time_constant_s > 0.0 {
+        1.0 - (-dt_s / time_constant_s).exp()
+    } else {
+        1.0
+    }
+}
+
 /// The truck's actuators and timing together, as a preset names them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Actuators {

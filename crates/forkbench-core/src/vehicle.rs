@@ -230,11 +230,25 @@ impl ForkliftSpec {
         }
     }
 
-    /// Takes the actuators and timing of `a` (a preset), keeping the geometry.
-    pub fn set_actuators(&mut self, a: Actuators) {
-        self.steering = a.steering;
-        self.drive = a.drive;
-        self.control = a.control;
+    /// This truck with the actuators and timing of `a` (a preset), its geometry kept.
+    pub fn with_actuators(self, a: Actuators) -> Self {
+        Self {
+            steering: a.steering,
+            drive: a.drive,
+            control: a.control,
+            ..self
+        }
+    }
+
+    /// From a steering command leaving the controller to the motor acting on it: the
+    /// steering's dead time and the bus.
+    pub fn steering_delay_s(&self) -> f64 {
+        self.steering.dead_time_s + self.control.transport_delay_s
+    }
+
+    /// The same for a speed command and the drive.
+    pub fn drive_delay_s(&self) -> f64 {
+        self.drive.dead_time_s + self.control.transport_delay_s
     }
 }
 

@@ -65,12 +65,8 @@ pub fn simulate(
 fn step(kind: Kind, p: &Params, x: f64, u: f64, dt: f64) -> f64 {
     match kind {
         Kind::Steering => {
-            let alpha = if p.time_constant_s > 0.0 {
-                1.0 - (-dt / p.time_constant_s).exp()
-            } else {
-                1.0
-            };
-            let mut delta = alpha * (u - x);
+            let mut delta =
+                forkbench_core::actuators::lag_fraction(dt, p.time_constant_s) * (u - x);
             if let Some(r) = p.limit_up {
                 delta = delta.clamp(-r * dt, r * dt);
             }

@@ -8,9 +8,7 @@ use forkbench_sim::SimConfig;
 
 /// The A30 with the first truck's actuators: what a test sets is all there is.
 fn ideal() -> ForkliftSpec {
-    let mut t = ForkliftSpec::default();
-    t.set_actuators(forkbench_core::actuators::Actuators::IDEAL);
-    t
+    ForkliftSpec::default().with_actuators(forkbench_core::actuators::Actuators::IDEAL)
 }
 
 fn truck(dead_s: f64, tau_s: f64, rate: f64) -> ForkliftSpec {

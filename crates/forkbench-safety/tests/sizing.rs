@@ -54,7 +54,7 @@ fn braking_in_the_physics_matches_the_controllers_analytic_stop() {
             let gain = d
                 .time_constant_s
                 .map_or(cfg.speed_gain_per_s, |tau| 1.0 / tau);
-            let delay_s = d.dead_time_s + truck.control.transport_delay_s;
+            let delay_s = truck.drive_delay_s();
             for v in [0.3, 0.6, 0.8] {
                 let b = braking_distance(&truck, &cfg, &pallet, v, load).expect("brakes");
                 let want = v * delay_s + analytic_stop_m(v, gain, decel);

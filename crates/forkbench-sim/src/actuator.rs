@@ -3,7 +3,7 @@
 use std::collections::VecDeque;
 
 use forkbench_core::ForkliftSpec;
-use forkbench_core::actuators::{DriveActuator, SteeringActuator};
+use forkbench_core::actuators::{DriveActuator, SteeringActuator, lag_fraction};
 
 /// A pure delay of whole physics steps: what goes in comes out that many steps later;
 /// before then, the value the truck stood with.
@@ -34,6 +34,9 @@ pub(crate) struct Steering {
     cfg: SteeringActuator,
     max_rad: f64,
     max_rate_radps: f64,
+    /// The physics step, and the share of its error the lag closes in one.
+    dt_s: f64,
+    lag: f64,
     delay: DelayLine,
     /// Where the actuator stands (before backlash and offset).
     motor_rad: f64,
@@ -44,22 +47,23 @@ pub(crate) struct Steering {
 
 impl Steering {
     pub(crate) fn new(spec: &ForkliftSpec, dt_s: f64) -> Self {
-        let delay_s = spec.steering.dead_time_s + spec.control.transport_delay_s;
         Self {
             cfg: spec.steering.clone(),
             max_rad: spec.max_steer_rad,
             max_rate_radps: spec.max_steer_rate_radps,
-            delay: DelayLine::new(delay_s, dt_s, 0.0),
+            dt_s,
+            lag: lag_fraction(dt_s, spec.steering.time_constant_s),
+            delay: DelayLine::new(spec.steering_delay_s(), dt_s, 0.0),
             motor_rad: 0.0,
             motor_rate_radps: 0.0,
             wheel_rad: 0.0,
         }
     }
 
-    /// One step under the command `cmd_rad`; returns the wheel's equivalent angle. A
-    /// non-finite command holds the actuator where it stands.
-    pub(crate) fn step(&mut self, cmd_rad: f64, dt_s: f64) -> f64 {
-        let max = self.max_rad;
+    /// One physics step under the command `cmd_rad`; returns the wheel's equivalent
+    /// angle. A non-finite command holds the actuator where it stands.
+    pub(crate) fn step(&mut self, cmd_rad: f64) -> f64 {
+        let (max, dt_s) = (self.max_rad, self.dt_s);
         let cmd = if cmd_rad.is_finite() {
             cmd_rad.clamp(-max, max)
         } else {
@@ -70,11 +74,8 @@ impl Steering {
         let rate = self.max_rate_radps * dt_s;
         let mut delta = if self.cfg.deadband_rad > 0.0 && err.abs() <= self.cfg.deadband_rad {
             0.0
-        } else if self.cfg.time_constant_s > 0.0 {
-            // The exact step of a first-order lag, so sampled responses match the analytic one.
-            (1.0 - (-dt_s / self.cfg.time_constant_s).exp()) * err
         } else {
-            err
+            self.lag * err
         };
         delta = delta.clamp(-rate, rate);
         if let Some(acc) = self.cfg.accel_limit_radps2 {
@@ -118,10 +119,9 @@ pub(crate) struct Drive {
 
 impl Drive {
     pub(crate) fn new(spec: &ForkliftSpec, dt_s: f64) -> Self {
-        let delay_s = spec.drive.dead_time_s + spec.control.transport_delay_s;
         Self {
             cfg: spec.drive.clone(),
-            delay: DelayLine::new(delay_s, dt_s, 0.0),
+            delay: DelayLine::new(spec.drive_delay_s(), dt_s, 0.0),
         }
     }
 
@@ -152,9 +152,7 @@ mod tests {
 
     /// The A30 with the first truck's actuators.
     fn ideal() -> ForkliftSpec {
-        let mut t = ForkliftSpec::default();
-        t.set_actuators(forkbench_core::actuators::Actuators::IDEAL);
-        t
+        ForkliftSpec::default().with_actuators(forkbench_core::actuators::Actuators::IDEAL)
     }
 
     fn truck(steering: SteeringActuator) -> ForkliftSpec {
@@ -179,7 +177,7 @@ mod tests {
             dt,
         );
         for k in 1..=200 {
-            let got = s.step(a, dt);
+            let got = s.step(a);
             let t = k as f64 * dt;
             // The command of step 1 acts from step 1 + d/dt.
             let since = t - dt - d;
@@ -202,7 +200,7 @@ mod tests {
             let rate = spec.max_steer_rate_radps * 0.01;
             let max = spec.max_steer_rad;
             legacy = (legacy + (cmd - legacy).clamp(-rate, rate)).clamp(-max, max);
-            assert_eq!(s.step(cmd, 0.01).to_bits(), legacy.to_bits(), "step {k}");
+            assert_eq!(s.step(cmd).to_bits(), legacy.to_bits(), "step {k}");
         }
     }
 
@@ -216,13 +214,10 @@ mod tests {
             0.01,
         );
         // Out to 0.1: the wheel trails the motor by half the play.
-        let w = (0..100).map(|_| s.step(0.1, 0.01)).last().expect("stepped");
+        let w = (0..100).map(|_| s.step(0.1)).last().expect("stepped");
         assert!((w - 0.09).abs() < 1e-12, "{w}");
         // Back by less than the play: the wheel does not move.
-        let w = (0..100)
-            .map(|_| s.step(0.085, 0.01))
-            .last()
-            .expect("stepped");
+        let w = (0..100).map(|_| s.step(0.085)).last().expect("stepped");
         assert!((w - 0.09).abs() < 1e-12, "{w}");
         let mut s = Steering::new(
             &truck(SteeringActuator {
@@ -231,8 +226,8 @@ mod tests {
             }),
             0.01,
         );
-        assert_eq!(s.step(0.008, 0.01), 0.0);
-        assert!((s.step(0.05, 0.01) - 0.05).abs() < 1e-12);
+        assert_eq!(s.step(0.008), 0.0);
+        assert!((s.step(0.05) - 0.05).abs() < 1e-12);
     }
 
     #[test]
@@ -247,7 +242,7 @@ mod tests {
         );
         let (mut prev_angle, mut prev_rate) = (0.0, 0.0);
         for _ in 0..400 {
-            let a = s.step(0.5, 0.01);
+            let a = s.step(0.5);
             let rate = (a - prev_angle) / 0.01;
             assert!((rate - prev_rate).abs() <= acc * 0.01 + 1e-9);
             assert!(a <= 0.5 + 2e-3, "overshoot under a milliradian or two: {a}");

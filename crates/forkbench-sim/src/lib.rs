@@ -337,7 +337,7 @@ impl Sim {
     /// actuators (`ForkliftSpec::steering`, `drive`, `control`) pass them on.
     pub fn step(&mut self, speed_cmd_mps: f64, steer_cmd_rad: f64) {
         let dt = self.cfg.dt_s;
-        self.steer_rad = self.steering.step(steer_cmd_rad, dt);
+        self.steer_rad = self.steering.step(steer_cmd_rad);
         self.apply_drive(speed_cmd_mps, dt);
         self.apply_tyres(dt);
         self.apply_pallet_floor_friction(dt);

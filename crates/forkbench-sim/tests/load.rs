@@ -108,7 +108,7 @@ fn analytic_stop_m(v0: f64, grip_mps2: f64, cfg: &SimConfig) -> f64 {
         .drive
         .time_constant_s
         .map_or(cfg.speed_gain_per_s, |tau| 1.0 / tau);
-    let delay_s = d.drive.dead_time_s + d.control.transport_delay_s;
+    let delay_s = d.drive_delay_s();
     let a = grip_mps2.min(limit);
     let v1 = a / gain;
     v0 * delay_s + (v0 * v0 - v1 * v1) / (2.0 * a) + v1 / gain

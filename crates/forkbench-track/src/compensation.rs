@@ -2,6 +2,7 @@
 
 use std::collections::VecDeque;
 
+use forkbench_core::actuators::lag_fraction;
 use forkbench_core::{ForkliftSpec, Path, Pose2};
 
 use crate::predictor::advance_pose;
@@ -9,6 +10,10 @@ use crate::{Command, Tracker, TrackerInput};
 
 /// Step of the forward prediction.
 const PREDICT_DT_S: f64 = 0.01;
+
+/// The speed loop's time constant when the truck does not set its own: the physics'
+/// default (`[sim] speed_gain_per_s` 4/s), which a tracker cannot read.
+const SIM_SPEED_LOOP_S: f64 = 0.25;
 
 /// A tracker that steers from where the truck will be once its command acts.
 pub struct DelayCompensated {
@@ -52,13 +57,12 @@ impl DelayCompensated {
     /// steering lag and rate limit and its speed loop.
     pub fn predict(&self, input: &TrackerInput) -> (Pose2, f64, f64) {
         let t = input.truck;
-        let steer_delay = t.steering.dead_time_s + t.control.transport_delay_s;
-        let drive_delay = t.drive.dead_time_s + t.control.transport_delay_s;
+        let (steer_delay, drive_delay) = (t.steering_delay_s(), t.drive_delay_s());
         let horizon = steer_delay.max(drive_delay);
         let (mut pose, mut v, mut steer) = (input.pose, input.speed_mps, input.steer_rad);
         let n = (horizon / PREDICT_DT_S).round() as usize;
         let now = (v, steer);
-        let tau_v = t.drive.time_constant_s.unwrap_or(0.25);
+        let tau_v = t.drive.time_constant_s.unwrap_or(SIM_SPEED_LOOP_S);
         for k in 0..n {
             let at = input.t_s + k as f64 * PREDICT_DT_S;
             let (_, steer_cmd) = self.issued_at(at - steer_delay, now);
@@ -78,12 +82,7 @@ impl DelayCompensated {
 
 /// One prediction step of the steering: the first-order lag within the rate limit.
 fn steer_step(t: &ForkliftSpec, steer: f64, cmd: f64) -> f64 {
-    let tau = t.steering.time_constant_s;
-    let alpha = if tau > 0.0 {
-        1.0 - (-PREDICT_DT_S / tau).exp()
-    } else {
-        1.0
-    };
+    let alpha = lag_fraction(PREDICT_DT_S, t.steering.time_constant_s);
     let r = t.max_steer_rate_radps * PREDICT_DT_S;
     steer + (alpha * (cmd - steer)).clamp(-r, r)
 }
@@ -130,9 +129,7 @@ mod tests {
 
     /// The A30 with the first truck's actuators.
     fn ideal() -> ForkliftSpec {
-        let mut t = ForkliftSpec::default();
-        t.set_actuators(forkbench_core::actuators::Actuators::IDEAL);
-        t
+        ForkliftSpec::default().with_actuators(forkbench_core::actuators::Actuators::IDEAL)
     }
 
     /// Without delays the prediction is the measured state: the compensation is a no-op.

@@ -55,7 +55,7 @@ pub fn apply_truck(
                 &format!("unknown preset {name:?} (known: {})", known.join(", ")),
             )
         })?;
-        out.set_actuators(a);
+        out = out.with_actuators(a);
     }
     for (path, v) in settings {
         if !set_field(&mut out, path, *v) {
