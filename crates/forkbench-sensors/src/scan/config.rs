@@ -68,6 +68,9 @@ impl Default for ScannerConfig {
 /// How far past its range a scanner is still asked for a target (the pallet's extent).
 pub const REACH_MARGIN_M: f64 = 0.5;
 
+/// Longest sweep a scanner may take: a trial keeps the truck's poses this far back.
+pub const MAX_SWEEP_S: f64 = 1.0;
+
 /// The scanner models known by name.
 pub const SCANNER_PRESETS: [&str; 2] = ["tim561", "kinect2"];
 
@@ -205,8 +208,11 @@ impl ScannerConfig {
                 return bad(f, "must be a finite number ≥ 0");
             }
         }
-        if self.sweep_s > 1.0 / self.rate_hz {
-            return bad("sweep_s", "must be at most one frame period (1 / rate_hz)");
+        if self.sweep_s > (1.0 / self.rate_hz).min(MAX_SWEEP_S) {
+            return bad(
+                "sweep_s",
+                "must be at most one frame period (1 / rate_hz) and at most 1 s",
+            );
         }
         if self.range_min_m >= self.range_max_m {
             return bad("range_min_m", "must be below range_max_m");

@@ -3,7 +3,7 @@
 mod caster;
 mod config;
 
-pub use config::{REACH_MARGIN_M, SCANNER_PRESETS, ScannerConfig};
+pub use config::{MAX_SWEEP_S, REACH_MARGIN_M, SCANNER_PRESETS, ScannerConfig};
 
 use forkbench_core::Pose2;
 use forkbench_core::signal::Scan;

@@ -39,8 +39,8 @@ pub(crate) struct WorldState {
     pub(crate) trail: std::collections::VecDeque<(f64, Pose2)>,
 }
 
-/// How far back the trail of true poses reaches: past any scanner's sweep.
-const TRAIL_S: f64 = 1.0;
+/// How far back the trail of true poses reaches: a scanner's longest sweep.
+const TRAIL_S: f64 = forkbench_sensors::scan::MAX_SWEEP_S;
 
 impl WorldState {
     /// Keeps the fork root's true pose now in the trail.
