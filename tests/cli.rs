@@ -794,7 +794,8 @@ fn one_path_for_two_formats_and_unbounded_inputs_are_refused() {
     ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
-        String::from_utf8_lossy(&out.stderr).contains("given to two of --rrd, --mcap and --ros2")
+        String::from_utf8_lossy(&out.stderr)
+            .contains("given to two of --rrd, --mcap, --ros2 and --actuator-log")
     );
     let dir = std::env::temp_dir();
     let out = forkbench(&[

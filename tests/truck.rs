@@ -1,4 +1,4 @@
-//! The truck's actuators through the binary: a step-test log identified back into a truck file that `--truck` takes, a trial's MCAP identified, a run's truck file refused naming the file, and a bad log refused naming its line and column.
+//! The truck's actuators through the binary: a step-test log identified back into a truck file that `--truck` takes, a trial's MCAP and actuator log identified, a run's truck file refused naming the file, and a bad log refused naming its line and column.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -60,30 +60,78 @@ fn a_step_test_is_identified_into_a_truck_file_a_trial_takes() {
 
 /// A trial's own MCAP is a log: the realistic truck's steering delay (0.06 s, 0.01 s on
 /// the bus, commands held for a 0.02 s period) and lag come back from one pick.
+/// A default (realistic) pick's MCAP, ROS 2 bag and `--actuator-log` CSV are the same
+/// log: each is identified as the realistic steering.
 #[test]
-fn a_trials_mcap_is_identified() {
-    let mcap = tmp("pick.mcap");
+fn a_trials_mcap_bag_and_actuator_log_are_identified() {
+    let (mcap, bag, csv) = (tmp("pick.mcap"), tmp("pick.ros2.mcap"), tmp("pick.csv"));
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/field-test.toml");
     let out = forkbench(&[
         "trial",
         s(&root),
-        "--truck",
-        "realistic",
         "--mcap",
         s(&mcap),
+        "--ros2",
+        s(&bag),
+        "--actuator-log",
+        s(&csv),
     ]);
     assert!(matches!(out.status.code(), Some(0 | 3)), "{}", text(&out));
-    let out = forkbench(&["identify", s(&mcap), "--json"]);
+    let header = std::fs::read_to_string(&csv).expect("the log");
+    assert!(
+        header.starts_with("t_s,steer_cmd_rad,steer_rad,speed_cmd_mps,speed_mps\n"),
+        "{}",
+        &header[..80.min(header.len())]
+    );
+    let mut fits = Vec::new();
+    for log in [&mcap, &bag, &csv] {
+        let out = forkbench(&["identify", s(log), "--json"]);
+        assert!(out.status.success(), "{}", text(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        let steering = &v["channels"][0]["settings"];
+        let d = steering["steering.dead_time_s"]
+            .as_f64()
+            .expect("dead time");
+        let tau = steering["steering.time_constant_s"].as_f64().expect("lag");
+        assert!(
+            (0.06..=0.1).contains(&d) && (tau - 0.08).abs() < 0.016,
+            "{v}"
+        );
+        fits.push((d, tau));
+    }
+    // The same samples (the MCAP's JSON and the CSV print them alike to a few ulps, the
+    // bag holds them as float32).
+    let same = |a: f64, b: f64| (a - b).abs() < 1e-4;
+    assert!(
+        fits.iter()
+            .all(|f| same(f.0, fits[0].0) && same(f.1, fits[0].1)),
+        "{fits:?}"
+    );
+    // Fields named on other topics: the steering alone, timed by the log.
+    let measured = "/forkbench/actuators/measured";
+    let fields =
+        "@log_time,/forkbench/actuators/command:drive.steering_angle,drive.steering_angle,,";
+    let out = forkbench(&[
+        "identify",
+        s(&bag),
+        "--json",
+        "--topic",
+        measured,
+        "--fields",
+        fields,
+    ]);
     assert!(out.status.success(), "{}", text(&out));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
-    let steering = &v["channels"][0]["settings"];
-    let d = steering["steering.dead_time_s"]
-        .as_f64()
-        .expect("dead time");
-    let tau = steering["steering.time_constant_s"].as_f64().expect("lag");
+    let channels = v["channels"].as_array().expect("channels");
+    assert_eq!(channels.len(), 1, "{v}");
+    let d = channels[0]["settings"]["steering.dead_time_s"].as_f64();
+    assert!(d.is_some_and(|d| same(d, fits[0].0)), "{v}");
+    // A topic the bag does not have is named.
+    let out = forkbench(&["identify", s(&bag), "--topic", "/nope"]);
     assert!(
-        (0.06..=0.1).contains(&d) && (tau - 0.08).abs() < 0.016,
-        "{v}"
+        text(&out).contains("no messages on topic /nope"),
+        "{}",
+        text(&out)
     );
 }
 

@@ -10,7 +10,15 @@ import sys
 
 from mcap.reader import make_reader
 from mcap_ros2.reader import read_ros2_messages
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+# ackermann_msgs is not among Humble's core definitions: its published .msg files, as
+# ros-drivers/ackermann_msgs has them (not the bag's copy).
+ACKERMANN = {
+    "ackermann_msgs/msg/AckermannDrive": "float32 steering_angle\nfloat32 steering_angle_velocity\n"
+    "float32 speed\nfloat32 acceleration\nfloat32 jerk\n",
+    "ackermann_msgs/msg/AckermannDriveStamped": "std_msgs/Header header\nAckermannDrive drive\n",
+}
 
 
 def main() -> None:
@@ -35,6 +43,8 @@ def main() -> None:
         count += 1
     # And with ROS 2 Humble's own definitions.
     store = get_typestore(Stores.ROS2_HUMBLE)
+    for name, text in ACKERMANN.items():
+        store.register(get_types_from_msg(text, name))
     with open(bag, "rb") as f:
         for _, channel, message in make_reader(f).iter_messages():
             store.deserialize_cdr(message.data, types[channel.topic])
@@ -65,6 +75,10 @@ def main() -> None:
         assert any(t.startswith("/grid/nav") for t in decoded), sorted(decoded)
         assert decoded["/markers"], sorted(decoded)
         assert any(m.ns == "obstacles" and m.type == 1 for m in scene), "no racks in the scene"
+    # The actuators: a commanded and a measured drive message for every estimated pose.
+    asked, got = decoded["/forkbench/actuators/command"], decoded["/forkbench/actuators/measured"]
+    assert len(asked) == len(got) == len(decoded["/forkbench/pose"]), (len(asked), len(got))
+    assert any(m.drive.steering_angle != 0 for m in got) and any(m.drive.speed > 0 for m in got)
     levels = {m.level for m in decoded["/rosout"]}
     assert levels <= {20, 30, 40}, levels
     print(f"ros2 bag ok: {count} messages on {len(decoded)} topics, {len(scans)} scans, "

@@ -56,6 +56,9 @@ class Scenario:
     def command_limits(self) -> tuple[float, float]:
         """(max speed m/s, max steering rad)."""
     @property
+    def control_period_s(self) -> float:
+        """How long one control tick (an environment's step) lasts, s."""
+    @property
     def has_mission(self) -> bool: ...
 
 def default_scenarios() -> list[Scenario]: ...

@@ -109,6 +109,17 @@ impl Scenario {
         )
     }
 
+    /// How long one control tick (an environment's step) lasts: the truck's control
+    /// period, or the physics step when control runs every step (s).
+    #[getter]
+    fn control_period_s(&self) -> f64 {
+        self.inner
+            .truck
+            .control
+            .period_s
+            .unwrap_or(self.inner.sim.dt_s)
+    }
+
     #[getter]
     fn has_mission(&self) -> bool {
         self.inner.mission.is_some()

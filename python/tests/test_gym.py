@@ -52,7 +52,10 @@ def test_the_expert_reproduces_the_batch_trial_at_the_episode_seed():
         want = forkbench.run_trial(scn, info["case"], seed=info["seed"])
         assert without_clock(end["outcome"]) == without_clock(want)
         assert end["success"] == want["success"] and end["failure"] == want["failure"]
-        assert term and steps >= round(want["sim_time_s"] / 0.01)
+        # One step per control tick (the truck's 0.02 s period by default), after the
+        # truck stood for its first fix and estimate (0.08 s by default).
+        tick_s = scn.control_period_s
+        assert term and steps >= round((want["sim_time_s"] - 0.1) / tick_s)
 
 
 def test_episodes_end_as_the_bench_judges():
@@ -65,7 +68,7 @@ def test_episodes_end_as_the_bench_judges():
         if term or trunc:
             break
     assert trunc and not term and info["failure"] == "timeout"
-    assert steps == round(env.scenario.timeout_s / 0.01)
+    assert steps == round(env.scenario.timeout_s / env.scenario.control_period_s)
     # After the end a step raises instead of repeating the terminal reward.
     with pytest.raises(RuntimeError, match="reset"):
         env.step([0.0, 0.0])

@@ -166,9 +166,9 @@ def test_a_runs_truck_is_its_actuators_and_timing():
         return without_clock(forkbench.run_trial(scn, seed=1, noise=False, **truck))  # type: ignore[arg-type]
 
     default = run()
-    # The default truck is the first one; the realistic one and a lag each act.
-    assert run(truck_preset="ideal") == default
-    assert run(truck_preset="realistic")["lateral_error_m"] != default["lateral_error_m"]
+    # The default truck is the realistic one; the first (ideal) one and a lag each act.
+    assert run(truck_preset="realistic") == default
+    assert run(truck_preset="ideal")["lateral_error_m"] != default["lateral_error_m"]
     assert run(truck={"steering.dead_time_s": 0.3})["lateral_error_m"] != default["lateral_error_m"]
     with pytest.raises(forkbench.ScenarioError, match="wheelbase_m"):
         run(truck={"wheelbase_m": 2.0})

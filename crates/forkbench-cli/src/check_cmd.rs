@@ -32,9 +32,17 @@ fn summary(scn: &Scenario) -> String {
     let w = &scn.world;
     let sensing = match &scn.pallet_sensing {
         forkbench_trial::scenario::sensors::PalletSensing::Gaussian => "gaussian".to_owned(),
-        forkbench_trial::scenario::sensors::PalletSensing::Scanner { sensors, detector } => {
+        forkbench_trial::scenario::sensors::PalletSensing::Scanner {
+            sensors,
+            detector,
+            latency_s,
+        } => {
             let names: Vec<&str> = sensors.iter().map(|s| s.name.as_str()).collect();
-            format!("{} with detector {}", names.join(" + "), detector.kind)
+            format!(
+                "{} with detector {} ({latency_s} s late)",
+                names.join(" + "),
+                detector.kind
+            )
         }
     };
     let yes = |ok: bool| if ok { "ok" } else { "REFUSED" };

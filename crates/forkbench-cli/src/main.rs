@@ -62,6 +62,10 @@ struct RecordFlags {
     /// Write a ROS 2 bag to FILE (.mcap, the ros2 profile: CDR messages, ros2msg schemas).
     #[arg(long)]
     ros2: Option<PathBuf>,
+    /// Write the actuator log to FILE (.csv: t_s, steer_cmd_rad, steer_rad, speed_cmd_mps,
+    /// speed_mps at every physics step), what `identify` reads.
+    #[arg(long, value_name = "FILE")]
+    actuator_log: Option<PathBuf>,
     /// Spawn a rerun viewer and stream to it.
     #[arg(long)]
     rerun: bool,
@@ -79,6 +83,7 @@ impl RecordFlags {
             rrd: self.rrd,
             mcap: self.mcap,
             ros2: self.ros2,
+            actuator_csv: self.actuator_log,
             rerun: self.rerun,
             connect: self.connect,
             force: self.force,

@@ -47,13 +47,18 @@ pub struct IdentifyArgs {
     /// Draw each channel's held-out run, measured against fitted (.svg or .png).
     #[arg(long, value_name = "FILE")]
     plot: Option<std::path::PathBuf>,
-    /// For an .mcap log: the topic whose JSON messages hold the samples (forkbench's own
-    /// recordings keep them on /forkbench/telemetry).
+    /// For an .mcap log or ROS 2 bag: the topic whose messages (JSON, or CDR by the bag's
+    /// own definitions) time the samples (forkbench's recordings keep them on
+    /// /forkbench/telemetry; its ROS 2 bags, found without this, on
+    /// /forkbench/actuators/command and /forkbench/actuators/measured).
     #[arg(long, default_value = forkbench_identify::mcap_log::TELEMETRY_TOPIC)]
     topic: String,
-    /// For an .mcap log: the message fields holding t_s, steer_cmd_rad, steer_rad,
-    /// speed_cmd_mps, speed_mps, in that order (an empty name leaves a channel out).
-    #[arg(long, value_delimiter = ',', num_args = 5, value_name = "FIELDS",
+    /// For an .mcap log: five comma-separated fields holding t_s, steer_cmd_rad,
+    /// steer_rad, speed_cmd_mps, speed_mps, in that order: dotted paths into the topic's
+    /// messages (a ROS 2 Time as seconds), `/other_topic:path` for a field of another topic
+    /// (its latest value at each sample), `@log_time` for the message's log time, and an
+    /// empty name to leave a channel out.
+    #[arg(long, value_delimiter = ',', value_name = "FIELDS",
           default_values_t = forkbench_identify::log::COLUMNS.map(str::to_owned))]
     fields: Vec<String>,
 }

@@ -63,23 +63,23 @@ pub struct ControlTiming {
 }
 
 impl Default for SteeringActuator {
-    /// The first truck's: the bench's own controllers are tuned for it (see docs/truck.md).
+    /// The realistic preset's (see docs/truck.md).
     fn default() -> Self {
-        Self::IDEAL
+        Actuators::REALISTIC.steering
     }
 }
 
 impl Default for DriveActuator {
-    /// The first truck's: the bench's own controllers are tuned for it (see docs/truck.md).
+    /// The realistic preset's (see docs/truck.md).
     fn default() -> Self {
-        Self::IDEAL
+        Actuators::REALISTIC.drive
     }
 }
 
 impl Default for ControlTiming {
-    /// The first truck's: the bench's own controllers are tuned for it (see docs/truck.md).
+    /// The realistic preset's (see docs/truck.md).
     fn default() -> Self {
-        Self::IDEAL
+        Actuators::REALISTIC.control
     }
 }
 
@@ -96,6 +96,11 @@ impl SteeringActuator {
 
     pub fn is_ideal(&self) -> bool {
         *self == Self::IDEAL
+    }
+
+    /// Whether this is the default (left out of serialised specs).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
     }
 
     /// Each value in its range, naming the field (`steering.<name>`).
@@ -128,6 +133,11 @@ impl DriveActuator {
         *self == Self::IDEAL
     }
 
+    /// Whether this is the default (left out of serialised specs).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+
     /// Each value in its range, naming the field (`drive.<name>`).
     pub fn validate(&self) -> Result<(), SettingsError> {
         in_ranges(&[
@@ -157,6 +167,11 @@ impl ControlTiming {
 
     pub fn is_ideal(&self) -> bool {
         *self == Self::IDEAL
+    }
+
+    /// Whether this is the default (left out of serialised specs).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
     }
 
     /// Each value in its range, naming the field (`control.<name>`).
@@ -274,16 +289,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn presets_are_valid_and_ideal_is_the_default() {
+    fn presets_are_valid_and_realistic_is_the_default() {
         for (name, _) in PRESETS {
             Actuators::preset(name)
                 .expect("named")
                 .validate()
                 .expect("valid");
         }
-        assert!(SteeringActuator::default().is_ideal());
-        assert!(DriveActuator::default().is_ideal());
-        assert!(ControlTiming::default().is_ideal());
+        assert_eq!(SteeringActuator::default(), Actuators::REALISTIC.steering);
+        assert_eq!(DriveActuator::default(), Actuators::REALISTIC.drive);
+        assert_eq!(ControlTiming::default(), Actuators::REALISTIC.control);
         assert!(!Actuators::REALISTIC.steering.is_ideal());
     }
 

@@ -38,14 +38,14 @@ pub struct ForkliftSpec {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fork_thickness_m: Option<f64>,
     /// The steering actuator (`[steering]` in a truck file, `[truck.steering]` in a
-    /// scenario); left out of serialised specs when ideal, so older settings keep their hashes.
-    #[serde(skip_serializing_if = "SteeringActuator::is_ideal")]
+    /// scenario); left out of serialised specs at its default.
+    #[serde(skip_serializing_if = "SteeringActuator::is_default")]
     pub steering: SteeringActuator,
     /// The traction drive (`[drive]`).
-    #[serde(skip_serializing_if = "DriveActuator::is_ideal")]
+    #[serde(skip_serializing_if = "DriveActuator::is_default")]
     pub drive: DriveActuator,
     /// The controller's period and transport delay (`[control]`).
-    #[serde(skip_serializing_if = "ControlTiming::is_ideal")]
+    #[serde(skip_serializing_if = "ControlTiming::is_default")]
     pub control: ControlTiming,
 }
 
@@ -76,9 +76,9 @@ impl Default for ForkliftSpec {
             max_steer_rate_radps: 0.8,
             rated_capacity_kg: DEFAULT_RATED_CAPACITY_KG,
             fork_thickness_m: None,
-            steering: SteeringActuator::IDEAL,
-            drive: DriveActuator::IDEAL,
-            control: ControlTiming::IDEAL,
+            steering: SteeringActuator::default(),
+            drive: DriveActuator::default(),
+            control: ControlTiming::default(),
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Identifies the truck's actuators from logs of commands and measured responses (the dead time on a grid, the time constant and limits by output-error least squares, validated on held-out runs), and makes such logs by driving the simulated truck through a step test.
 
+pub mod cdr;
 pub mod check;
 pub mod excite;
 pub mod fit;

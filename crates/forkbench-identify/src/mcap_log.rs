@@ -1,15 +1,79 @@
-//! An actuator log from an MCAP recording: one topic's JSON messages, with the fields that hold the time, commands and responses named (forkbench's own telemetry by default).
+//! An actuator log from an MCAP recording or ROS 2 bag: JSON or CDR messages (decoded by the bag's own definitions), each column a field of a named topic, the others held at their latest value at each message of the time's topic.
 
+use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
 
+use serde_json::Value;
+
+use crate::cdr::Schema;
 use crate::log::{ActuatorLog, COLUMNS, LogError, parse_csv};
 
 /// Where forkbench's recordings keep each control step.
 pub const TELEMETRY_TOPIC: &str = "/forkbench/telemetry";
 
-/// Reads `topic`'s JSON messages in `path` as a log: `fields` name the time, steering
-/// command and response, speed command and response (in [`COLUMNS`]' order; an empty
-/// name leaves that channel out). Messages in another encoding are refused.
+/// Where forkbench's ROS 2 bags keep the commanded and measured steering and speed
+/// (`ackermann_msgs/msg/AckermannDriveStamped`).
+pub const ROS2_COMMAND_TOPIC: &str = "/forkbench/actuators/command";
+pub const ROS2_MEASURED_TOPIC: &str = "/forkbench/actuators/measured";
+
+/// A time field that is the message's log time, not one of its fields.
+pub const LOG_TIME: &str = "@log_time";
+
+/// The fields of forkbench's own ROS 2 bags, in [`COLUMNS`]' order.
+pub fn ros2_fields() -> [String; 5] {
+    let m = ROS2_MEASURED_TOPIC;
+    [
+        "header.stamp".to_owned(),
+        "drive.steering_angle".to_owned(),
+        format!("{m}:drive.steering_angle"),
+        "drive.speed".to_owned(),
+        format!("{m}:drive.speed"),
+    ]
+}
+
+/// One column's source: a topic and a dotted path into its messages.
+#[derive(Debug, Clone, PartialEq)]
+struct Source {
+    topic: String,
+    path: String,
+}
+
+/// `/topic:path` names its own topic; a bare path is on `topic`.
+fn source(spec: &str, topic: &str) -> Source {
+    match spec.split_once(':') {
+        Some((t, p)) if t.starts_with('/') => Source {
+            topic: t.to_owned(),
+            path: p.to_owned(),
+        },
+        _ => Source {
+            topic: topic.to_owned(),
+            path: spec.to_owned(),
+        },
+    }
+}
+
+/// The number at `path` (dots between names, array indices as numbers) of `v`; a
+/// `builtin_interfaces/Time` (`sec`, `nanosec`) as seconds.
+fn number_at(v: &Value, path: &str) -> Option<f64> {
+    let mut at = v;
+    for key in path.split('.').filter(|k| !k.is_empty()) {
+        at = match at {
+            Value::Array(a) => a.get(key.parse::<usize>().ok()?)?,
+            _ => at.get(key)?,
+        };
+    }
+    match at {
+        Value::Object(o) => Some(o.get("sec")?.as_f64()? + o.get("nanosec")?.as_f64()? * 1e-9),
+        _ => at.as_f64(),
+    }
+}
+
+/// Reads a log from the MCAP at `path`: `fields` name the time, steering command and
+/// response, speed command and response (in [`COLUMNS`]' order; an empty name leaves
+/// that channel out), each a path into `topic`'s messages or `/other:path`. A row is
+/// made at each message of the time's topic, the other topics' fields at their latest
+/// values by then. forkbench's own ROS 2 bag is read with [`ros2_fields`] when the
+/// defaults name a telemetry topic it does not have.
 pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<ActuatorLog, LogError> {
     let file = path.display().to_string();
     let bad = |reason: String| LogError::File {
@@ -18,48 +82,161 @@ pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<Actua
     };
     let bytes = forkbench_core::files::read_bytes(path, crate::log::MAX_LOG_BYTES)
         .map_err(|e| bad(e.to_string()))?;
-    let stream =
-        mcap::MessageStream::new(&bytes).map_err(|e| bad(format!("not an MCAP file: {e}")))?;
-    // Rebuilt as CSV text, so the one reader's checks (time, NaN, channels) apply.
-    let used: Vec<(usize, &String)> = fields
+    let topics = topics_in(&bytes).map_err(&bad)?;
+    let defaults = COLUMNS.map(str::to_owned);
+    let (topic, fields) = if topic == TELEMETRY_TOPIC
+        && *fields == defaults
+        && !topics.contains(TELEMETRY_TOPIC)
+        && topics.contains(ROS2_COMMAND_TOPIC)
+    {
+        (ROS2_COMMAND_TOPIC, ros2_fields())
+    } else {
+        (topic, fields.clone())
+    };
+    if fields[0].is_empty() {
+        return Err(bad(
+            "the time field (the first of --fields) is required".into()
+        ));
+    }
+    let used: Vec<(usize, Source)> = fields
         .iter()
         .enumerate()
         .filter(|(_, f)| !f.is_empty())
+        .map(|(i, f)| (i, source(f, topic)))
         .collect();
+    for (_, s) in &used {
+        if !topics.contains(&s.topic) {
+            return Err(bad(format!("no messages on topic {}", s.topic)));
+        }
+    }
+    let csv = rows(&bytes, &used).map_err(bad)?;
+    parse_csv(&csv, &format!("{file} (topic {topic})"))
+}
+
+/// The topics that carry messages.
+fn topics_in(bytes: &[u8]) -> Result<BTreeSet<String>, String> {
+    let summary = mcap::Summary::read(bytes).map_err(|e| format!("not an MCAP file: {e}"))?;
+    let mut topics = BTreeSet::new();
+    if let Some(s) = summary {
+        topics.extend(s.channels.values().map(|c| c.topic.clone()));
+        return Ok(topics);
+    }
+    for m in mcap::MessageStream::new(bytes).map_err(|e| format!("not an MCAP file: {e}"))? {
+        topics.insert(
+            m.map_err(|e| format!("reading a message: {e}"))?
+                .channel
+                .topic
+                .clone(),
+        );
+    }
+    Ok(topics)
+}
+
+/// Each needed message's log time, its topic and the values of the columns it feeds.
+type Sample = (u64, String, Vec<(usize, f64)>);
+
+/// The log as CSV text (so the one reader's checks apply): a row per message of the
+/// time's topic once every column has a value.
+fn rows(bytes: &[u8], used: &[(usize, Source)]) -> Result<String, String> {
+    let mut samples = samples(bytes, used)?;
+    samples.sort_by_key(|s| s.0);
+    let row_topic = &used[0].1.topic;
+    let mut latest: Vec<Option<f64>> = vec![None; used.len()];
     let mut csv = used
         .iter()
         .map(|(i, _)| COLUMNS[*i])
         .collect::<Vec<_>>()
         .join(",")
         + "\n";
-    let mut found = 0usize;
+    // Messages logged at the same instant are one sample: a row sees all of them.
+    for group in samples.chunk_by(|a, b| a.0 == b.0) {
+        for (_, _, values) in group {
+            for (k, v) in values {
+                latest[*k] = Some(*v);
+            }
+        }
+        if group.iter().any(|(_, t, _)| t == row_topic) && latest.iter().all(Option::is_some) {
+            let cells: Vec<String> = latest.iter().flatten().map(f64::to_string).collect();
+            csv.push_str(&cells.join(","));
+            csv.push('\n');
+        }
+    }
+    Ok(csv)
+}
+
+/// The needed messages decoded (JSON, or CDR by their channel's `ros2msg` schema).
+fn samples(bytes: &[u8], used: &[(usize, Source)]) -> Result<Vec<Sample>, String> {
+    let mut schemas: HashMap<u16, Schema> = HashMap::new();
+    let mut out = Vec::new();
+    let stream = mcap::MessageStream::new(bytes).map_err(|e| format!("not an MCAP file: {e}"))?;
     for m in stream {
-        let m = m.map_err(|e| bad(format!("reading a message: {e}")))?;
-        if m.channel.topic != topic {
+        let m = m.map_err(|e| format!("reading a message: {e}"))?;
+        let topic = &m.channel.topic;
+        if !used.iter().any(|(_, s)| &s.topic == topic) {
             continue;
         }
-        if m.channel.message_encoding != "json" {
-            return Err(bad(format!(
-                "topic {topic} is {:?}-encoded; identify reads JSON messages",
-                m.channel.message_encoding
-            )));
-        }
-        let v: serde_json::Value = serde_json::from_slice(&m.data)
-            .map_err(|e| bad(format!("a message on {topic} is not JSON: {e}")))?;
-        let cells: Vec<String> = used
+        let v = match m.channel.message_encoding.as_str() {
+            "json" => serde_json::from_slice(&m.data)
+                .map_err(|e| format!("a message on {topic} is not JSON: {e}"))?,
+            "cdr" => {
+                let schema = match schemas.entry(m.channel.id) {
+                    std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                    std::collections::hash_map::Entry::Vacant(e) => e.insert(schema_of(&m)?),
+                };
+                schema
+                    .decode(&m.data)
+                    .map_err(|e| format!("a message on {topic}: {e}"))?
+            }
+            other => {
+                return Err(format!(
+                    "topic {topic} is {other:?}-encoded; identify reads JSON and CDR"
+                ));
+            }
+        };
+        let values = used
             .iter()
-            .map(|(_, name)| {
-                v.get(name.as_str())
-                    .and_then(serde_json::Value::as_f64)
-                    .map_or("NaN".to_owned(), |x| x.to_string())
+            .enumerate()
+            .filter(|(_, (_, s))| &s.topic == topic)
+            .map(|(k, (_, s))| {
+                let x = if s.path == LOG_TIME {
+                    Some(m.log_time as f64 * 1e-9)
+                } else {
+                    number_at(&v, &s.path)
+                };
+                x.map(|x| (k, x))
+                    .ok_or_else(|| format!("topic {topic} has no number at {:?}", s.path))
             })
-            .collect();
-        csv.push_str(&cells.join(","));
-        csv.push('\n');
-        found += 1;
+            .collect::<Result<Vec<_>, String>>()?;
+        out.push((m.log_time, topic.clone(), values));
     }
-    if found == 0 {
-        return Err(bad(format!("no messages on topic {topic}")));
+    Ok(out)
+}
+
+/// The `ros2msg` schema of a CDR message's channel.
+fn schema_of(m: &mcap::Message<'_>) -> Result<Schema, String> {
+    let topic = &m.channel.topic;
+    let s = m
+        .channel
+        .schema
+        .as_ref()
+        .filter(|s| s.encoding == "ros2msg")
+        .ok_or_else(|| format!("topic {topic} is CDR without a ros2msg schema"))?;
+    let text =
+        std::str::from_utf8(&s.data).map_err(|_| format!("topic {topic}: schema not UTF-8"))?;
+    Schema::parse(&s.name, text).map_err(|e| format!("topic {topic}: schema {}: {e}", s.name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_reach_numbers_times_and_other_topics() {
+        let v = serde_json::json!({"h": {"stamp": {"sec": 2, "nanosec": 500_000_000}}, "a": [1.0, 2.5]});
+        assert_eq!(number_at(&v, "h.stamp"), Some(2.5));
+        assert_eq!(number_at(&v, "a.1"), Some(2.5));
+        assert_eq!(number_at(&v, "a.7"), None);
+        assert_eq!(source("/m:drive.speed", "/c").topic, "/m");
+        assert_eq!(source("drive.speed", "/c").topic, "/c");
     }
-    parse_csv(&csv, &format!("{file} (topic {topic})"))
 }

@@ -1,5 +1,6 @@
 //! Recording sinks for forkbench trials: MCAP (Foxglove schemas, JSON) and rerun (.rrd or a live viewer).
 
+pub mod actuator_csv;
 pub mod bag;
 pub mod detect;
 pub mod mcap_sink;
@@ -13,6 +14,7 @@ use std::path::Path;
 
 use forkbench_core::{PalletSpec, Pose2};
 
+pub use actuator_csv::ActuatorCsv;
 pub use mcap_sink::McapRecorder;
 #[cfg(feature = "rerun")]
 pub use rerun_sink::{RerunRecorder, RerunTarget};

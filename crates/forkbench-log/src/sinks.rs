@@ -1,4 +1,4 @@
-//! The recording sinks a run asks for (an .rrd, an MCAP, a ROS 2 bag, a viewer), opened together and fed one trial.
+//! The recording sinks a run asks for (an .rrd, an MCAP, a ROS 2 bag, a viewer, an actuator log), opened together and fed one trial.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -7,7 +7,7 @@ use forkbench_trial::{
     Case, Recorder, Resolved, Scenario, Tee, TrialError, TrialOptions, TrialOutcome,
 };
 
-use crate::{LogError, McapRecorder, Ros2Recorder, check_writable};
+use crate::{ActuatorCsv, LogError, McapRecorder, Ros2Recorder, check_writable};
 #[cfg(feature = "rerun")]
 use crate::{RerunRecorder, RerunTarget};
 
@@ -18,6 +18,8 @@ pub struct RecordTargets {
     pub mcap: Option<PathBuf>,
     /// A ROS 2 bag (MCAP, `ros2` profile).
     pub ros2: Option<PathBuf>,
+    /// The actuator log as CSV (what `forkbench identify` reads).
+    pub actuator_csv: Option<PathBuf>,
     /// Spawn a rerun viewer.
     pub rerun: bool,
     /// A running rerun viewer at HOST:PORT.
@@ -40,6 +42,7 @@ pub enum RecordError {
 pub struct Sinks {
     pub mcap: Option<McapRecorder>,
     pub ros2: Option<Ros2Recorder>,
+    pub actuator_csv: Option<ActuatorCsv>,
     #[cfg(feature = "rerun")]
     pub rerun: Vec<RerunRecorder>,
     pub viewer_error: Option<LogError>,
@@ -58,7 +61,13 @@ impl std::fmt::Debug for Sinks {
 impl Sinks {
     /// Checks file targets before anything runs, then opens every sink.
     pub fn open(a: &RecordTargets, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
-        let files: Vec<&PathBuf> = a.rrd.iter().chain(&a.mcap).chain(&a.ros2).collect();
+        let files: Vec<&PathBuf> = a
+            .rrd
+            .iter()
+            .chain(&a.mcap)
+            .chain(&a.ros2)
+            .chain(&a.actuator_csv)
+            .collect();
         for (i, p) in files.iter().enumerate() {
             if files[..i]
                 .iter()
@@ -66,8 +75,8 @@ impl Sinks {
             {
                 return Err(LogError::Io {
                     path: p.display().to_string(),
-                    message: "given to two of --rrd, --mcap and --ros2; each format needs its \
-                              own file"
+                    message: "given to two of --rrd, --mcap, --ros2 and --actuator-log; each \
+                              output needs its own file"
                         .into(),
                 });
             }
@@ -89,6 +98,7 @@ impl Sinks {
         Ok(Self {
             mcap,
             ros2,
+            actuator_csv: a.actuator_csv.as_deref().map(ActuatorCsv::create),
             #[cfg(feature = "rerun")]
             rerun,
             viewer_error,
@@ -108,6 +118,9 @@ impl Sinks {
             if let Some(m) = self.ros2.as_mut() {
                 refs.push(m);
             }
+            if let Some(m) = self.actuator_csv.as_mut() {
+                refs.push(m);
+            }
             #[cfg(feature = "rerun")]
             for r in self.rerun.iter_mut() {
                 refs.push(r);
@@ -116,6 +129,12 @@ impl Sinks {
         };
         let mut result = self.mcap.as_mut().map_or(Ok(()), McapRecorder::finish);
         if let Some(m) = self.ros2.as_mut()
+            && let Err(e) = m.finish()
+            && result.is_ok()
+        {
+            result = Err(e);
+        }
+        if let Some(m) = self.actuator_csv.as_mut()
             && let Err(e) = m.finish()
             && result.is_ok()
         {

@@ -121,7 +121,8 @@ pub struct Nav350Config {
     pub position_sigma_m: f64,
     /// Heading σ (the datasheet's ±0.15° read as 2σ).
     pub heading_sigma_rad: f64,
-    /// Time from measurement (the sweep's end) to delivery; the datasheet gives none.
+    /// Time from measurement (the sweep's end) to delivery. The datasheet gives none; the
+    /// default is a choice: the pose computed from the finished sweep, then sent over Ethernet.
     pub latency_s: f64,
 }
 
@@ -131,7 +132,7 @@ impl Default for Nav350Config {
             rate_hz: 8.0,
             position_sigma_m: 0.002,
             heading_sigma_rad: 0.075_f64.to_radians(),
-            latency_s: 0.0,
+            latency_s: 0.05,
         }
     }
 }

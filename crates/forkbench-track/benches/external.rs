@@ -71,6 +71,7 @@ fn bench(c: &mut Criterion) {
                     pose: Pose2::new(1.0, 0.02, 0.01),
                     speed_mps: 0.8,
                     steer_rad: 0.0,
+                    fix_measured_s: None,
                     truck: &truck,
                 };
                 tracker.command(&input)

@@ -142,6 +142,7 @@ mod tests {
             pose: Pose2::new(1.0, 2.0, 0.3),
             speed_mps: 0.5,
             steer_rad: 0.1,
+            fix_measured_s: None,
             truck: &truck,
         };
         assert_eq!(c.predict(&input), (input.pose, 0.5, 0.1));
@@ -159,6 +160,7 @@ mod tests {
             pose: Pose2::new(0.0, 0.0, 0.0),
             speed_mps: 0.8,
             steer_rad: 0.0,
+            fix_measured_s: None,
             truck: &truck,
         };
         let (p, v, _) = c.predict(&input);

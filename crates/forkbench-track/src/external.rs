@@ -50,6 +50,8 @@ enum RequestMsg<'a> {
         id: u64,
         t_s: f64,
         pose: Pose2,
+        /// When the newest localisation fix in `pose` was measured (null before one).
+        fix_measured_s: Option<f64>,
         speed_mps: f64,
         steer_rad: f64,
     },
@@ -219,6 +221,7 @@ impl Tracker for ExternalTracker {
             id,
             t_s: input.t_s,
             pose: input.pose,
+            fix_measured_s: input.fix_measured_s,
             speed_mps: input.speed_mps,
             steer_rad: input.steer_rad,
         };

@@ -237,7 +237,13 @@ impl PurePursuit {
         if g.remaining_m < self.cfg.approach_distance_m {
             speed = speed.min(self.cfg.approach_speed_mps);
         }
-        g.command(stop_profile(speed, self.cfg.decel_mps2, g.remaining_m))
+        let drive = DriveAnswer::of(truck, speed_mps);
+        g.command(stop_profile(
+            speed,
+            self.cfg.decel_mps2,
+            g.remaining_m,
+            drive,
+        ))
     }
 
     /// Where the path is, relative to the truck: closest sample, look-ahead point, the
@@ -373,9 +379,52 @@ impl Geometry {
     }
 }
 
-/// Stop at the goal: v ≤ √(2 a d), with a small floor so the last millimetres close.
-pub(crate) fn stop_profile(speed_mps: f64, decel_mps2: f64, remaining_m: f64) -> f64 {
-    speed_mps.min((2.0 * decel_mps2 * remaining_m.max(0.0)).sqrt().max(0.02))
+/// How the truck's drive answers a speed command, as a stop needs it: how far it runs on
+/// after a zero command at its present speed (its dead time and bus, then its declared
+/// speed loop's lag), and the slowest command that moves it (its creep threshold). A
+/// truck that declares no speed loop is taken to answer at once, as the first truck did.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct DriveAnswer {
+    run_on_m: f64,
+    creep_mps: f64,
+}
+
+impl DriveAnswer {
+    pub(crate) fn of(truck: &ForkliftSpec, speed_mps: f64) -> Self {
+        let lag_s = truck.drive.time_constant_s.unwrap_or(0.0);
+        Self {
+            run_on_m: speed_mps.abs() * (truck.drive_delay_s() + lag_s),
+            creep_mps: truck.drive.creep_speed_mps,
+        }
+    }
+}
+
+/// Stop at the goal: v ≤ √(2 a d), with a small floor (at least the drive's creep speed)
+/// so the last millimetres close; `d` is the distance left less how far the truck runs
+/// on, so its command falls to the floor where it will come to rest on the goal.
+pub(crate) fn stop_profile(
+    speed_mps: f64,
+    decel_mps2: f64,
+    remaining_m: f64,
+    drive: DriveAnswer,
+) -> f64 {
+    let d = remaining_m - drive.run_on_m;
+    speed_mps.min(
+        (2.0 * decel_mps2 * d.max(0.0))
+            .sqrt()
+            .max(0.02)
+            .max(drive.creep_mps),
+    )
+}
+
+/// A moving command at least the drive's creep speed, so it moves the truck.
+pub(crate) fn above_creep(speed_mps: f64, truck: &ForkliftSpec) -> f64 {
+    let creep = truck.drive.creep_speed_mps;
+    if speed_mps != 0.0 && speed_mps.abs() < creep {
+        creep.copysign(speed_mps)
+    } else {
+        speed_mps
+    }
 }
 
 /// The command without a path: stand still, done.

@@ -4,7 +4,7 @@ use forkbench_core::settings::{self, Settings, SettingsError};
 use forkbench_core::{ForkliftSpec, Path};
 use serde::{Deserialize, Serialize};
 
-use crate::pursuit::stop_profile;
+use crate::pursuit::{DriveAnswer, stop_profile};
 use crate::{Command, PurePursuit, Tracker, TrackerConfig, TrackerInput};
 
 /// Settings of the regulated tracker (SI units).
@@ -93,7 +93,12 @@ impl RegulatedPurePursuit {
     }
 
     /// The regulated speed for the pursuit arc's curvature and the distance left.
-    fn speed(&self, arc_curvature_per_m: f64, remaining_m: f64, truck: &ForkliftSpec) -> f64 {
+    fn speed(
+        &self,
+        arc_curvature_per_m: f64,
+        remaining_m: f64,
+        (truck, measured_mps): (&ForkliftSpec, f64),
+    ) -> f64 {
         let c = &self.cfg;
         let mut v = c.cruise_speed_mps.min(truck.max_speed_mps);
         let radius = 1.0 / arc_curvature_per_m.abs().max(1e-9);
@@ -104,7 +109,8 @@ impl RegulatedPurePursuit {
             let scaled = v * remaining_m.max(0.0) / c.approach_distance_m;
             v = scaled.max(c.min_approach_speed_mps.min(v));
         }
-        stop_profile(v, c.decel_mps2, remaining_m)
+        let drive = DriveAnswer::of(truck, measured_mps);
+        stop_profile(v, c.decel_mps2, remaining_m, drive)
     }
 }
 
@@ -124,7 +130,8 @@ impl Tracker for RegulatedPurePursuit {
         let Some(g) = self.pursuit.geometry(&input.pose, ld, input.truck) else {
             return crate::pursuit::stopped(&input.pose);
         };
-        g.command(self.speed(g.arc_curvature_per_m, g.remaining_m, input.truck))
+        let at = (input.truck, input.speed_mps);
+        g.command(self.speed(g.arc_curvature_per_m, g.remaining_m, at))
     }
 }
 
@@ -141,9 +148,9 @@ mod tests {
     fn slows_on_tight_arcs_and_on_the_approach() {
         let truck = ForkliftSpec::default();
         let rpp = RegulatedPurePursuit::new(RegulatedConfig::default());
-        let open = rpp.speed(0.0, 10.0, &truck);
-        let tight = rpp.speed(1.0, 10.0, &truck);
-        let approach = rpp.speed(0.0, 1.0, &truck);
+        let open = rpp.speed(0.0, 10.0, (&truck, 0.0));
+        let tight = rpp.speed(1.0, 10.0, (&truck, 0.0));
+        let approach = rpp.speed(0.0, 1.0, (&truck, 0.0));
         assert!((open - 0.8).abs() < 1e-12, "{open}");
         assert!((0.25..0.5).contains(&tight), "{tight}");
         assert!(approach < open && approach >= 0.15, "{approach}");
@@ -165,6 +172,7 @@ mod tests {
             pose: Pose2::new(x, y, 0.0),
             speed_mps: v,
             steer_rad: 0.0,
+            fix_measured_s: None,
             truck: &truck,
         };
         assert!(

@@ -2,6 +2,7 @@
 
 use forkbench_core::{ForkliftSpec, Path};
 
+use crate::pursuit::above_creep;
 use crate::{Command, PurePursuit, Tracker, TrackerConfig, TrackerInput};
 
 /// Steering within this of the segment's first curvature counts as set.
@@ -88,7 +89,7 @@ impl SegmentFollower {
             let scale = (1.0 - lag / STEER_LAG_STOP_RAD).clamp(MIN_SPEED_SHARE, 1.0);
             return Command {
                 done: false,
-                speed_mps: cmd.speed_mps * scale,
+                speed_mps: above_creep(cmd.speed_mps * scale, input.truck),
                 ..cmd
             };
         }

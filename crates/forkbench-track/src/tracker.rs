@@ -15,6 +15,9 @@ pub struct TrackerInput<'a> {
     pub speed_mps: f64,
     /// Measured equivalent steering angle.
     pub steer_rad: f64,
+    /// When the newest localisation fix in `pose` was measured: `pose` is that fix
+    /// carried forward to `t_s` over the odometry. None before any fix.
+    pub fix_measured_s: Option<f64>,
     pub truck: &'a ForkliftSpec,
 }
 

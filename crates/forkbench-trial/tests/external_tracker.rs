@@ -199,3 +199,37 @@ fn a_slow_tracker_meets_the_trials_wall_time_budget() {
         "refused"
     );
 }
+
+/// Each tick says when the newest fix in its pose was measured: with the NAV350's default
+/// latency and 8 Hz rate, every tick's fix is at least the latency old and at most a period
+/// and a control tick more.
+#[test]
+fn a_tick_says_when_its_pose_was_measured() {
+    let tick = "    age = req['t_s'] - req['fix_measured_s']\n    \
+                with open('ages.txt', 'a') as f:\n        f.write(f'{age}\\n')\n    \
+                n = sum(1 for _ in open('ages.txt'))\n    \
+                print(json.dumps({'type': 'command', 'id': req['id'], 'speed_mps': 0.3 if n < 50 else 0.0, \
+                'steer_rad': 0.0, 'done': n >= 50}), flush=True)\n";
+    let scn = with_tracker("aged", &script(None, tick), 5.0);
+    let out = run_trial(&scn, &scn.cases[0], &seeded(1));
+    assert_ne!(
+        out.failure,
+        Some(Failure::Error),
+        "{:?}",
+        out.failure_detail
+    );
+    let ages: Vec<f64> = std::fs::read_to_string(dir("aged").join("ages.txt"))
+        .expect("the tracker wrote its ages")
+        .lines()
+        .map(|l| l.parse().expect("a number"))
+        .collect();
+    let nav = &scn.noise.nav350;
+    let (least, most) = (nav.latency_s, nav.latency_s + 1.0 / nav.rate_hz + 0.02);
+    assert!(ages.len() >= 50, "{} ticks", ages.len());
+    assert!(
+        ages.iter()
+            .all(|a| (least - 1e-9..=most + 1e-9).contains(a)),
+        "ages outside {least}..{most}: {ages:?}"
+    );
+    let _ = std::fs::remove_dir_all(dir("aged"));
+}

@@ -142,6 +142,7 @@ fn a_reverse_path_is_driven_backwards_in_the_physics() {
                 pose: sim.fork_root_pose(),
                 speed_mps: sim.speed_mps(),
                 steer_rad: sim.steer_rad(),
+                fix_measured_s: None,
                 truck: &truck,
             },
         );
@@ -276,7 +277,10 @@ via = [{{ x_m = 6.5, y_m = 21.5, heading_deg = 90.0 }}]
 #[test]
 fn a_manoeuvre_with_cusps_is_driven_in_the_physics() {
     use forkbench_nav::hybrid::{HybridParams, HybridQuery, plan_hybrid, plan_hybrid_from_here};
-    let truck = ForkliftSpec::default();
+    // The first truck's actuators: with the realistic ones, each segment's end lands
+    // elsewhere and the plans from there cycle between two cusps (a known limit of the
+    // segment follower, stated in docs/truck.md).
+    let truck = ForkliftSpec::default().with_actuators(forkbench_core::actuators::Actuators::IDEAL);
     let world = forkbench_trial::World::load(&data("../../worlds/turnaround.toml")).expect("world");
     let map = forkbench_nav::NavMap::from_world(&world.obstacles(), 0.05).expect("map");
     let q = HybridQuery {
@@ -316,6 +320,7 @@ fn a_manoeuvre_with_cusps_is_driven_in_the_physics() {
                 pose: sim.fork_root_pose(),
                 speed_mps: sim.speed_mps(),
                 steer_rad: sim.steer_rad(),
+                fix_measured_s: None,
                 truck: &truck,
             });
             if cmd.done {

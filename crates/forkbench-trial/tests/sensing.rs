@@ -183,3 +183,80 @@ fn a_scanners_frame_rate_bounds_its_looks() {
     );
     assert_eq!(slow.estimates_missed, slow.estimates - 1, "{slow:?}");
 }
+
+/// What a trial's plans and replans were: (time, replan number) of each plan, and the
+/// range of each "replan at R m" event.
+#[derive(Default)]
+struct Plans {
+    at: Vec<(f64, u32)>,
+    replan_ranges_m: Vec<f64>,
+}
+
+impl forkbench_trial::Recorder for Plans {
+    fn plan(&mut self, t: f64, i: u32, _: &forkbench_core::Path, _: Option<&[[f64; 2]]>) {
+        self.at.push((t, i));
+    }
+    fn event(&mut self, _: f64, _: forkbench_trial::Level, text: &str) {
+        if let Some(r) = text
+            .strip_prefix("replan at ")
+            .and_then(|r| r.split(' ').next())
+        {
+            self.replan_ranges_m.push(r.parse().expect("a range"));
+        }
+    }
+}
+
+fn plans(scn: &Scenario, seed: u64) -> Plans {
+    let mut rec = Plans::default();
+    let opts = TrialOptions {
+        seed: Some(seed),
+        ..TrialOptions::default()
+    };
+    forkbench_trial::run_trial_recorded(scn, &scn.cases[0], &opts, &mut rec);
+    rec
+}
+
+/// A detector's estimate reaches the controller its latency after the scan: the first
+/// plan waits for it, and a re-estimate's replan comes that much later, nearer the pallet.
+#[test]
+fn a_detectors_latency_delays_its_estimates() {
+    let with = |latency_s: f64| {
+        let extra = format!(
+            "[replan]\nenabled = true\nreestimate_at_m = [3.5]\n\
+             [sensors.pallet]\nkind = \"tim561\"\nlatency_s = {latency_s}\n"
+        );
+        scenario(&extra, NEAR).expect("loads")
+    };
+    let (prompt, late) = (plans(&with(0.0), 3), plans(&with(0.6), 3));
+    let first = |p: &Plans| p.at.first().expect("a first plan").0;
+    assert!(
+        first(&late) - first(&prompt) > 0.6 - 0.011,
+        "{:?} vs {:?}",
+        late.at,
+        prompt.at
+    );
+    // The re-estimate at 3.5 m replans once its estimate arrives: 0.6 s of driving later.
+    let (a, b) = (&prompt.replan_ranges_m, &late.replan_ranges_m);
+    assert!(!a.is_empty() && !b.is_empty(), "{a:?} {b:?}");
+    assert!(
+        b[0] < a[0] - 0.3,
+        "replanned at {} m, without latency {} m",
+        b[0],
+        a[0]
+    );
+    // Refused where it cannot act, or out of range, naming the field.
+    let e = scenario(
+        "[sensors.pallet]\nkind = \"gaussian\"\nlatency_s = 0.1\n",
+        NEAR,
+    )
+    .expect_err("gaussian")
+    .to_string();
+    assert!(e.contains("sensors.pallet.latency_s"), "{e}");
+    let e = scenario(
+        "[sensors.pallet]\nkind = \"tim561\"\nlatency_s = -1.0\n",
+        NEAR,
+    )
+    .expect_err("negative")
+    .to_string();
+    assert!(e.contains("sensors.pallet.latency_s"), "{e}");
+}

@@ -21,10 +21,17 @@ use msgs::{Marker, MsgType, Shape};
 /// The map frame every pose is given in.
 const MAP: &str = "map";
 
+/// The commanded and the measured steering and speed at every physics step, what
+/// `forkbench identify` reads from a bag.
+const ACTUATORS_COMMAND: &str = "/forkbench/actuators/command";
+const ACTUATORS_MEASURED: &str = "/forkbench/actuators/measured";
+
 /// The fixed topics and their types; a scanner's `/scan/<name>` is added when it first
 /// scans.
-const TOPICS: [(&str, &MsgType); 8] = [
+const TOPICS: [(&str, &MsgType); 10] = [
     ("/tf", &msgs::TF_MSG),
+    (ACTUATORS_COMMAND, &msgs::ACKERMANN_MSG),
+    (ACTUATORS_MEASURED, &msgs::ACKERMANN_MSG),
     ("/forkbench/scene", &msgs::MARKER_ARRAY_MSG),
     ("/forkbench/pose", &msgs::POSE_STAMPED_MSG),
     ("/forkbench/fix", &msgs::POSE_STAMPED_MSG),
@@ -248,6 +255,10 @@ impl Recorder for Ros2Recorder {
         self.write("/tf", &msgs::TF_MSG, s.t_s, &tf);
         let pose = msgs::pose_stamped(s.t_s, MAP, &s.estimate);
         self.write("/forkbench/pose", &msgs::POSE_STAMPED_MSG, s.t_s, &pose);
+        let asked = msgs::ackermann(s.t_s, "fork_root", s.steer_cmd_rad, s.speed_cmd_mps);
+        self.write(ACTUATORS_COMMAND, &msgs::ACKERMANN_MSG, s.t_s, &asked);
+        let got = msgs::ackermann(s.t_s, "fork_root", s.steer_rad, s.speed_mps);
+        self.write(ACTUATORS_MEASURED, &msgs::ACKERMANN_MSG, s.t_s, &got);
         if let Some(fix) = s.fix {
             let msg = msgs::pose_stamped(s.t_s, MAP, &fix);
             self.write("/forkbench/fix", &msgs::POSE_STAMPED_MSG, s.t_s, &msg);

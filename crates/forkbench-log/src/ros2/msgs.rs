@@ -166,6 +166,34 @@ pub const OCCUPANCY_GRID_MSG: MsgType = MsgType {
     ],
 };
 
+const ACKERMANN_DRIVE: &str = "float32 steering_angle\nfloat32 steering_angle_velocity\n\
+float32 speed\nfloat32 acceleration\nfloat32 jerk\n";
+const ACKERMANN_DRIVE_STAMPED: &str = "std_msgs/Header header\nAckermannDrive drive\n";
+
+pub const ACKERMANN_MSG: MsgType = MsgType {
+    name: "ackermann_msgs/msg/AckermannDriveStamped",
+    parts: &[
+        (
+            "ackermann_msgs/AckermannDriveStamped",
+            ACKERMANN_DRIVE_STAMPED,
+        ),
+        ("std_msgs/Header", HEADER),
+        ("builtin_interfaces/Time", TIME),
+        ("ackermann_msgs/AckermannDrive", ACKERMANN_DRIVE),
+    ],
+};
+
+/// A steering angle and speed (commanded or measured) at `t_s`, the rest of the drive
+/// message left 0.
+pub fn ackermann(t_s: f64, frame: &str, steer_rad: f64, speed_mps: f64) -> Vec<u8> {
+    let mut w = CdrWriter::new();
+    header(&mut w, t_s, frame);
+    for v in [steer_rad, 0.0, speed_mps, 0.0, 0.0] {
+        w.f32(v as f32);
+    }
+    w.into_bytes()
+}
+
 pub const FLOAT64_MSG: MsgType = MsgType {
     name: "std_msgs/msg/Float64",
     parts: &[("std_msgs/Float64", "float64 data\n")],

@@ -102,9 +102,9 @@ impl ScannerConfig {
             spot_at_cover_m: 0.007,
             max_incidence_rad: 80f64.to_radians(),
             echo_separation_m: 0.3,
-            // Every beam at once by default, as the bench scanned before; the TiM561's
-            // mirror turns once per frame with 270° of it carrying beams: 0.75 / 15 s.
-            sweep_s: 0.0,
+            // The TiM561's mirror turns once per frame with 270° of it carrying beams:
+            // 0.75 / 15 s.
+            sweep_s: 0.05,
         }
     }
 

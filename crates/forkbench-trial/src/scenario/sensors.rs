@@ -33,7 +33,18 @@ struct PalletSensorFile {
     #[serde(default)]
     scanners: BTreeMap<String, toml::Table>,
     detector: Option<toml::Table>,
+    /// From a scan's end to its estimate reaching the controller (the scan's transfer and
+    /// the detector's computation).
+    latency_s: Option<f64>,
 }
+
+/// A detector's estimate reaches the controller this long after its scan ended. No
+/// datasheet gives it: a choice, the scan's transfer after the sweep and a detector's
+/// computation.
+pub const DEFAULT_DETECTOR_LATENCY_S: f64 = 0.03;
+
+/// Most a detector may take.
+const MAX_DETECTOR_LATENCY_S: f64 = 2.0;
 
 /// One scanner on the truck: its model's name and settings.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -54,12 +65,22 @@ pub enum PalletSensing {
     Scanner {
         sensors: Vec<NamedScanner>,
         detector: ComponentSpec,
+        /// From a scan's end to its estimate reaching the controller.
+        latency_s: f64,
     },
 }
 
 impl PalletSensing {
     pub fn is_gaussian(&self) -> bool {
         matches!(self, PalletSensing::Gaussian)
+    }
+
+    /// From a scan's end to its estimate reaching the controller (0 for the Gaussian).
+    pub fn latency_s(&self) -> f64 {
+        match self {
+            PalletSensing::Scanner { latency_s, .. } => *latency_s,
+            PalletSensing::Gaussian => 0.0,
+        }
     }
 
     /// The settings of this sensing's scanner of model `name`, if it has one.
@@ -97,6 +118,7 @@ pub(super) fn resolve(
     let Some(p) = f.and_then(|s| s.pallet.as_ref()) else {
         return Ok(PalletSensing::Gaussian);
     };
+    let latency_s = latency_of(p, file)?;
     if p.kind == "gaussian" {
         return Ok(PalletSensing::Gaussian);
     }
@@ -160,7 +182,33 @@ pub(super) fn resolve(
     let table = toml::Value::Table(p.detector.clone().unwrap_or_default());
     let detector = ComponentSpec::from_value(Role::Detector, &table, Some("pockets"), ".".into())
         .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))?;
-    Ok(PalletSensing::Scanner { sensors, detector })
+    Ok(PalletSensing::Scanner {
+        sensors,
+        detector,
+        latency_s,
+    })
+}
+
+/// `[sensors.pallet] latency_s`, in range; refused for the Gaussian estimate.
+fn latency_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
+    let field = "sensors.pallet.latency_s";
+    if p.kind == "gaussian" && p.latency_s.is_some() {
+        return Err(invalid(
+            file,
+            field,
+            "the gaussian estimate has no scan or detector to be late; its σ stands for the \
+             whole pipeline",
+        ));
+    }
+    let latency_s = p.latency_s.unwrap_or(DEFAULT_DETECTOR_LATENCY_S);
+    if !(latency_s.is_finite() && (0.0..=MAX_DETECTOR_LATENCY_S).contains(&latency_s)) {
+        return Err(invalid(
+            file,
+            field,
+            &format!("{latency_s} s must lie in 0–{MAX_DETECTOR_LATENCY_S} s"),
+        ));
+    }
+    Ok(latency_s)
 }
 
 /// The sensing a kind names with every setting at its default (`--pallet-sensing`).
@@ -176,6 +224,7 @@ pub(crate) fn of_kind(
             scanner: None,
             scanners: BTreeMap::new(),
             detector: None,
+            latency_s: None,
         }),
     };
     resolve(Some(&f), truck, file)

@@ -31,6 +31,12 @@ impl<'a> Steering<'a, StageError> for PickDrive {
         pose: Pose2,
         rec: &mut R,
     ) -> Result<(), StageError> {
+        if let Some((due_s, est)) = t.sense.in_flight
+            && t.world.sim.time_s() + 1e-9 >= due_s
+        {
+            t.sense.in_flight = None;
+            t.take_estimate(&pose, est, rec);
+        }
         if t.sense.on_prior {
             if t.frame_due() {
                 let missed = t.verdict.out.estimates_missed;
@@ -141,6 +147,7 @@ impl<'a> Trial<'a> {
             pose,
             speed_mps: self.world.sim.speed_mps(),
             steer_rad: self.world.sim.steer_rad(),
+            fix_measured_s: self.loc.last_fix_measured_s,
             truck: &self.run.truck,
         }
     }
@@ -311,11 +318,26 @@ impl<'a> Trial<'a> {
             );
             return Ok(());
         };
+        let latency_s = self.run.pallet_sensing.latency_s();
+        if latency_s > 0.0 {
+            // The detector's answer reaches the controller later: a newer one replaces it.
+            self.sense.in_flight = Some((self.world.sim.time_s() + latency_s, new_est));
+        } else {
+            self.take_estimate(pose, new_est, rec);
+        }
+        Ok(())
+    }
+
+    /// A new pallet estimate reaching the controller with the truck at `pose`: a replan
+    /// when it moved past the thresholds.
+    fn take_estimate<R: Recorder + ?Sized>(&mut self, pose: &Pose2, new_est: Pose2, rec: &mut R) {
+        let range = pose.distance_to(&self.sense.pallet_est);
+        let truth = self.world.sim.pallet_pose();
         let moved = new_est.distance_to(&self.sense.pallet_est);
         let turned = wrap_angle(new_est.heading_rad - self.sense.pallet_est.heading_rad).abs();
         let limits = &self.scn.replan;
         if moved <= limits.position_threshold_m && turned <= limits.heading_threshold_rad {
-            return Ok(());
+            return;
         }
         let t = self.world.sim.time_s();
         let replan = self.replanned(pose, &new_est);
@@ -344,7 +366,6 @@ impl<'a> Trial<'a> {
                 self.verdict.out.replans_failed += 1;
             }
         }
-        Ok(())
     }
 }
 

@@ -64,7 +64,9 @@ impl<'a> Trial<'a> {
         let deadline_s = self.world.sim.time_s() + limit_s;
         let every = self.control_steps_per_tick();
         let mut last = None;
-        // The tick's command and control, held until the next tick.
+        // The tick's command (before the safety gate) and control, held until the next
+        // tick; the safety function acts on the drive at every step, as a safety
+        // controller does beside the truck's computer.
         let mut held: Option<(Command, Control, u32)> = None;
         let ended = loop {
             if self.world.sim.time_s() >= deadline_s {
@@ -74,7 +76,8 @@ impl<'a> Trial<'a> {
                 && *since < every
             {
                 *since += 1;
-                let (cmd, control) = (*cmd, *control);
+                let (mut cmd, control) = (*cmd, *control);
+                cmd.speed_mps = self.safety_gate(cmd.speed_mps, rec);
                 self.physics_step(&cmd, None, pose, rec);
                 match steering.stepped(self, control, &cmd, rec) {
                     Ok(false) => continue,
@@ -91,17 +94,15 @@ impl<'a> Trial<'a> {
             }
             last = Some((fix, pose));
             let control = self.caller_turn(deadline_s, fix, pose).await;
-            let cmd = match steering.command(self, control, pose) {
-                Ok(Some(cmd)) => {
-                    let mut cmd = applied(control, cmd, &self.scn.truck);
-                    cmd.speed_mps = self.safety_gate(cmd.speed_mps, rec);
-                    cmd
-                }
+            let asked = match steering.command(self, control, pose) {
+                Ok(Some(cmd)) => applied(control, cmd, &self.scn.truck),
                 Ok(None) => break Ok(true),
                 Err(e) => break Err(e),
             };
+            let mut cmd = asked;
+            cmd.speed_mps = self.safety_gate(asked.speed_mps, rec);
             self.physics_step(&cmd, fix, pose, rec);
-            held = Some((cmd, control, 1));
+            held = Some((asked, control, 1));
             match steering.stepped(self, control, &cmd, rec) {
                 Ok(false) => {}
                 Ok(true) => break Ok(true),

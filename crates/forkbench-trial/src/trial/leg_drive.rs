@@ -1,7 +1,7 @@
 //! A mission leg's drive: a follower's commands through the one drive loop until it stops at the path's end; a touch of a rack or wall ends the leg.
 
 use forkbench_core::{Path, Pose2};
-use forkbench_track::{Command, PurePursuit, Tracker, TrackerInput};
+use forkbench_track::{Command, DelayCompensated, PurePursuit, Tracker, TrackerInput};
 
 use super::engine::Steering;
 use super::error::LegError;
@@ -12,8 +12,9 @@ use crate::recorder::Recorder;
 use crate::scenario::mission::MissionSpec;
 
 impl Trial<'_> {
-    /// Follows `path` (forward or reverse) with the mission's pure pursuit until it stops at
-    /// the end; a touch of a rack or wall ends the leg.
+    /// Follows `path` (forward or reverse) with the mission's pure pursuit, steering from
+    /// where the truck will be once its command acts (a no-op for a truck without
+    /// delays), until it stops at the end; a touch of a rack or wall ends the leg.
     pub(super) async fn drive_path<R: Recorder + ?Sized>(
         &mut self,
         path: &Path,
@@ -21,7 +22,8 @@ impl Trial<'_> {
         stats: &mut DriveStats,
         rec: &mut R,
     ) -> Result<(), LegError> {
-        let mut tracker = PurePursuit::with_config(m.tracker.clone());
+        let pursuit = Box::new(PurePursuit::with_config(m.tracker.clone()));
+        let mut tracker = DelayCompensated::new(pursuit, "pure_pursuit_compensated");
         tracker.reset(path, &self.scn.truck);
         self.drive_with(|input| Tracker::command(&mut tracker, input), m, stats, rec)
             .await

@@ -39,6 +39,7 @@ impl Trial<'_> {
             if let Some(fix) = r.pose {
                 // Carried from when it was measured: a late fix is not the pose now.
                 self.loc.predictor.fix_measured_ago(fix, t_s - r.measured_s);
+                self.loc.last_fix_measured_s = Some(r.measured_s);
             }
         }
         let pose = self.loc.predictor.pose().unwrap_or(self.loc.first_fix);

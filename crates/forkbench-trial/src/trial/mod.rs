@@ -59,7 +59,9 @@ pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
 pub use session::{Session, SessionEnd};
 pub use session_view::SceneView;
-pub use truck_knobs::{TRUCK_KNOBS, apply_truck, truck_file_settings, truck_path};
+pub use truck_knobs::{
+    TRUCK_KNOBS, apply_truck, sensor_timing_for, truck_file_settings, truck_path,
+};
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
 /// (negative: before it).
@@ -228,6 +230,8 @@ async fn prepare<'a, R: Recorder + ?Sized>(
     };
     trial.tracker.reset(&path, &scn.truck);
     trial.set_path(path);
-    trial.verdict.pick_started = (trial.world.sim.time_s(), trial.world.travelled_m);
+    // The pick began when the truck stood waiting for its first fix and estimate.
+    let began = trial.world.sim.time_s() - trial.verdict.pick_waited_s;
+    trial.verdict.pick_started = (began, trial.world.travelled_m);
     Ok(trial)
 }

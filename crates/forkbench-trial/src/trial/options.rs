@@ -185,6 +185,8 @@ pub struct Resolved {
     pub pallet_sensing: PalletSensing,
     /// The localiser, with any missing reflectors.
     pub localizer: ComponentSpec,
+    /// The NAV350's settings, its timing as the run's truck preset has it.
+    pub nav350: forkbench_sensors::Nav350Config,
     /// The localiser's noise scale (1 unless overridden).
     pub localization_noise_scale: f64,
     /// The odometry's errors, scaled.
@@ -213,13 +215,15 @@ impl Scenario {
             ));
         }
         let mut pallet_estimate = self.noise.pallet_estimate.clone();
-        let pallet_sensing = match o.pallet_noise_scale {
+        let mut pallet_sensing = match o.pallet_noise_scale {
             Some(s) => {
                 pallet_estimate.scale = s;
                 self.scaled_sensing(sensing, s)?
             }
             None => sensing,
         };
+        let mut nav350 = self.noise.nav350.clone();
+        super::sensor_timing_for(o.truck_preset.as_deref(), &mut nav350, &mut pallet_sensing);
         let localization_noise_scale = match o.localization_noise_scale {
             Some(s) => {
                 self.check_localizer_scale(&localizer)?;
@@ -236,6 +240,7 @@ impl Scenario {
             pallet_estimate,
             pallet_sensing,
             localizer,
+            nav350,
             localization_noise_scale,
             odometry: self.scaled_odometry(o.odometry_noise_scale)?,
             wall_budget_s: opts.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
@@ -339,6 +344,7 @@ impl Scenario {
             PalletSensing::Scanner {
                 mut sensors,
                 detector,
+                latency_s,
             } => {
                 if sensors.iter().all(|n| !n.scanner.has_noise()) {
                     return Err(invalid(
@@ -354,7 +360,11 @@ impl Scenario {
                 for n in &mut sensors {
                     n.scanner = n.scanner.scaled_errors(s);
                 }
-                Ok(PalletSensing::Scanner { sensors, detector })
+                Ok(PalletSensing::Scanner {
+                    sensors,
+                    detector,
+                    latency_s,
+                })
             }
         }
     }

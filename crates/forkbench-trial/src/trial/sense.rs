@@ -30,6 +30,7 @@ impl Trial<'_> {
         true_pallet: &Pose2,
         rec: &mut R,
     ) -> Result<(), StageError> {
+        let from = self.world.sim.time_s();
         let fix = self.wait_for_fix(rec)?;
         self.loc.first_fix = fix
             .or(self.loc.predictor.pose())
@@ -38,7 +39,20 @@ impl Trial<'_> {
         let range = self.loc.first_fix.distance_to(true_pallet);
         let believed = self.loc.first_fix;
         if let Some(est) = self.estimate(true_pallet, range, &believed, rec)? {
+            self.await_detector(rec)?;
             self.adopt_estimate(est, true_pallet);
+        }
+        self.verdict.pick_waited_s = self.world.sim.time_s() - from;
+        Ok(())
+    }
+
+    /// The truck stands while the detector's first estimate is on its way.
+    fn await_detector<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<(), StageError> {
+        let due_s = self.world.sim.time_s() + self.run.pallet_sensing.latency_s();
+        while self.world.sim.time_s() + 1e-9 < due_s {
+            let (_, pose) = self.sense(rec)?;
+            let steer = self.world.sim.steer_rad();
+            self.physics_step(&crate::phase::open_loop(0.0, steer, &pose), None, pose, rec);
         }
         Ok(())
     }

@@ -71,7 +71,7 @@ fn build_components(scn: &Scenario, run: &Resolved) -> Result<Built, SettingsErr
     let tracker = scn.registry.tracker(&run.tracker)?;
     let surfaces = scn.world.fixed_surfaces();
     let cx = LocalizerContext {
-        nav350: &scn.noise.nav350,
+        nav350: &run.nav350,
         noise: run.noise,
         noise_scale: run.localization_noise_scale,
         reflectors: &scn.world.reflector,
@@ -195,13 +195,7 @@ impl<'a> Trial<'a> {
             },
             loc: localisation(localizer, run, start),
             sense: perception(scn, run, detector, true_pallet),
-            verdict: Verdict {
-                out,
-                step_criteria: scn.registry.step_criteria(),
-                timed_out: true,
-                pick_started: (0.0, 0.0),
-                phase_measures: std::collections::BTreeMap::new(),
-            },
+            verdict: Verdict::new(out, scn.registry.step_criteria()),
             planner,
             tracker,
             path: forkbench_core::Path::default(),
@@ -237,6 +231,7 @@ fn localisation(localizer: Box<dyn Localizer>, run: &Resolved, start: Pose2) -> 
         stats: LocStats::new(0.0),
         leg_stats: LocStats::new(0.0),
         fix_lost: false,
+        last_fix_measured_s: None,
     }
 }
 
@@ -255,5 +250,6 @@ fn perception(
         detector,
         pallet_est,
         on_prior: false,
+        in_flight: None,
     }
 }

@@ -91,6 +91,8 @@ pub(crate) struct Localisation {
     pub(crate) leg_stats: LocStats,
     /// The last reading gave no pose (the log says so once, and again when one returns).
     pub(crate) fix_lost: bool,
+    /// When the newest fix taken was measured.
+    pub(crate) last_fix_measured_s: Option<f64>,
 }
 
 /// Where the truck believes the pallet is: the sensing and the estimate.
@@ -106,6 +108,8 @@ pub(crate) struct Perception {
     /// The plan aims at the prior (`[pick] when_not_seen = "prior"`): every scanner frame
     /// is looked at until the face is found, then the truck replans once onto it.
     pub(crate) on_prior: bool,
+    /// An estimate on its way from the detector: when it reaches the controller, and it.
+    pub(crate) in_flight: Option<(f64, Pose2)>,
 }
 
 /// The outcome being built and what judges it.
@@ -117,8 +121,24 @@ pub(crate) struct Verdict {
     pub(crate) timed_out: bool,
     /// Simulated time and distance travelled when the pick's drive began.
     pub(crate) pick_started: (f64, f64),
+    /// How long the truck stood for the pick's first fix and estimate: part of the pick.
+    pub(crate) pick_waited_s: f64,
     /// What the running phase measured, by name (see `PhaseOutcome::measures`).
     pub(crate) phase_measures: BTreeMap<String, f64>,
+}
+
+impl Verdict {
+    /// A verdict not yet reached: the pick not started, its drive timed out until it ends.
+    pub(crate) fn new(out: TrialOutcome, step_criteria: Vec<Box<dyn StepCriterion>>) -> Self {
+        Self {
+            out,
+            step_criteria,
+            timed_out: true,
+            pick_started: (0.0, 0.0),
+            pick_waited_s: 0.0,
+            phase_measures: BTreeMap::new(),
+        }
+    }
 }
 
 /// A trial in progress: its scenario and run, the controllers and the plan they follow,

@@ -133,6 +133,30 @@ pub fn truck_file_settings(
     Ok((preset, settings))
 }
 
+/// The sensors' timing under `preset`: the `ideal` truck is the bench's first one as it
+/// was sensed too, a NAV350 delivering each fix at once, scans taken in an instant and
+/// their estimates used at once;
+/// any other preset leaves the sensors as configured.
+pub fn sensor_timing_for(
+    preset: Option<&str>,
+    nav350: &mut forkbench_sensors::Nav350Config,
+    sensing: &mut crate::scenario::sensors::PalletSensing,
+) {
+    if preset != Some("ideal") {
+        return;
+    }
+    nav350.latency_s = 0.0;
+    if let crate::scenario::sensors::PalletSensing::Scanner {
+        sensors, latency_s, ..
+    } = sensing
+    {
+        *latency_s = 0.0;
+        for n in sensors {
+            n.scanner.sweep_s = 0.0;
+        }
+    }
+}
+
 fn number(path: &str, v: &toml::Value) -> Result<f64, TrialError> {
     match v {
         toml::Value::Float(f) => Ok(*f),
