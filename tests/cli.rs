@@ -485,7 +485,7 @@ fn batch_writes_results_and_regress_gates_them() {
     let warned = forkbench(&["regress", "--baseline", base.to_str().expect("utf8"), td]);
     let err = String::from_utf8_lossy(&warned.stderr);
     assert!(
-        err.contains("warning: scenario settings differ from the baseline's batch: field-test: tolerances.lateral_m"),
+        err.contains("note: changed since the baseline's batch (still paired by seed): field-test: tolerances.lateral_m"),
         "{err}"
     );
     // A baseline claiming 100 of 100 against 4 of 4 is no drop; one claiming a row that

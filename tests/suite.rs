@@ -3,6 +3,7 @@
 mod cli;
 mod external_planner;
 mod external_tracker;
+mod gate_candidate;
 mod hostile_input;
 mod navigation;
 mod papercuts;

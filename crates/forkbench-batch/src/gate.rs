@@ -151,12 +151,11 @@ pub fn paired_trials_needed(drop: f64, alpha: f64, rows: usize) -> Option<u64> {
     trials_needed(MAX_TRIALS_SEARCHED, |n| paired_power(n, drop, drop, level))
 }
 
-/// Why the results cannot be paired with the baseline trial by trial, if they cannot.
-fn unpaired_reason(
-    base: &Baseline,
-    now: Option<&Manifest>,
-    differences: &[String],
-) -> Option<String> {
+/// Why the results cannot be paired with the baseline trial by trial, if they cannot: a
+/// trial's seed depends only on the batch seed, the seed scheme, the scenario, the case
+/// and the trial, so changed settings, components or noise scales still run the same
+/// trials (they are listed as what changed, not a reason to unpair).
+fn unpaired_reason(base: &Baseline, now: Option<&Manifest>) -> Option<String> {
     if base.trials.is_empty() {
         return Some(
             "the baseline has no per-trial results (made by an older forkbench or from counts \
@@ -181,19 +180,6 @@ fn unpaired_reason(
         why.push(format!(
             "trial seeds derived by scheme {} ≠ the baseline's {}",
             now.seed_scheme, then.seed_scheme
-        ));
-    }
-    if then.overrides() != now.overrides() {
-        why.push(format!(
-            "noise scales or sensing overrides {} ≠ the baseline's {}",
-            overrides_text(&now.overrides()),
-            overrides_text(&then.overrides())
-        ));
-    }
-    if !differences.is_empty() {
-        why.push(format!(
-            "scenario settings differ ({})",
-            differences.join("; ")
         ));
     }
     (!why.is_empty()).then(|| why.join("; "))
@@ -391,13 +377,21 @@ pub fn regress(
     manifest: Option<&Manifest>,
     o: &GateOptions,
 ) -> GateReport {
-    let differences = manifest.map_or_else(Vec::new, |m| base.setting_differences(m));
+    let mut differences = manifest.map_or_else(Vec::new, |m| base.setting_differences(m));
+    if let (Some(then), Some(now)) = (base.provenance.as_ref().map(|p| &p.manifest), manifest)
+        && then.overrides() != now.overrides()
+    {
+        differences.push(format!(
+            "the run's overrides: {} → {}",
+            overrides_text(&then.overrides()),
+            overrides_text(&now.overrides())
+        ));
+    }
     let index: HashMap<TrialKey, (u64, bool)> = records
         .iter()
         .map(|r| (r.key(), (r.outcome.seed, r.outcome.success)))
         .collect();
-    let reason =
-        unpaired_reason(base, manifest, &differences).or_else(|| seed_mismatch(base, &index));
+    let reason = unpaired_reason(base, manifest).or_else(|| seed_mismatch(base, &index));
     let mut rows: Vec<RegressRow> = base
         .rows
         .iter()

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod baseline;
+mod candidate;
 mod case_grid;
 mod checks;
 mod compare;
@@ -37,6 +38,7 @@ mod sweep;
 mod verdicts;
 
 pub use baseline::{Baseline, BaselineRow, BaselineTrial, MAX_BASELINE_BYTES};
+pub use candidate::{Mapping, map_components};
 pub use case_grid::{CaseCells, ErrorGroup, case_grids, error_groups};
 pub use compare::{CompareOptions, CompareReport, CompareRow, Discordant, compare};
 pub use export::write_csv;

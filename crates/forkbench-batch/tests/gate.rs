@@ -151,17 +151,21 @@ fn a_slow_steering_actuator_fails_the_gate_with_junit_numbers() {
     let mut slow = scenario("field-test.toml");
     slow.truck.max_steer_rate_radps = 0.05;
     let (_, worse) = run(&spec(vec![slow], 60, 1), "steer-worse");
-    // As a changed scenario: unpaired, and the warning names the setting.
+    // As a changed scenario: the same seeds run the same trials, so still paired, failing,
+    // and the change listed.
     let g = gate(&base, &worse, &GateOptions::default());
-    match &g.pairing {
-        Pairing::Unpaired { reason } => {
-            assert!(
-                reason.contains("truck.max_steer_rate_radps: 0.8 → 0.05"),
-                "{reason}"
-            );
-        }
-        p => panic!("{p:?}"),
-    }
+    assert!(
+        matches!(g.pairing, Pairing::Paired { .. }),
+        "{:?}",
+        g.pairing
+    );
+    assert!(
+        g.setting_differences
+            .iter()
+            .any(|d| d.contains("truck.max_steer_rate_radps: 0.8 → 0.05")),
+        "{:?}",
+        g.setting_differences
+    );
     assert!(!g.passed);
     // As a degraded build (same settings): paired, and failing with the numbers.
     let g = gate_as_build(&base, &worse, &GateOptions::default());
