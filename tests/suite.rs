@@ -6,6 +6,7 @@ mod external_tracker;
 mod gate_candidate;
 mod hostile_input;
 mod navigation;
+mod outputs;
 mod papercuts;
 mod ros2;
 mod scenario_fuzz;

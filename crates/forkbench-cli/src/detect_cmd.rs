@@ -110,6 +110,9 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
         frame: a.frame.clone(),
         prior: a.prior,
     };
+    if let Some(out) = &a.out {
+        forkbench_core::files::check_not_input(out, std::slice::from_ref(&a.bag))?;
+    }
     let mut lines = a.out.as_deref().map(AtomicWriter::create).transpose()?;
     let mut tally = Tally {
         results: Vec::new(),

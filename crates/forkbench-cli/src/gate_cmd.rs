@@ -82,17 +82,33 @@ pub struct CompareArgs {
 
 /// `forkbench baseline`: success counts and every trial's outcome, written atomically.
 pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::Result<()> {
+    forkbench_core::files::check_not_input(out, &batch_files(dir))?;
     let (s, records, _) = batch::load_batch(dir)?;
     let description =
         description.unwrap_or_else(|| format!("success counts from {}", dir.display()));
     let b = Baseline::from_results(&s, &records, description);
     b.write(out)?;
-    crate::emit(&format!(
+    let said = format!(
         "baseline with {} rows and {} trials written to {}\n",
         b.rows.len(),
         b.trials.len(),
         out.display()
-    ))
+    );
+    if forkbench_core::files::is_stdout(out) {
+        // The baseline itself went to standard output.
+        eprint!("{said}");
+        Ok(())
+    } else {
+        crate::emit(&said)
+    }
+}
+
+/// The files of a batch directory that the gate commands read.
+pub fn batch_files(dir: &Path) -> Vec<PathBuf> {
+    ["trials.jsonl", "summary.json", "manifest.json"]
+        .iter()
+        .map(|f| dir.join(f))
+        .collect()
 }
 
 /// The gate over a results directory, and the results' provenance.
@@ -127,6 +143,11 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
         min_detectable_drop: a.min_detectable_drop,
     };
     o.validate()?;
+    if let Some(file) = &a.junit {
+        let mut inputs = batch_files(&a.results);
+        inputs.push(a.baseline.clone());
+        forkbench_core::files::check_not_input(file, &inputs)?;
+    }
     let b = Baseline::load(&a.baseline)?;
     let (report, provenance) = gate(&b, &a.results, &a.mappings, &o)?;
     if let batch::Pairing::Unpaired { reason } = &report.pairing {

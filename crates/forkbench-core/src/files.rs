@@ -16,6 +16,13 @@ pub enum FileError {
     TooLarge { path: String, max: u64 },
     #[error("{path}: not UTF-8 text")]
     NotText { path: String },
+    #[error(
+        "{path}: exists and is {kind}, which an output would replace; give a file's path, \
+         or - for standard output"
+    )]
+    NotAnOutput { path: String, kind: &'static str },
+    #[error("{path}: is {input}, which this command reads; give the output another name")]
+    IsInput { path: String, input: String },
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> FileError + '_ {
@@ -35,9 +42,46 @@ fn kind_of(t: std::fs::FileType) -> &'static str {
         "a device"
     } else if t.is_socket() {
         "a socket"
+    } else if t.is_symlink() {
+        "a symbolic link"
     } else {
         "not a file"
     }
+}
+
+/// An output may replace a regular file, or create one; what else stands at `path` (a
+/// symbolic link, FIFO, device, socket or folder) is refused, never replaced.
+pub fn check_output(path: &Path) -> Result<(), FileError> {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if !m.file_type().is_file() => Err(FileError::NotAnOutput {
+            path: path.display().to_string(),
+            kind: kind_of(m.file_type()),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// An output that would replace one of the command's `inputs` is refused: it would
+/// destroy what the command reads.
+pub fn check_not_input(out: &Path, inputs: &[std::path::PathBuf]) -> Result<(), FileError> {
+    let Ok(o) = std::fs::canonicalize(out) else {
+        return Ok(());
+    };
+    match inputs
+        .iter()
+        .find(|i| std::fs::canonicalize(i).is_ok_and(|c| c == o))
+    {
+        Some(i) => Err(FileError::IsInput {
+            path: out.display().to_string(),
+            input: i.display().to_string(),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Whether `path` means standard output (`-`).
+pub fn is_stdout(path: &Path) -> bool {
+    path.as_os_str() == "-"
 }
 
 /// Reads at most `max` bytes of `path`, which must be a regular file (a FIFO would block,
@@ -105,6 +149,7 @@ pub struct AtomicWriter {
 
 impl AtomicWriter {
     pub fn create(path: &Path) -> Result<Self, FileError> {
+        check_output(path)?;
         let tmp = temporary(path);
         let file = std::fs::File::create(&tmp).map_err(io_err(path))?;
         Ok(Self {
@@ -150,6 +195,14 @@ impl Drop for AtomicWriter {
 /// Writes `bytes` to `path` so that a reader sees the old file or the new one, never a
 /// part: a temporary file in the same folder, flushed to disk, then renamed over `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    if is_stdout(path) {
+        let mut out = std::io::stdout().lock();
+        return out
+            .write_all(bytes)
+            .and_then(|()| out.flush())
+            .map_err(io_err(path));
+    }
+    check_output(path)?;
     let tmp = temporary(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
@@ -167,6 +220,48 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An output never replaces a link, FIFO, device or folder; a regular file it does.
+    #[test]
+    fn outputs_replace_only_regular_files() {
+        let dir = std::env::temp_dir().join(format!("fb-outputs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let file = dir.join("out.json");
+        write_atomic(&file, b"1").expect("a new file");
+        write_atomic(&file, b"2").expect("a regular file replaced");
+        let link = dir.join("link.json");
+        std::os::unix::fs::symlink(&file, &link).expect("symlink");
+        let e = write_atomic(&link, b"3").expect_err("a link").to_string();
+        assert!(
+            e.contains("a symbolic link") && e.contains("- for standard output"),
+            "{e}"
+        );
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .expect("kept")
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read(&file).expect("read"), b"2");
+        // A FIFO of its own, not a device of the machine's: a broken check must not cost
+        // the machine its /dev/null.
+        let fifo = dir.join("fifo");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+        for special in [fifo.as_path(), dir.as_path()] {
+            assert!(
+                write_atomic(special, b"x").is_err(),
+                "{}",
+                special.display()
+            );
+            assert!(
+                AtomicWriter::create(special).is_err(),
+                "{}",
+                special.display()
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn special_files_are_refused_and_sizes_capped() {
