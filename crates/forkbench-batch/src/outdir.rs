@@ -18,7 +18,8 @@ const BATCH_FILES: [&str; 5] = [
 impl BatchSpec {
     /// Starts `dir` over for `force_new`, deleting only what a batch wrote: refused where
     /// no manifest says forkbench wrote the directory, and of `recordings/` only the
-    /// recordings (.rrd, .mcap), the folder itself only when that leaves it empty.
+    /// recordings (.rrd, .mcap), the folder itself only when that leaves it empty. No
+    /// symbolic link is followed.
     fn reset_dir(&self, dir: &Path, want: &Manifest) -> Result<(), BatchError> {
         let ours = Manifest::read(dir).ok().flatten().is_some();
         let rec = dir.join("recordings");
@@ -40,7 +41,10 @@ impl BatchSpec {
         for f in BATCH_FILES {
             remove_if_present(&dir.join(f))?;
         }
-        if rec.is_dir() {
+        // A `recordings` that is a symbolic link is not descended: what it points at is
+        // not the batch's to delete.
+        let real_dir = std::fs::symlink_metadata(&rec).is_ok_and(|m| m.file_type().is_dir());
+        if real_dir {
             for entry in std::fs::read_dir(&rec).map_err(io(&rec))?.flatten() {
                 let path = entry.path();
                 let recording = path.extension().is_some_and(|e| e == "rrd" || e == "mcap");

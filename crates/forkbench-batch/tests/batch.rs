@@ -203,6 +203,28 @@ fn resume_refuses_other_settings_and_force_new_starts_over() {
     assert_eq!(seen.into_inner(), 0);
 }
 
+/// `force_new` never follows a symbolic link: a `recordings` that links elsewhere keeps
+/// what it points at.
+#[test]
+fn force_new_does_not_follow_a_linked_recordings_folder() {
+    let d = tmp("force-link");
+    let elsewhere = tmp("force-link-elsewhere");
+    std::fs::create_dir_all(&elsewhere).expect("dir");
+    let theirs = elsewhere.join("theirs.mcap");
+    std::fs::write(&theirs, "not the batch's").expect("write");
+    let mut base = spec(vec![scenario("field-test.toml")], 2, 3);
+    batch::run_batch(&base, &d, 2, &|_| {}).expect("runs");
+    let _ = std::fs::remove_dir_all(d.join("recordings"));
+    std::os::unix::fs::symlink(&elsewhere, d.join("recordings")).expect("symlink");
+    base.force_new = true;
+    batch::run_batch(&base, &d, 2, &|_| {}).expect("starts over");
+    assert_eq!(
+        std::fs::read_to_string(&theirs).expect("kept"),
+        "not the batch's"
+    );
+    let _ = std::fs::remove_dir_all(&elsewhere);
+}
+
 /// Trials a directory holds from another build are not resumed: one verdict would mix
 /// two versions of the code (a commit the directory names, or none recorded).
 #[test]
