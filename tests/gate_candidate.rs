@@ -1,23 +1,11 @@
 //! Gating your own component against what you ship: a candidate tracker's results mapped onto the built-in's baseline (`regress --as`) pair trial by trial, pass when equal and fail when worse; a changed setting keeps the pairing and is listed.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn forkbench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_forkbench"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+use crate::common::{forkbench, s};
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("forkbench-candidate-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8")
+    crate::common::tmp_in("forkbench-candidate", name)
 }
 
 fn field_test() -> PathBuf {

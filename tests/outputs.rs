@@ -3,21 +3,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn forkbench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_forkbench"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+use crate::common::{forkbench, s};
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("forkbench-outputs-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8")
+    crate::common::tmp_in("forkbench-outputs", name)
 }
 
 fn err(out: &Output) -> String {

@@ -1,6 +1,7 @@
 //! The end-to-end tests of the `forkbench` binary as one test binary: each file a module, built and linked once (a binary per file repeats the release build of everything they share).
 
 mod cli;
+mod common;
 mod external_planner;
 mod external_tracker;
 mod gate_candidate;

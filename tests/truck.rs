@@ -1,27 +1,16 @@
 //! The truck's actuators through the binary: a step-test log identified back into a truck file that `--truck` takes, a trial's MCAP and actuator log identified, a run's truck file refused naming the file, and a bad log refused naming its line and column.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn forkbench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_forkbench"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+use crate::common::{forkbench, s};
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("forkbench-truck-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir.join(name)
+    crate::common::tmp_in("forkbench-truck", name)
 }
 
 fn text(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8")
 }
 
 #[test]

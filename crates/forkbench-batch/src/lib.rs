@@ -50,6 +50,7 @@ pub use guard::guarded;
 pub use manifest::{DirLock, Manifest, build_commit};
 pub use mode_pairs::{ModePairs, mode_pairs, mode_pairs_markdown};
 pub use modes::ReplanModes;
+pub use outdir::batch_files;
 pub use provenance::{Provenance, RunEntry, rfc3339, scenario_differences};
 pub use records_run::run_records;
 pub use replay::Replay;

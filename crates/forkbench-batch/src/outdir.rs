@@ -15,6 +15,12 @@ const BATCH_FILES: [&str; 5] = [
     provenance::RUNS_FILE,
 ];
 
+/// The files a batch writes into `dir` (besides `recordings/`): what a command reading the
+/// batch must not write over.
+pub fn batch_files(dir: &Path) -> Vec<std::path::PathBuf> {
+    BATCH_FILES.iter().map(|f| dir.join(f)).collect()
+}
+
 impl BatchSpec {
     /// Starts `dir` over for `force_new`, deleting only what a batch wrote: refused where
     /// no manifest says forkbench wrote the directory, and of `recordings/` only the

@@ -82,7 +82,7 @@ pub struct CompareArgs {
 
 /// `forkbench baseline`: success counts and every trial's outcome, written atomically.
 pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::Result<()> {
-    forkbench_core::files::check_not_input(out, &batch_files(dir))?;
+    forkbench_core::files::check_not_input(out, &batch::batch_files(dir))?;
     let (s, records, _) = batch::load_batch(dir)?;
     let description =
         description.unwrap_or_else(|| format!("success counts from {}", dir.display()));
@@ -101,14 +101,6 @@ pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::
     } else {
         crate::emit(&said)
     }
-}
-
-/// The files of a batch directory that the gate commands read.
-pub fn batch_files(dir: &Path) -> Vec<PathBuf> {
-    ["trials.jsonl", "summary.json", "manifest.json"]
-        .iter()
-        .map(|f| dir.join(f))
-        .collect()
 }
 
 /// The gate over a results directory, and the results' provenance.
@@ -144,7 +136,7 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
     };
     o.validate()?;
     if let Some(file) = &a.junit {
-        let mut inputs = batch_files(&a.results);
+        let mut inputs = batch::batch_files(&a.results);
         inputs.push(a.baseline.clone());
         forkbench_core::files::check_not_input(file, &inputs)?;
     }

@@ -59,9 +59,7 @@ pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
 pub use session::{Session, SessionEnd};
 pub use session_view::SceneView;
-pub use truck_knobs::{
-    TRUCK_KNOBS, apply_truck, sensor_timing_for, truck_file_settings, truck_path,
-};
+pub use truck_knobs::{TRUCK_KNOBS, apply_truck, truck_file_settings, truck_path};
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
 /// (negative: before it).

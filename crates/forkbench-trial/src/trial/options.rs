@@ -223,7 +223,11 @@ impl Scenario {
             None => sensing,
         };
         let mut nav350 = self.noise.nav350.clone();
-        super::sensor_timing_for(o.truck_preset.as_deref(), &mut nav350, &mut pallet_sensing);
+        super::truck_knobs::sensor_timing_for(
+            o.truck_preset.as_deref(),
+            &mut nav350,
+            &mut pallet_sensing,
+        );
         let localization_noise_scale = match o.localization_noise_scale {
             Some(s) => {
                 self.check_localizer_scale(&localizer)?;

@@ -51,10 +51,15 @@ impl Trial<'_> {
         let due_s = self.world.sim.time_s() + self.run.pallet_sensing.latency_s();
         while self.world.sim.time_s() + 1e-9 < due_s {
             let (_, pose) = self.sense(rec)?;
-            let steer = self.world.sim.steer_rad();
-            self.physics_step(&crate::phase::open_loop(0.0, steer, &pose), None, pose, rec);
+            self.stand_step(pose, rec);
         }
         Ok(())
+    }
+
+    /// One physics step standing, the wheel where it is, at the believed `pose`.
+    fn stand_step<R: Recorder + ?Sized>(&mut self, pose: Pose2, rec: &mut R) {
+        let steer = self.world.sim.steer_rad();
+        self.physics_step(&crate::phase::open_loop(0.0, steer, &pose), None, pose, rec);
     }
 
     /// Before the localiser's first reading ever (a NAV350 delivers it a latency after its
@@ -72,8 +77,7 @@ impl Trial<'_> {
             if !first || readings(self) > 0 || self.world.sim.time_s() >= until {
                 return Ok(fix);
             }
-            let steer = self.world.sim.steer_rad();
-            self.physics_step(&crate::phase::open_loop(0.0, steer, &pose), None, pose, rec);
+            self.stand_step(pose, rec);
         }
     }
 

@@ -135,9 +135,8 @@ pub fn truck_file_settings(
 
 /// The sensors' timing under `preset`: the `ideal` truck is the bench's first one as it
 /// was sensed too, a NAV350 delivering each fix at once, scans taken in an instant and
-/// their estimates used at once;
-/// any other preset leaves the sensors as configured.
-pub fn sensor_timing_for(
+/// their estimates used at once; any other preset leaves the sensors as configured.
+pub(crate) fn sensor_timing_for(
     preset: Option<&str>,
     nav350: &mut forkbench_sensors::Nav350Config,
     sensing: &mut crate::scenario::sensors::PalletSensing,

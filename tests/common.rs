@@ -1,0 +1,24 @@
+//! What the end-to-end test modules share: the binary run with arguments, a temporary path of a test's own, a path as an argument.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The `forkbench` binary run with `args` to completion.
+pub fn forkbench(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_forkbench"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+/// `name` in the folder `<temp>/<folder>-<pid>`, made if absent.
+pub fn tmp_in(folder: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("{folder}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir.join(name)
+}
+
+/// A path as a command-line argument.
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8")
+}
