@@ -18,7 +18,15 @@ fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// A fresh folder of the test's own: tests run in parallel in one process, so a name used
+/// twice would let one test empty the other's folder under it.
 fn tmp(name: &str) -> PathBuf {
+    static USED: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    {
+        let mut used = USED.lock().expect("names");
+        assert!(!used.iter().any(|u| u == name), "tmp({name:?}) used twice");
+        used.push(name.to_string());
+    }
     let d = std::env::temp_dir().join(format!(
         "forkbench-hostile-in-{}-{name}",
         std::process::id()
@@ -74,7 +82,7 @@ fn csv_and_markdown_cells_cannot_inject() {
 
 #[test]
 fn special_files_are_refused_at_once() {
-    let dir = tmp("special");
+    let dir = tmp("special-outputs");
     let t0 = Instant::now();
     let o = forkbench(&[
         "regress",
