@@ -1,4 +1,4 @@
-//! What the end-to-end test modules share: the binary run with arguments, a temporary path of a test's own, a path as an argument.
+//! What the end-to-end test modules share: the binary run with arguments, a temporary path of a test's own, a path as an argument, the repository's root.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -21,4 +21,9 @@ pub fn tmp_in(folder: &str, name: &str) -> PathBuf {
 /// A path as a command-line argument.
 pub fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8")
+}
+
+/// The repository's root (scenarios/, worlds/).
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }

@@ -160,3 +160,48 @@ fn a_changed_setting_keeps_the_gate_paired() {
         "{err}"
     );
 }
+
+/// `compare --b-from`: a candidate run in its own batch compared with the shipped
+/// tracker's batch, pair by pair on the shared seeds; batches of another seed are refused.
+#[test]
+fn compare_pairs_a_candidate_run_apart_with_what_you_ship() {
+    let shipped = batch("cmp-shipped", "pure_pursuit", &[]);
+    let cand = batch("cmp-cand", "pure_pursuit_compensated", &[]);
+    let o = forkbench(&[
+        "compare",
+        s(&cand),
+        "--a",
+        "pure_pursuit_compensated",
+        "--b",
+        "pure_pursuit",
+        "--b-from",
+        s(&shipped),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    let pairs: u64 = v["rows"]
+        .as_array()
+        .expect("rows")
+        .iter()
+        .map(|r| r["pairs"].as_u64().expect("pairs"))
+        .sum();
+    assert_eq!(pairs, 12, "{v}");
+    let other = batch("cmp-seed", "pure_pursuit", &["--seed", "9"]);
+    let o = forkbench(&[
+        "compare",
+        s(&cand),
+        "--a",
+        "pure_pursuit_compensated",
+        "--b",
+        "pure_pursuit",
+        "--b-from",
+        s(&other),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("cannot be paired"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}

@@ -2,10 +2,12 @@
 
 mod cli;
 mod common;
+mod components_file;
 mod external_planner;
 mod external_tracker;
 mod gate_candidate;
 mod hostile_input;
+mod hostile_round4;
 mod navigation;
 mod outputs;
 mod papercuts;

@@ -61,7 +61,11 @@ def forkbench_runs(exe, yaml_path, planner, runs, extra):
            "--seed", "0", "--runs", str(runs), "--json", "--start", "%g,%g,0" % START,
            "--goal", "%g,%g,0" % GOAL] + extra
     out = []
-    for line in subprocess.run(cmd, check=True, capture_output=True, text=True).stdout.splitlines():
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    # Exit 3 says some run found no path (its line has success false); others are errors.
+    if done.returncode not in (0, 3):
+        raise SystemExit(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr.strip()}")
+    for line in done.stdout.splitlines():
         v = json.loads(line)
         t = v["timing_s"]
         simple = v.get("simplified") or {}

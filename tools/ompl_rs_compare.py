@@ -110,7 +110,9 @@ def forkbench_runs(exe, yaml_path, todo):
         r = subprocess.run([exe, "plan", "hybrid-astar", "--map", yaml_path, "--start", arg(a), "--goal", arg(b),
                             "--margin-m", str(MARGIN_M), "--json"], capture_output=True, text=True)
         if r.returncode != 0:
-            out.append({"success": False, "time_s": None, "error": r.stderr.strip()})
+            # Exit 3: the search ran and found no path (its JSON line says why); else an error.
+            why = json.loads(r.stdout)["error"] if r.returncode == 3 else r.stderr.strip()
+            out.append({"success": False, "time_s": None, "error": why})
             continue
         m = json.loads(r.stdout)["manoeuvre"]
         out.append({"success": True, "time_s": m["time_s"], "length_m": m["length_m"],

@@ -68,6 +68,7 @@ refused.
 from __future__ import annotations
 
 import os
+import threading
 from collections.abc import Sequence
 from typing import Any
 
@@ -111,6 +112,25 @@ def _render_modes() -> list[str]:
 
 
 ACTION_MODES = ("command", "residual")
+
+
+class _Exclusive:
+    """One thread at a time in an environment's core: a second thread's call is refused
+    with a message saying why, not pyo3's bare "Already borrowed"."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+
+    def __enter__(self) -> None:
+        if not self._lock.acquire(blocking=False):
+            raise RuntimeError(
+                "this environment is being stepped or reset by another thread; an environment "
+                "is used by one thread at a time (give each thread its own, or step many "
+                "with PalletPickVectorEnv)"
+            )
+
+    def __exit__(self, *_: object) -> None:
+        self._lock.release()
 
 
 class _Actions:
@@ -208,11 +228,11 @@ class PalletPickEnv(gymnasium.Env):
                 + ("" if render_mode not in RENDER_MODES else " (no display for 'human')")
             )
         self.render_mode = render_mode
-        self.metadata = {"render_modes": modes, "render_fps": 100 / ticks_per_step}
         self.scenario = _scenario(scenario)
         self._case = case
         self._actions = _Actions(self.scenario, action_mode, normalize_actions, residual_limits)
         self._window: Any = None
+        self._busy = _Exclusive()
         self._core = _forkbench.PickEnv(
             self.scenario,
             case=case,
@@ -228,6 +248,8 @@ class PalletPickEnv(gymnasium.Env):
             episode=episode,
             phase_reward=phase_reward,
         )
+        # After the core has checked ticks_per_step (at least 1).
+        self.metadata = {"render_modes": modes, "render_fps": 100 / ticks_per_step}
         self.observation_space, self.action_space = _spaces(
             self._core.observation_size, self._actions
         )
@@ -244,14 +266,16 @@ class PalletPickEnv(gymnasium.Env):
             cases = self.scenario.cases
             case = cases[int(self.np_random.integers(len(cases)))]
         trial_seed = int(self.np_random.integers(0, 2**63 - 1))
-        self._ended = False
-        return self._core.reset(trial_seed, case)
+        with self._busy:
+            self._ended = False
+            return self._core.reset(trial_seed, case)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         self._refuse_after_end()
         a = self._actions.command(action).reshape(2)
         step = self._core.residual_step if self._actions.residual else self._core.step
-        out = self._mark_end(step(float(a[0]), float(a[1])))
+        with self._busy:
+            out = self._mark_end(step(float(a[0]), float(a[1])))
         if self._window is not None:
             self.render()
         return out
@@ -261,7 +285,8 @@ class PalletPickEnv(gymnasium.Env):
         (``human``); None without a render mode."""
         if self.render_mode is None:
             return None
-        frame = self._core.render()
+        with self._busy:
+            frame = self._core.render()
         if self._window is not None and frame is not None:
             self._window.show(frame)
             return None
@@ -275,7 +300,8 @@ class PalletPickEnv(gymnasium.Env):
     def expert_step(self) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """One step under the scenario's own tracker (a reference to compare against)."""
         self._refuse_after_end()
-        return self._mark_end(self._core.expert_step())
+        with self._busy:
+            return self._mark_end(self._core.expert_step())
 
     def _refuse_after_end(self) -> None:
         # A step after the end would repeat the terminal reward: Gymnasium's contract is
@@ -347,6 +373,7 @@ class PalletPickVectorEnv(VectorEnv):
     ) -> None:
         self.scenario = _scenario(scenario)
         self._actions = _Actions(self.scenario, action_mode, normalize_actions, residual_limits)
+        self._busy = _Exclusive()
         self._core = _forkbench.PickVecEnv(
             self.scenario,
             num_envs,
@@ -381,14 +408,16 @@ class PalletPickVectorEnv(VectorEnv):
         elif not isinstance(seed, int):
             seed = int(seed[0])
         self._np_random_seed = seed
-        obs, infos = self._core.reset(seed)
+        with self._busy:
+            obs, infos = self._core.reset(seed)
         return obs, self._batch_infos(list(enumerate(infos)))
 
     def step(
         self, actions: Any
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         a = self._actions.command(actions).reshape(self.num_envs, 2)
-        obs, rewards, terminated, truncated, ended = self._core.step(a, self._actions.residual)
+        with self._busy:
+            obs, rewards, terminated, truncated, ended = self._core.step(a, self._actions.residual)
         return obs, rewards, terminated, truncated, self._batch_infos(ended) if ended else {}
 
     @property

@@ -56,6 +56,15 @@ impl Scenario {
             .map_err(|e| scenario_error(py, &e))
     }
 
+    /// This scenario with the planners and trackers a components file defines usable by
+    /// name (`planner=` / `tracker=` of trials, batches and environments), as the CLI's
+    /// `--components FILE`.
+    fn with_components(&self, py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let s = (*self.inner).clone().with_components_file(&path);
+        s.map(|s| Scenario { inner: Arc::new(s) })
+            .map_err(|e| scenario_error(py, &e))
+    }
+
     /// This scenario localised by `kind` at its default settings (gaussian, nav350).
     fn with_localizer(&self, py: Python<'_>, kind: &str) -> PyResult<Self> {
         let s = (*self.inner).clone().with_localizer(kind);

@@ -74,6 +74,8 @@ pub struct PickVecEnv {
     /// Time spent stepping in Rust (the GIL released) since the last reset: what the
     /// Python side's overhead is measured against.
     stepping: std::time::Duration,
+    /// Whether `reset` has run: a step before it has no episodes to step.
+    was_reset: bool,
 }
 
 type VecReset<'py> = (Bound<'py, PyArray2<f32>>, Vec<Bound<'py, PyDict>>);
@@ -165,6 +167,7 @@ impl PickVecEnv {
             slots: std::sync::Mutex::new(slots),
             pool,
             stepping: std::time::Duration::ZERO,
+            was_reset: false,
         })
     }
 
@@ -190,6 +193,7 @@ impl PickVecEnv {
         let controls = vec![Control::Tracker; self.n];
         let (obs, _) = self.run(py, &controls)?;
         self.stepping = std::time::Duration::ZERO;
+        self.was_reset = true;
         let infos = self
             .slots()
             .iter()
@@ -218,6 +222,11 @@ impl PickVecEnv {
         actions: PyReadonlyArray2<'py, f64>,
         residual: bool,
     ) -> PyResult<VecStep<'py>> {
+        if !self.was_reset {
+            return Err(PyRuntimeError::new_err(
+                "step before reset: call reset() first (it starts every environment's episode)",
+            ));
+        }
         let a = actions.as_array();
         if a.shape() != [self.n, 2] {
             return Err(PyValueError::new_err(format!(

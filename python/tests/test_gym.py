@@ -146,3 +146,39 @@ def test_a_vector_environment_is_capped_by_memory():
         PalletPickVectorEnv(1_000_000)
     with pytest.raises(ValueError, match="at least 1"):
         PalletPickVectorEnv(0)
+
+
+def test_misuse_is_refused_with_a_reason() -> None:
+    with pytest.raises(ValueError, match="ticks_per_step"):
+        PalletPickEnv(ticks_per_step=0)
+    vec = PalletPickVectorEnv(2)
+    with pytest.raises(RuntimeError, match="step before reset"):
+        vec.step(vec.action_space.sample())
+    vec.reset(seed=1)
+    vec.step(vec.action_space.sample())
+
+
+def test_one_environment_is_stepped_by_one_thread_at_a_time() -> None:
+    import threading
+
+    env = PalletPickEnv()
+    env.reset(seed=3)
+    errors: list[str] = []
+
+    def drive() -> None:
+        for _ in range(300):
+            try:
+                _, _, term, trunc, _ = env.step(np.array([0.5, 0.0], dtype=np.float32))
+            except RuntimeError as e:
+                errors.append(str(e))
+                return
+            if term or trunc:
+                return
+
+    threads = [threading.Thread(target=drive) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert all("Already borrowed" not in e for e in errors), errors
+    assert all("one thread at a time" in e or "has ended" in e for e in errors), errors

@@ -172,3 +172,17 @@ def test_a_runs_truck_is_its_actuators_and_timing():
     assert run(truck={"steering.dead_time_s": 0.3})["lateral_error_m"] != default["lateral_error_m"]
     with pytest.raises(forkbench.ScenarioError, match="wheelbase_m"):
         run(truck={"wheelbase_m": 2.0})
+
+
+def test_a_tracker_from_a_components_file_runs_on_any_scenario(tmp_path):
+    import shutil
+
+    shutil.copy(ROOT / "examples/trackers/stanley.py", tmp_path / "stanley.py")
+    (tmp_path / "components.toml").write_text(
+        '[[tracker]]\nname = "stan"\nkind = "external"\ncommand = ["python3", "stanley.py"]\n'
+    )
+    scn = forkbench.load("field-test").with_components(tmp_path / "components.toml")
+    out = forkbench.run_trial(scn, seed=1, tracker="stan")
+    assert out["tracker"] == "stan"
+    with pytest.raises(forkbench.ScenarioError, match="components file"):
+        forkbench.run_trial(forkbench.load("field-test"), seed=1, tracker="stan")

@@ -2,6 +2,12 @@
 
 use crate::{BatchError, BatchSpec, DEFAULT_ALPHA, MAX_JOBS, paired_trials_needed};
 
+/// A trial record's size in memory and on disk, generously (a record with stages, people
+/// and a failure's details).
+const RECORD_BYTES: u64 = 2048;
+/// The records one batch process may hold.
+const MAX_RECORD_BYTES: u64 = 4 << 30;
+
 impl BatchSpec {
     /// The batch's own arguments: trials, shard, worker threads and unique names.
     pub fn check(&self, jobs: usize) -> Result<(), BatchError> {
@@ -17,13 +23,38 @@ impl BatchSpec {
                 self.shard.0, self.shard.1
             )));
         }
-        if jobs > MAX_JOBS {
+        if !(1..=MAX_JOBS).contains(&jobs) {
             return Err(BatchError::Invalid(format!(
-                "jobs {jobs}: at most {MAX_JOBS} worker threads"
+                "jobs {jobs}: at least 1 and at most {MAX_JOBS} worker threads"
             )));
         }
+        self.check_bytes()?;
         self.check_names()?;
         self.check_components()
+    }
+
+    /// Refuses a batch (or its shard) whose records could not be held: every record is
+    /// kept for the summary and written to `trials.jsonl`, so the trial count is bounded by
+    /// the bytes its records take, before anything is allocated for them.
+    fn check_bytes(&self) -> Result<(), BatchError> {
+        let total: u64 = self
+            .row_sizes()
+            .iter()
+            .fold(0u64, |a, (_, n)| a.saturating_add(*n));
+        let mine = total.div_ceil(self.shard.1.max(1));
+        let bytes = mine.saturating_mul(RECORD_BYTES);
+        if bytes <= MAX_RECORD_BYTES {
+            return Ok(());
+        }
+        Err(BatchError::Invalid(format!(
+            "trials: this batch{} would run {mine} trials, about {:.1} GB of records held in \
+             memory and written; at most {} trials ({:.1} GB) per process: lower --trials or \
+             split it with --shard I/N",
+            if self.shard.1 > 1 { "'s shard" } else { "" },
+            bytes as f64 / 1e9,
+            MAX_RECORD_BYTES / RECORD_BYTES,
+            MAX_RECORD_BYTES as f64 / 1e9,
+        )))
     }
 
     /// Refuses a batch too small for the paired gate to see a success-rate drop of `drop`

@@ -25,6 +25,7 @@ mod mode_pairs;
 mod modes;
 mod order;
 mod outdir;
+pub mod prints;
 mod provenance;
 mod records_run;
 mod replay;

@@ -67,6 +67,31 @@ pub struct ScenarioEntry {
     /// FNV-1a of `settings` as compact JSON.
     pub settings_hash: String,
     pub settings: Value,
+    /// The external components it runs in this batch, each with the content of the files
+    /// its command names: an edited script makes a resume refuse, naming the file.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub components: Vec<crate::prints::ComponentPrint>,
+}
+
+impl ScenarioEntry {
+    /// The entry of `s`: its resolved settings (without the path) and their hash.
+    pub fn of(s: &forkbench_trial::Scenario) -> Result<Self, BatchError> {
+        let mut settings =
+            serde_json::to_value(s).map_err(|e| BatchError::Invalid(e.to_string()))?;
+        if let Some(map) = settings.as_object_mut() {
+            map.remove("file");
+        }
+        Ok(ScenarioEntry {
+            name: s.name.clone(),
+            file: s.file.clone(),
+            settings_hash: format!(
+                "{:016x}",
+                forkbench_core::hash::fnv1a(settings.to_string().bytes())
+            ),
+            settings,
+            components: Vec::new(),
+        })
+    }
 }
 
 pub(super) const FILE: &str = "manifest.json";
@@ -121,20 +146,9 @@ impl Manifest {
             .scenarios
             .iter()
             .map(|s| {
-                let mut settings =
-                    serde_json::to_value(s).map_err(|e| BatchError::Invalid(e.to_string()))?;
-                if let Some(map) = settings.as_object_mut() {
-                    map.remove("file");
-                }
-                Ok(ScenarioEntry {
-                    name: s.name.clone(),
-                    file: s.file.clone(),
-                    settings_hash: format!(
-                        "{:016x}",
-                        forkbench_core::hash::fnv1a(settings.to_string().bytes())
-                    ),
-                    settings,
-                })
+                let mut e = ScenarioEntry::of(s)?;
+                e.components = crate::prints::prints_of(s, &spec.planners, &spec.trackers);
+                Ok(e)
             })
             .collect::<Result<_, BatchError>>()?;
         Ok(Manifest {

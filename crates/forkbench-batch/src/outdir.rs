@@ -21,11 +21,30 @@ pub fn batch_files(dir: &Path) -> Vec<std::path::PathBuf> {
     BATCH_FILES.iter().map(|f| dir.join(f)).collect()
 }
 
+/// The recordings the batch in `dir` may have written: one name per trial of its
+/// `trials.jsonl` (as `batch --record` names them), in either mode, in each format. A
+/// file of yours beside them in `recordings/` is not among them.
+fn recording_names(dir: &Path) -> std::collections::HashSet<String> {
+    let records = crate::store::read_records_torn(&dir.join("trials.jsonl"))
+        .map(|(r, _)| r)
+        .unwrap_or_default();
+    let mut names = std::collections::HashSet::new();
+    for r in &records {
+        for replan in [false, true] {
+            let stem = r.outcome.recording_stem(replan);
+            for ext in ["rrd", "mcap", "ros2.mcap"] {
+                names.insert(format!("{stem}.{ext}"));
+            }
+        }
+    }
+    names
+}
+
 impl BatchSpec {
     /// Starts `dir` over for `force_new`, deleting only what a batch wrote: refused where
     /// no manifest says forkbench wrote the directory, and of `recordings/` only the
-    /// recordings (.rrd, .mcap), the folder itself only when that leaves it empty. No
-    /// symbolic link is followed.
+    /// recordings named for its trials, the folder itself only when that leaves it
+    /// empty. No symbolic link is followed.
     fn reset_dir(&self, dir: &Path, want: &Manifest) -> Result<(), BatchError> {
         let ours = Manifest::read(dir).ok().flatten().is_some();
         let rec = dir.join("recordings");
@@ -44,6 +63,7 @@ impl BatchSpec {
                 present.join(", ")
             )));
         }
+        let ours_recorded = recording_names(dir);
         for f in BATCH_FILES {
             remove_if_present(&dir.join(f))?;
         }
@@ -53,8 +73,8 @@ impl BatchSpec {
         if real_dir {
             for entry in std::fs::read_dir(&rec).map_err(io(&rec))?.flatten() {
                 let path = entry.path();
-                let recording = path.extension().is_some_and(|e| e == "rrd" || e == "mcap");
-                if recording && entry.file_type().is_ok_and(|t| t.is_file()) {
+                let name = entry.file_name().to_string_lossy().into_owned();
+                if ours_recorded.contains(&name) && entry.file_type().is_ok_and(|t| t.is_file()) {
                     remove_if_present(&path)?;
                 }
             }

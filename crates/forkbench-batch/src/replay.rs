@@ -4,6 +4,7 @@ use std::path::Path;
 
 use forkbench_trial::{Case, Scenario, TrialOptions, TrialOutcome, defaults};
 
+use crate::manifest::ScenarioEntry;
 use crate::{BatchError, Manifest, TrialRecord};
 
 /// A recorded trial and the scenario it came from, ready to run again.
@@ -107,12 +108,30 @@ fn candidates(records: &Path, name: &str) -> Result<Vec<Scenario>, BatchError> {
     {
         return Ok(embedded);
     }
-    let scn = Scenario::load(Path::new(&entry.file)).map_err(|e| {
+    let file = Path::new(&entry.file);
+    let named = |why: &str| {
         BatchError::Invalid(format!(
-            "{}'s manifest names {} for scenario {name:?}; pass its file with --scenario: {e}",
+            "{}'s manifest names {} for scenario {name:?}, {why}; pass its file with --scenario",
             dir.display(),
-            entry.file
+            forkbench_trial::text::visible(&entry.file)
         ))
-    })?;
-    Ok(vec![scn])
+    };
+    // A manifest is a file anyone may have handed over: a path outside the batch's
+    // directory is used only when it holds the very scenario the batch ran, and what
+    // it holds otherwise is never quoted (nor its components run).
+    let inside = match (file.canonicalize(), dir.canonicalize()) {
+        (Ok(f), Ok(d)) => f.starts_with(d),
+        _ => false,
+    };
+    match Scenario::load(file) {
+        Err(e) if inside => Err(named(&format!("which does not load: {e}"))),
+        Err(_) => Err(named(
+            "outside the batch's directory, which does not load as a scenario",
+        )),
+        Ok(scn) if inside => Ok(vec![scn]),
+        Ok(scn) if ScenarioEntry::of(&scn)?.settings_hash == entry.settings_hash => Ok(vec![scn]),
+        Ok(_) => Err(named(
+            "outside the batch's directory, whose settings are not the ones the batch ran",
+        )),
+    }
 }

@@ -225,6 +225,26 @@ fn force_new_does_not_follow_a_linked_recordings_folder() {
     let _ = std::fs::remove_dir_all(&elsewhere);
 }
 
+/// `force_new` deletes of `recordings/` only the recordings named for the batch's own
+/// trials: a recording of yours kept there survives, the folder with it.
+#[test]
+fn force_new_deletes_only_the_recordings_of_its_trials() {
+    let d = tmp("force-own");
+    let mut base = spec(vec![scenario("field-test.toml")], 2, 3);
+    batch::run_batch(&base, &d, 2, &|_| {}).expect("runs");
+    let rec = d.join("recordings");
+    std::fs::create_dir_all(&rec).expect("dir");
+    let records = batch::read_records(&d.join("trials.jsonl")).expect("records");
+    let batch_own = rec.join(format!("{}.rrd", records[0].outcome.recording_stem(false)));
+    std::fs::write(&batch_own, "the batch's").expect("write");
+    let mine = rec.join("my-review.rrd");
+    std::fs::write(&mine, "mine").expect("write");
+    base.force_new = true;
+    batch::run_batch(&base, &d, 2, &|_| {}).expect("starts over");
+    assert!(!batch_own.exists(), "the batch's recording is deleted");
+    assert_eq!(std::fs::read_to_string(&mine).expect("kept"), "mine");
+}
+
 /// Trials a directory holds from another build are not resumed: one verdict would mix
 /// two versions of the code (a commit the directory names, or none recorded).
 #[test]

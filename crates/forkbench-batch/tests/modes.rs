@@ -91,14 +91,21 @@ fn force_new_deletes_only_what_a_batch_wrote() {
     let ours = dir.join("batch");
     batch::run_batch(&spec, &ours, 1, &|_| {}).expect("batch");
     std::fs::create_dir_all(ours.join("recordings")).expect("mkdir");
-    std::fs::write(ours.join("recordings/t.mcap"), "m").expect("write");
+    let first = &batch::read_records(&ours.join("trials.jsonl")).expect("records")[0];
+    let recording = format!("recordings/{}.mcap", first.outcome.recording_stem(false));
+    std::fs::write(ours.join(&recording), "m").expect("write");
+    std::fs::write(ours.join("recordings/t.mcap"), "yours").expect("write");
     std::fs::write(ours.join("recordings/notes.txt"), "n").expect("write");
     let spec = BatchSpec {
         force_new: true,
         ..spec
     };
     batch::run_batch(&spec, &ours, 1, &|_| {}).expect("starts over");
-    assert!(!ours.join("recordings/t.mcap").exists());
+    assert!(!ours.join(&recording).exists());
+    assert!(
+        ours.join("recordings/t.mcap").is_file(),
+        "a recording not named for a trial"
+    );
     assert!(ours.join("recordings/notes.txt").is_file());
     let _ = std::fs::remove_dir_all(dir);
 }

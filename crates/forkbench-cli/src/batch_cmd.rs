@@ -82,6 +82,10 @@ pub struct BatchArgs {
     /// Trackers to run every case with, by name (default: each scenario's own).
     #[arg(long = "tracker", num_args = 1..)]
     pub trackers: Vec<String>,
+    /// Planners and trackers defined by name for --planner and --tracker on every
+    /// scenario (beside those of a components.toml next to each scenario file).
+    #[arg(long, value_name = "FILE")]
+    pub components: Option<PathBuf>,
     /// Worker threads.
     #[arg(long, default_value_t = 2)]
     pub jobs: usize,
@@ -196,6 +200,10 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
             .map(|p| defaults::load_scenario(p))
             .collect::<Result<_, _>>()?
     };
+    let scenarios = scenarios
+        .into_iter()
+        .map(|s| crate::with_components(s, a.components.as_deref()))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     scenarios.iter().for_each(crate::warn_slips);
     let shard = match a.shard.as_deref() {
         Some(text) => {
@@ -209,6 +217,13 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         bail!("--ros2 writes bags of the recorded trials, and --record none records none");
     }
     let out = batch::shard_dir(&a.out, shard);
+    if let Some(j) = &a.junit {
+        // The report must not replace what the batch reads or writes.
+        let mut inputs = batch::batch_files(&out);
+        inputs.extend(a.scenarios.iter().cloned());
+        inputs.extend(a.components.iter().cloned());
+        forkbench_core::files::check_not_input(j, &inputs)?;
+    }
     let a = BatchArgs { out, ..a };
     batch::check_floor(a.floor)?;
     let modes =
@@ -243,6 +258,8 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
 /// result is a failure: exit 3).
 pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     let (spec, a) = prepare(a)?;
+    // Before anything is sized by the trial count (the progress bar lists the jobs).
+    spec.check(a.jobs)?;
     if let Some(d) = a.min_detectable_drop {
         spec.check_power(d)?;
     }
@@ -286,14 +303,14 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     }
     shown?;
     for w in summary.dead_rows() {
-        eprintln!("warning: {w}");
+        eprintln!("warning: {}", forkbench_trial::text::visible(&w));
     }
     let below = summary.below_floor(a.floor);
     if !below.is_empty() {
         eprintln!(
             "below the floor of {:.1} %: {}",
             100.0 * a.floor.unwrap_or(0.0),
-            below.join(", ")
+            forkbench_trial::text::visible(&below.join(", "))
         );
     }
     Ok(below.is_empty())

@@ -72,6 +72,11 @@ pub struct CompareArgs {
     /// Planner or tracker B, by name.
     #[arg(long)]
     pub b: String,
+    /// Take B's trials from this batch directory instead (your candidate run apart from
+    /// what you ship): the two batches pair trial by trial when their seed and seed
+    /// scheme match, and are refused otherwise.
+    #[arg(long, value_name = "DIR")]
+    pub b_from: Option<PathBuf>,
     #[arg(long, default_value_t = batch::DEFAULT_ALPHA)]
     pub alpha: f64,
     #[arg(long, value_enum, default_value_t = CorrectionArg::Holm)]
@@ -96,7 +101,7 @@ pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::
     );
     if forkbench_core::files::is_stdout(out) {
         // The baseline itself went to standard output.
-        eprint!("{said}");
+        eprint!("{}", forkbench_trial::text::visible(&said));
         Ok(())
     } else {
         crate::emit(&said)
@@ -143,10 +148,16 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
     let b = Baseline::load(&a.baseline)?;
     let (report, provenance) = gate(&b, &a.results, &a.mappings, &o)?;
     if let batch::Pairing::Unpaired { reason } = &report.pairing {
-        eprintln!("warning: compared unpaired: {reason}");
+        eprintln!(
+            "warning: compared unpaired: {}",
+            forkbench_trial::text::visible(reason)
+        );
     }
     for c in &report.setting_differences {
-        eprintln!("note: changed since the baseline's batch (still paired by seed): {c}");
+        eprintln!(
+            "note: changed since the baseline's batch (still paired by seed): {}",
+            forkbench_trial::text::visible(c)
+        );
     }
     if let Some(file) = &a.junit {
         let cases = batch::junit::regress_cases(&report, a.fail_on_new);
@@ -163,14 +174,30 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
 
 /// `forkbench compare`: A against B in one batch, pair by pair.
 pub fn compare(a: &CompareArgs) -> anyhow::Result<()> {
-    let file = a.results.join("trials.jsonl");
-    if !file.is_file() {
-        bail!(
-            "{}: no trials.jsonl (not a batch directory)",
-            a.results.display()
+    let trials = |dir: &Path| -> anyhow::Result<PathBuf> {
+        let file = dir.join("trials.jsonl");
+        if !file.is_file() {
+            bail!("{}: no trials.jsonl (not a batch directory)", dir.display());
+        }
+        Ok(file)
+    };
+    let file = trials(&a.results)?;
+    let mut records = batch::read_numbered(&file)?;
+    let mut label = file.display().to_string();
+    if let Some(other) = &a.b_from {
+        let file_b = trials(other)?;
+        same_seeds(&a.results, other)?;
+        let named = |r: &batch::TrialRecord, n: &str| {
+            r.outcome.planner == n || r.outcome.tracker == n || mode_of(r) == n
+        };
+        records.retain(|(_, r)| named(r, &a.a));
+        records.extend(
+            batch::read_numbered(&file_b)?
+                .into_iter()
+                .filter(|(_, r)| named(r, &a.b)),
         );
+        label = format!("{label} (line A) / {} (line B)", file_b.display());
     }
-    let records = batch::read_numbered(&file)?;
     let o = CompareOptions {
         alpha: a.alpha,
         correction: a.correction.into(),
@@ -179,5 +206,38 @@ pub fn compare(a: &CompareArgs) -> anyhow::Result<()> {
     if a.json {
         return crate::emit(&format!("{}\n", serde_json::to_string(&report)?));
     }
-    crate::emit(&report.markdown(&file.display().to_string()))
+    crate::emit(&report.markdown(&label))
+}
+
+/// A record's replanning mode as `compare` names it.
+fn mode_of(r: &batch::TrialRecord) -> &'static str {
+    if r.replan.unwrap_or(false) {
+        "replan"
+    } else {
+        "plan_once"
+    }
+}
+
+/// Two batches pair trial by trial only when their seeds come from the same batch seed
+/// by the same scheme.
+fn same_seeds(a: &Path, b: &Path) -> anyhow::Result<()> {
+    let read = |d: &Path| -> anyhow::Result<batch::Manifest> {
+        batch::Manifest::read(d)?.ok_or_else(|| {
+            anyhow::anyhow!("{}: no manifest.json (not a batch directory)", d.display())
+        })
+    };
+    let (ma, mb) = (read(a)?, read(b)?);
+    if (ma.seed, ma.seed_scheme) != (mb.seed, mb.seed_scheme) {
+        bail!(
+            "{} ran with batch seed {} (scheme {}) and {} with {} (scheme {}): their trials are \
+             not the same trials, so they cannot be paired; run both with the same --seed",
+            a.display(),
+            ma.seed,
+            ma.seed_scheme,
+            b.display(),
+            mb.seed,
+            mb.seed_scheme
+        );
+    }
+    Ok(())
 }

@@ -2,6 +2,8 @@
 
 mod accuracy_cmd;
 mod batch_cmd;
+mod out;
+pub(crate) use out::{emit, emit_json_line};
 mod check_cmd;
 mod corridor_cmd;
 mod coverage_cmd;
@@ -21,7 +23,6 @@ mod truck_cmd;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context as _;
 use clap::{Parser, Subcommand, ValueEnum};
 use forkbench_core::{ForkliftSpec, Pose2};
 
@@ -31,7 +32,8 @@ use forkbench_core::{ForkliftSpec, Pose2};
     version,
     about = "Physics test bench for autonomous forklift pallet picking",
     after_help = "Exit status: 0 ok; 1 error or bad input; 2 usage; 3 the run worked and its \
-                  result is a failure (a failed pick or mission, a regression in `regress`, a row \
+                  result is a failure (a failed pick or mission, no path from a global `plan`, a \
+                  regression in `regress`, a row \
                   below `batch --floor`)."
 )]
 struct Cli {
@@ -107,6 +109,10 @@ struct TrialCli {
     /// Tracker by name: the scenario's own or a registered kind (default: the scenario's).
     #[arg(long)]
     tracker: Option<String>,
+    /// Planners and trackers defined by name (`[[planner]]`, `[[tracker]]` tables) for
+    /// --planner and --tracker, beside those of a components.toml next to the scenario.
+    #[arg(long, value_name = "FILE")]
+    components: Option<PathBuf>,
     /// Ideal sensors everywhere: no localisation, pallet-sensing or odometry error.
     #[arg(long)]
     no_noise: bool,
@@ -168,7 +174,7 @@ impl TrialCli {
             overrides,
         )?;
         let ok = trial_cmd::run(
-            &self.scenario,
+            (&self.scenario, self.components.as_deref()),
             self.case.as_deref(),
             &opts,
             (self.json, mission),
@@ -180,7 +186,8 @@ impl TrialCli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Plan one pick path from a start pose to a pallet pose.
+    /// Plan one pick path from a start pose to a pallet pose, or a global route on a map
+    /// (exit status 3 when the search ran and found no path).
     Plan(plan_cmd::PlanCli),
     /// Run one pick trial from a scenario file (exit status 3 when the pick fails).
     Trial(TrialCli),
@@ -284,31 +291,6 @@ enum Command {
     },
 }
 
-/// Writes command output; a closed pipe (`forkbench … | head`) ends output quietly.
-pub(crate) fn emit(text: &str) -> anyhow::Result<()> {
-    use std::io::Write as _;
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => other.context("writing to stdout"),
-    }
-}
-
-/// Writes `value` as one JSON line to stdout, serialised as it is written (no copy of the
-/// whole text in memory); a closed pipe is not an error.
-pub(crate) fn emit_json_line<T: serde::Serialize>(value: &T) -> anyhow::Result<()> {
-    use std::io::Write as _;
-    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    let written = serde_json::to_writer(&mut out, value)
-        .map_err(std::io::Error::from)
-        .and_then(|()| out.write_all(b"\n"))
-        .and_then(|()| out.flush());
-    match written {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => other.context("writing to stdout"),
-    }
-}
-
 pub(crate) fn parse_pose(text: &str) -> Result<Pose2, String> {
     Pose2::parse_ui(text).map_err(|e| e.to_string())
 }
@@ -371,7 +353,9 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             Ok(if ok { Done::Ok } else { Done::PickFailed })
         }
         Command::Plan(args) => match args.route()? {
-            Some(route) => route_cmd::run(&route).map(|()| Done::Ok),
+            Some(route) => {
+                route_cmd::run(&route).map(|found| if found { Done::Ok } else { Done::PickFailed })
+            }
             None => plan_cmd::run(args.resolve()?).map(|()| Done::Ok),
         },
         Command::Reproduce {
@@ -447,10 +431,23 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!(
                 "error: {}",
-                forkbench_trial::text::compact_numbers(&format!("{e:#}"))
+                forkbench_trial::text::visible(&forkbench_trial::text::compact_numbers(&format!(
+                    "{e:#}"
+                )))
             );
             ExitCode::FAILURE
         }
+    }
+}
+
+/// `scn` with the components `file` defines usable by name (`--components FILE`).
+pub(crate) fn with_components(
+    scn: forkbench_trial::Scenario,
+    file: Option<&std::path::Path>,
+) -> anyhow::Result<forkbench_trial::Scenario> {
+    match file {
+        Some(f) => Ok(scn.with_components_file(f)?),
+        None => Ok(scn),
     }
 }
 

@@ -24,7 +24,7 @@ pub struct PlanCli {
     #[arg(long, value_parser = crate::parse_pose, allow_hyphen_values = true)]
     pub goal: Pose2,
     /// Path curvature at the start in m⁻¹ (from the current steering angle; spiral only).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_curvature)]
     pub start_curvature: f64,
     /// Forklift spec overrides (TOML with fields of ForkliftSpec).
     #[arg(long)]
@@ -48,8 +48,8 @@ pub struct PlanCli {
     pub map: Option<PathBuf>,
     /// PRM: samples drawn over the map (the paper's 500); with --first-solution, the
     /// most samples drawn before giving up (default 5000).
-    #[arg(long)]
-    pub nodes: Option<usize>,
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub nodes: Option<u64>,
     /// PRM: grow the roadmap one sample at a time, each joined to its 10 nearest
     /// neighbours within --connect-m (OMPL's PRM strategy), and stop as soon as start
     /// and goal are connected: the time to a first solution.
@@ -154,6 +154,12 @@ impl PlanCli {
         let Some(planner) = kind else {
             return Ok(None);
         };
+        if self.start_curvature != 0.0 {
+            anyhow::bail!(
+                "plan {}: --start-curvature is for pick planners (a global plan starts from rest)",
+                self.planner
+            );
+        }
         if planner.kinodynamic() {
             self.refuse_for_manoeuvres()?;
         }
@@ -176,6 +182,7 @@ impl PlanCli {
             goal: self.goal,
             nodes: self
                 .nodes
+                .map(|n| usize::try_from(n).unwrap_or(usize::MAX))
                 .unwrap_or(if self.first_solution { 5000 } else { 500 }),
             first_solution: self.first_solution,
             runs: self.runs as usize,
@@ -359,4 +366,12 @@ fn text_report(
         let _ = writeln!(s, "plot                 {}", file.display());
     }
     s
+}
+
+/// `--start-curvature`: a finite curvature a truck can steer to (at most 10 /m).
+fn parse_curvature(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v.abs() <= 10.0 => Ok(v),
+        _ => Err(format!("{text:?}: expected a curvature in 1/m within ±10")),
+    }
 }

@@ -20,7 +20,10 @@ pub fn replay(
     let run = job.scenario.resolve(&opts)?;
     let r = forkbench_log::run_recorded((&job.scenario, job.case()?), (&opts, &run), rec)?;
     if let Some(e) = &r.viewer_error {
-        eprintln!("error: {e} (the trial ran without the viewer)");
+        eprintln!(
+            "error: {} (the trial ran without the viewer)",
+            forkbench_trial::text::visible(&e.to_string())
+        );
     }
     let out = &r.outcome;
     let same = job.reproduces(out);

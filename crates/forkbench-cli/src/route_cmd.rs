@@ -85,13 +85,34 @@ impl RouteArgs {
     }
 }
 
-pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
+/// Plans `a.runs` times; whether every run found a path (a search that ran and found
+/// none is a verdict, exit 3, for every planner alike; bad input is an error).
+pub fn run(a: &RouteArgs) -> anyhow::Result<bool> {
     let map = forkbench_trial::prm_study::load_map(&a.map, a.resolution_m)?;
     let mut a = a.clone();
+    let mut all_found = true;
     for run in 0..a.runs.max(1) {
         let q = a.query();
-        let plan = plan_global(&map, &q)
-            .with_context(|| format!("plan {} on {}", a.planner.name(), a.map.display()))?;
+        let plan = match plan_global(&map, &q) {
+            Err(
+                e @ (forkbench_nav::NavError::Unreachable(_)
+                | forkbench_nav::NavError::Budget { .. }),
+            ) => {
+                all_found = false;
+                crate::emit(&if a.json {
+                    format!(
+                        "{}\n",
+                        json!({"planner": a.planner.name(), "seed": a.seed, "polyline_m": null, "error": e.to_string()})
+                    )
+                } else {
+                    format!("no path found: {e}\n")
+                })?;
+                a.seed = a.seed.wrapping_add(1);
+                continue;
+            }
+            r => r.with_context(|| format!("plan {} on {}", a.planner.name(), a.map.display()))?,
+        };
+        all_found &= plan.route.points.is_some();
         if let (Some(file), 0) = (&a.plot, run) {
             forkbench_report::map::draw_route(file, a.planner, &a.map, &map, &q, &plan)?;
         }
@@ -103,7 +124,7 @@ pub fn run(a: &RouteArgs) -> anyhow::Result<()> {
         crate::emit(&report(&a, &map.grid, &q, &plan, simplified.as_ref()))?;
         a.seed = a.seed.wrapping_add(1);
     }
-    Ok(())
+    Ok(all_found)
 }
 
 /// The smoothing result as JSON: the samples, or why there are none.

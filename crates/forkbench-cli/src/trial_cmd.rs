@@ -9,13 +9,13 @@ use forkbench_trial::{TrialOptions, TrialOutcome};
 /// `trial` (a pick, or a whole mission when the scenario has one) and `mission` (which
 /// requires one and prints each leg): runs, records, prints; Ok(success).
 pub fn run(
-    file: &Path,
+    (file, components): (&Path, Option<&Path>),
     case: Option<&str>,
     opts: &TrialOptions,
     (json, mission): (bool, bool),
     rec: &forkbench_log::RecordTargets,
 ) -> anyhow::Result<bool> {
-    let scn = forkbench_trial::defaults::load_scenario(file)?;
+    let scn = crate::with_components(forkbench_trial::defaults::load_scenario(file)?, components)?;
     crate::warn_slips(&scn);
     if mission && scn.mission.is_none() {
         anyhow::bail!(
@@ -35,7 +35,10 @@ pub fn run(
         viewer_error,
     } = forkbench_log::run_recorded((&scn, case), (opts, &run), rec)?;
     if let Some(e) = &viewer_error {
-        eprintln!("error: {e} (the trial ran without the viewer)");
+        eprintln!(
+            "error: {} (the trial ran without the viewer)",
+            forkbench_trial::text::visible(&e.to_string())
+        );
     }
     // The outcome is printed even when a recording failed (it is computed); the error
     // then makes the exit status non-zero.

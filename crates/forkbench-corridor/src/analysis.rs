@@ -72,6 +72,17 @@ pub fn check_inputs(
         if junction == Junction::T && a != 90.0 {
             return bad("angle_deg", a, "a T junction turns by 90°");
         }
+        // The minimum-width search starts just wider than the vehicle's circumscribed
+        // circle: a resolution too fine for even that is refused here, not by the allocator.
+        let first = v.circumscribed_m() + cell_m;
+        if search_states(v, junction, first, a, cell_m) > MAX_SEARCH_STATES {
+            return bad(
+                "resolution_m",
+                cell_m,
+                "needs more than 1e7 search states (cells × 1° heading layers) even for the \
+                 narrowest corridor the search tries: use a coarser --resolution",
+            );
+        }
         if let Some(w) = width_m
             && search_states(v, junction, w, a, cell_m) > MAX_SEARCH_STATES
         {
@@ -89,6 +100,27 @@ pub fn check_inputs(
 /// Most search states (grid cells × heading layers) one analysis may allocate: bounds
 /// its memory (about 20 bytes each) and time.
 pub const MAX_SEARCH_STATES: f64 = 1e7;
+
+/// The widest corridor, up to `upto_m`, whose search stays within
+/// [`MAX_SEARCH_STATES`]: where the minimum-width search stops widening.
+pub fn widest_searchable_m(
+    v: &Vehicle,
+    junction: Junction,
+    angle_deg: f64,
+    cell_m: f64,
+    upto_m: f64,
+) -> f64 {
+    let fits = |w: f64| search_states(v, junction, w, angle_deg, cell_m) <= MAX_SEARCH_STATES;
+    if fits(upto_m) {
+        return upto_m;
+    }
+    let (mut lo, mut hi) = (v.width_m, upto_m);
+    while hi - lo > cell_m {
+        let mid = (lo + hi) / 2.0;
+        if fits(mid) { lo = mid } else { hi = mid }
+    }
+    lo
+}
 
 /// States a search of this bend at this resolution allocates, in f64 (no overflow for
 /// absurd widths), with 1° heading layers.

@@ -72,7 +72,13 @@ pub fn analyse(q: &CorridorQuery) -> Result<CorridorRun, CorridorError> {
     for &deg in &q.angles_deg {
         let th = deg.to_radians();
         for mode in modes_for(&q.vehicle) {
-            let bound = 20.0 * q.vehicle.circumscribed_m();
+            let bound = crate::analysis::widest_searchable_m(
+                &q.vehicle,
+                q.junction,
+                deg,
+                q.cell_m,
+                20.0 * q.vehicle.circumscribed_m(),
+            );
             let w = min_width_m(&q.vehicle, mode, q.junction, th, res, bound);
             let g = q
                 .width_m

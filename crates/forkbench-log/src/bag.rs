@@ -199,7 +199,7 @@ impl State {
 fn decode(topic: &str, k: Kind, data: &[u8]) -> Vec<BagEvent> {
     let scan = match k {
         Kind::Ros2Tf => {
-            return transforms(data).unwrap_or_else(|e| {
+            return transforms(data, topic).unwrap_or_else(|e| {
                 vec![BagEvent::BadTransform {
                     topic: topic.to_owned(),
                     reason: e.to_string(),
@@ -247,15 +247,27 @@ fn ros2_scan(data: &[u8]) -> Result<BagScan, String> {
         topic: String::new(),
         stamp_s: m.stamp_s,
         frame_id: m.frame_id,
-        scan: Scan {
+        scan: forwards(Scan {
             sensor: Pose2::new(0.0, 0.0, 0.0),
             angle_min_rad: lo,
             angle_step_rad: inc,
             range_min_m: min_m,
             range_max_m: max_m,
             ranges_m: ranges(m.ranges_m.iter().map(|r| Some(f64::from(*r))), min_m, max_m),
-        },
+        }),
     })
+}
+
+/// `scan` with its beams in increasing angle: a scanner mounted upside down publishes
+/// them clockwise (a negative increment), and the detectors read beams counter-clockwise.
+fn forwards(mut scan: Scan) -> Scan {
+    if scan.angle_step_rad < 0.0 {
+        let n = scan.ranges_m.len();
+        scan.angle_min_rad += scan.angle_step_rad * n.saturating_sub(1) as f64;
+        scan.angle_step_rad = -scan.angle_step_rad;
+        scan.ranges_m.reverse();
+    }
+    scan
 }
 
 /// The angle fields must describe the ranges: a non-zero finite increment, and
@@ -344,19 +356,19 @@ fn foxglove_scan(data: &[u8]) -> Result<BagScan, String> {
         topic: String::new(),
         stamp_s: m.timestamp.sec as f64 + m.timestamp.nsec as f64 * 1e-9,
         frame_id: m.frame_id,
-        scan: Scan {
+        scan: forwards(Scan {
             sensor,
             angle_min_rad: m.start_angle,
             angle_step_rad: inc,
             range_min_m: 0.0,
             range_max_m: f64::MAX,
             ranges_m: ranges(m.ranges.into_iter(), 0.0, f64::MAX),
-        },
+        }),
     })
 }
 
 /// The transforms of one `tf2_msgs/msg/TFMessage`, each as a 2-D pose.
-fn transforms(data: &[u8]) -> Result<Vec<BagEvent>, CdrError> {
+fn transforms(data: &[u8], topic: &str) -> Result<Vec<BagEvent>, CdrError> {
     let mut r = CdrReader::new(data)?;
     let count = r.u32()? as usize;
     let mut out = Vec::with_capacity(count.min(data.len() / 64));
@@ -367,6 +379,19 @@ fn transforms(data: &[u8]) -> Result<Vec<BagEvent>, CdrError> {
         let mut v = [0.0; 7];
         for x in &mut v {
             *x = r.f64()?;
+        }
+        // A quaternion far from unit length (zero, or NaN) has no rotation to take.
+        let norm = v[3..].iter().map(|q| q * q).sum::<f64>().sqrt();
+        if !(v.iter().all(|x| x.is_finite()) && (0.5..=2.0).contains(&norm)) {
+            out.push(BagEvent::BadTransform {
+                topic: topic.to_owned(),
+                reason: format!(
+                    "{parent:?} → {child:?}: translation ({}, {}, {}) and rotation ({}, {}, {}, {}): \
+                     not finite, or not a rotation (|q| = {norm})",
+                    v[0], v[1], v[2], v[3], v[4], v[5], v[6]
+                ),
+            });
+            continue;
         }
         out.push(BagEvent::Transform {
             parent: parent.trim_start_matches('/').to_owned(),
@@ -403,5 +428,60 @@ impl Frames {
             at = parent;
         }
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scan published clockwise (an inverted mount) reads as the same beams as the
+    /// same scan published counter-clockwise.
+    #[test]
+    fn a_reversed_laser_scan_reads_as_the_forward_one() {
+        let fwd = Scan {
+            sensor: Pose2::new(0.0, 0.0, 0.0),
+            angle_min_rad: -1.0,
+            angle_step_rad: 0.5,
+            range_min_m: 0.05,
+            range_max_m: 10.0,
+            ranges_m: vec![1.0, 2.0, 3.0, 4.0, 5.0],
+        };
+        let rev = Scan {
+            angle_min_rad: 1.0,
+            angle_step_rad: -0.5,
+            ranges_m: vec![5.0, 4.0, 3.0, 2.0, 1.0],
+            ..fwd.clone()
+        };
+        let a = ros2_scan(&crate::ros2::msgs::laser_scan(1.0, "laser", &fwd)).expect("forwards");
+        let b = ros2_scan(&crate::ros2::msgs::laser_scan(1.0, "laser", &rev)).expect("reversed");
+        assert!(b.scan.angle_step_rad > 0.0);
+        assert!((a.scan.angle_min_rad - b.scan.angle_min_rad).abs() < 1e-6);
+        assert_eq!(a.scan.ranges_m, b.scan.ranges_m);
+        assert_eq!(b.scan.ranges_m, vec![1.0, 2.0, 3.0, 4.0, 5.0]);
+    }
+
+    /// A transform with a zero or NaN quaternion is reported as bad, not used as a yaw of
+    /// 0; the good one beside it in the same message is used.
+    #[test]
+    fn a_degenerate_transform_is_counted_not_used() {
+        let mut w = crate::ros2::cdr::CdrWriter::new();
+        w.len(2);
+        for (child, q) in [("base_link", [0.0; 4]), ("laser", [0.0, 0.0, 0.0, 1.0])] {
+            w.i32(1);
+            w.u32(0);
+            w.string("map");
+            w.string(child);
+            for x in [1.0, 2.0, 0.0].into_iter().chain(q) {
+                w.f64(x);
+            }
+        }
+        let events = transforms(&w.into_bytes(), "/tf").expect("decodes");
+        assert_eq!(events.len(), 2);
+        assert!(
+            matches!(&events[0], BagEvent::BadTransform { reason, .. } if reason.contains("not a rotation")),
+            "{events:?}"
+        );
+        assert!(matches!(&events[1], BagEvent::Transform { child, .. } if child == "laser"));
     }
 }

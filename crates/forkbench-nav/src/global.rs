@@ -244,8 +244,9 @@ impl GlobalPlan {
     }
 }
 
-/// Plans `q` on `map`.
-pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError> {
+/// The query's distances in range: a NaN or negative margin would let a path cut an
+/// obstacle, and an infinite one abort.
+fn check_query(q: &GlobalQuery) -> Result<(), NavError> {
     if !(q.inflate_m.is_finite() && (0.0..=crate::MAX_INFLATION_M).contains(&q.inflate_m)) {
         return Err(NavError::Params(format!(
             "inflation {} m: must lie within 0..{} m",
@@ -253,6 +254,22 @@ pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError
             crate::MAX_INFLATION_M
         )));
     }
+    forkbench_core::settings::in_ranges(&[
+        ("margin_m", q.margin_m, 0.0, MAX_MARGIN_M),
+        ("lead_m", q.lead_m[0], 0.0, MAX_LEAD_M),
+        ("approach_m", q.lead_m[1], 0.0, MAX_LEAD_M),
+    ])
+    .map_err(|e| NavError::Params(e.to_string()))
+}
+
+/// Most clearance a query may keep around the footprint: a truck's width.
+pub const MAX_MARGIN_M: f64 = 2.0;
+/// Longest straight lead-in or lead-out a smoothed route may ask for.
+pub const MAX_LEAD_M: f64 = 100.0;
+
+/// Plans `q` on `map`.
+pub fn plan_global(map: &NavMap, q: &GlobalQuery) -> Result<GlobalPlan, NavError> {
+    check_query(q)?;
     let inflated;
     let footprint;
     let space: &dyn FreeSpace = match q.collision {

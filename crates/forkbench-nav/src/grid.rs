@@ -66,14 +66,17 @@ impl OccupancyGrid {
         })
     }
 
-    /// The obstacles rasterised onto a free floor that spans them and `extra` points, with
-    /// `margin_m` around: a cell is occupied when an obstacle overlaps any part of it.
-    pub fn from_obstacles(
+    /// The origin and size in cells of [`OccupancyGrid::from_obstacles`]'s grid, without
+    /// making it: a scenario's settings are refused at load when it could never be made.
+    pub fn layout_for(
         obstacles: &[Obstacle],
         extra: &[[f64; 2]],
         resolution_m: f64,
         margin_m: f64,
-    ) -> Result<Self, GridError> {
+    ) -> Result<([f64; 2], (usize, usize)), GridError> {
+        if !(resolution_m.is_finite() && resolution_m >= 1e-3) {
+            return Err(GridError::Resolution(resolution_m));
+        }
         let mut corners = Vec::with_capacity(4 * obstacles.len() + extra.len());
         for (index, o) in obstacles.iter().enumerate() {
             let finite = [
@@ -107,7 +110,19 @@ impl OccupancyGrid {
                 height: h as usize,
             });
         }
-        let mut grid = Self::new(resolution_m, origin, (w as usize, h as usize), Cell::Free)?;
+        Ok((origin, (w as usize, h as usize)))
+    }
+
+    /// The obstacles rasterised onto a free floor that spans them and `extra` points, with
+    /// `margin_m` around: a cell is occupied when an obstacle overlaps any part of it.
+    pub fn from_obstacles(
+        obstacles: &[Obstacle],
+        extra: &[[f64; 2]],
+        resolution_m: f64,
+        margin_m: f64,
+    ) -> Result<Self, GridError> {
+        let (origin, (w, h)) = Self::layout_for(obstacles, extra, resolution_m, margin_m)?;
+        let mut grid = Self::new(resolution_m, origin, (w, h), Cell::Free)?;
         for o in obstacles {
             grid.fill_rect(&rect_corners(&o.centre, o.length_m, o.width_m));
         }

@@ -111,6 +111,44 @@ fn redact_quoted(message: &str) -> String {
     out
 }
 
+/// Deepest nesting a map YAML may have, in brackets or in indentation: map_server's file
+/// is flat, and a YAML parser's time grows with the square of the depth.
+pub const MAX_YAML_DEPTH: usize = 32;
+
+/// Why `text` nests too deeply to be a map's YAML, if it does: flow brackets or
+/// indentation deeper than [`MAX_YAML_DEPTH`] levels.
+fn too_deep(text: &str) -> Option<String> {
+    for (n, line) in text.lines().enumerate() {
+        let indent = line.len() - line.trim_start_matches([' ', '\t']).len();
+        if indent > 4 * MAX_YAML_DEPTH {
+            return Some(format!(
+                "line {}: indented {indent} columns, deeper than a map's YAML ever is (at most {})",
+                n + 1,
+                4 * MAX_YAML_DEPTH
+            ));
+        }
+    }
+    // Every bracket counts, quoted or not: a quote a parser would not honour must not
+    // hide a nest from this check, and a flat map never has 32 brackets open.
+    let (mut depth, mut line) = (0usize, 1usize);
+    for c in text.chars() {
+        match c {
+            '\n' => line += 1,
+            '[' | '{' => {
+                depth += 1;
+                if depth > MAX_YAML_DEPTH {
+                    return Some(format!(
+                        "line {line}: brackets nest deeper than {MAX_YAML_DEPTH} levels; a map's YAML is flat"
+                    ));
+                }
+            }
+            ']' | '}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    None
+}
+
 /// Largest map YAML read.
 pub const MAX_YAML_BYTES: u64 = 1 << 20;
 
@@ -121,6 +159,12 @@ pub const MAX_IMAGE_BYTES: u64 = 256 << 20;
 pub fn read_map(path: &Path) -> Result<OccupancyGrid, MapError> {
     let p = path.display().to_string();
     let text = forkbench_core::files::read_text(path, MAX_YAML_BYTES)?;
+    if let Some(reason) = too_deep(&text) {
+        return Err(MapError::Yaml {
+            path: p,
+            message: reason,
+        });
+    }
     let meta: MapYaml = serde_norway::from_str(&text).map_err(|e| MapError::Yaml {
         path: p.clone(),
         message: redact_quoted(&e.to_string()),

@@ -36,6 +36,7 @@ pub enum TableError {
 #[serde(deny_unknown_fields)]
 pub struct BsplineTable {
     pub paper: String,
+    #[serde(deserialize_with = "forkbench_core::exact::array")]
     pub start_mm_deg: [f64; 3],
     pub pick_distance_mm: f64,
     pub case: Vec<BsplineCase>,

@@ -34,7 +34,9 @@ pub struct FieldSetSpec {
     pub speed_max_mps: f64,
     pub direction: Direction,
     /// A convex polygon `[[x_m, y_m], …]` in the fork-root frame (x forward, y left).
+    #[serde(deserialize_with = "forkbench_core::exact::arrays")]
     pub protective: Vec<[f64; 2]>,
+    #[serde(deserialize_with = "forkbench_core::exact::arrays")]
     pub warning: Vec<[f64; 2]>,
 }
 

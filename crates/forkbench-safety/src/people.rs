@@ -20,6 +20,8 @@ pub const YIELD_GAP_M: f64 = 0.5;
 /// Most waypoints a route may have, and the longest wait a setting may ask for.
 pub const MAX_ROUTE_POINTS: usize = 64;
 const MAX_TIME_S: f64 = 3600.0;
+/// How far from the origin a route point may lie: a world's extent.
+pub const MAX_ROUTE_COORD_M: f64 = 1e4;
 
 /// What moves: a person (two legs in the scan plane) or another truck (a rectangle).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -39,10 +41,11 @@ pub struct MoverSpec {
     pub width_m: Option<f64>,
     /// Waypoints `[x_m, y_m]` in the map, in order; it stands at the first until it sets
     /// off, and leaves the world at the last.
+    #[serde(deserialize_with = "forkbench_core::exact::arrays")]
     pub route: Vec<[f64; 2]>,
     pub speed_mps: f64,
     /// When it sets off: drawn per trial from the seed, uniformly within `[from, to]`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "forkbench_core::exact::array")]
     pub start_s: [f64; 2],
     /// It stands at waypoint `pause_at` (an index into `route`) for `pause_s`.
     pub pause_at: Option<usize>,
@@ -60,8 +63,18 @@ impl MoverSpec {
                 format!("must list 2 to {MAX_ROUTE_POINTS} points (got {n})"),
             ));
         }
-        if self.route.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(SettingsError::field("route", "points must be finite"));
+        if let Some(v) = self
+            .route
+            .iter()
+            .flatten()
+            .find(|v| !(v.is_finite() && v.abs() <= MAX_ROUTE_COORD_M))
+        {
+            return Err(SettingsError::field(
+                "route",
+                format!(
+                    "points lie within ±{MAX_ROUTE_COORD_M} m of the origin, as a world does (got {v})"
+                ),
+            ));
         }
         let (lo, hi) = match self.kind {
             MoverKind::Person => WALKING_MPS,

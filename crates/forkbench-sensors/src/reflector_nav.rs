@@ -156,6 +156,14 @@ impl ReflectorNav {
         let mut measured = settings.measurement.clone();
         measured.range_sigma_m *= noise_scale;
         measured.bearing_sigma_rad *= noise_scale;
+        // One order whatever the world file's: noise is drawn, and reflectors matched,
+        // in this order, so a reordered list must not change a sweep.
+        let mut map = map.to_vec();
+        map.sort_by(|a, b| {
+            (a.x_m.total_cmp(&b.x_m))
+                .then(a.y_m.total_cmp(&b.y_m))
+                .then(a.name.cmp(&b.name))
+        });
         let present = map
             .iter()
             .filter(|r| !settings.missing_reflectors.contains(&r.name))
@@ -164,7 +172,7 @@ impl ReflectorNav {
         Self {
             settings,
             measured,
-            map: map.to_vec(),
+            map,
             present,
             blocking: Sight::new(surfaces),
             cadence: Cadence::new(rate_hz, latency_s),

@@ -26,8 +26,9 @@ pub enum NavStudyError {
     World(#[from] TrialError),
     #[error(transparent)]
     Map(#[from] MapError),
-    #[error("{file}: rasterising: {source}")]
-    Grid { file: String, source: GridError },
+    /// The grid error is the message's end, not a source: a chain printer would say it twice.
+    #[error("{file}: rasterising: {reason}")]
+    Grid { file: String, reason: GridError },
     #[error(transparent)]
     Nav(#[from] NavError),
 }
@@ -46,9 +47,9 @@ pub fn run(runs: u64) -> Result<PrmStudy, NavStudyError> {
     let world = crate::defaults::embedded_world(STUDY_WORLD)?;
     let inflate_m = forkbench_nav::luo_inflation_m(&ForkliftSpec::default());
     let grid = NavMap::from_world(&world.obstacles(), STUDY_RESOLUTION_M)
-        .map_err(|source| NavStudyError::Grid {
+        .map_err(|reason| NavStudyError::Grid {
             file: format!("worlds/{STUDY_WORLD}"),
-            source,
+            reason,
         })?
         .grid
         .inflated(inflate_m);
@@ -80,11 +81,11 @@ fn study_leg(world: &crate::World) -> Result<([f64; 2], [f64; 2]), TrialError> {
 /// A planning map: a ROS map_server YAML, or a world TOML rasterised at `resolution_m`.
 pub fn load_map(map: &Path, resolution_m: f64) -> Result<NavMap, NavStudyError> {
     if map.extension().is_some_and(|e| e == "yaml" || e == "yml") {
-        return Ok(NavMap::from_grid(forkbench_nav::read_map(map)?));
+        return Ok(NavMap::from_grid(crate::World::read_grid(map)?));
     }
     let world = crate::World::load(map)?;
-    NavMap::from_world(&world.obstacles(), resolution_m).map_err(|source| NavStudyError::Grid {
+    NavMap::from_world(&world.obstacles(), resolution_m).map_err(|reason| NavStudyError::Grid {
         file: map.display().to_string(),
-        source,
+        reason,
     })
 }

@@ -103,6 +103,26 @@ fn bad_movers_and_fields_are_refused_at_load_with_the_line_and_field() {
     assert!(e.contains("mover[0].start_s"), "{e}");
 }
 
+/// A route point far beyond any world is refused at load, as are more route points than a
+/// trial could step; a long route is checked by its legs, not metre by metre, so hundreds
+/// of movers on kilometre-long routes load at once.
+#[test]
+fn far_routes_and_too_many_route_points_are_refused_and_long_routes_load_fast() {
+    let far = "[[mover]]\nkind = \"person\"\nroute = [[1, 5], [1e300, 5]]\nspeed_mps = 1.2\n";
+    let e = pick(far).expect_err("a point at 1e300 m");
+    assert!(e.contains("mover[0].route") && e.contains("10000"), "{e}");
+    let long = "[[mover]]\nkind = \"person\"\nroute = [[-9000, 5], [9000, 5], [9000, 6], [-9000, 6]]\nspeed_mps = 1.2\n";
+    let t0 = std::time::Instant::now();
+    pick(&long.repeat(500)).expect("500 movers on 36 km routes clear of the post");
+    assert!(
+        t0.elapsed() < std::time::Duration::from_secs(20),
+        "{:?}",
+        t0.elapsed()
+    );
+    let e = pick(&long.repeat(1100)).expect_err("4,400 route points");
+    assert!(e.contains("4400") && e.contains("4096"), "{e}");
+}
+
 /// The scenario file as the main job's people scenarios are written.
 fn warehouse_people(scale: Option<f64>) -> Scenario {
     let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -14,6 +14,7 @@ mod format_doc;
 mod layering;
 mod localization;
 mod missions;
+mod order_free;
 mod pallet_kinds;
 mod people;
 mod phases;

@@ -92,16 +92,17 @@ impl PalletModel {
                 ),
             ));
         }
-        let (blocks, pocket_height_m) = if face.is_side() && !self.notches.is_empty() {
-            let h = self
-                .notches
-                .iter()
-                .map(|n| n.height_m)
-                .fold(f64::INFINITY, f64::min);
-            (self.notched_blocks(), h)
-        } else {
-            (self.blocks.clone(), self.pocket_height_m)
-        };
+        // The parts in one order whatever the file's: contacts and scans are resolved in
+        // the colliders' order, so a reordered table would otherwise change outcomes.
+        // Across, then along (the order the built-in kinds are written in).
+        let mut canonical = self.clone();
+        canonical.blocks.sort_by(|a, b| {
+            (a.y_m.total_cmp(&b.y_m))
+                .then(a.x_m.total_cmp(&b.x_m))
+                .then(a.length_m.total_cmp(&b.length_m))
+                .then(a.width_m.total_cmp(&b.width_m))
+        });
+        let (blocks, pocket_height_m) = canonical.cut_for(face);
         let (depth_m, width_m) = match face {
             PalletFace::Front | PalletFace::Back => (self.depth_m, self.width_m),
             PalletFace::Left | PalletFace::Right => (self.width_m, self.depth_m),
@@ -120,6 +121,21 @@ impl PalletModel {
             blocks,
             pocket_height_m: Some(pocket_height_m),
         })
+    }
+
+    /// The parts a scan plane cuts when entering from `face`, and the pocket height there:
+    /// through the notches from a notched side.
+    fn cut_for(&self, face: PalletFace) -> (Vec<PalletBlock>, f64) {
+        if face.is_side() && !self.notches.is_empty() {
+            let h = self
+                .notches
+                .iter()
+                .map(|n| n.height_m)
+                .fold(f64::INFINITY, f64::min);
+            (self.notched_blocks(), h)
+        } else {
+            (self.blocks.clone(), self.pocket_height_m)
+        }
     }
 
     /// The parts with every notch cut out of them: what a scan plane through the notches

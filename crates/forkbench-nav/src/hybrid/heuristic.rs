@@ -2,6 +2,7 @@
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
+use std::time::Instant;
 
 use crate::grid::{Cell, OccupancyGrid};
 
@@ -17,11 +18,35 @@ pub(crate) struct Distances {
     dist: Vec<f64>,
 }
 
+/// Most coarse cells the heuristic holds: its memory and its Dijkstra's work, whatever the
+/// map's extent.
+pub(crate) const MAX_COARSE_CELLS: f64 = (1u64 << 22) as f64;
+
+/// The coarse cell: the setting's, never finer than the map's own cells (each fine cell
+/// must fall in one coarse cell for the relaxation to hold), and coarser where the map's
+/// area would otherwise take more than [`MAX_COARSE_CELLS`]; a coarser cell only weakens
+/// the bound, which stays a lower bound.
+fn coarse_cell_m(cell_m: f64, resolution_m: f64, area_m2: f64) -> f64 {
+    let floor = cell_m.max(resolution_m);
+    floor.max((area_m2 / MAX_COARSE_CELLS).sqrt() * 1.001)
+}
+
 impl Distances {
     /// `inflated`: the map grown by a radius the truck covers in every pose; `start` and
-    /// `goal` cells count as free whatever the map says.
-    pub fn to_goal(inflated: &OccupancyGrid, cell_m: f64, start: [f64; 2], goal: [f64; 2]) -> Self {
+    /// `goal` cells count as free whatever the map says. `None` when `deadline` passes
+    /// first: the search's time budget covers this too.
+    pub fn to_goal(
+        inflated: &OccupancyGrid,
+        cell_m: f64,
+        (start, goal): ([f64; 2], [f64; 2]),
+        deadline: Instant,
+    ) -> Option<Self> {
         let (lo, hi) = inflated.extent();
+        let cell_m = coarse_cell_m(
+            cell_m,
+            inflated.resolution_m,
+            (hi[0] - lo[0]) * (hi[1] - lo[1]),
+        );
         let nx = (((hi[0] - lo[0]) / cell_m).ceil() as usize).max(1);
         let ny = (((hi[1] - lo[1]) / cell_m).ceil() as usize).max(1);
         let mut free = vec![false; nx * ny];
@@ -48,9 +73,9 @@ impl Distances {
             }
         }
         if let Some(g) = d.index(goal) {
-            d.dijkstra(g, &free);
+            d.dijkstra(g, &free, deadline)?;
         }
-        d
+        Some(d)
     }
 
     fn index(&self, p: [f64; 2]) -> Option<usize> {
@@ -60,13 +85,18 @@ impl Distances {
             .then(|| fy as usize * self.nx + fx as usize)
     }
 
-    fn dijkstra(&mut self, goal: usize, free: &[bool]) {
+    fn dijkstra(&mut self, goal: usize, free: &[bool], deadline: Instant) -> Option<()> {
         let (nx, ny) = (self.nx as i64, self.ny as i64);
         let diag = self.cell_m * std::f64::consts::SQRT_2;
         let mut heap = BinaryHeap::new();
         self.dist[goal] = 0.0;
         heap.push(Reverse((0u64, goal)));
+        let mut popped = 0u32;
         while let Some(Reverse((d_bits, i))) = heap.pop() {
+            popped = popped.wrapping_add(1);
+            if popped.is_multiple_of(4096) && Instant::now() > deadline {
+                return None;
+            }
             let d = f64::from_bits(d_bits);
             if d > self.dist[i] {
                 continue;
@@ -103,6 +133,7 @@ impl Distances {
                 }
             }
         }
+        Some(())
     }
 
     /// Distance from `p` to the goal, less a cell's diagonal (`p` may lie anywhere in its

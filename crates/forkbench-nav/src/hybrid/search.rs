@@ -159,17 +159,27 @@ pub fn plan_hybrid(map: &NavMap, q: &HybridQuery) -> Result<Manoeuvre, NavError>
     let relaxed = relaxed_grid(map, q);
     let ends = ([q.start.x_m, q.start.y_m], [q.goal.x_m, q.goal.y_m]);
     let body = Body::of(&q.truck, q.margin_m, q.load);
+    let deadline = t0 + std::time::Duration::from_secs_f64(q.params.max_time_s);
+    let over_budget = || NavError::Budget {
+        expansions: 0,
+        time_s: t0.elapsed().as_secs_f64(),
+    };
+    let dist =
+        Distances::to_goal(&relaxed, q.params.cell_m, ends, deadline).ok_or_else(over_budget)?;
     let cx = Ctx {
         map,
         q,
         body: body.clone(),
         extent: map.grid.extent(),
-        dist: Distances::to_goal(&relaxed, q.params.cell_m, ends.0, ends.1),
+        dist,
         near: map.inflated(super::covered_radius_m(&q.truck, q.margin_m) + q.params.proximity_m),
         kappa_max,
         step_m: primitive_length_m(q.params.cell_m, kappa_max, q.params.headings),
         reach_m: body.reach_m(),
     };
+    if Instant::now() > deadline {
+        return Err(over_budget());
+    }
     check_ends(&cx)?;
     if !cx.dist.at(ends.0).is_finite() {
         return Err(NavError::Unreachable(

@@ -170,6 +170,21 @@ impl MissionFile {
             }
         };
         self.check(file)?;
+        // A trial rasterises the world at this resolution: one that never could is a
+        // setting error here, not a failure of every trial.
+        forkbench_nav::OccupancyGrid::layout_for(
+            &world.obstacles(),
+            &[],
+            self.global.resolution_m,
+            0.0,
+        )
+        .map_err(|e| {
+            invalid(
+                file,
+                "mission.global.resolution_m",
+                &format!("the world cannot be rasterised at it: {e}"),
+            )
+        })?;
         let via = self
             .via
             .iter()

@@ -5,6 +5,7 @@ mod file;
 mod hints;
 mod limits;
 pub mod mission;
+mod named;
 mod pallet;
 mod safety;
 pub mod sensors;
@@ -29,6 +30,7 @@ pub use file::{
     ReplanMethod, WhenNotSeen,
 };
 pub use limits::Replan;
+pub use named::{BESIDE as COMPONENTS_BESIDE, load_components};
 pub use world::{PalletSlot, RectFile, World};
 
 use checks::{check_values, resolve_cases};
@@ -95,7 +97,12 @@ pub(crate) fn parse<T: serde::de::DeserializeOwned>(
 ) -> Result<T, TrialError> {
     toml::from_str(text).map_err(|e| {
         let mut message = crate::text::compact_numbers(e.to_string().trim_end());
-        let hint = hints::misplaced_key(text, &message);
+        let hint = hints::misplaced_key(
+            text,
+            &message,
+            // An empty span is the document's: a top-level key is missing.
+            e.span().filter(|s| !s.is_empty()).map(|s| s.start),
+        );
         if message.chars().count() > MAX_MESSAGE_CHARS {
             message = message.chars().take(MAX_MESSAGE_CHARS).collect::<String>() + " …";
         }
@@ -120,6 +127,10 @@ pub struct Scenario {
     /// Builds the components this scenario names (and any a run asks for by name).
     #[serde(skip)]
     pub registry: Arc<Registry>,
+    /// Components defined by name in a components file, usable with `--planner` and
+    /// `--tracker` (a manifest fingerprints the ones a batch uses).
+    #[serde(skip)]
+    named: Vec<ComponentSpec>,
     pub seed: u64,
     pub pallet: PalletSpec,
     /// How the scenario names its pallet (`pallet_kind epal-1`, `pallet_model NAME`);
@@ -190,7 +201,13 @@ impl Scenario {
         let text = read(path)?;
         let dir = forkbench_plan::external::dir_of(path);
         let layout = Self::parse_layout(&text, &file, |world| World::load(&dir.join(world)))?;
-        layout.with_components(&text, registry, dir)
+        let scn = layout.with_components(&text, registry, dir.clone())?;
+        // The documented rule: a components file beside the scenario comes with it.
+        let beside = dir.join(named::BESIDE);
+        match beside.is_file() {
+            true => scn.with_components_file(&beside),
+            false => Ok(scn),
+        }
     }
 
     /// Parses scenario text; `load_world` resolves the `world` path. Components are built
@@ -296,7 +313,7 @@ impl Scenario {
                 reason,
             } if reason == "missing" => {
                 let key = field.rsplit('.').next().unwrap_or(&field);
-                let hint = hints::misplaced_key(text, &format!("missing field `{key}`"));
+                let hint = hints::misplaced_key(text, &format!("missing field `{key}`"), None);
                 TrialError::Invalid {
                     file,
                     field,
@@ -318,6 +335,7 @@ impl Scenario {
             planner: ComponentSpec::of_kind(Role::Planner, "bspline"),
             tracker: ComponentSpec::of_kind(Role::Tracker, "pure_pursuit"),
             registry: Registry::shared(),
+            named: Vec::new(),
             seed: f.seed,
             pallet,
             pallet_kind: pallet_label,

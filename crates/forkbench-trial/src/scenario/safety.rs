@@ -68,6 +68,17 @@ pub(super) fn check_movers(
     let obstacles = world.obstacles();
     // The same racks and walls, in the same order, by name.
     let labels = world.footprint_obstacles().1;
+    let points: usize = f.mover.iter().map(|m| m.route.len()).sum();
+    if points > MAX_MOVER_ROUTE_POINTS {
+        return Err(invalid(
+            file,
+            "mover",
+            &format!(
+                "the movers' routes list {points} points in all; at most \
+                 {MAX_MOVER_ROUTE_POINTS} (every point is stepped and sensed each physics step)"
+            ),
+        ));
+    }
     for (k, m) in f.mover.iter().enumerate() {
         let at = tables
             .get(k)
@@ -82,34 +93,34 @@ pub(super) fn check_movers(
     Ok(())
 }
 
-/// Where a mover's route runs through an obstacle, if it does.
+/// Where a mover's route runs through an obstacle, if it does. A body carried along a
+/// straight leg, heading along it, sweeps exactly one rectangle (the leg's length plus
+/// its own), so each leg costs one exact test per obstacle whatever its length.
 fn route_blocked(m: &MoverSpec, obstacles: &[Obstacle], labels: &[String]) -> Option<String> {
     let (l, w) = m.body_m();
-    for leg in m.route.windows(2) {
+    for (k, leg) in m.route.windows(2).enumerate() {
         let (a, b) = (leg[0], leg[1]);
         let len = (b[0] - a[0]).hypot(b[1] - a[1]);
         let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
-        let steps = (len / ROUTE_CHECK_STEP_M).ceil().max(1.0) as usize;
-        for i in 0..=steps {
-            let u = i as f64 / steps as f64;
-            let p = Pose2::new(a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]), heading);
-            let hit = obstacles.iter().position(|o| {
-                forkbench_safety::rect_gap_m(&(o.centre, o.length_m, o.width_m), &(p, l, w)) <= 0.0
-            });
-            if let Some(o) = hit {
-                let name = labels.get(o).map_or("a rack or wall", String::as_str);
-                return Some(format!(
-                    "runs through {name} near ({:.2}, {:.2}) m",
-                    p.x_m, p.y_m
-                ));
-            }
+        let centre = Pose2::new((a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, heading);
+        let swept = (centre, len + l, w);
+        let hit = obstacles.iter().position(|o| {
+            forkbench_safety::rect_gap_m(&(o.centre, o.length_m, o.width_m), &swept) <= 0.0
+        });
+        if let Some(o) = hit {
+            let name = labels.get(o).map_or("a rack or wall", String::as_str);
+            return Some(format!(
+                "leg {k} from ({:.2}, {:.2}) m to ({:.2}, {:.2}) m runs through {name}",
+                a[0], a[1], b[0], b[1]
+            ));
         }
     }
     None
 }
 
-/// Spacing of the poses a route is checked at (less than a leg's width).
-const ROUTE_CHECK_STEP_M: f64 = 0.05;
+/// Most route points over all of a scenario's movers: each is stepped, sensed and judged
+/// every physics step, so the total bounds a trial's work, not the count of movers.
+pub const MAX_MOVER_ROUTE_POINTS: usize = 4096;
 
 impl Scenario {
     /// The truck's outline drawn fields are checked against: fork tips, chassis' rear,

@@ -115,15 +115,35 @@ impl World {
         Self::parse(&read(path)?, &file)
     }
 
-    /// A map from SLAM or Nav2 as a world: its occupied and unknown cells, merged into
-    /// rectangles, are the racks (the physics and the planners see the same cells). A map
-    /// has no named places: scenarios give poses.
-    pub fn from_map(path: &FsPath) -> Result<Self, TrialError> {
+    /// A map_server map's grid, its cells within the world's extent (±10 km): the bound
+    /// every planner's memory and work is sized by, for scenarios and `plan --map` alike.
+    pub fn read_grid(path: &FsPath) -> Result<forkbench_nav::OccupancyGrid, TrialError> {
         let file = path.display().to_string();
         let grid = forkbench_nav::read_map(path).map_err(|e| TrialError::Parse {
             file: file.clone(),
             message: e.to_string(),
         })?;
+        let (lo, hi) = grid.extent();
+        if lo.iter().chain(&hi).any(|v| v.abs() > MAX_WORLD_EXTENT_M) {
+            return Err(invalid(
+                &file,
+                "resolution",
+                &format!(
+                    "the map's cells span ({:.6e}, {:.6e}) to ({:.6e}, {:.6e}) m, beyond ±10 km \
+                     (a world's extent): check origin and resolution",
+                    lo[0], lo[1], hi[0], hi[1]
+                ),
+            ));
+        }
+        Ok(grid)
+    }
+
+    /// A map from SLAM or Nav2 as a world: its occupied and unknown cells, merged into
+    /// rectangles, are the racks (the physics and the planners see the same cells). A map
+    /// has no named places: scenarios give poses.
+    pub fn from_map(path: &FsPath) -> Result<Self, TrialError> {
+        let file = path.display().to_string();
+        let grid = Self::read_grid(path)?;
         let rack = forkbench_nav::blocked_rects(&grid)
             .into_iter()
             .enumerate()

@@ -97,6 +97,13 @@ impl Scenario {
         let Some(name) = name.filter(|n| *n != own.name) else {
             return Ok(own.clone());
         };
+        if let Some(spec) = self
+            .named()
+            .iter()
+            .find(|s| s.role == role && s.name == name)
+        {
+            return Ok(spec.clone());
+        }
         let spec = ComponentSpec::of_kind(role, name);
         self.registry
             .check(&spec)
@@ -104,8 +111,9 @@ impl Scenario {
                 file: self.file.clone(),
                 field: role.to_string(),
                 reason: format!(
-                    "{name:?} is neither this scenario's {role} ({:?}) nor a {role} kind usable \
-                 with default settings: {e}",
+                    "{name:?} is neither this scenario's {role} ({:?}), nor one a components \
+                 file defines (`--components FILE`, or components.toml beside the scenario), \
+                 nor a {role} kind usable with default settings: {e}",
                     own.name
                 ),
             })?;

@@ -1,0 +1,111 @@
+//! External components defined once: a components file names a tracker usable with `--tracker` on any scenario (and one beside a scenario comes with it), and a batch's manifest fingerprints its script, so a resume after an edit is refused, naming the file.
+
+use std::path::PathBuf;
+
+use crate::common::{forkbench, repo_root, s, tmp_in};
+
+fn tmp(name: &str) -> PathBuf {
+    tmp_in("forkbench-components", name)
+}
+
+fn text(o: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// A folder holding stanley.py and a components file defining it as `stan`.
+fn components(folder: &str) -> (PathBuf, PathBuf) {
+    let dir = tmp(folder);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let script = dir.join("stanley.py");
+    std::fs::copy(repo_root().join("examples/trackers/stanley.py"), &script).expect("copy");
+    let file = dir.join("components.toml");
+    std::fs::write(
+        &file,
+        "[[tracker]]\nname = \"stan\"\nkind = \"external\"\ncommand = [\"python3\", \"stanley.py\"]\ntimeout_s = 5.0\n",
+    )
+    .expect("components");
+    (file, script)
+}
+
+#[test]
+fn a_tracker_defined_once_runs_on_any_scenario_and_an_edited_script_refuses_a_resume() {
+    let (file, script) = components("resume");
+    let field = repo_root().join("scenarios/field-test.toml");
+    let out = tmp("resume-out");
+    let batch = |extra: &[&str]| {
+        let mut args = vec![
+            "batch",
+            s(&field),
+            "--components",
+            s(&file),
+            "--tracker",
+            "stan",
+            "--trials",
+            "2",
+            "--record",
+            "none",
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        forkbench(&args)
+    };
+    let first = batch(&["--force-new"]);
+    assert!(
+        matches!(first.status.code(), Some(0 | 3)),
+        "{}",
+        text(&first)
+    );
+    assert!(text(&first).contains("stan"), "{}", text(&first));
+    let again = batch(&[]);
+    assert!(
+        matches!(again.status.code(), Some(0 | 3)),
+        "{}",
+        text(&again)
+    );
+    let mut edited = std::fs::read_to_string(&script).expect("script");
+    edited.push_str("\n# tuned\n");
+    std::fs::write(&script, edited).expect("edit");
+    let stale = batch(&[]);
+    assert_eq!(stale.status.code(), Some(1), "{}", text(&stale));
+    assert!(
+        text(&stale).contains("stanley.py") && text(&stale).contains("different batch"),
+        "{}",
+        text(&stale)
+    );
+    // Without the file, the name is unknown, and the message says where names come from.
+    let o = forkbench(&["trial", s(&field), "--tracker", "stan"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("components file"), "{}", text(&o));
+}
+
+#[test]
+fn a_components_file_beside_a_scenario_comes_with_it() {
+    let (_, _) = components("beside");
+    let dir = tmp("beside");
+    let scn = dir.join("field.toml");
+    let original =
+        std::fs::read_to_string(repo_root().join("scenarios/field-test.toml")).expect("field test");
+    std::fs::write(&scn, original).expect("scenario");
+    let o = forkbench(&["trial", s(&scn), "--tracker", "stan", "--json"]);
+    assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(v["tracker"], "stan", "{v}");
+    // A malformed file is refused naming its line and field.
+    std::fs::write(
+        dir.join("components.toml"),
+        "[[tracker]]\nkind = \"external\"\n",
+    )
+    .expect("write");
+    let o = forkbench(&["trial", s(&scn), "--tracker", "stan"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o).contains("components.toml:1") && text(&o).contains("tracker[0].name"),
+        "{}",
+        text(&o)
+    );
+}
