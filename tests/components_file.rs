@@ -2,18 +2,10 @@
 
 use std::path::PathBuf;
 
-use crate::common::{forkbench, repo_root, s, tmp_in};
+use crate::common::{forkbench, repo_root, s, text, tmp_in};
 
 fn tmp(name: &str) -> PathBuf {
     tmp_in("forkbench-components", name)
-}
-
-fn text(o: &std::process::Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 /// A folder holding stanley.py and a components file defining it as `stan`.

@@ -3,18 +3,10 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::common::{forkbench, s, tmp_in};
+use crate::common::{forkbench, s, text, tmp_in};
 
 fn tmp(name: &str) -> PathBuf {
     tmp_in("forkbench-hostile4", name)
-}
-
-fn text(o: &std::process::Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 /// `forkbench args`, which must exit 1 (bad input) or 2 (clap's usage error) at once,
