@@ -101,3 +101,45 @@ fn a_components_file_beside_a_scenario_comes_with_it() {
         text(&o)
     );
 }
+
+/// A detector defined by name in a components file is what `detect --detector NAME`
+/// runs; an unknown name is refused, naming where names come from.
+#[test]
+fn detect_runs_a_detector_defined_by_name() {
+    let dir = tmp("detector");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let file = dir.join("components.toml");
+    std::fs::write(&file, "[[detector]]\nname = \"fit\"\nkind = \"face_fit\"\n").expect("write");
+    let mcap = dir.join("field.mcap");
+    let field = repo_root().join("scenarios/field-test.toml");
+    let o = forkbench(&[
+        "trial",
+        s(&field),
+        "--no-noise",
+        "--mcap",
+        s(&mcap),
+        "--force",
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
+    let o = forkbench(&[
+        "detect",
+        s(&mcap),
+        "--scenario",
+        s(&field),
+        "--components",
+        s(&file),
+        "--detector",
+        "fit",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("detector fit on"), "{}", text(&o));
+    let o = forkbench(&[
+        "detect",
+        s(&mcap),
+        "--scenario",
+        s(&field),
+        "--detector",
+        "nope",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+}

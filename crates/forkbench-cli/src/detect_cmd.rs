@@ -27,10 +27,14 @@ pub struct DetectArgs {
     /// Scenario (file or embedded name) whose pallet and detector are used.
     #[arg(long, default_value = "field-test")]
     scenario: PathBuf,
-    /// A registered detector kind with its default settings instead of the scenario's
-    /// (`pockets`, `face_fit`), to compare detectors on the same bag.
+    /// A detector instead of the scenario's, to compare detectors on the same bag: one a
+    /// components file defines by name, or a registered kind with its default settings
+    /// (`pockets`, `face_fit`).
     #[arg(long)]
     detector: Option<String>,
+    /// Detectors (and planners, trackers) defined by name (`[[detector]]` tables).
+    #[arg(long, value_name = "FILE")]
+    components: Option<PathBuf>,
     /// Give faces in FRAME (e.g. map), placing each scan through the file's /tf and
     /// /tf_static; default: each scan's own frame_id.
     #[arg(long)]
@@ -103,7 +107,10 @@ struct Tally {
 /// Runs `forkbench detect`: reads, detects, writes the lines, scores, prints.
 pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     let (gate, labels) = a.check()?;
-    let scn = forkbench_trial::defaults::load_scenario(&a.scenario)?;
+    let scn = crate::with_components(
+        forkbench_trial::defaults::load_scenario(&a.scenario)?,
+        a.components.as_deref(),
+    )?;
     let (name, mut detector) = build_detector(a, &scn)?;
     let opts = DetectOptions {
         topics: a.topic.clone(),
@@ -168,7 +175,12 @@ fn build_detector(
 ) -> anyhow::Result<(String, Box<dyn forkbench_sensors::detector::PalletDetector>)> {
     Ok(match &a.detector {
         Some(kind) => {
-            let spec = ComponentSpec::of_kind(Role::Detector, kind);
+            let spec = scn
+                .named()
+                .iter()
+                .find(|s| s.role == Role::Detector && &s.name == kind)
+                .cloned()
+                .unwrap_or_else(|| ComponentSpec::of_kind(Role::Detector, kind));
             let d = scn
                 .registry
                 .detector(&spec)

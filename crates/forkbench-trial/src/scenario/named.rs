@@ -1,4 +1,4 @@
-//! A components file: external (or configured built-in) planners and trackers defined once by name, usable with `--planner` / `--tracker` on any scenario.
+//! A components file: external (or configured built-in) planners, trackers and detectors defined once by name, usable with `--planner` / `--tracker` on any scenario and `detect --detector`.
 
 use std::path::Path as FsPath;
 use std::sync::Arc;
@@ -22,11 +22,13 @@ struct NamedFile {
     planner: Vec<toml::Spanned<toml::Value>>,
     #[serde(default)]
     tracker: Vec<toml::Spanned<toml::Value>>,
+    #[serde(default)]
+    detector: Vec<toml::Spanned<toml::Value>>,
 }
 
-/// The components `path` defines (`[[planner]]` and `[[tracker]]` tables, each with a
-/// `name` and a `kind`), each checked against `registry`; external commands run in the
-/// file's directory. Errors name the file, line and field.
+/// The components `path` defines (`[[planner]]`, `[[tracker]]` and `[[detector]]` tables,
+/// each with a `name` and a `kind`), each checked against `registry`; external commands
+/// run in the file's directory. Errors name the file, line and field.
 pub fn load_components(
     path: &FsPath,
     registry: &Registry,
@@ -36,7 +38,12 @@ pub fn load_components(
     let f: NamedFile = super::parse(&text, &file)?;
     let dir = forkbench_plan::external::dir_of(path);
     let mut out: Vec<ComponentSpec> = Vec::new();
-    for (role, list) in [(Role::Planner, &f.planner), (Role::Tracker, &f.tracker)] {
+    let roles = [
+        (Role::Planner, &f.planner),
+        (Role::Tracker, &f.tracker),
+        (Role::Detector, &f.detector),
+    ];
+    for (role, list) in roles {
         for (i, v) in list.iter().enumerate() {
             let line = text[..v.span().start.min(text.len())]
                 .lines()
