@@ -143,3 +143,34 @@ fn detect_runs_a_detector_defined_by_name() {
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
 }
+
+/// A batch run with `--components` replays with the same file.
+#[test]
+fn a_trial_of_a_defined_tracker_replays_with_its_components_file() {
+    let (file, _) = components("replay");
+    let field = repo_root().join("scenarios/field-test.toml");
+    let out = tmp("replay-out");
+    let o = forkbench(&[
+        "batch",
+        s(&field),
+        "--components",
+        s(&file),
+        "--tracker",
+        "stan",
+        "--trials",
+        "1",
+        "--record",
+        "none",
+        "--force-new",
+        "--out",
+        s(&out),
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
+    let records = out.join("trials.jsonl");
+    let o = forkbench(&["replay", s(&records), "--components", s(&file)]);
+    assert!(
+        text(&o).contains("identical to the recorded outcome"),
+        "{}",
+        text(&o)
+    );
+}

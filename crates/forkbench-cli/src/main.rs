@@ -204,6 +204,9 @@ enum Command {
         /// Scenario file the trial came from (default: the embedded scenario of that name).
         #[arg(long)]
         scenario: Option<PathBuf>,
+        /// The components file the batch ran with (`batch --components FILE`).
+        #[arg(long, value_name = "FILE")]
+        components: Option<PathBuf>,
         #[command(flatten)]
         record: RecordFlags,
     },
@@ -347,9 +350,11 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
             file,
             line,
             scenario,
+            components,
             record,
         } => {
-            let ok = replay_cmd::replay(&file, line, scenario.as_deref(), &record.args())?;
+            let from = (scenario.as_deref(), components.as_deref());
+            let ok = replay_cmd::replay(&file, line, from, &record.args())?;
             Ok(if ok { Done::Ok } else { Done::PickFailed })
         }
         Command::Plan(args) => match args.route()? {

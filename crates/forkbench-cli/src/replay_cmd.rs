@@ -9,13 +9,14 @@ use anyhow::{Context as _, bail};
 pub fn replay(
     file: &Path,
     line: usize,
-    scenario: Option<&Path>,
+    (scenario, components): (Option<&Path>, Option<&Path>),
     rec: &forkbench_log::RecordTargets,
 ) -> anyhow::Result<bool> {
     if line == 0 {
         bail!("--line 0: lines are numbered from 1");
     }
-    let job = forkbench_batch::Replay::load(file, line, scenario)?;
+    let mut job = forkbench_batch::Replay::load(file, line, scenario)?;
+    job.scenario = crate::with_components(job.scenario, components)?;
     let opts = job.options();
     let run = job.scenario.resolve(&opts)?;
     let r = forkbench_log::run_recorded((&job.scenario, job.case()?), (&opts, &run), rec)?;
