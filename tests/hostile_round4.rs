@@ -375,3 +375,55 @@ fn batch_junit_never_replaces_an_input() {
     );
     assert_eq!(std::fs::read_to_string(&scn).expect("kept"), before);
 }
+
+/// `detect` reports each located face's evidence score and counts the faces its
+/// threshold turned down; `--min-score` is range-checked. (Turning faces down is
+/// measured on simulated façades in `sensors/src/evidence.rs`.)
+#[test]
+fn detect_reports_the_evidence_score_and_applies_its_threshold() {
+    let field = crate::common::repo_root().join("scenarios/field-test.toml");
+    let mcap = tmp("evidence.mcap");
+    let o = forkbench(&[
+        "trial",
+        s(&field),
+        "--no-noise",
+        "--mcap",
+        s(&mcap),
+        "--force",
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
+    let lines = tmp("evidence.jsonl");
+    let run = |min: &str| {
+        forkbench(&[
+            "detect",
+            s(&mcap),
+            "--scenario",
+            s(&field),
+            "--min-score",
+            min,
+            "--out",
+            s(&lines),
+            "--json",
+        ])
+    };
+    let o = run("0.5");
+    assert!(o.status.success(), "{}", text(&o));
+    let first: serde_json::Value = serde_json::from_str(
+        std::fs::read_to_string(&lines)
+            .expect("lines")
+            .lines()
+            .next()
+            .expect("a line"),
+    )
+    .expect("json");
+    let score = first["score"].as_f64().expect("a score");
+    assert!(first["found"] == true && score > 0.5, "{first}");
+    // The summary counts what the threshold turned down (none of a simulated face).
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("summary");
+    assert_eq!(
+        (v["found"].as_u64(), v["rejected"].as_u64()),
+        (Some(1), Some(0)),
+        "{v}"
+    );
+    refused(&["detect", s(&mcap), "--min-score", "1.5"], "--min-score");
+}

@@ -32,6 +32,11 @@ pub struct DetectArgs {
     /// (`pockets`, `face_fit`).
     #[arg(long)]
     detector: Option<String>,
+    /// Least evidence score (0–1) a located face needs to count as a pallet: its parts
+    /// return at the face, the beams through its pockets go deeper, nothing stands in
+    /// front. 0 reports every located face.
+    #[arg(long, default_value_t = forkbench_log::detect::DEFAULT_MIN_SCORE)]
+    min_score: f64,
     /// Detectors (and planners, trackers) defined by name (`[[detector]]` tables).
     #[arg(long, value_name = "FILE")]
     components: Option<PathBuf>,
@@ -72,6 +77,9 @@ impl DetectArgs {
         if !(self.match_deg > 0.0 && self.match_deg <= 180.0) {
             bail!("--match-deg {}: from 0 (excluded) to 180°", self.match_deg);
         }
+        if !(0.0..=1.0).contains(&self.min_score) {
+            bail!("--min-score {}: from 0 to 1", self.min_score);
+        }
         if let Some(p) = &self.prior {
             let lim = forkbench_trial::scenario::MAX_WORLD_EXTENT_M;
             if !(p.x_m.abs() <= lim && p.y_m.abs() <= lim && p.heading_rad.is_finite()) {
@@ -101,6 +109,8 @@ struct Tally {
     results: Vec<Option<Pose2>>,
     errors: Vec<String>,
     found: usize,
+    /// Located faces the evidence turned down.
+    rejected: usize,
     seconds: f64,
 }
 
@@ -116,6 +126,7 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
         topics: a.topic.clone(),
         frame: a.frame.clone(),
         prior: a.prior,
+        min_score: a.min_score,
     };
     if let Some(out) = &a.out {
         forkbench_core::files::check_not_input(out, std::slice::from_ref(&a.bag))?;
@@ -125,6 +136,7 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
         results: Vec::new(),
         errors: Vec::new(),
         found: 0,
+        rejected: 0,
         seconds: 0.0,
     };
     let mut write_error = None;
@@ -234,6 +246,7 @@ fn take(
 ) {
     tally.results.push(r.face);
     tally.found += usize::from(r.found);
+    tally.rejected += usize::from(r.rejected.is_some());
     if let Some(e) = &r.error {
         tally
             .errors
@@ -262,6 +275,8 @@ fn line(r: &ScanResult) -> serde_json::Value {
         "points": r.points,
         "rms_m": r.rms_m,
         "stringers": r.stringers,
+        "score": r.score,
+        "rejected": r.rejected.map(|f| json!({"x_m": f.x_m, "y_m": f.y_m, "heading_deg": f.heading_rad.to_degrees()})),
         "error": r.error,
     })
 }
@@ -283,6 +298,8 @@ fn report(
             "scan_topics": summary.scan_topics,
             "scans": n,
             "found": t.found,
+            "rejected": t.rejected,
+            "min_score": a.min_score,
             "unusable": t.errors.len(),
             "bad_transforms": summary.bad_transforms,
             "seconds": t.seconds,
@@ -305,6 +322,12 @@ fn report(
         t.errors.len(),
         t.seconds,
     );
+    if t.rejected > 0 {
+        s += &format!(
+            "{} located faces turned down by the scan's evidence (score below {}: parts, pockets or the space in front disagree)\n",
+            t.rejected, a.min_score
+        );
+    }
     if let Some(sc) = scores {
         s += &forkbench_report::detect::scores_text(sc);
     }

@@ -20,7 +20,14 @@ pub struct DetectOptions {
     pub frame: Option<String>,
     /// Where the pallet should be, in that frame.
     pub prior: Option<Pose2>,
+    /// Least evidence score (`forkbench_sensors::evidence`) a located face needs to be
+    /// reported found: below it the scan says there is no pallet there.
+    pub min_score: f64,
 }
+
+/// The default `min_score`: a face whose parts, pockets and front agree with the scan
+/// at least half-way (a choice; a wall or a rack's uprights score near 0).
+pub const DEFAULT_MIN_SCORE: f64 = 0.5;
 
 /// One scan and what the detector made of it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,6 +50,11 @@ pub struct ScanResult {
     pub stringers: Option<usize>,
     /// Why the scan could not be used (malformed, or not placeable in the frame).
     pub error: Option<String>,
+    /// The evidence score of the face the detector located (also when it fell below
+    /// `min_score` and the scan counts as no pallet).
+    pub score: Option<f64>,
+    /// A located face the evidence turned down.
+    pub rejected: Option<Pose2>,
 }
 
 /// Why a run stopped early: the detector could not answer, or the file could not be read
@@ -124,6 +136,8 @@ fn blank(index: usize, topic: String, error: Option<String>) -> ScanResult {
         rms_m: None,
         stringers: None,
         error,
+        score: None,
+        rejected: None,
     }
 }
 
@@ -154,9 +168,16 @@ fn one(
             }
         }
     }
-    let found = detect_in(detector, &[(s.topic.as_str(), scan)], pallet, opts.prior)?;
+    let scans = [(s.topic.as_str(), scan)];
+    let found = detect_in(detector, &scans, pallet, opts.prior)?;
     if let Some(f) = found {
         let d = f.detection;
+        let ev = forkbench_sensors::evidence::face_evidence(&scans[0].1, pallet, &d.face);
+        r.score = Some(ev.score);
+        if ev.score < opts.min_score {
+            r.rejected = Some(d.face);
+            return Ok(r);
+        }
         r.found = true;
         r.face = Some(d.face);
         r.points = Some(d.points);

@@ -2,6 +2,7 @@
 
 pub mod detect;
 pub mod detector;
+pub mod evidence;
 pub mod external;
 pub mod face_fit;
 pub mod localizer;
