@@ -1,6 +1,6 @@
 //! External components defined once: a components file names a tracker usable with `--tracker` on any scenario (and one beside a scenario comes with it), and a batch's manifest fingerprints its script, so a resume after an edit is refused, naming the file.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::common::{forkbench, repo_root, s, text, tmp_in};
 
@@ -23,29 +23,33 @@ fn components(folder: &str) -> (PathBuf, PathBuf) {
     (file, script)
 }
 
+/// The field test batched with `stan` from the components `file` into `out`.
+fn stan_batch(file: &Path, out: &Path, trials: &str, extra: &[&str]) -> std::process::Output {
+    let field = repo_root().join("scenarios/field-test.toml");
+    let mut args = vec![
+        "batch",
+        s(&field),
+        "--components",
+        s(file),
+        "--tracker",
+        "stan",
+        "--trials",
+        trials,
+        "--record",
+        "none",
+        "--out",
+        s(out),
+    ];
+    args.extend_from_slice(extra);
+    forkbench(&args)
+}
+
 #[test]
 fn a_tracker_defined_once_runs_on_any_scenario_and_an_edited_script_refuses_a_resume() {
     let (file, script) = components("resume");
     let field = repo_root().join("scenarios/field-test.toml");
     let out = tmp("resume-out");
-    let batch = |extra: &[&str]| {
-        let mut args = vec![
-            "batch",
-            s(&field),
-            "--components",
-            s(&file),
-            "--tracker",
-            "stan",
-            "--trials",
-            "2",
-            "--record",
-            "none",
-            "--out",
-            s(&out),
-        ];
-        args.extend_from_slice(extra);
-        forkbench(&args)
-    };
+    let batch = |extra: &[&str]| stan_batch(&file, &out, "2", extra);
     let first = batch(&["--force-new"]);
     assert!(
         matches!(first.status.code(), Some(0 | 3)),
@@ -148,23 +152,8 @@ fn detect_runs_a_detector_defined_by_name() {
 #[test]
 fn a_trial_of_a_defined_tracker_replays_with_its_components_file() {
     let (file, _) = components("replay");
-    let field = repo_root().join("scenarios/field-test.toml");
     let out = tmp("replay-out");
-    let o = forkbench(&[
-        "batch",
-        s(&field),
-        "--components",
-        s(&file),
-        "--tracker",
-        "stan",
-        "--trials",
-        "1",
-        "--record",
-        "none",
-        "--force-new",
-        "--out",
-        s(&out),
-    ]);
+    let o = stan_batch(&file, &out, "1", &["--force-new"]);
     assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
     let records = out.join("trials.jsonl");
     let o = forkbench(&["replay", s(&records), "--components", s(&file)]);

@@ -167,17 +167,21 @@ fn a_changed_setting_keeps_the_gate_paired() {
 fn compare_pairs_a_candidate_run_apart_with_what_you_ship() {
     let shipped = batch("cmp-shipped", "pure_pursuit", &[]);
     let cand = batch("cmp-cand", "pure_pursuit_compensated", &[]);
-    let o = forkbench(&[
-        "compare",
-        s(&cand),
-        "--a",
-        "pure_pursuit_compensated",
-        "--b",
-        "pure_pursuit",
-        "--b-from",
-        s(&shipped),
-        "--json",
-    ]);
+    let compare = |shipped: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "compare",
+            s(&cand),
+            "--a",
+            "pure_pursuit_compensated",
+            "--b",
+            "pure_pursuit",
+            "--b-from",
+            s(shipped),
+        ];
+        args.extend_from_slice(extra);
+        forkbench(&args)
+    };
+    let o = compare(&shipped, &["--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
     let pairs: u64 = v["rows"]
@@ -188,16 +192,7 @@ fn compare_pairs_a_candidate_run_apart_with_what_you_ship() {
         .sum();
     assert_eq!(pairs, 12, "{v}");
     let other = batch("cmp-seed", "pure_pursuit", &["--seed", "9"]);
-    let o = forkbench(&[
-        "compare",
-        s(&cand),
-        "--a",
-        "pure_pursuit_compensated",
-        "--b",
-        "pure_pursuit",
-        "--b-from",
-        s(&other),
-    ]);
+    let o = compare(&other, &[]);
     assert_eq!(o.status.code(), Some(1));
     assert!(
         String::from_utf8_lossy(&o.stderr).contains("cannot be paired"),

@@ -85,6 +85,9 @@ fn mode_of(name: &str) -> Option<bool> {
     }
 }
 
+/// Records with their 1-based lines in `trials.jsonl`.
+type Numbered<'a> = &'a [(usize, TrialRecord)];
+
 /// The trials of one side, keyed by everything but what the sides differ in.
 fn side<'a>(
     records: &'a [(usize, TrialRecord)],
@@ -119,14 +122,16 @@ fn side<'a>(
         .collect()
 }
 
-/// What A and B are of this batch: planners, trackers, or the two replanning modes.
-fn kind_of(records: &[(usize, TrialRecord)], a: &str, b: &str) -> Result<Axis, BatchError> {
-    let planners: BTreeSet<&str> = records
+/// What A and B are of these batches: planners, trackers, or the two replanning modes.
+fn kind_of((ra, rb): (Numbered<'_>, Numbered<'_>), a: &str, b: &str) -> Result<Axis, BatchError> {
+    let planners: BTreeSet<&str> = ra
         .iter()
+        .chain(rb)
         .map(|(_, r)| r.outcome.planner.as_str())
         .collect();
-    let trackers: BTreeSet<&str> = records
+    let trackers: BTreeSet<&str> = ra
         .iter()
+        .chain(rb)
         .map(|(_, r)| r.outcome.tracker.as_str())
         .collect();
     if a == b {
@@ -211,9 +216,21 @@ pub fn compare(
     b: &str,
     o: &CompareOptions,
 ) -> Result<CompareReport, BatchError> {
+    compare_apart((records, records), a, b, o)
+}
+
+/// [`compare`] with A's trials taken from `ra` and B's from `rb`: two batches of one
+/// batch seed and seed scheme (a candidate run apart from what is shipped) run the same
+/// trials at the same keys.
+pub fn compare_apart(
+    (ra, rb): (Numbered<'_>, Numbered<'_>),
+    a: &str,
+    b: &str,
+    o: &CompareOptions,
+) -> Result<CompareReport, BatchError> {
     crate::check_alpha(o.alpha)?;
-    let axis = kind_of(records, a, b)?;
-    let (sa, sb) = (side(records, a, axis), side(records, b, axis));
+    let axis = kind_of((ra, rb), a, b)?;
+    let (sa, sb) = (side(ra, a, axis), side(rb, b, axis));
     let (counts, discordant, paired) = tally(&sa, &sb, (a, b));
     let kind = match axis {
         Axis::Planner => "planner",

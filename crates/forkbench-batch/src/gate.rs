@@ -169,20 +169,7 @@ fn unpaired_reason(base: &Baseline, now: Option<&Manifest>) -> Option<String> {
     let Some(now) = now else {
         return Some("the results have no manifest.json, so their batch seed is unknown".into());
     };
-    let mut why = Vec::new();
-    if then.seed != now.seed {
-        why.push(format!(
-            "batch seed {} ≠ the baseline's {}",
-            now.seed, then.seed
-        ));
-    }
-    if then.seed_scheme != now.seed_scheme {
-        why.push(format!(
-            "trial seeds derived by scheme {} ≠ the baseline's {}",
-            now.seed_scheme, then.seed_scheme
-        ));
-    }
-    (!why.is_empty()).then(|| why.join("; "))
+    now.seed_difference(then, "the baseline")
 }
 
 /// Trials at the same key as a baseline trial but another seed: records edited, or made

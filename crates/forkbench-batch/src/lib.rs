@@ -41,7 +41,7 @@ mod verdicts;
 pub use baseline::{Baseline, BaselineRow, BaselineTrial, MAX_BASELINE_BYTES};
 pub use candidate::{Mapping, map_components};
 pub use case_grid::{CaseCells, ErrorGroup, case_grids, error_groups};
-pub use compare::{CompareOptions, CompareReport, CompareRow, Discordant, compare};
+pub use compare::{CompareOptions, CompareReport, CompareRow, Discordant, compare, compare_apart};
 pub use export::write_csv;
 pub use gate::{
     DEFAULT_ALPHA, GateOptions, GateReport, PairCounts, Pairing, RegressRow, Verdict,

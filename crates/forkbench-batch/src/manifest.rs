@@ -212,6 +212,26 @@ impl Manifest {
         super::write_atomic(&path, (text + "\n").as_bytes())
     }
 
+    /// Why this batch's trials are not `other`'s (named `other_name`) at the same keys:
+    /// another batch seed, or trial seeds derived by another scheme; `None` when they
+    /// are, whatever else changed (a trial's seed depends on nothing else).
+    pub fn seed_difference(&self, other: &Manifest, other_name: &str) -> Option<String> {
+        let mut why = Vec::new();
+        if other.seed != self.seed {
+            why.push(format!(
+                "batch seed {} ≠ {other_name}'s {}",
+                self.seed, other.seed
+            ));
+        }
+        if other.seed_scheme != self.seed_scheme {
+            why.push(format!(
+                "trial seeds derived by scheme {} ≠ {other_name}'s {}",
+                self.seed_scheme, other.seed_scheme
+            ));
+        }
+        (!why.is_empty()).then(|| why.join("; "))
+    }
+
     /// Where two manifests differ, as `field: ours → theirs` lines (paths into the JSON;
     /// scenario files' paths are left out, their content is compared).
     pub fn differences(&self, other: &Manifest) -> Vec<String> {

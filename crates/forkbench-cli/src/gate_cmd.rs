@@ -172,7 +172,7 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
     Ok(report.passed)
 }
 
-/// `forkbench compare`: A against B in one batch, pair by pair.
+/// `forkbench compare`: A against B in one batch (or B from another), pair by pair.
 pub fn compare(a: &CompareArgs) -> anyhow::Result<()> {
     let trials = |dir: &Path| -> anyhow::Result<PathBuf> {
         let file = dir.join("trials.jsonl");
@@ -182,40 +182,33 @@ pub fn compare(a: &CompareArgs) -> anyhow::Result<()> {
         Ok(file)
     };
     let file = trials(&a.results)?;
-    let mut records = batch::read_numbered(&file)?;
-    let mut label = file.display().to_string();
-    if let Some(other) = &a.b_from {
-        let file_b = trials(other)?;
-        same_seeds(&a.results, other)?;
-        let named = |r: &batch::TrialRecord, n: &str| {
-            r.outcome.planner == n || r.outcome.tracker == n || mode_of(r) == n
-        };
-        records.retain(|(_, r)| named(r, &a.a));
-        records.extend(
-            batch::read_numbered(&file_b)?
-                .into_iter()
-                .filter(|(_, r)| named(r, &a.b)),
-        );
-        label = format!("{label} (line A) / {} (line B)", file_b.display());
-    }
+    let records = batch::read_numbered(&file)?;
     let o = CompareOptions {
         alpha: a.alpha,
         correction: a.correction.into(),
     };
-    let report = batch::compare(&records, &a.a, &a.b, &o)?;
+    let (report, label) = match &a.b_from {
+        None => (
+            batch::compare(&records, &a.a, &a.b, &o)?,
+            file.display().to_string(),
+        ),
+        Some(other) => {
+            let file_b = trials(other)?;
+            same_seeds(&a.results, other)?;
+            let records_b = batch::read_numbered(&file_b)?;
+            let report = batch::compare_apart((&records, &records_b), &a.a, &a.b, &o)?;
+            let label = format!(
+                "{} (line A) / {} (line B)",
+                file.display(),
+                file_b.display()
+            );
+            (report, label)
+        }
+    };
     if a.json {
         return crate::emit(&format!("{}\n", serde_json::to_string(&report)?));
     }
     crate::emit(&report.markdown(&label))
-}
-
-/// A record's replanning mode as `compare` names it.
-fn mode_of(r: &batch::TrialRecord) -> &'static str {
-    if r.replan.unwrap_or(false) {
-        "replan"
-    } else {
-        "plan_once"
-    }
 }
 
 /// Two batches pair trial by trial only when their seeds come from the same batch seed
@@ -227,16 +220,11 @@ fn same_seeds(a: &Path, b: &Path) -> anyhow::Result<()> {
         })
     };
     let (ma, mb) = (read(a)?, read(b)?);
-    if (ma.seed, ma.seed_scheme) != (mb.seed, mb.seed_scheme) {
+    if let Some(why) = ma.seed_difference(&mb, &b.display().to_string()) {
         bail!(
-            "{} ran with batch seed {} (scheme {}) and {} with {} (scheme {}): their trials are \
-             not the same trials, so they cannot be paired; run both with the same --seed",
-            a.display(),
-            ma.seed,
-            ma.seed_scheme,
-            b.display(),
-            mb.seed,
-            mb.seed_scheme
+            "{}: {why}; their trials are not the same trials, so they cannot be paired; run \
+             both with the same --seed",
+            a.display()
         );
     }
     Ok(())

@@ -100,7 +100,7 @@ pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence
     let frac = |k: usize, n: usize| if n == 0 { 1.0 } else { k as f64 / n as f64 };
     e.score = frac(e.part_hits, e.part_beams)
         * frac(e.pocket_through, e.pocket_beams)
-        * (1.0 - frac(e.blocked, across.max(1)).min(1.0) * f64::from(u8::from(across > 0)));
+        * (1.0 - e.blocked as f64 / across.max(1) as f64);
     e
 }
 

@@ -1,7 +1,6 @@
 //! A components file: external (or configured built-in) planners, trackers and detectors defined once by name, usable with `--planner` / `--tracker` on any scenario and `detect --detector`.
 
 use std::path::Path as FsPath;
-use std::sync::Arc;
 
 use serde::Deserialize;
 
@@ -96,7 +95,7 @@ impl Scenario {
 
     /// [`Scenario::with_named`] with the components of the file at `path`.
     pub fn with_components_file(self, path: &FsPath) -> Result<Self, TrialError> {
-        let named = load_components(path, &Arc::clone(&self.registry))?;
+        let named = load_components(path, &self.registry)?;
         Ok(self.with_named(named))
     }
 
