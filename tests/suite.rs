@@ -3,6 +3,7 @@
 mod cli;
 mod common;
 mod components_file;
+mod dataset;
 mod external_planner;
 mod external_tracker;
 mod gate_candidate;

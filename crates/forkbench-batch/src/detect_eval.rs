@@ -11,13 +11,21 @@ use crate::stats::percentile_sorted;
 
 /// What is true of one scan: whether the pallet is in it, and where its face is (in the
 /// frame the detections are given in), when known.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Label {
     pub index: usize,
     pub present: bool,
     #[serde(default)]
     pub face: Option<LabelFace>,
+    /// The pallet's kind, as `forkbench dataset` writes it (read by people and learning
+    /// code, not by the scoring).
+    #[serde(default)]
+    pub kind: Option<serde::de::IgnoredAny>,
+    /// The scene's clutter kinds, as `forkbench dataset` writes them: the scores are
+    /// also given per kind.
+    #[serde(default)]
+    pub clutter: Vec<String>,
 }
 
 /// A labelled face: centre and heading into the pallet (degrees at the interface).
@@ -39,6 +47,11 @@ impl LabelFace {
 #[serde(deny_unknown_fields)]
 struct LabelFile {
     scans: Vec<Label>,
+    /// What `forkbench dataset` records of the set: its settings and the faces' frame.
+    #[serde(default, rename = "dataset")]
+    _dataset: Option<serde::de::IgnoredAny>,
+    #[serde(default, rename = "frame")]
+    _frame: Option<serde::de::IgnoredAny>,
 }
 
 /// The labels of a JSON file `{"scans": [{"index": 0, "present": true, "face": {"x_m": …,
@@ -61,8 +74,12 @@ pub fn parse_labels(text: &str, file: &str) -> Result<BTreeMap<usize, Label>, Ba
                 return Err(bad(format!("scan {}: a face but present false", l.index)));
             }
         }
-        if out.insert(l.index, l).is_some() {
-            return Err(bad(format!("scan {} is labelled twice", l.index)));
+        if l.clutter.len() > 1024 {
+            return Err(bad(format!("scan {}: over 1,024 clutter items", l.index)));
+        }
+        let index = l.index;
+        if out.insert(index, l).is_some() {
+            return Err(bad(format!("scan {index} is labelled twice")));
         }
     }
     Ok(out)
@@ -111,6 +128,8 @@ pub struct Scores {
     pub true_negatives: usize,
     pub precision: Option<f64>,
     pub recall: Option<f64>,
+    /// Scans answered right (found right or rightly empty) over the labelled ones.
+    pub accuracy: Option<f64>,
     /// Over matches whose label has a face.
     pub lateral_error_m: Option<Spread>,
     pub depth_error_m: Option<Spread>,
@@ -153,6 +172,7 @@ pub fn score(found: &[Option<Pose2>], labels: &BTreeMap<usize, Label>, gate: Gat
         true_negatives: tn,
         precision: ratio(tp, fp),
         recall: ratio(tp, fneg),
+        accuracy: ratio(tp + tn, labelled - tp - tn),
         lateral_error_m: spread(&errs[0]),
         depth_error_m: spread(&errs[1]),
         heading_error_rad: spread(&errs[2]),
@@ -175,6 +195,8 @@ mod tests {
                 index,
                 present,
                 face,
+                kind: None,
+                clutter: Vec::new(),
             },
         )
     }
@@ -217,6 +239,7 @@ mod tests {
         );
         assert_eq!(s.precision, Some(1.0 / 3.0));
         assert_eq!(s.recall, Some(1.0 / 3.0));
+        assert_eq!(s.accuracy, Some(2.0 / 5.0));
         let lat = s.lateral_error_m.expect("one match");
         assert!((lat.median - 0.01).abs() < 1e-12, "{lat:?}");
         let e = parse_labels(

@@ -14,6 +14,7 @@ mod candidate;
 mod case_grid;
 mod checks;
 mod compare;
+pub mod detect_curve;
 pub mod detect_eval;
 mod export;
 mod gate;

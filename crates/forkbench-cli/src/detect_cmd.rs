@@ -5,6 +5,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context as _, bail};
+use forkbench_batch::detect_curve::{
+    ByPlace, ClutterScore, CurvePoint, by_clutter, by_place, curve,
+};
 use forkbench_batch::detect_eval::{Gate, Label, Scores, parse_labels, score};
 use forkbench_core::Pose2;
 use forkbench_core::files::AtomicWriter;
@@ -67,6 +70,10 @@ pub struct DetectArgs {
     /// Draw the labelled scans' errors to FILE (.svg or .png; needs --labels).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// Draw precision, recall and false positives over the score threshold, and the
+    /// precision-recall curve, to FILE (.svg or .png; needs --labels).
+    #[arg(long)]
+    curve: Option<PathBuf>,
 }
 
 impl DetectArgs {
@@ -86,8 +93,8 @@ impl DetectArgs {
                 bail!("--prior ({}, {}) m: must lie within ±{lim} m", p.x_m, p.y_m);
             }
         }
-        if self.plot.is_some() && self.labels.is_none() {
-            bail!("--plot draws the errors against the labels: give --labels too");
+        if (self.plot.is_some() || self.curve.is_some()) && self.labels.is_none() {
+            bail!("--plot and --curve draw against the labels: give --labels too");
         }
         let labels = match &self.labels {
             Some(f) => {
@@ -104,9 +111,20 @@ impl DetectArgs {
     }
 }
 
+/// The labelled scans' scores: at the threshold asked for, over every threshold, and by
+/// the labelled face's range and bearing.
+struct Scored {
+    at_threshold: Scores,
+    curve: Vec<CurvePoint>,
+    by_place: ByPlace,
+    by_clutter: Vec<ClutterScore>,
+}
+
 /// What the run saw, for the summary.
 struct Tally {
     results: Vec<Option<Pose2>>,
+    /// Each scan's located faces and their scores, for the curve over the threshold.
+    candidates: Vec<Vec<(Pose2, f64)>>,
     errors: Vec<String>,
     found: usize,
     /// Located faces the evidence turned down.
@@ -134,6 +152,7 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     let mut lines = a.out.as_deref().map(AtomicWriter::create).transpose()?;
     let mut tally = Tally {
         results: Vec::new(),
+        candidates: Vec::new(),
         errors: Vec::new(),
         found: 0,
         rejected: 0,
@@ -158,9 +177,17 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     });
     let summary = summary.with_context(|| format!("after {} scans", tally.results.len()))?;
     check_topics(a, &summary)?;
-    let scores = labels.as_ref().map(|l| score(&tally.results, l, gate));
+    let scores = labels.as_ref().map(|l| Scored {
+        at_threshold: score(&tally.results, l, gate),
+        curve: curve(&tally.candidates, l, gate),
+        by_place: by_place(&tally.results, l, gate),
+        by_clutter: by_clutter(&tally.results, l, gate),
+    });
     if let (Some(file), Some(l)) = (&a.plot, &labels) {
         forkbench_report::detect::draw(file, &tally.results, l)?;
+    }
+    if let (Some(file), Some(s)) = (&a.curve, &scores) {
+        forkbench_report::detect_curve::draw(file, &s.curve, a.min_score)?;
     }
     report(a, &name, &summary, &tally, scores.as_ref())?;
     if !tally.errors.is_empty() {
@@ -245,6 +272,7 @@ fn take(
     write_error: &mut Option<anyhow::Error>,
 ) {
     tally.results.push(r.face);
+    tally.candidates.push(r.candidates.clone());
     tally.found += usize::from(r.found);
     tally.rejected += usize::from(r.rejected.is_some());
     if let Some(e) = &r.error {
@@ -286,7 +314,7 @@ fn report(
     detector: &str,
     summary: &BagSummary,
     t: &Tally,
-    scores: Option<&Scores>,
+    scores: Option<&Scored>,
 ) -> anyhow::Result<()> {
     let n = t.results.len();
     let rate = n as f64 / t.seconds.max(1e-9);
@@ -304,7 +332,10 @@ fn report(
             "bad_transforms": summary.bad_transforms,
             "seconds": t.seconds,
             "scans_per_s": rate,
-            "scores": scores,
+            "scores": scores.map(|s| &s.at_threshold),
+            "curve": scores.map(|s| &s.curve),
+            "by_place": scores.map(|s| &s.by_place),
+            "by_clutter": scores.map(|s| &s.by_clutter),
         });
         return crate::emit(&format!("{v}\n"));
     }
@@ -329,7 +360,10 @@ fn report(
         );
     }
     if let Some(sc) = scores {
-        s += &forkbench_report::detect::scores_text(sc);
+        s += &forkbench_report::detect::scores_text(&sc.at_threshold);
+        s += &forkbench_report::detect_curve::curve_text(&sc.curve, a.min_score);
+        s += &forkbench_report::detect_curve::by_place_text(&sc.by_place);
+        s += &forkbench_report::detect_curve::by_clutter_text(&sc.by_clutter);
     }
     crate::emit(&s)
 }

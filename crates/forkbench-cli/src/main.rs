@@ -7,6 +7,7 @@ pub(crate) use out::{emit, emit_json_line};
 mod check_cmd;
 mod corridor_cmd;
 mod coverage_cmd;
+mod dataset_cmd;
 mod detect_cmd;
 mod gate_cmd;
 mod map_cmd;
@@ -260,6 +261,9 @@ enum Command {
     /// forkbench MCAP): a JSON line per scan, a summary, and with --labels precision,
     /// recall and face-pose errors (exit 1 when a scan was unusable, after the rest).
     Detect(detect_cmd::DetectArgs),
+    /// Labelled scans on demand: randomised scenes (a pallet or none, clutter) as a ROS 2
+    /// bag and the labels detect --labels reads, to train or score a detector.
+    Dataset(dataset_cmd::DatasetArgs),
     /// Reflector coverage of a world: reflectors in sight and the NAV350 fix's predicted
     /// 1σ at every free cell.
     Coverage(coverage_cmd::CoverageArgs),
@@ -375,6 +379,7 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Scan(args) => scan_cmd::run(&args).map(|()| Done::Ok),
         Command::Coverage(args) => coverage_cmd::run(&args).map(|()| Done::Ok),
         Command::Detect(args) => detect_cmd::run(&args).map(|()| Done::Ok),
+        Command::Dataset(args) => dataset_cmd::run(&args).map(|()| Done::Ok),
         Command::Check(args) => check_cmd::run(&args).map(|()| Done::Ok),
         Command::SafetyFields(args) => safety_cmd::run(&args).map(|()| Done::Ok),
         Command::Identify(args) => truck_cmd::identify(&args).map(|()| Done::Ok),

@@ -9,6 +9,8 @@ pub mod coverage;
 #[cfg(feature = "figures")]
 pub mod detect;
 #[cfg(feature = "figures")]
+pub mod detect_curve;
+#[cfg(feature = "figures")]
 pub mod figure;
 pub mod html;
 #[cfg(feature = "figures")]

@@ -222,6 +222,22 @@ pub fn detect(
     pallet: &PalletSpec,
     prior: Option<&Pose2>,
 ) -> Option<Detection> {
+    detect_ranked(cfg, scan, pallet, prior).into_iter().next()
+}
+
+/// Most faces [`detect_ranked`] gives: a cluttered scan has many spacings that fit, and
+/// each further one costs the evidence stage a pass over the scan.
+pub const MAX_CANDIDATES: usize = 24;
+
+/// Every face the scan's stringer-like pieces could make, the one [`detect`] picks first
+/// and the rest in the same order of preference, faces within a centimetre and a
+/// hundredth of a radian of a better one left out; at most [`MAX_CANDIDATES`].
+pub fn detect_ranked(
+    cfg: &DetectorConfig,
+    scan: &Scan,
+    pallet: &PalletSpec,
+    prior: Option<&Pose2>,
+) -> Vec<Detection> {
     let (edge_w, spacing) = pallet.edge_part_m();
     let widths = [edge_w, pallet.centre_part_width_m()];
     let segs: Vec<Segment> = segments(scan, cfg.break_m)
@@ -290,7 +306,22 @@ pub fn detect(
         }
         None => (3 - d.stringers.min(3)) as f64 * 1e6 + d.face.distance_to(&s),
     };
-    found.min_by(|a, b| score(a).total_cmp(&score(b)))
+    let mut ranked: Vec<(f64, Detection)> = found.map(|d| (score(&d), d)).collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out: Vec<Detection> = Vec::new();
+    for (_, d) in ranked {
+        let same = |o: &Detection| {
+            o.face.distance_to(&d.face) < 0.01
+                && wrap_angle(o.face.heading_rad - d.face.heading_rad).abs() < 0.01
+        };
+        if !out.iter().any(same) {
+            out.push(d);
+            if out.len() == MAX_CANDIDATES {
+                break;
+            }
+        }
+    }
+    out
 }
 
 /// Whether a straight piece could be a stringer's face: as wide as one (the returns span

@@ -4,7 +4,7 @@ use forkbench_core::signal::Scan;
 use forkbench_core::{PalletSpec, Pose2};
 use serde::Serialize;
 
-use crate::detect::{Detection, DetectorConfig, detect};
+use crate::detect::{Detection, DetectorConfig, detect, detect_ranked};
 
 /// One sensor's scan, as the truck knows it: `scan.sensor` is the sensor's pose from the
 /// truck's own localisation, so a detection is in the map as the truck believes it.
@@ -30,6 +30,9 @@ pub struct DetectRequest<'a> {
 pub struct Found {
     pub detection: Detection,
     pub sensor: usize,
+    /// The detector's own confidence in [0, 1], when it gives one: the evidence stage
+    /// then takes it in place of the scan's evidence (an external detector's `score`).
+    pub score: Option<f64>,
 }
 
 /// Why a detector could not answer (an external process that hung, crashed or broke the
@@ -47,6 +50,20 @@ pub trait PalletDetector: Send {
 
     /// The pallet's face pose, or `None` when no scan shows it.
     fn detect(&mut self, req: &DetectRequest<'_>) -> Result<Option<Found>, DetectorError>;
+
+    /// Every face the scans could hold, the one `detect` would give first: the evidence
+    /// stage ([`crate::evidence::verified`]) takes the first the scan bears out. A
+    /// detector that locates one face gives it alone (the default).
+    fn candidates(&mut self, req: &DetectRequest<'_>) -> Result<Vec<Found>, DetectorError> {
+        Ok(self.detect(req)?.into_iter().collect())
+    }
+
+    /// The candidate the evidence chose, made final (a model fit refines it there, so
+    /// only one face pays for it). The default keeps it as it is.
+    fn finish(&mut self, req: &DetectRequest<'_>, found: Found) -> Found {
+        let _ = req;
+        found
+    }
 }
 
 /// The built-in pocket detector ([`detect`]) on each scan in turn: the first sensor that
@@ -68,9 +85,31 @@ impl PalletDetector for Pockets {
             detect(&self.cfg, s.scan, req.pallet, req.prior.as_ref()).map(|detection| Found {
                 detection,
                 sensor: i,
+                score: None,
             })
         }))
     }
+
+    fn candidates(&mut self, req: &DetectRequest<'_>) -> Result<Vec<Found>, DetectorError> {
+        Ok(ranked(&self.cfg, req))
+    }
+}
+
+/// The pocket stage's faces in every scan, the first sensor's first.
+pub(crate) fn ranked(cfg: &DetectorConfig, req: &DetectRequest<'_>) -> Vec<Found> {
+    req.scans
+        .iter()
+        .enumerate()
+        .flat_map(|(i, s)| {
+            detect_ranked(cfg, s.scan, req.pallet, req.prior.as_ref())
+                .into_iter()
+                .map(move |detection| Found {
+                    detection,
+                    sensor: i,
+                    score: None,
+                })
+        })
+        .collect()
 }
 
 /// Runs `detector` on named scans (shortest-reaching sensor first): builds the request

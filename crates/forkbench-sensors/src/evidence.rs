@@ -5,6 +5,8 @@ use forkbench_core::pallet::PalletSpec;
 use forkbench_core::signal::Scan;
 use serde::Serialize;
 
+use crate::detector::{DetectRequest, DetectorError, Found, PalletDetector};
+
 /// How much a return may stray from the face line and still be the face: a scanner's
 /// range noise and the face's own unevenness, growing with range (beam divergence).
 const FACE_TOLERANCE_M: f64 = 0.05;
@@ -24,7 +26,8 @@ const MIN_DISCERNIBLE_M: f64 = 0.1;
 /// What the scan says of one face hypothesis.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
 pub struct Evidence {
-    /// The product of the three fractions below: 1 when every beam agrees.
+    /// The product of the three fractions below and the share of the face's parts and
+    /// pockets some beam met: 1 when every beam agrees and each was met.
     pub score: f64,
     /// Beams at the face's parts, and how many returned from the face line.
     pub part_beams: usize,
@@ -36,6 +39,60 @@ pub struct Evidence {
     pub blocked: usize,
 }
 
+/// What the evidence stage made of a request's candidate faces.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Verdict {
+    /// The best-scoring candidate (the detector's order deciding ties), when its score
+    /// reaches the threshold, made final by the detector, with its score.
+    pub chosen: Option<(Found, f64)>,
+    /// Every candidate's face and score in the detector's order, so a threshold other
+    /// than the one asked for can be applied afterwards (a precision-recall curve).
+    pub scored: Vec<(Pose2, f64)>,
+}
+
+impl Verdict {
+    /// The best-scoring candidate (the first of equals) and its score.
+    pub fn best(&self) -> Option<(Pose2, f64)> {
+        best_of(&self.scored)
+    }
+}
+
+/// The best-scoring of faces in the detector's order of preference (the first of equals).
+pub fn best_of(scored: &[(Pose2, f64)]) -> Option<(Pose2, f64)> {
+    scored
+        .iter()
+        .copied()
+        .reduce(|b, c| if c.1 > b.1 { c } else { b })
+}
+
+/// The location stage, then the evidence: each of `detector`'s candidate faces scored
+/// against its scan (or by the detector's own score when it gives one), the best taken
+/// when it reaches `min_score`. A scan that bears none out holds no pallet.
+pub fn verified(
+    detector: &mut dyn PalletDetector,
+    req: &DetectRequest<'_>,
+    min_score: f64,
+) -> Result<Verdict, DetectorError> {
+    let mut v = Verdict::default();
+    let mut best: Option<(Found, f64)> = None;
+    for c in detector.candidates(req)? {
+        let Some(s) = req.scans.get(c.sensor) else {
+            continue;
+        };
+        let score = c
+            .score
+            .unwrap_or_else(|| face_evidence(s.scan, req.pallet, &c.detection.face).score);
+        v.scored.push((c.detection.face, score));
+        if best.as_ref().is_none_or(|b| score > b.1) {
+            best = Some((c, score));
+        }
+    }
+    v.chosen = best
+        .filter(|b| b.1 >= min_score)
+        .map(|(c, score)| (detector.finish(req, c), score));
+    Ok(v)
+}
+
 /// The evidence `scan` holds for a face at `face` (centre, heading into the pallet, in
 /// the scan's frame) of `pallet`: a fraction is 1 when no beam falls in its class.
 pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence {
@@ -45,6 +102,9 @@ pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence
     let (hc, hs) = (face.heading_rad.cos(), face.heading_rad.sin());
     let mut e = Evidence::default();
     let mut across = 0usize;
+    // Which parts and pockets some beam told about: a face of which the scan saw only a
+    // part has less for it than one seen whole.
+    let mut told = vec![false; parts.len() + pockets.len()];
     for (i, &r) in scan.ranges_m.iter().enumerate() {
         let a = scan.sensor.heading_rad + scan.angle_min_rad + i as f64 * scan.angle_step_rad;
         let (dx, dy) = (a.cos(), a.sin());
@@ -71,11 +131,13 @@ pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence
             continue;
         }
         let inside = |span: &[f64; 2]| s > span[0] + EDGE_MARGIN_M && s < span[1] - EDGE_MARGIN_M;
-        if parts.iter().any(inside) {
+        if let Some(k) = parts.iter().position(inside) {
+            told[k] = true;
             e.part_beams += 1;
             let tol = FACE_TOLERANCE_M + FACE_TOLERANCE_PER_M * t;
             e.part_hits += usize::from(returned && (r - t).abs() <= tol);
-        } else if let Some(span) = pockets.iter().find(|p| inside(p)) {
+        } else if let Some(k) = pockets.iter().position(inside) {
+            let span = &pockets[k];
             // How deep the beam can go before the pocket's side: an oblique beam meets it
             // early, so it is asked for less.
             let slope = (-dx * hs + dy * hc) / toward;
@@ -93,14 +155,22 @@ pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence
             if need < MIN_DISCERNIBLE_M {
                 continue;
             }
+            told[parts.len() + k] = true;
             e.pocket_beams += 1;
             e.pocket_through += usize::from(!returned || r >= t + need);
         }
     }
     let frac = |k: usize, n: usize| if n == 0 { 1.0 } else { k as f64 / n as f64 };
+    // A face no beam meets at its parts (seen edge-on, from behind, or out of view) has
+    // no evidence for it, which is not evidence.
+    if e.part_beams == 0 {
+        return e;
+    }
+    let seen = told.iter().filter(|t| **t).count() as f64 / told.len().max(1) as f64;
     e.score = frac(e.part_hits, e.part_beams)
         * frac(e.pocket_through, e.pocket_beams)
-        * (1.0 - e.blocked as f64 / across.max(1) as f64);
+        * (1.0 - e.blocked as f64 / across.max(1) as f64)
+        * seen;
     e
 }
 

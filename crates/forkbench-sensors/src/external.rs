@@ -73,6 +73,9 @@ enum ResponseMsg {
         /// RMS distance of the returns from the fitted face, if it has one.
         #[serde(default)]
         rms_m: Option<f64>,
+        /// Its own confidence in [0, 1], thresholded in place of the scan's evidence.
+        #[serde(default)]
+        score: Option<f64>,
     },
     None {
         id: u64,
@@ -212,6 +215,7 @@ impl PalletDetector for ExternalDetector {
                 face,
                 sensor,
                 rms_m,
+                score,
                 ..
             } => {
                 if let Some(why) = implausible(&face, sensor, req) {
@@ -222,6 +226,9 @@ impl PalletDetector for ExternalDetector {
                         "rms_m {r:e}: a residual is a finite distance ≥ 0"
                     )));
                 }
+                if let Some(v) = score.filter(|v| !(0.0..=1.0).contains(v)) {
+                    return Err(fail(format!("score {v:e}: a confidence lies in [0, 1]")));
+                }
                 Ok(Some(Found {
                     detection: Detection {
                         face,
@@ -230,6 +237,7 @@ impl PalletDetector for ExternalDetector {
                         rms_m: rms_m.unwrap_or(f64::NAN),
                     },
                     sensor,
+                    score,
                 }))
             }
         }

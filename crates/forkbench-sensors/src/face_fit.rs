@@ -24,8 +24,21 @@ impl PalletDetector for FaceFit {
             Some(Found {
                 detection: refine(&self.cfg, s.scan, req.pallet, &first),
                 sensor: i,
+                score: None,
             })
         }))
+    }
+
+    fn candidates(&mut self, req: &DetectRequest<'_>) -> Result<Vec<Found>, DetectorError> {
+        Ok(crate::detector::ranked(&self.cfg, req))
+    }
+
+    fn finish(&mut self, req: &DetectRequest<'_>, found: Found) -> Found {
+        let scan = req.scans[found.sensor].scan;
+        Found {
+            detection: refine(&self.cfg, scan, req.pallet, &found.detection),
+            ..found
+        }
     }
 }
 

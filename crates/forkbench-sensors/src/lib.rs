@@ -1,5 +1,6 @@
 //! Sensor models: NAV350 laser localisation, the pallet-pose estimate, world-seeing scanners and pallet detectors, drawing only from a passed-in RNG.
 
+pub mod dataset;
 pub mod detect;
 pub mod detector;
 pub mod evidence;

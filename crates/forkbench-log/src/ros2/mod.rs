@@ -2,6 +2,7 @@
 
 pub mod cdr;
 pub mod msgs;
+pub mod scan_bag;
 mod signals;
 
 pub use signals::topic;

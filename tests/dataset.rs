@@ -1,0 +1,141 @@
+//! `forkbench dataset` end to end: a labelled set written deterministically (bag, labels, NumPy), scored by `detect --labels` with the curve and the clutter table, and bad specs refused naming the field.
+
+use crate::common::{forkbench, s, text, tmp_in};
+
+fn json(o: &std::process::Output) -> serde_json::Value {
+    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(o)))
+}
+
+#[test]
+fn a_set_is_written_by_seed_and_scored_with_its_labels() {
+    let dir = tmp_in("dataset-e2e", "set");
+    let twin = tmp_in("dataset-e2e", "twin");
+    for d in [&dir, &twin] {
+        let o = forkbench(&[
+            "dataset",
+            "--out",
+            s(d),
+            "--scans",
+            "400",
+            "--seed",
+            "5",
+            "--npy",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+    }
+    for f in ["scans.mcap", "labels.json", "scans.npy", "labels.npy"] {
+        let (a, b) = (
+            std::fs::read(dir.join(f)).expect("written"),
+            std::fs::read(twin.join(f)).expect("written"),
+        );
+        assert!(a == b, "{f} differs between two runs of one seed");
+    }
+    let npy = std::fs::read(dir.join("scans.npy")).expect("npy");
+    let header = String::from_utf8_lossy(&npy[10..128]);
+    assert!(header.contains("'shape': (400, 819)"), "{header}");
+    assert_eq!((npy.len() - 128) % 4, 0);
+    let labels: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("labels.json")).expect("labels"))
+            .expect("json");
+    let scans = labels["scans"].as_array().expect("scans");
+    assert_eq!(scans.len(), 400);
+    let present = scans.iter().filter(|l| l["present"] == true).count();
+    assert!(
+        (140..=260).contains(&present),
+        "{present} of 400 with a pallet"
+    );
+    // The detector on its own labels: few false detections at the default threshold, the
+    // clear faces found, and the curve and the clutter table given.
+    let o = forkbench(&[
+        "detect",
+        s(&dir.join("scans.mcap")),
+        "--labels",
+        s(&dir.join("labels.json")),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let v = json(&o);
+    let sc = &v["scores"];
+    assert!(sc["precision"].as_f64().expect("p") >= 0.95, "{sc}");
+    assert!(sc["recall"].as_f64().expect("r") >= 0.75, "{sc}");
+    let at = v["curve"]
+        .as_array()
+        .expect("curve")
+        .iter()
+        .find(|p| (p["threshold"].as_f64().expect("t") - 0.85).abs() < 1e-9)
+        .expect("the default threshold on the curve");
+    assert!(
+        at["false_positive_rate"].as_f64().expect("fpr") <= 0.03,
+        "{at}"
+    );
+    let kinds: Vec<&str> = v["by_clutter"]
+        .as_array()
+        .expect("by clutter")
+        .iter()
+        .map(|k| k["kind"].as_str().expect("kind"))
+        .collect();
+    assert!(
+        kinds.contains(&"upright") && kinds.contains(&"person"),
+        "{kinds:?}"
+    );
+    // Without the evidence every located face counts: far more false detections.
+    let o = forkbench(&[
+        "detect",
+        s(&dir.join("scans.mcap")),
+        "--labels",
+        s(&dir.join("labels.json")),
+        "--min-score",
+        "0",
+        "--json",
+    ]);
+    let loose = json(&o)["scores"]["false_positives"].as_u64().expect("fp");
+    assert!(
+        loose > 3 * sc["false_positives"].as_u64().expect("fp").max(1),
+        "{loose}"
+    );
+    let other = tmp_in("dataset-e2e", "other");
+    let o = forkbench(&[
+        "dataset",
+        "--out",
+        s(&other),
+        "--scans",
+        "400",
+        "--seed",
+        "6",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        std::fs::read(other.join("labels.json")).expect("labels")
+            != std::fs::read(dir.join("labels.json")).expect("labels")
+    );
+}
+
+#[test]
+fn bad_specs_and_outputs_are_refused_naming_why() {
+    let spec = tmp_in("dataset-bad", "spec.toml");
+    let out = tmp_in("dataset-bad", "out");
+    for (body, says) in [
+        ("scans = 0\n", "scans"),
+        ("[clutter]\nkinds = [\"ghost\"]\n", "clutter.kinds"),
+        ("range_m = [5.0, 2.0]\n", "range_m"),
+        ("colour = 1\n", "colour"),
+        ("present_fraction = 1.5\n", "present_fraction"),
+        ("scanner = \"velodyne\"\n", "velodyne"),
+    ] {
+        std::fs::write(&spec, body).expect("spec");
+        let o = forkbench(&["dataset", s(&spec), "--out", s(&out)]);
+        assert_eq!(o.status.code(), Some(1), "{body}: {}", text(&o));
+        assert!(text(&o).contains(says), "{body}: {}", text(&o));
+        assert!(
+            text(&o).contains("spec.toml") || says == "velodyne",
+            "{}",
+            text(&o)
+        );
+    }
+    let file = tmp_in("dataset-bad", "a-file");
+    std::fs::write(&file, "mine").expect("file");
+    let o = forkbench(&["dataset", "--out", s(&file), "--scans", "10"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("not a directory"), "{}", text(&o));
+    assert_eq!(std::fs::read_to_string(&file).expect("kept"), "mine");
+}
