@@ -139,3 +139,40 @@ fn bad_specs_and_outputs_are_refused_naming_why() {
     assert!(text(&o).contains("not a directory"), "{}", text(&o));
     assert_eq!(std::fs::read_to_string(&file).expect("kept"), "mine");
 }
+
+#[test]
+fn a_trials_min_score_acts_and_is_range_checked() {
+    let base =
+        std::fs::read_to_string(crate::common::repo_root().join("scenarios/field-test.toml"))
+            .expect("field test");
+    let with = |extra: &str| {
+        let f = tmp_in("dataset-trial", &format!("f{}.toml", extra.len()));
+        let text = base.replace(
+            "kind = \"tim561+kinect2\"",
+            &format!("kind = \"tim561+kinect2\"\n{extra}"),
+        );
+        assert_ne!(text, base);
+        std::fs::write(&f, text).expect("scenario");
+        f
+    };
+    // The check chooses another face among the detector's than its own first one, which
+    // the default (0) takes: the estimate the replanning pick ends on moves.
+    let est = |f: &std::path::Path| {
+        let v = json(&forkbench(&["trial", s(f), "--replan", "--json"]));
+        assert_eq!(v["estimates_missed"], 0, "{v}");
+        v["estimate_lateral_error_m"].as_f64().expect("estimate")
+    };
+    let strict = with("min_score = 1.0");
+    let base_file = with("min_score = 0");
+    assert!((est(&strict) - est(&base_file)).abs() > 1e-4);
+    let o = forkbench(&["check", s(&with("min_score = 0.85"))]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("evidence ≥ 0.85"), "{}", text(&o));
+    let o = forkbench(&["check", s(&with("min_score = 1.5"))]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o).contains("sensors.pallet.min_score"),
+        "{}",
+        text(&o)
+    );
+}

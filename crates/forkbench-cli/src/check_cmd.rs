@@ -36,10 +36,11 @@ fn summary(scn: &Scenario) -> String {
             sensors,
             detector,
             latency_s,
+            min_score,
         } => {
             let names: Vec<&str> = sensors.iter().map(|s| s.name.as_str()).collect();
             format!(
-                "{} with detector {} ({latency_s} s late)",
+                "{} with detector {} ({latency_s} s late, faces taken at evidence ≥ {min_score})",
                 names.join(" + "),
                 detector.kind
             )

@@ -21,11 +21,10 @@ mod scan_cmd;
 mod trial_cmd;
 mod truck_cmd;
 
-use std::path::PathBuf;
-use std::process::ExitCode;
-
 use clap::{Parser, Subcommand, ValueEnum};
 use forkbench_core::{ForkliftSpec, Pose2};
+use std::path::PathBuf;
+use std::process::ExitCode;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -261,8 +260,7 @@ enum Command {
     /// forkbench MCAP): a JSON line per scan, a summary, and with --labels precision,
     /// recall and face-pose errors (exit 1 when a scan was unusable, after the rest).
     Detect(detect_cmd::DetectArgs),
-    /// Labelled scans on demand: randomised scenes (a pallet or none, clutter) as a ROS 2
-    /// bag and the labels detect --labels reads, to train or score a detector.
+    /// Labelled cluttered scans on demand: a ROS 2 bag and the labels detect --labels reads.
     Dataset(dataset_cmd::DatasetArgs),
     /// Reflector coverage of a world: reflectors in sight and the NAV350 fix's predicted
     /// 1σ at every free cell.

@@ -26,11 +26,7 @@ pub struct DetectOptions {
     pub min_score: f64,
 }
 
-/// The default `min_score` (a choice): on generated cluttered sets of the field pallet
-/// (seeds 1 and 11, `forkbench dataset`) the lowest threshold at which no clutter scene
-/// was taken for a pallet; a face seen whole and bearing out every part and pocket
-/// scores near 1, rack uprights and a missing middle part near 2/3.
-pub const DEFAULT_MIN_SCORE: f64 = 0.85;
+pub use forkbench_sensors::evidence::DEFAULT_MIN_SCORE;
 
 /// One scan and what the detector made of it.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -102,10 +102,23 @@ fn draw_on<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    use crate::figure::err;
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(crate::figure::err)?;
     let panels = root.split_evenly((1, 2));
-    let mut left = ChartBuilder::on(&panels[0])
+    draw_rates(&panels[0], curve, min_score)?;
+    draw_pr(&panels[1], curve, min_score)
+}
+
+/// Precision, recall and false positives over the threshold, the one in use dashed.
+fn draw_rates<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    curve: &[CurvePoint],
+    min_score: f64,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    use crate::figure::err;
+    let mut left = ChartBuilder::on(area)
         .margin(14)
         .x_label_area_size(40)
         .y_label_area_size(50)
@@ -150,11 +163,27 @@ where
         .position(SeriesLabelPosition::LowerLeft)
         .draw()
         .map_err(err)?;
-    let mut right = ChartBuilder::on(&panels[1])
+    Ok(())
+}
+
+/// Precision against recall, the threshold in use circled.
+fn draw_pr<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    curve: &[CurvePoint],
+    min_score: f64,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    use crate::figure::err;
+    let mut right = ChartBuilder::on(area)
         .margin(14)
         .x_label_area_size(40)
         .y_label_area_size(50)
-        .caption("precision against recall (circled: the threshold in use)", ("sans-serif", 18))
+        .caption(
+            "precision against recall (circled: the threshold in use)",
+            ("sans-serif", 18),
+        )
         .build_cartesian_2d(0.0..1.02, 0.0..1.02)
         .map_err(err)?;
     right

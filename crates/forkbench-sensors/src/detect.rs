@@ -250,40 +250,7 @@ pub fn detect_ranked(
                 .any(|&w| looks_like_a_stringer(cfg, s, scan, w))
         })
         .collect();
-    let mut candidates = Vec::new();
-    for (i, a) in segs.iter().enumerate() {
-        for (j, b) in segs.iter().enumerate().skip(i + 1) {
-            let d = dist(a.centre, b.centre);
-            if (d - 2.0 * spacing).abs() <= cfg.spacing_tolerance_m {
-                // The outer pair; the centre stringer, when visible, sits between them.
-                let mid = [
-                    (a.centre[0] + b.centre[0]) / 2.0,
-                    (a.centre[1] + b.centre[1]) / 2.0,
-                ];
-                let mut set = vec![a, b];
-                if let Some(c) = segs[i + 1..j]
-                    .iter()
-                    .find(|c| dist(c.centre, mid) <= cfg.line_tolerance_m)
-                {
-                    set.push(c);
-                }
-                candidates.push(Candidate {
-                    segs: set,
-                    centre_from_first_m: d / 2.0,
-                });
-            } else if (d - spacing).abs() <= cfg.spacing_tolerance_m {
-                // Two neighbours, the third hidden: which two they are is ambiguous, so
-                // both readings are candidates for the prior to decide.
-                // (left, centre): the centre is the second; (centre, right): the first.
-                for centre_from_first_m in [d, 0.0] {
-                    candidates.push(Candidate {
-                        segs: vec![a, b],
-                        centre_from_first_m,
-                    });
-                }
-            }
-        }
-    }
+    let candidates = pair_up(cfg, &segs, spacing);
     let found: Vec<Detection> = candidates
         .iter()
         .filter_map(|c| face_of(c, scan, pallet))
@@ -322,6 +289,46 @@ pub fn detect_ranked(
         }
     }
     out
+}
+
+/// The faces stringer-like pieces could make: outer pairs (the centre one between them
+/// when seen) and neighbours with the third hidden, read both ways.
+fn pair_up<'a>(cfg: &DetectorConfig, segs: &'a [Segment], spacing: f64) -> Vec<Candidate<'a>> {
+    let mut candidates = Vec::new();
+    for (i, a) in segs.iter().enumerate() {
+        for (j, b) in segs.iter().enumerate().skip(i + 1) {
+            let d = dist(a.centre, b.centre);
+            if (d - 2.0 * spacing).abs() <= cfg.spacing_tolerance_m {
+                // The outer pair; the centre stringer, when visible, sits between them.
+                let mid = [
+                    (a.centre[0] + b.centre[0]) / 2.0,
+                    (a.centre[1] + b.centre[1]) / 2.0,
+                ];
+                let mut set = vec![a, b];
+                if let Some(c) = segs[i + 1..j]
+                    .iter()
+                    .find(|c| dist(c.centre, mid) <= cfg.line_tolerance_m)
+                {
+                    set.push(c);
+                }
+                candidates.push(Candidate {
+                    segs: set,
+                    centre_from_first_m: d / 2.0,
+                });
+            } else if (d - spacing).abs() <= cfg.spacing_tolerance_m {
+                // Two neighbours, the third hidden: which two they are is ambiguous, so
+                // both readings are candidates for the prior to decide.
+                // (left, centre): the centre is the second; (centre, right): the first.
+                for centre_from_first_m in [d, 0.0] {
+                    candidates.push(Candidate {
+                        segs: vec![a, b],
+                        centre_from_first_m,
+                    });
+                }
+            }
+        }
+    }
+    candidates
 }
 
 /// Whether a straight piece could be a stringer's face: as wide as one (the returns span
@@ -382,131 +389,5 @@ fn face_of(c: &Candidate<'_>, scan: &Scan, pallet: &PalletSpec) -> Option<Detect
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scan::{Errors, RayHit, ScannerConfig, Seen, Surface, WorldView, scan};
-
-    /// Boxes (centre pose, length along its heading, width) as a world.
-    struct Boxes(Vec<(Pose2, f64, f64)>);
-
-    impl WorldView for Boxes {
-        fn cast_ray(&self, _: [f64; 2], _: [f64; 2], _: f64) -> Option<RayHit> {
-            None
-        }
-
-        fn surfaces_near(&self, _: [f64; 2], _: f64, out: &mut Vec<Surface>) {
-            for (c, l, w) in &self.0 {
-                out.extend(Surface::rect(c, *l, *w, Seen::Fixed));
-            }
-        }
-    }
-
-    fn ideal(world: &Boxes) -> Scan {
-        let cfg = ScannerConfig::tim561();
-        scan::<rand::rngs::ThreadRng>(&cfg, world, Pose2::new(0.0, 0.0, 0.0), Errors::Ideal)
-    }
-
-    fn assert_close(got: &Pose2, want: &Pose2, tol_m: f64, tol_rad: f64) {
-        let dh = forkbench_core::units::wrap_angle(got.heading_rad - want.heading_rad);
-        assert!(
-            got.distance_to(want) < tol_m && dh.abs() < tol_rad,
-            "got {got:?}, want {want:?}"
-        );
-    }
-
-    #[test]
-    fn a_noise_free_scan_gives_the_face_pose() {
-        let p = PalletSpec::field_1200();
-        for truth in [
-            Pose2::new(4.0, 0.3, 10f64.to_radians()),
-            Pose2::new(6.5, 1.5, -15f64.to_radians()),
-            Pose2::new(2.0, -0.4, 0.0),
-        ] {
-            let world = Boxes(p.part_boxes(&truth));
-            let d = detect(&DetectorConfig::default(), &ideal(&world), &p, None).expect("found");
-            assert_eq!(d.stringers, 3);
-            // Exact up to the beam spacing: each stringer's edges are known to within
-            // one step at its range, so its centre to half of one.
-            let half_step = 0.5 * truth.x_m.hypot(truth.y_m) * 0.33f64.to_radians();
-            assert_close(&d.face, &truth, half_step + 0.002, 0.5f64.to_radians());
-            assert!(d.rms_m < 0.005, "{d:?}");
-        }
-    }
-
-    #[test]
-    fn a_hidden_stringer_leaves_two_and_the_prior_decides() {
-        let p = PalletSpec::field_1200();
-        let truth = Pose2::new(4.0, 0.0, 0.0);
-        let mut boxes = p.part_boxes(&truth);
-        // An upright in front of the right-hand stringer (negative y).
-        let y = -p.edge_part_m().1;
-        boxes.push((Pose2::new(3.0, y, 0.0), 0.1, 0.3));
-        let world = Boxes(boxes);
-        let prior = Pose2::new(4.1, 0.1, 0.05);
-        let d =
-            detect(&DetectorConfig::default(), &ideal(&world), &p, Some(&prior)).expect("found");
-        assert_eq!(d.stringers, 2);
-        assert_close(&d.face, &truth, 0.01, 0.5f64.to_radians());
-    }
-
-    #[test]
-    fn no_pallet_is_not_found() {
-        let p = PalletSpec::field_1200();
-        // A wall and a lone box the width of a stringer.
-        let world = Boxes(vec![
-            (Pose2::new(6.0, 0.0, 0.0), 0.2, 8.0),
-            (Pose2::new(3.0, 1.0, 0.0), 0.5, p.edge_part_m().0),
-        ]);
-        assert_eq!(
-            detect(&DetectorConfig::default(), &ideal(&world), &p, None),
-            None
-        );
-    }
-
-    /// With the TiM561's errors (20 mm noise, a per-scan bias within ±60 mm, mixed
-    /// returns at the stringers' edges), the pallet is still found at 4 m and the face
-    /// heading stays within a few degrees.
-    #[test]
-    fn a_modelled_tim561_scan_still_finds_the_pallet() {
-        use rand::SeedableRng;
-        let p = PalletSpec::field_1200();
-        let truth = Pose2::new(4.0, 0.3, 10f64.to_radians());
-        let world = Boxes(p.part_boxes(&truth));
-        let cfg = ScannerConfig::tim561();
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
-        let mut heading_errors = Vec::new();
-        let mut lateral = Vec::new();
-        for _ in 0..50 {
-            let bias_m = cfg.draw_bias(&mut rng);
-            let e = Errors::Modelled {
-                bias_m,
-                rng: &mut rng,
-            };
-            let sc = scan(&cfg, &world, Pose2::new(0.0, 0.0, 0.0), e);
-            if let Some(d) = detect(&DetectorConfig::default(), &sc, &p, None) {
-                let local = truth.to_local(&d.face);
-                heading_errors.push(local.heading_rad.abs().to_degrees());
-                lateral.push(local.y_m.abs());
-            }
-        }
-        assert!(
-            heading_errors.len() >= 45,
-            "found in {} of 50",
-            heading_errors.len()
-        );
-        heading_errors.sort_by(f64::total_cmp);
-        lateral.sort_by(f64::total_cmp);
-        let (h, l) = (
-            heading_errors[heading_errors.len() / 2],
-            lateral[lateral.len() / 2],
-        );
-        eprintln!(
-            "found in {} of 50; median |heading error| {h:.2}°, |lateral| {l:.3} m",
-            lateral.len()
-        );
-        assert!(
-            h < 3.0 && l < 0.03,
-            "median |heading| {h}°, |lateral| {l} m"
-        );
-    }
-}
+#[path = "detect_tests.rs"]
+mod tests;

@@ -36,6 +36,9 @@ struct PalletSensorFile {
     /// From a scan's end to its estimate reaching the controller (the scan's transfer and
     /// the detector's computation).
     latency_s: Option<f64>,
+    /// Least evidence score a located face needs (`forkbench_sensors::evidence`); 0: the
+    /// detector's own answer, unchecked.
+    min_score: Option<f64>,
 }
 
 /// A detector's estimate reaches the controller this long after its scan ended. No
@@ -67,6 +70,10 @@ pub enum PalletSensing {
         detector: ComponentSpec,
         /// From a scan's end to its estimate reaching the controller.
         latency_s: f64,
+        /// Least evidence score a located face needs to be taken; 0 (the default, left
+        /// out of the settings' fingerprint): the detector's own face, unchecked.
+        #[serde(skip_serializing_if = "is_off")]
+        min_score: f64,
     },
 }
 
@@ -79,6 +86,14 @@ impl PalletSensing {
     pub fn latency_s(&self) -> f64 {
         match self {
             PalletSensing::Scanner { latency_s, .. } => *latency_s,
+            PalletSensing::Gaussian => 0.0,
+        }
+    }
+
+    /// Least evidence score a located face needs (0 for the Gaussian: nothing to check).
+    pub fn min_score(&self) -> f64 {
+        match self {
+            PalletSensing::Scanner { min_score, .. } => *min_score,
             PalletSensing::Gaussian => 0.0,
         }
     }
@@ -119,6 +134,7 @@ pub(super) fn resolve(
         return Ok(PalletSensing::Gaussian);
     };
     let latency_s = latency_of(p, file)?;
+    let min_score = min_score_of(p, file)?;
     if p.kind == "gaussian" {
         return Ok(PalletSensing::Gaussian);
     }
@@ -186,7 +202,31 @@ pub(super) fn resolve(
         sensors,
         detector,
         latency_s,
+        min_score,
     })
+}
+
+fn is_off(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// `[sensors.pallet] min_score`, in 0–1 (default 0: trials take the detector's own face
+/// until their committed outcomes are regenerated with the check on); refused for the
+/// Gaussian estimate.
+fn min_score_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
+    let field = "sensors.pallet.min_score";
+    if p.kind == "gaussian" && p.min_score.is_some() {
+        return Err(invalid(
+            file,
+            field,
+            "the gaussian estimate has no scan to check a face against",
+        ));
+    }
+    let v = p.min_score.unwrap_or(0.0);
+    if !(0.0..=1.0).contains(&v) {
+        return Err(invalid(file, field, &format!("{v} must lie in 0–1")));
+    }
+    Ok(v)
 }
 
 /// `[sensors.pallet] latency_s`, in range; refused for the Gaussian estimate.
@@ -225,6 +265,7 @@ pub(crate) fn of_kind(
             scanners: BTreeMap::new(),
             detector: None,
             latency_s: None,
+            min_score: None,
         }),
     };
     resolve(Some(&f), truck, file)

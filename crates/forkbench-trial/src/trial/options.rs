@@ -349,6 +349,7 @@ impl Scenario {
                 mut sensors,
                 detector,
                 latency_s,
+                min_score,
             } => {
                 if sensors.iter().all(|n| !n.scanner.has_noise()) {
                     return Err(invalid(
@@ -368,6 +369,7 @@ impl Scenario {
                     sensors,
                     detector,
                     latency_s,
+                    min_score,
                 })
             }
         }

@@ -3,7 +3,8 @@
 use forkbench_core::signal::Scan;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, Signal, Style};
-use forkbench_sensors::detector::detect_in;
+use forkbench_sensors::detector::{DetectRequest, SensorScan};
+use forkbench_sensors::evidence::verified;
 use forkbench_sensors::scan::{Errors, WorldView, scan_swept};
 use rand_chacha::ChaCha8Rng;
 
@@ -189,8 +190,17 @@ impl Trial<'_> {
         let Some(detector) = self.sense.detector.as_mut() else {
             return Ok(None);
         };
-        let Some(found) = detect_in(detector.as_mut(), &scans, &self.scn.pallet, Some(prior))?
-        else {
+        let views: Vec<SensorScan<'_>> = scans
+            .iter()
+            .map(|(sensor, scan)| SensorScan { sensor, scan })
+            .collect();
+        let req = DetectRequest {
+            scans: &views,
+            pallet: &self.scn.pallet,
+            prior: Some(prior),
+        };
+        let min_score = self.run.pallet_sensing.min_score();
+        let Some((found, _)) = verified(detector.as_mut(), &req, min_score)?.chosen else {
             return Ok(None);
         };
         let face = found.detection.face;
