@@ -176,3 +176,45 @@ fn a_trials_min_score_acts_and_is_range_checked() {
         text(&o)
     );
 }
+
+#[test]
+fn a_worlds_clutter_is_seen_and_checked() {
+    let root = crate::common::repo_root();
+    let base = std::fs::read_to_string(root.join("scenarios/field-test.toml")).expect("field test");
+    let scenario = tmp_in("dataset-clutter", "field.toml");
+    let world = tmp_in("dataset-clutter", "clutter.toml");
+    std::fs::write(&scenario, format!("world = \"clutter.toml\"\n{base}")).expect("scenario");
+    let run = |clutter: &str| {
+        std::fs::write(&world, format!("name = \"clutter\"\n{clutter}")).expect("world");
+        forkbench(&["trial", s(&scenario), "--json"])
+    };
+    // A person and a box off the way: the pick is as without them.
+    let aside = "[[clutter]]\nkind = \"person\"\nx_m = -2.0\ny_m = 9.0\n\
+                 [[clutter]]\nkind = \"box\"\nx_m = 4.0\ny_m = 10.0\nheading_deg = 30.0\n";
+    let o = run(aside);
+    assert_eq!(json(&o)["success"], true, "{}", text(&o));
+    let o = forkbench(&["check", s(&scenario)]);
+    assert!(text(&o).contains("2 clutter items"), "{}", text(&o));
+    // A wall 1.5 m before the pallet's face hides it from the truck.
+    let hiding = "[[clutter]]\nkind = \"wall\"\nx_m = 2.165\ny_m = 13.455\nheading_deg = 192.8\n";
+    let v = json(&run(hiding));
+    assert_eq!(v["success"], false, "{v}");
+    for (bad, says) in [
+        (
+            "[[clutter]]\nkind = \"ghost\"\nx_m = 0.0\ny_m = 0.0\n",
+            "clutter[0].kind",
+        ),
+        (
+            "[[clutter]]\nkind = \"person\"\nx_m = 0.0\ny_m = 0.0\nlength_m = 2.0\n",
+            "clutter[0].length_m",
+        ),
+        (
+            "[[clutter]]\nkind = \"box\"\nx_m = 1e300\ny_m = 0.0\n",
+            "clutter[0].x_m",
+        ),
+    ] {
+        let o = run(bad);
+        assert_eq!(o.status.code(), Some(1), "{bad}: {}", text(&o));
+        assert!(text(&o).contains(says), "{bad}: {}", text(&o));
+    }
+}

@@ -50,10 +50,11 @@ fn summary(scn: &Scenario) -> String {
     let mut lines = vec![
         format!("scenario     {} ({})", one_line(&scn.name), scn.file),
         format!(
-            "world        {}: {} walls, {} racks, {} slots, {} stations, {} reflectors",
+            "world        {}: {} walls, {} racks, {} clutter items, {} slots, {} stations, {} reflectors",
             one_line(&w.name),
             w.wall.len(),
             w.rack.len(),
+            w.clutter.len(),
             w.pallet_slot.len(),
             w.station.len(),
             w.reflector.len()

@@ -1,6 +1,7 @@
 //! Scenario and world files (TOML, unknown fields rejected), validated into SI-unit cases before any simulation.
 
 mod checks;
+pub mod clutter;
 mod file;
 mod hints;
 mod limits;

@@ -103,6 +103,9 @@ pub struct World {
     /// NAV350 reflectors (points in the scanner's plane).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub reflector: Vec<forkbench_sensors::reflectors::Reflector>,
+    /// Fixed clutter (`[[clutter]]`): scans see it, the truck strikes it, plans avoid it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clutter: Vec<super::clutter::ClutterFile>,
 }
 
 impl World {
@@ -199,6 +202,20 @@ impl World {
                     }
                 }
             }
+        }
+        if w.clutter.len() > super::clutter::MAX_CLUTTER {
+            return Err(invalid(
+                file,
+                "clutter",
+                &format!(
+                    "{} items; at most {}",
+                    w.clutter.len(),
+                    super::clutter::MAX_CLUTTER
+                ),
+            ));
+        }
+        for (i, c) in w.clutter.iter().enumerate() {
+            c.check(file, &format!("clutter[{i}]"))?;
         }
         for (kind, list) in [("pallet_slot", &w.pallet_slot), ("station", &w.station)] {
             let mut seen = std::collections::HashMap::new();
@@ -335,6 +352,12 @@ impl World {
                 });
             }
         }
+        for c in &self.clutter {
+            for (centre, l, w) in c.rects() {
+                obstacles.add_rect(&centre, l, w);
+                labels.push(format!("{} {:?}", c.kind, c.name));
+            }
+        }
         (obstacles, labels)
     }
 
@@ -354,15 +377,24 @@ impl World {
             .map(PalletSlot::pose)
     }
 
-    /// Racks and walls as simulator obstacles.
+    /// Racks, walls and clutter as simulator obstacles.
     pub fn obstacles(&self) -> Vec<Obstacle> {
+        let clutter = self.clutter.iter().flat_map(|c| c.rects());
         self.rack
             .iter()
             .chain(&self.wall)
-            .map(|r| Obstacle {
-                centre: Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
-                length_m: r.length_m,
-                width_m: r.width_m,
+            .map(|r| {
+                (
+                    Pose2::new(r.x_m, r.y_m, r.heading_deg.to_radians()),
+                    r.length_m,
+                    r.width_m,
+                )
+            })
+            .chain(clutter)
+            .map(|(centre, length_m, width_m)| Obstacle {
+                centre,
+                length_m,
+                width_m,
             })
             .collect()
     }
