@@ -27,10 +27,9 @@ pub fn run(a: &CheckArgs) -> anyhow::Result<()> {
     crate::emit(&summary(&scn))
 }
 
-fn summary(scn: &Scenario) -> String {
-    let fit = scn.fork_fit();
-    let w = &scn.world;
-    let sensing = match &scn.pallet_sensing {
+/// The pallet sensing in one line: scanners, detector, latency and threshold.
+fn sensing_line(scn: &Scenario) -> String {
+    match &scn.pallet_sensing {
         forkbench_trial::scenario::sensors::PalletSensing::Gaussian => "gaussian".to_owned(),
         forkbench_trial::scenario::sensors::PalletSensing::Scanner {
             sensors,
@@ -45,7 +44,13 @@ fn summary(scn: &Scenario) -> String {
                 detector.kind
             )
         }
-    };
+    }
+}
+
+fn summary(scn: &Scenario) -> String {
+    let fit = scn.fork_fit();
+    let w = &scn.world;
+    let sensing = sensing_line(scn);
     let yes = |ok: bool| if ok { "ok" } else { "REFUSED" };
     let mut lines = vec![
         format!("scenario     {} ({})", one_line(&scn.name), scn.file),
