@@ -147,7 +147,12 @@ pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence
             e.blocked += 1;
             continue;
         }
-        let inside = |span: &[f64; 2]| s > span[0] + EDGE_MARGIN_M && s < span[1] - EDGE_MARGIN_M;
+        // The margin is at most a quarter of the span: a GMA's 35 mm stringers keep a
+        // middle for beams to fall in.
+        let inside = |span: &[f64; 2]| {
+            let m = EDGE_MARGIN_M.min((span[1] - span[0]) / 4.0);
+            s > span[0] + m && s < span[1] - m
+        };
         if let Some(k) = parts.iter().position(inside) {
             told[k] = true;
             e.part_beams += 1;
