@@ -15,4 +15,5 @@ mod papercuts;
 mod ros2;
 mod scenario_fuzz;
 mod shards;
+mod success_run;
 mod truck;

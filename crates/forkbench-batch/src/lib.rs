@@ -35,6 +35,7 @@ mod seed;
 mod shard;
 pub mod stats;
 mod store;
+pub mod success_run;
 mod summary;
 mod sweep;
 mod verdicts;

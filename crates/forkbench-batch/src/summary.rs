@@ -55,6 +55,10 @@ pub struct SummaryRow {
     /// scenario has them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub safety: Option<super::SafetySummary>,
+    /// The reliability the row demonstrates, as a success-run test states it (absent in
+    /// summaries written before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub success_run: Option<crate::success_run::SuccessRun>,
 }
 
 /// Success of one mission leg (or cycle phase) across a row's trials.
@@ -211,6 +215,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 legs: leg_summaries(a.legs),
                 phases: leg_summaries(a.phases),
                 safety: a.safety.finish(),
+                success_run: Some(crate::success_run::success_run(a.k, a.n)),
             }
         })
         .collect();
@@ -288,6 +293,7 @@ impl Summary {
         s.push_str(&self.legs_markdown());
         s.push_str(&self.phases_markdown());
         s.push_str(&super::safety_summary::markdown(&self.rows));
+        s.push_str(&crate::success_run::markdown(&self.rows));
         s
     }
 }

@@ -147,12 +147,7 @@ pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence
             e.blocked += 1;
             continue;
         }
-        // The margin is at most a quarter of the span: a GMA's 35 mm stringers keep a
-        // middle for beams to fall in.
-        let inside = |span: &[f64; 2]| {
-            let m = EDGE_MARGIN_M.min((span[1] - span[0]) / 4.0);
-            s > span[0] + m && s < span[1] - m
-        };
+        let inside = |span: &[f64; 2]| well_inside(s, span);
         if let Some(k) = parts.iter().position(inside) {
             told[k] = true;
             e.part_beams += 1;
@@ -194,6 +189,13 @@ pub fn face_evidence(scan: &Scan, pallet: &PalletSpec, face: &Pose2) -> Evidence
         * (1.0 - e.blocked as f64 / across.max(1) as f64)
         * seen;
     e
+}
+
+/// Whether a beam crossing the face at `s` falls inside `span` by the edge margin, at
+/// most a quarter of the span (a GMA's 35 mm stringers keep a middle for beams to meet).
+fn well_inside(s: f64, span: &[f64; 2]) -> bool {
+    let m = EDGE_MARGIN_M.min((span[1] - span[0]) / 4.0);
+    s > span[0] + m && s < span[1] - m
 }
 
 /// The lateral spans `[right, left]` of the parts at the face (those starting within a

@@ -2,6 +2,7 @@
 
 mod safety;
 mod sections;
+mod success_run;
 mod svg;
 
 use std::path::{Path, PathBuf};
@@ -88,6 +89,7 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> Result<String> {
         h.push_str("<h2>Safety: people and safety fields</h2>");
         h.push_str(&safety);
     }
+    h.push_str(&success_run::table(&summary));
     h.push_str("<h2>Failures by first failed criterion</h2>");
     h.push_str(&sections::failure_breakdown(&summary));
     let maps = sections::heatmaps(&manifest, &records);
