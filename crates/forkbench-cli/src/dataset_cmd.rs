@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, bail};
 use forkbench_sensors::dataset::{DatasetSpec, Sample, sample};
-use forkbench_sensors::scan::{SCANNER_PRESETS, ScannerConfig};
 use serde_json::json;
 
 /// A spec file is a few settings.
@@ -73,16 +72,8 @@ pub fn run(a: &DatasetArgs) -> anyhow::Result<()> {
         .with_context(|| format!("scenario {:?}", spec.scenario))?;
     let scanner = scn
         .pallet_sensing
-        .scanner(&spec.scanner)
-        .cloned()
-        .or_else(|| ScannerConfig::preset(&spec.scanner))
-        .with_context(|| {
-            format!(
-                "scanner {:?}: unknown (known: {})",
-                spec.scanner,
-                SCANNER_PRESETS.join(", ")
-            )
-        })?;
+        .scanner_or_preset(&spec.scanner)
+        .map_err(|e| anyhow::anyhow!("scanner {e}"))?;
     prepare_dir(&a.out)?;
     let samples: Vec<Sample> = (0..spec.scans)
         .map(|i| sample(&spec, &scn.pallet, &scanner, i))

@@ -2,9 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context as _;
 use forkbench_core::Pose2;
-use forkbench_sensors::scan::{SCANNER_PRESETS, ScannerConfig};
 use forkbench_trial::trial::{ScanReport, scan_once};
 use serde_json::json;
 
@@ -36,19 +34,10 @@ pub struct ScanArgs {
 
 pub fn run(a: &ScanArgs) -> anyhow::Result<()> {
     let scn = forkbench_trial::defaults::load_scenario(&a.scenario)?;
-    // The scenario's own scanner of that model (with its settings), else the model's.
     let cfg = scn
         .pallet_sensing
-        .scanner(&a.sensor)
-        .cloned()
-        .or_else(|| ScannerConfig::preset(&a.sensor))
-        .with_context(|| {
-            format!(
-                "--sensor {:?}: unknown (known: {})",
-                a.sensor,
-                SCANNER_PRESETS.join(", ")
-            )
-        })?;
+        .scanner_or_preset(&a.sensor)
+        .map_err(|e| anyhow::anyhow!("--sensor {e}"))?;
     let case = scn.pick_case(a.case.as_deref())?;
     if let Some(at) = &a.at {
         check_at(at, &scn, case)?;

@@ -108,6 +108,15 @@ impl PalletSensing {
         }
     }
 
+    /// The scanner of model `name`: this sensing's own settings for it when it has that
+    /// scanner, else the model's preset; `Err` lists the models known.
+    pub fn scanner_or_preset(&self, name: &str) -> Result<ScannerConfig, String> {
+        self.scanner(name)
+            .cloned()
+            .or_else(|| ScannerConfig::preset(name))
+            .ok_or_else(|| format!("{name:?}: unknown (known: {})", SCANNER_PRESETS.join(", ")))
+    }
+
     /// The pocket detector's settings, when this sensing uses it or the face fit on it
     /// (else its defaults).
     pub fn pocket_settings(&self) -> DetectorConfig {
