@@ -5,6 +5,8 @@ use std::collections::BTreeMap;
 use forkbench_core::Pose2;
 use serde::Serialize;
 
+use forkbench_sensors::evidence::best_of;
+
 use crate::detect_eval::{Gate, Label, face_error, score};
 
 /// Thresholds a curve is drawn at: 0 to 1 in twentieths.
@@ -26,13 +28,7 @@ pub struct CurvePoint {
 pub fn at_threshold(candidates: &[Vec<(Pose2, f64)>], t: f64) -> Vec<Option<Pose2>> {
     candidates
         .iter()
-        .map(|c| {
-            let best = c
-                .iter()
-                .copied()
-                .reduce(|b, x| if x.1 > b.1 { x } else { b });
-            best.filter(|(_, s)| *s >= t).map(|(f, _)| f)
-        })
+        .map(|c| best_of(c).filter(|(_, s)| *s >= t).map(|(f, _)| f))
         .collect()
 }
 

@@ -2,6 +2,7 @@
 
 use forkbench_batch::detect_curve::{Bin, ByPlace, ClutterScore, CurvePoint};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use crate::Result;
@@ -108,6 +109,33 @@ where
     draw_pr(&panels[1], curve, min_score)
 }
 
+/// A chart of rates (0 to 1 up the side) over 0 to `x_max`, captioned and its axes named.
+fn rate_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    x_max: f64,
+    (x_desc, y_desc): (&str, &str),
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>>
+where
+    DB::ErrorType: 'static,
+{
+    use crate::figure::err;
+    let mut chart = ChartBuilder::on(area)
+        .margin(14)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .caption(caption, ("sans-serif", 18))
+        .build_cartesian_2d(0.0..x_max, 0.0..1.02)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
+}
+
 /// Precision, recall and false positives over the threshold, the one in use dashed.
 fn draw_rates<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -118,18 +146,12 @@ where
     DB::ErrorType: 'static,
 {
     use crate::figure::err;
-    let mut left = ChartBuilder::on(area)
-        .margin(14)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .caption("over the score threshold", ("sans-serif", 18))
-        .build_cartesian_2d(0.0..1.0, 0.0..1.02)
-        .map_err(err)?;
-    left.configure_mesh()
-        .x_desc("threshold (--min-score)")
-        .y_desc("rate")
-        .draw()
-        .map_err(err)?;
+    let mut left = rate_chart(
+        area,
+        "over the score threshold",
+        1.0,
+        ("threshold (--min-score)", "rate"),
+    )?;
     type Get = fn(&CurvePoint) -> Option<f64>;
     let series: [(&str, Get, RGBColor); 3] = [
         ("precision", |p| p.precision, BLUE),
@@ -176,22 +198,12 @@ where
     DB::ErrorType: 'static,
 {
     use crate::figure::err;
-    let mut right = ChartBuilder::on(area)
-        .margin(14)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .caption(
-            "precision against recall (circled: the threshold in use)",
-            ("sans-serif", 18),
-        )
-        .build_cartesian_2d(0.0..1.02, 0.0..1.02)
-        .map_err(err)?;
-    right
-        .configure_mesh()
-        .x_desc("recall")
-        .y_desc("precision")
-        .draw()
-        .map_err(err)?;
+    let mut right = rate_chart(
+        area,
+        "precision against recall (circled: the threshold in use)",
+        1.02,
+        ("recall", "precision"),
+    )?;
     let pr: Vec<(f64, f64)> = curve
         .iter()
         .filter_map(|p| Some((p.recall?, p.precision?)))

@@ -223,41 +223,50 @@ fn is_off(v: &f64) -> bool {
 /// until their committed outcomes are regenerated with the check on); refused for the
 /// Gaussian estimate.
 fn min_score_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
-    let field = "sensors.pallet.min_score";
-    if p.kind == "gaussian" && p.min_score.is_some() {
-        return Err(invalid(
-            file,
-            field,
-            "the gaussian estimate has no scan to check a face against",
-        ));
-    }
-    let v = p.min_score.unwrap_or(0.0);
-    if !(0.0..=1.0).contains(&v) {
-        return Err(invalid(file, field, &format!("{v} must lie in 0–1")));
-    }
-    Ok(v)
+    scanning_setting(
+        p,
+        file,
+        ("min_score", p.min_score, 0.0),
+        (1.0, ""),
+        "the gaussian estimate has no scan to check a face against",
+    )
 }
 
 /// `[sensors.pallet] latency_s`, in range; refused for the Gaussian estimate.
 fn latency_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
-    let field = "sensors.pallet.latency_s";
-    if p.kind == "gaussian" && p.latency_s.is_some() {
+    scanning_setting(
+        p,
+        file,
+        ("latency_s", p.latency_s, DEFAULT_DETECTOR_LATENCY_S),
+        (MAX_DETECTOR_LATENCY_S, " s"),
+        "the gaussian estimate has no scan or detector to be late; its σ stands for the \
+         whole pipeline",
+    )
+}
+
+/// A `[sensors.pallet]` setting of the scans and detector (`key`, as written, default):
+/// refused with the gaussian estimate (`gaussian_why`), else its value or default within
+/// 0–`max` (`unit` after the numbers in the message).
+fn scanning_setting(
+    p: &PalletSensorFile,
+    file: &str,
+    (key, value, default): (&str, Option<f64>, f64),
+    (max, unit): (f64, &str),
+    gaussian_why: &str,
+) -> Result<f64, TrialError> {
+    let field = format!("sensors.pallet.{key}");
+    if p.kind == "gaussian" && value.is_some() {
+        return Err(invalid(file, &field, gaussian_why));
+    }
+    let v = value.unwrap_or(default);
+    if !(v.is_finite() && (0.0..=max).contains(&v)) {
         return Err(invalid(
             file,
-            field,
-            "the gaussian estimate has no scan or detector to be late; its σ stands for the \
-             whole pipeline",
+            &field,
+            &format!("{v}{unit} must lie in 0–{max}{unit}"),
         ));
     }
-    let latency_s = p.latency_s.unwrap_or(DEFAULT_DETECTOR_LATENCY_S);
-    if !(latency_s.is_finite() && (0.0..=MAX_DETECTOR_LATENCY_S).contains(&latency_s)) {
-        return Err(invalid(
-            file,
-            field,
-            &format!("{latency_s} s must lie in 0–{MAX_DETECTOR_LATENCY_S} s"),
-        ));
-    }
-    Ok(latency_s)
+    Ok(v)
 }
 
 /// The sensing a kind names with every setting at its default (`--pallet-sensing`).
