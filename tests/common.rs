@@ -36,3 +36,18 @@ pub fn text(o: &Output) -> String {
         String::from_utf8_lossy(&o.stderr)
     )
 }
+
+/// The field test without noise recorded as a forkbench MCAP at `mcap` (replacing one
+/// there): scans for `detect` to read.
+pub fn record_field_mcap(mcap: &Path) {
+    let field = repo_root().join("scenarios/field-test.toml");
+    let o = forkbench(&[
+        "trial",
+        s(&field),
+        "--no-noise",
+        "--mcap",
+        s(mcap),
+        "--force",
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
+}
