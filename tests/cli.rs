@@ -593,8 +593,11 @@ fn batch_records_failures_and_replay_reproduces_a_trial() {
     let out = forkbench(&[
         "batch",
         scn.to_str().expect("utf8"),
+        // Both modes, so the field test (one failure in 20 a mode) fails twice.
         "--trials",
-        "6",
+        "20",
+        "--modes",
+        "both",
         "--out",
         d,
         "--max-recordings",

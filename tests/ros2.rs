@@ -266,13 +266,11 @@ fn a_trials_scans_through_its_bag_and_detect_give_its_estimates() {
         out.status.code().is_some_and(|c| c == 0 || c == 3),
         "{out:?}"
     );
-    // At the trial's own threshold (its default, 0: the detector's own face).
+    // At the trial's own threshold (its default, `detect`'s too).
     let out = detect(&[
         bag.to_str().expect("utf-8"),
         "--frame",
         "map",
-        "--min-score",
-        "0",
         "--out",
         lines.to_str().expect("utf-8"),
     ]);

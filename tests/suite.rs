@@ -12,6 +12,7 @@ mod hostile_round4;
 mod navigation;
 mod outputs;
 mod papercuts;
+mod rare;
 mod ros2;
 mod scenario_fuzz;
 mod shards;

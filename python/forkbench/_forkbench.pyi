@@ -100,6 +100,30 @@ def run_batch(
     truck_preset: str | None = None,
     truck: Mapping[str, float] | None = None,
 ) -> list[Outcome]: ...
+def estimate(
+    scenario: Scenario,
+    case: str | None = None,
+    *,
+    event: str = "failure",
+    method: str = "ce",
+    budget: int = 2000,
+    seed: int = 1,
+    jobs: int | None = None,
+    planner: str | None = None,
+    tracker: str | None = None,
+) -> dict[str, Any]: ...
+def falsify(
+    scenario: Scenario,
+    case: str | None = None,
+    *,
+    event: str = "failure",
+    budget: int = 2000,
+    seed: int = 1,
+    monte_carlo: bool = False,
+    jobs: int | None = None,
+    planner: str | None = None,
+    tracker: str | None = None,
+) -> dict[str, Any]: ...
 def report(
     dir: str | os.PathLike[str],
     *,

@@ -62,6 +62,7 @@ pub fn run_trial<'py>(
             truck: truck.unwrap_or_default(),
         },
         wall_budget_s: None,
+        uncertain: Default::default(),
     };
     // The CLI's own check: values in range, and every override acting on this scenario.
     let run = scn

@@ -4,6 +4,7 @@ mod batch;
 mod convert;
 mod env;
 mod obs;
+mod rare;
 mod render;
 mod report;
 mod scenario;
@@ -25,6 +26,8 @@ fn _forkbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scenario::default_scenarios, m)?)?;
     m.add_function(wrap_pyfunction!(batch::run_trial, m)?)?;
     m.add_function(wrap_pyfunction!(batch::run_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(rare::estimate, m)?)?;
+    m.add_function(wrap_pyfunction!(rare::falsify, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(report::replay, m)?)?;
     m.add("OBSERVATION_FIELDS", obs::FIELDS.to_vec())?;

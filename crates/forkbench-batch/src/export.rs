@@ -38,6 +38,8 @@ struct Row<'a> {
     path_length_m: f64,
     sim_time_s: f64,
     wall_time_ms: f64,
+    /// Signed margin to failure (the outcome's `robustness`).
+    robustness: Option<f64>,
     /// Handling cycles: the phases that succeeded, the first that failed, the totals.
     phases_done: Option<usize>,
     failed_phase: &'a str,
@@ -163,6 +165,7 @@ fn row<'a>(r: &'a TrialRecord, finite: impl Fn(f64) -> Option<f64>) -> Row<'a> {
         path_length_m: o.path_length_m,
         sim_time_s: o.sim_time_s,
         wall_time_ms: o.wall_time_ms,
+        robustness: o.robustness,
         phases_done: (!o.phases.is_empty()).then(|| o.phases.iter().filter(|p| p.success).count()),
         failed_phase: o
             .phases

@@ -28,6 +28,7 @@ mod order;
 mod outdir;
 pub mod prints;
 mod provenance;
+pub mod rare;
 mod records_run;
 mod replay;
 mod safety_summary;
@@ -187,6 +188,9 @@ impl TrialRecord {
             replan: self.replan,
             overrides: self.overrides.clone(),
             wall_budget_s: None,
+            // A search's trial had its values given; a batch's drew them, and pinning
+            // what it drew gives the same.
+            uncertain: self.outcome.uncertain.clone(),
         }
     }
 }
@@ -322,6 +326,7 @@ impl BatchSpec {
             replan: j.replan,
             overrides: self.overrides.clone(),
             wall_budget_s: None,
+            uncertain: Default::default(),
         };
         let names = (j.planner.as_str(), j.tracker.as_str());
         let outcome = guarded(s, &case.name, names, seed, || run_trial(s, case, &opts));

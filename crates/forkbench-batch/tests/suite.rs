@@ -7,4 +7,5 @@ mod gate;
 mod hostile_external;
 mod modes;
 mod noise_knobs;
+mod rare;
 mod rust_planner_example;

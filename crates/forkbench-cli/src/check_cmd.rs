@@ -110,8 +110,27 @@ fn summary(scn: &Scenario) -> String {
             }
         ));
     }
+    lines.extend(uncertain(scn));
     lines.extend(cases(scn));
     lines.join("\n") + "\n"
+}
+
+/// Each uncertain parameter: its distribution and the range a trial or a search reaches.
+fn uncertain(scn: &Scenario) -> Vec<String> {
+    use forkbench_trial::scenario::uncertain::Z_LIMIT;
+    scn.uncertain
+        .0
+        .iter()
+        .map(|u| {
+            format!(
+                "uncertain    {}: {}, reaching {:.4} to {:.4}",
+                u.name,
+                u.dist,
+                u.dist.at(-Z_LIMIT),
+                u.dist.at(Z_LIMIT)
+            )
+        })
+        .collect()
 }
 
 /// The steering actuator as it will act (docs/truck.md).

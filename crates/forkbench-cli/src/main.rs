@@ -13,6 +13,7 @@ mod gate_cmd;
 mod map_cmd;
 mod mission_report;
 mod plan_cmd;
+mod rare_cmd;
 mod replay_cmd;
 mod reproduce_cmd;
 mod route_cmd;
@@ -54,7 +55,7 @@ enum ReproduceArg {
 
 /// Recording targets of one trial.
 #[derive(Debug, clap::Args)]
-struct RecordFlags {
+pub(crate) struct RecordFlags {
     /// Write a rerun recording to FILE (.rrd).
     #[arg(long)]
     rrd: Option<PathBuf>,
@@ -80,7 +81,7 @@ struct RecordFlags {
 }
 
 impl RecordFlags {
-    fn args(self) -> forkbench_log::RecordTargets {
+    pub(crate) fn args(self) -> forkbench_log::RecordTargets {
         forkbench_log::RecordTargets {
             rrd: self.rrd,
             mcap: self.mcap,
@@ -195,21 +196,13 @@ enum Command {
     /// pick (exit status 3 when a leg or the pick fails).
     Mission(TrialCli),
     /// Re-run one trial from its JSON line (in a batch's trials.jsonl) and record it.
-    Replay {
-        /// File with JSON lines (e.g. DIR/trials.jsonl).
-        file: PathBuf,
-        /// 1-based line of the trial to replay (default: the first).
-        #[arg(long, default_value_t = 1)]
-        line: usize,
-        /// Scenario file the trial came from (default: the embedded scenario of that name).
-        #[arg(long)]
-        scenario: Option<PathBuf>,
-        /// The components file the batch ran with (`batch --components FILE`).
-        #[arg(long, value_name = "FILE")]
-        components: Option<PathBuf>,
-        #[command(flatten)]
-        record: RecordFlags,
-    },
+    Replay(replay_cmd::ReplayArgs),
+    /// P(event) over a scenario's [[uncertain]] parameters with its confidence interval:
+    /// cross-entropy importance sampling (or --method mc), every trial kept.
+    Estimate(rare_cmd::EstimateArgs),
+    /// The most likely failure over a scenario's [[uncertain]] parameters within a trial
+    /// budget, and the least robust trial (exit 3 when a failure was found).
+    Falsify(rare_cmd::FalsifyArgs),
     /// Monte-Carlo batch over scenarios × cases × planners × trackers × trials (default: the embedded scenario set).
     Batch(batch_cmd::BatchArgs),
     /// Combine shard outputs into one summary: shard directories, or the --out of a
@@ -348,16 +341,14 @@ fn run(cli: Cli) -> anyhow::Result<Done> {
         Command::Compare(args) => gate_cmd::compare(&args).map(|()| Done::Ok),
         Command::Trial(t) => t.run(false),
         Command::Mission(t) => t.run(true),
-        Command::Replay {
-            file,
-            line,
-            scenario,
-            components,
-            record,
-        } => {
-            let from = (scenario.as_deref(), components.as_deref());
-            let ok = replay_cmd::replay(&file, line, from, &record.args())?;
+        Command::Replay(a) => {
+            let ok = replay_cmd::replay_args(a)?;
             Ok(if ok { Done::Ok } else { Done::PickFailed })
+        }
+        Command::Estimate(a) => rare_cmd::estimate(&a).map(|()| Done::Ok),
+        Command::Falsify(a) => {
+            let found = rare_cmd::falsify(a)?;
+            Ok(if found { Done::PickFailed } else { Done::Ok })
         }
         Command::Plan(args) => match args.route()? {
             Some(route) => {

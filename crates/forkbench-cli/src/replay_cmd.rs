@@ -1,8 +1,32 @@
 //! `forkbench replay`: one trial re-run from its JSON line, recorded, and checked against the record.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, bail};
+
+/// `forkbench replay`'s arguments.
+#[derive(Debug, clap::Args)]
+pub struct ReplayArgs {
+    /// File with JSON lines (e.g. DIR/trials.jsonl).
+    file: PathBuf,
+    /// 1-based line of the trial to replay (default: the first).
+    #[arg(long, default_value_t = 1)]
+    line: usize,
+    /// Scenario file the trial came from (default: the embedded scenario of that name).
+    #[arg(long)]
+    scenario: Option<PathBuf>,
+    /// The components file the batch ran with (`batch --components FILE`).
+    #[arg(long, value_name = "FILE")]
+    components: Option<PathBuf>,
+    #[command(flatten)]
+    record: crate::RecordFlags,
+}
+
+/// `forkbench replay` as the command line gives it.
+pub fn replay_args(a: ReplayArgs) -> anyhow::Result<bool> {
+    let from = (a.scenario.as_deref(), a.components.as_deref());
+    replay(&a.file, a.line, from, &a.record.args())
+}
 
 /// `forkbench replay`: re-runs one trial from its JSON line, records it, and checks that
 /// the outcome is the recorded one.

@@ -207,6 +207,7 @@ pub fn options(
         replan: replan.then_some(true),
         overrides,
         wall_budget_s: None,
+        uncertain: Default::default(),
     };
     opts.validate()?;
     Ok(opts)

@@ -9,6 +9,7 @@ pub mod pallet;
 pub mod path;
 pub mod pose;
 pub mod quantile;
+pub mod run_settings;
 pub mod settings;
 pub mod signal;
 pub mod units;

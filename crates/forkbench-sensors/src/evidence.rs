@@ -48,8 +48,8 @@ pub const DEFAULT_MIN_SCORE: f64 = 0.85;
 /// What the evidence stage made of a request's candidate faces.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Verdict {
-    /// The best-scoring candidate (the detector's order deciding ties), when its score
-    /// reaches the threshold, made final by the detector, with its score.
+    /// The detector's first candidate whose score reaches the threshold, made final by
+    /// the detector, with its score.
     pub chosen: Option<(Found, f64)>,
     /// Every candidate's face and score in the detector's order, so a threshold other
     /// than the one asked for can be applied afterwards (a precision-recall curve).
@@ -72,18 +72,18 @@ pub fn best_of(scored: &[(Pose2, f64)]) -> Option<(Pose2, f64)> {
 }
 
 /// The location stage, then the evidence: each of `detector`'s candidate faces scored
-/// against its scan (or by the detector's own score when it gives one), the best taken
-/// when it reaches `min_score`. A scan that bears none out holds no pallet. At
-/// `min_score` 0 the evidence chooses nothing: the detector's own first face is taken,
-/// as its `detect` gives it.
+/// against its scan (or by the detector's own score when it gives one), and the first
+/// in the detector's order of preference that reaches `min_score` taken: the evidence
+/// vetoes, the detector ranks (its best fit is often the truer face when two pass). A
+/// scan that bears none out holds no pallet. At `min_score` 0 the evidence chooses
+/// nothing: the detector's own first face is taken, as its `detect` gives it.
 pub fn verified(
     detector: &mut dyn PalletDetector,
     req: &DetectRequest<'_>,
     min_score: f64,
 ) -> Result<Verdict, DetectorError> {
     let mut v = Verdict::default();
-    let mut first: Option<(Found, f64)> = None;
-    let mut best: Option<(Found, f64)> = None;
+    let mut chosen: Option<(Found, f64)> = None;
     for c in detector.candidates(req)? {
         let Some(s) = req.scans.get(c.sensor) else {
             continue;
@@ -92,21 +92,11 @@ pub fn verified(
             .score
             .unwrap_or_else(|| face_evidence(s.scan, req.pallet, &c.detection.face).score);
         v.scored.push((c.detection.face, score));
-        if first.is_none() {
-            first = Some((c, score));
-        }
-        if best.as_ref().is_none_or(|b| score > b.1) {
-            best = Some((c, score));
+        if chosen.is_none() && score >= min_score {
+            chosen = Some((c, score));
         }
     }
-    if min_score <= 0.0 {
-        first = first.or(best);
-        v.chosen = first.map(|(c, score)| (detector.finish(req, c), score));
-        return Ok(v);
-    }
-    v.chosen = best
-        .filter(|b| b.1 >= min_score)
-        .map(|(c, score)| (detector.finish(req, c), score));
+    v.chosen = chosen.map(|(c, score)| (detector.finish(req, c), score));
     Ok(v)
 }
 

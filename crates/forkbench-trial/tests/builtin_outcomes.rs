@@ -52,15 +52,17 @@ fn rerun(want: &Value) -> Value {
         // The records of plan-once came from the scenario's own setting.
         replan: replan.then_some(true),
         wall_budget_s: None,
+        uncertain: Default::default(),
     };
     let out = run_trial(scn, case, &opts);
     let mut v = serde_json::to_value(&out).expect("serialises");
     let m = v.as_object_mut().expect("object");
     m.remove("wall_time_ms");
     // Fields the records predate (pallet-estimate counts and errors, every broken
-    // criterion and the likely cause, the step criteria's measures).
+    // criterion and the likely cause, the step criteria's measures, the robustness).
     for later in [
         "measures",
+        "robustness",
         "estimates",
         "estimates_missed",
         "estimate_lateral_error_m",

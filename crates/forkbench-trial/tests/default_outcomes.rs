@@ -50,6 +50,7 @@ fn rerun(want: &Value, scenarios: &[forkbench_trial::Scenario], ideal: bool) -> 
         },
         replan: Some(replan),
         wall_budget_s: None,
+        uncertain: Default::default(),
     };
     let mut v = serde_json::to_value(run_trial(scn, case, &opts)).expect("serialises");
     without_clock_times(&mut v);

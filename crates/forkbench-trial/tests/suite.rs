@@ -24,3 +24,4 @@ mod session;
 mod settings_ranges;
 mod staging;
 mod trial;
+mod uncertain;

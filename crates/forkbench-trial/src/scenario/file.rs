@@ -275,6 +275,9 @@ pub(super) struct ScenarioFile {
     pub(super) mover: Vec<forkbench_safety::MoverSpec>,
     /// Sensors beyond the defaults (`[sensors.pallet]`).
     pub(super) sensors: Option<super::sensors::SensorsFile>,
+    /// Settings left to chance (`[[uncertain]]`).
+    #[serde(default)]
+    pub(super) uncertain: Vec<toml::Spanned<super::uncertain_file::UncertainFile>>,
 }
 
 fn default_true() -> bool {

@@ -4,12 +4,15 @@ mod checks;
 pub mod clutter;
 mod file;
 mod hints;
+mod input;
 mod limits;
 pub mod mission;
 mod named;
 mod pallet;
 mod safety;
 pub mod sensors;
+pub mod uncertain;
+pub mod uncertain_file;
 mod world;
 
 use std::path::{Path as FsPath, PathBuf};
@@ -64,58 +67,8 @@ pub(crate) fn invalid_setting(
 /// Longest simulated trial a scenario may ask for: bounds the steps one trial takes.
 pub const MAX_TIMEOUT_S: f64 = 600.0;
 
-/// Largest scenario or world file read: far above any real one, and a bound on what a
-/// wrong path (a device, a huge file) can make the loader read.
-pub const MAX_INPUT_BYTES: u64 = 4 << 20;
-
-/// Longest parse message passed on: toml quotes the offending input, which for a
-/// pathological file can be most of it.
-const MAX_MESSAGE_CHARS: usize = 2000;
-
-pub(crate) fn read(path: &FsPath) -> Result<String, TrialError> {
-    // The one capped reader: regular files only, so a FIFO or a device is refused at once
-    // instead of blocking or growing without end.
-    forkbench_core::files::read_text(path, MAX_INPUT_BYTES).map_err(|e| match e {
-        forkbench_core::files::FileError::Io { cause, .. } => TrialError::Read {
-            file: path.display().to_string(),
-            cause,
-        },
-        other => {
-            let file = path.display().to_string();
-            let message = other.to_string();
-            let message = message
-                .strip_prefix(&format!("{file}: "))
-                .unwrap_or(&message)
-                .to_owned();
-            TrialError::Parse { file, message }
-        }
-    })
-}
-
-pub(crate) fn parse<T: serde::de::DeserializeOwned>(
-    text: &str,
-    file: &str,
-) -> Result<T, TrialError> {
-    toml::from_str(text).map_err(|e| {
-        let mut message = crate::text::compact_numbers(e.to_string().trim_end());
-        let hint = hints::misplaced_key(
-            text,
-            &message,
-            // An empty span is the document's: a top-level key is missing.
-            e.span().filter(|s| !s.is_empty()).map(|s| s.start),
-        );
-        if message.chars().count() > MAX_MESSAGE_CHARS {
-            message = message.chars().take(MAX_MESSAGE_CHARS).collect::<String>() + " …";
-        }
-        if let Some(hint) = hint {
-            message = format!("{message}\n{hint}");
-        }
-        TrialError::Parse {
-            file: file.to_owned(),
-            message,
-        }
-    })
-}
+pub use input::MAX_INPUT_BYTES;
+pub(crate) use input::{parse, read};
 
 /// A loaded, validated scenario file (serialisable: a batch's manifest records it whole).
 #[derive(Debug, Clone, Serialize)]
@@ -175,6 +128,9 @@ pub struct Scenario {
     /// People and other vehicles on routes through the world (`[[mover]]`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub movers: Vec<forkbench_safety::MoverSpec>,
+    /// Settings each trial draws (`[[uncertain]]`).
+    #[serde(skip_serializing_if = "uncertain::UncertainSet::is_empty")]
+    pub uncertain: uncertain::UncertainSet,
     /// Likely slips the file is still valid with (radians in a degrees key), as
     /// `file:line: …`; front ends print them.
     #[serde(skip)]
@@ -329,6 +285,8 @@ impl Scenario {
         };
         let zero = Pose2::new(0.0, 0.0, 0.0);
         let pallet_sensing = sensors::resolve(f.sensors.as_ref(), &f.truck, file)?;
+        let uncertain = uncertain_file::resolve(&f.uncertain, &f.mover, (file, text))?;
+        uncertain_file::check_sensing(&uncertain, pallet_sensing.is_gaussian(), file)?;
         Ok(Scenario {
             file: file.to_owned(),
             name: f.name,
@@ -358,6 +316,7 @@ impl Scenario {
             phases: Vec::new(),
             safety: f.safety,
             movers: f.mover,
+            uncertain,
             warnings: hints::unit_warnings(text, file),
         })
     }

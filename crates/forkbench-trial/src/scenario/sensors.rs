@@ -70,9 +70,9 @@ pub enum PalletSensing {
         detector: ComponentSpec,
         /// From a scan's end to its estimate reaching the controller.
         latency_s: f64,
-        /// Least evidence score a located face needs to be taken; 0 (the default, left
-        /// out of the settings' fingerprint): the detector's own face, unchecked.
-        #[serde(skip_serializing_if = "is_off")]
+        /// Least evidence score a located face needs to be taken (the detector's
+        /// candidates in its own order, the first that reaches it); 0: the detector's
+        /// own first face, unchecked.
         min_score: f64,
     },
 }
@@ -87,6 +87,14 @@ impl PalletSensing {
         match self {
             PalletSensing::Scanner { latency_s, .. } => *latency_s,
             PalletSensing::Gaussian => 0.0,
+        }
+    }
+
+    /// Sets the scans' latency (the Gaussian has none; an uncertain parameter on it is
+    /// refused at load).
+    pub(crate) fn set_latency_s(&mut self, v: f64) {
+        if let PalletSensing::Scanner { latency_s, .. } = self {
+            *latency_s = v;
         }
     }
 
@@ -215,18 +223,17 @@ pub(super) fn resolve(
     })
 }
 
-fn is_off(v: &f64) -> bool {
-    *v == 0.0
-}
-
-/// `[sensors.pallet] min_score`, in 0–1 (default 0: trials take the detector's own face
-/// until their committed outcomes are regenerated with the check on); refused for the
-/// Gaussian estimate.
+/// `[sensors.pallet] min_score`, in 0–1 (default `detect`'s threshold, so a trial's
+/// detector is the one `detect` measures); refused for the Gaussian estimate.
 fn min_score_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
     scanning_setting(
         p,
         file,
-        ("min_score", p.min_score, 0.0),
+        (
+            "min_score",
+            p.min_score,
+            forkbench_sensors::evidence::DEFAULT_MIN_SCORE,
+        ),
         (1.0, ""),
         "the gaussian estimate has no scan to check a face against",
     )

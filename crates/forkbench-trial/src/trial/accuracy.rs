@@ -109,7 +109,8 @@ fn study_cell(
     case: &Case,
     (draws, seed): (u32, u64),
 ) -> Result<AccuracyRow, StageError> {
-    let (sim, root, truth, _) = build_world(scn, &scn.truck, case, seed, None)?;
+    let (sim, root, truth, _) =
+        build_world(scn, &scn.truck, case, (seed, &Default::default()), None)?;
     // The scenario's own detector (the pocket detector where it senses without scans).
     let (_, mut detector) = super::look::scenario_detector(scn)?;
     let (mut lat, mut along, mut head) = (Vec::new(), Vec::new(), Vec::new());

@@ -56,6 +56,11 @@ pub struct Criterion {
     pub irreversible: bool,
     reading: Option<fn(&TrialOutcome, &Limits) -> Reading>,
     check: fn(&Judged<'_>) -> Option<String>,
+    /// Signed margin to its limit, (limit − measured) / limit: negative exactly when
+    /// broken; −1 when broken for a criterion with no continuous measure; `None` when
+    /// nothing was measured (the forks never reached the face) or when the measure is a
+    /// target the drive holds (a depth reached).
+    margin: fn(&Judged<'_>) -> Option<f64>,
 }
 
 impl Criterion {
@@ -88,6 +93,7 @@ pub const PICK_CRITERIA: &[Criterion] = &[
         irreversible: true,
         reading: None,
         check: collision,
+        margin: |j| j.m.collision.then_some(-1.0),
     },
     Criterion {
         failure: Failure::ContactForce,
@@ -99,6 +105,7 @@ pub const PICK_CRITERIA: &[Criterion] = &[
             limit: format!("{:.0} N", t.contact_force_n),
         }),
         check: contact_force,
+        margin: |j| Some(ratio(j.tol.contact_force_n, j.m.max_contact_force_n)),
     },
     Criterion {
         failure: Failure::PalletDisplaced,
@@ -118,6 +125,14 @@ pub const PICK_CRITERIA: &[Criterion] = &[
             ),
         }),
         check: pallet_displaced,
+        margin: |j| {
+            Some(
+                ratio(j.tol.pallet_displacement_m, j.m.pallet_displacement_m).min(ratio(
+                    j.tol.pallet_rotation_rad,
+                    j.m.pallet_rotation_rad.abs(),
+                )),
+            )
+        },
     },
     Criterion {
         failure: Failure::LateralError,
@@ -131,6 +146,7 @@ pub const PICK_CRITERIA: &[Criterion] = &[
             limit: format!("{} m", t.lateral_m),
         }),
         check: lateral_error,
+        margin: |j| j.m.lateral_error_m.map(|e| ratio(j.tol.lateral_m, e.abs())),
     },
     Criterion {
         failure: Failure::HeadingError,
@@ -144,6 +160,10 @@ pub const PICK_CRITERIA: &[Criterion] = &[
             limit: format!("{}°", t.heading_deg()),
         }),
         check: heading_error,
+        margin: |j| {
+            j.m.heading_error_rad
+                .map(|e| ratio(j.tol.heading_rad, e.abs()))
+        },
     },
     Criterion {
         failure: Failure::Timeout,
@@ -151,6 +171,7 @@ pub const PICK_CRITERIA: &[Criterion] = &[
         irreversible: false,
         reading: None,
         check: timeout,
+        margin: |j| j.m.timed_out.then_some(-1.0),
     },
     Criterion {
         failure: Failure::InsertionDepth,
@@ -164,6 +185,15 @@ pub const PICK_CRITERIA: &[Criterion] = &[
             limit: format!("≥ {} m", t.insertion_depth_m),
         }),
         check: insertion_depth,
+        // Only a shortfall counts: the drive holds the forks at their target depth, so a
+        // met depth's margin is the same in every pick and says nothing of how near it
+        // came to failing.
+        margin: |j| {
+            let need = j.tol.insertion_depth_m;
+            Some(j.m.insertion_depth_m)
+                .filter(|d| d.is_finite() && *d < need)
+                .map(|d| (d - need) / need)
+        },
     },
     Criterion {
         failure: Failure::ForkOutsidePocket,
@@ -171,6 +201,10 @@ pub const PICK_CRITERIA: &[Criterion] = &[
         irreversible: false,
         reading: None,
         check: fork_outside_pocket,
+        margin: |j| {
+            let clearance = (j.pallet.pocket_width_m - j.truck.fork_width_m) / 2.0;
+            Some(ratio(clearance, j.m.worst_pocket_miss_m))
+        },
     },
 ];
 
@@ -180,6 +214,26 @@ pub(super) fn broken(j: &Judged<'_>) -> Vec<(Failure, String)> {
         .iter()
         .filter_map(|c| (c.check)(j).map(|why| (c.failure, why)))
         .collect()
+}
+
+/// The pick's robustness: the least of its criteria's margins (see [`Criterion`]),
+/// negative when one is broken; `None` when no criterion measured anything.
+pub(super) fn robustness(j: &Judged<'_>) -> Option<f64> {
+    PICK_CRITERIA
+        .iter()
+        .filter_map(|c| (c.margin)(j))
+        .reduce(f64::min)
+}
+
+/// (limit − measured) / limit, for a limit above zero (else the sign alone).
+fn ratio(limit: f64, measured: f64) -> f64 {
+    if limit > 0.0 {
+        (limit - measured) / limit
+    } else if measured > limit {
+        -1.0
+    } else {
+        0.0
+    }
 }
 
 /// Whether a criterion whose breach is final is broken by the measurements now.

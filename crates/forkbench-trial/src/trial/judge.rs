@@ -30,6 +30,7 @@ impl Trial<'_> {
         let now = self.measure();
         let m = self.pick_measures(&now, self.verdict.timed_out);
         let mut broken = super::criteria::broken(&self.judged(m));
+        self.verdict.out.robustness = super::criteria::robustness(&self.judged(m));
         for c in &self.verdict.step_criteria {
             if let Some(v) = c.value() {
                 self.verdict.out.measures.insert(c.measure().to_owned(), v);

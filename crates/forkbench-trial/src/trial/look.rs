@@ -38,7 +38,8 @@ pub fn scan_once(
     seed: u64,
     ideal: bool,
 ) -> Result<ScanReport, StageError> {
-    let (sim, root, truth, _) = build_world(scn, &scn.truck, case, seed, at)?;
+    let (sim, root, truth, _) =
+        build_world(scn, &scn.truck, case, (seed, &Default::default()), at)?;
     let pose = cfg.sensor_pose(&root);
     // Its own stream, so a scan does not shift the trial's other draws.
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ super::streams::SCAN_ONCE);

@@ -29,6 +29,7 @@ mod staging;
 mod state;
 mod streams;
 mod truck_knobs;
+mod uncertain_apply;
 mod world;
 
 use std::time::Instant;
@@ -60,6 +61,7 @@ pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOption
 pub use session::{Session, SessionEnd};
 pub use session_view::SceneView;
 pub use truck_knobs::{TRUCK_KNOBS, apply_truck, truck_file_settings, truck_path};
+pub use uncertain_apply::Shift;
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
 /// (negative: before it).
@@ -159,6 +161,18 @@ fn unresolved(scn: &Scenario, case: &Case, opts: &TrialOptions, e: &TrialError) 
 /// The whole trial: setup, the mission's legs, staging, the pick and its verdict, and
 /// (unless a session takes the pick alone) the phases after it.
 pub(crate) async fn run_stages<R: Recorder + ?Sized>(
+    scn: &Scenario,
+    case: &Case,
+    run: &Resolved,
+    link: Option<link::Link>,
+    rec: &mut R,
+) -> TrialOutcome {
+    let mut out = stages(scn, case, run, link, rec).await;
+    out.settle_robustness();
+    out
+}
+
+async fn stages<R: Recorder + ?Sized>(
     scn: &Scenario,
     case: &Case,
     run: &Resolved,

@@ -132,6 +132,9 @@ pub struct TrialOptions {
     /// Most wall time one trial may take, external components' answers included
     /// (`None`: `DEFAULT_WALL_BUDGET_S`); past it the trial ends as an error.
     pub wall_budget_s: Option<f64>,
+    /// Uncertain parameters pinned to these values instead of drawn (a search's point,
+    /// a replay); each must be declared and within its distribution's reach.
+    pub uncertain: crate::scenario::uncertain::Values,
 }
 
 /// A trial's wall-time budget unless a run sets one: built-in trials take well under a
@@ -195,6 +198,10 @@ pub struct Resolved {
     pub wall_budget_s: f64,
     /// The scenario's truck with the run's actuator and timing changes.
     pub truck: forkbench_core::ForkliftSpec,
+    /// The values of the scenario's uncertain parameters this trial runs with.
+    pub uncertain: crate::scenario::uncertain::Values,
+    /// Where they put the true pallet and the start off the case's.
+    pub shift: super::uncertain_apply::Shift,
 }
 
 impl Scenario {
@@ -235,7 +242,7 @@ impl Scenario {
             }
             None => 1.0,
         };
-        Ok(Resolved {
+        let mut run = Resolved {
             seed: opts.seed.unwrap_or(self.seed),
             planner: self.component(Role::Planner, opts.planner.as_deref())?,
             tracker: self.component(Role::Tracker, opts.tracker.as_deref())?,
@@ -249,7 +256,36 @@ impl Scenario {
             odometry: self.scaled_odometry(o.odometry_noise_scale)?,
             wall_budget_s: opts.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
             truck: self.truck_for(o)?,
-        })
+            uncertain: BTreeMap::new(),
+            shift: Default::default(),
+        };
+        self.with_uncertain(&mut run, &opts.uncertain)?;
+        Ok(run)
+    }
+
+    /// `run` with the scenario's uncertain parameters drawn (or `pinned`) and applied.
+    fn with_uncertain(
+        &self,
+        run: &mut Resolved,
+        pinned: &BTreeMap<String, f64>,
+    ) -> Result<(), TrialError> {
+        let d = super::uncertain_apply::draw(self, run.seed, pinned)?;
+        if !d.truck.is_empty() {
+            run.truck = super::apply_truck(&run.truck, None, &d.truck)?;
+            run.truck
+                .control
+                .steps_per_tick(self.sim.dt_s)
+                .map_err(|e| invalid_setting(&self.file, "truck", &e))?;
+        }
+        if let Some(v) = d.detector_latency_s {
+            run.pallet_sensing.set_latency_s(v);
+        }
+        if let Some(v) = d.nav350_latency_s {
+            run.nav350.latency_s = v;
+        }
+        run.shift = d.shift;
+        run.uncertain = d.values;
+        Ok(())
     }
 
     /// This scenario's truck with the run's preset and settings, its control period

@@ -58,11 +58,8 @@ pub(super) struct Monitor {
 impl SafetyRun {
     /// The scenario's movers (their starts drawn from the trial's seed, a stream per
     /// mover) and its safety function; `None` when it has neither.
-    pub(super) fn new(
-        scn: &Scenario,
-        truck: &forkbench_core::ForkliftSpec,
-        seed: u64,
-    ) -> Result<Option<Self>, String> {
+    pub(super) fn new(scn: &Scenario, run: &super::Resolved) -> Result<Option<Self>, String> {
+        let (truck, seed) = (&run.truck, run.seed);
         let cfg = scn.safety.as_ref().filter(|c| c.monitor);
         if scn.movers.is_empty() && cfg.is_none() {
             return Ok(None);
@@ -71,14 +68,18 @@ impl SafetyRun {
         let movers: Vec<Mover> = scn
             .movers
             .iter()
-            .map(|m| {
+            .enumerate()
+            .map(|(i, m)| {
                 // Identical movers are told apart by how many came before.
                 let twin = seen.iter().filter(|o| **o == m).count();
                 seen.push(m);
                 let mut rng = mover_stream(seed, m, twin);
                 let [a, b] = m.start_s;
-                let start = if b > a { rng.random_range(a..=b) } else { a };
-                Mover::new(m.clone(), start)
+                let drawn = if b > a { rng.random_range(a..=b) } else { a };
+                let (start, speed) = super::uncertain_apply::mover_pins(scn, &run.uncertain, i);
+                let mut spec = m.clone();
+                spec.speed_mps = speed.unwrap_or(spec.speed_mps);
+                Mover::new(spec, start.unwrap_or(drawn))
             })
             .collect();
         let monitor = match cfg {

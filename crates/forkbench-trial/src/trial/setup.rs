@@ -151,6 +151,7 @@ impl<'a> Trial<'a> {
     ) -> Result<Self, Box<TrialOutcome>> {
         let names = (run.planner.name.as_str(), run.tracker.name.as_str());
         let mut out = TrialOutcome::blank(&scn.name, &case.name, names, run.seed, run.noise);
+        out.uncertain = run.uncertain.clone();
         let mut fail = |out: &mut TrialOutcome, why: String| {
             rec.event(0.0, Level::Error, &why);
             out.fail(Failure::Error, why);
@@ -163,14 +164,14 @@ impl<'a> Trial<'a> {
             }
         };
         let (sim, start, true_pallet, obstacles) =
-            match build_world(scn, &run.truck, case, run.seed, None) {
+            match build_world(scn, &run.truck, case, (run.seed, &run.shift), None) {
                 Ok(w) => w,
                 Err(e) => {
                     fail(&mut out, e.to_string());
                     return Err(Box::new(out));
                 }
             };
-        let safety = match super::safety_run::SafetyRun::new(scn, &run.truck, run.seed) {
+        let safety = match super::safety_run::SafetyRun::new(scn, run) {
             Ok(s) => s,
             Err(e) => {
                 fail(&mut out, format!("the safety function: {e}"));

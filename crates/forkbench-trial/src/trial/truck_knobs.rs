@@ -8,32 +8,7 @@ use forkbench_core::actuators::{Actuators, PRESETS};
 use crate::TrialError;
 use crate::scenario::invalid;
 
-/// The truck settings a run may change, by their names in a sweep and their dotted paths
-/// in a truck file: the actuators and the control timing. The geometry is the scenario's.
-pub const TRUCK_KNOBS: [(&str, &str); 14] = [
-    ("steering_rate_limit_radps", "max_steer_rate_radps"),
-    ("steering_dead_time_s", "steering.dead_time_s"),
-    ("steering_time_constant_s", "steering.time_constant_s"),
-    ("steering_accel_limit_radps2", "steering.accel_limit_radps2"),
-    ("steering_deadband_rad", "steering.deadband_rad"),
-    ("steering_backlash_rad", "steering.backlash_rad"),
-    ("steering_offset_rad", "steering.offset_rad"),
-    ("drive_dead_time_s", "drive.dead_time_s"),
-    ("drive_time_constant_s", "drive.time_constant_s"),
-    ("drive_accel_limit_mps2", "drive.accel_limit_mps2"),
-    ("drive_brake_limit_mps2", "drive.brake_limit_mps2"),
-    ("drive_creep_speed_mps", "drive.creep_speed_mps"),
-    ("control_period_s", "control.period_s"),
-    ("control_transport_delay_s", "control.transport_delay_s"),
-];
-
-/// The dotted path of a sweep knob's name, or of a dotted path itself.
-pub fn truck_path(name: &str) -> Option<&'static str> {
-    TRUCK_KNOBS
-        .iter()
-        .find(|(k, p)| *k == name || *p == name)
-        .map(|(_, p)| *p)
-}
+pub use forkbench_core::run_settings::{TRUCK_KNOBS, truck_path};
 
 fn bad(field: &str, reason: &str) -> TrialError {
     invalid("options", field, reason)
@@ -58,7 +33,7 @@ pub fn apply_truck(
         out = out.with_actuators(a);
     }
     for (path, v) in settings {
-        if !set_field(&mut out, path, *v) {
+        if !forkbench_core::run_settings::set(&mut out, path, *v) {
             let known: Vec<&str> = TRUCK_KNOBS.iter().map(|(_, p)| *p).collect();
             return Err(bad(
                 path,
@@ -72,31 +47,6 @@ pub fn apply_truck(
     out.validate()
         .map_err(|e| bad(&format!("truck.{}", e.field.unwrap_or_default()), &e.reason))?;
     Ok(out)
-}
-
-/// Sets the truck's setting at `path` (one of [`TRUCK_KNOBS`]); false for another path.
-/// Set field by field, not through the serialised form, which leaves out what equals
-/// the first truck's.
-fn set_field(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
-    let (st, dr, ct) = (&mut t.steering, &mut t.drive, &mut t.control);
-    match path {
-        "max_steer_rate_radps" => t.max_steer_rate_radps = v,
-        "steering.dead_time_s" => st.dead_time_s = v,
-        "steering.time_constant_s" => st.time_constant_s = v,
-        "steering.accel_limit_radps2" => st.accel_limit_radps2 = Some(v),
-        "steering.deadband_rad" => st.deadband_rad = v,
-        "steering.backlash_rad" => st.backlash_rad = v,
-        "steering.offset_rad" => st.offset_rad = v,
-        "drive.dead_time_s" => dr.dead_time_s = v,
-        "drive.time_constant_s" => dr.time_constant_s = Some(v),
-        "drive.accel_limit_mps2" => dr.accel_limit_mps2 = Some(v),
-        "drive.brake_limit_mps2" => dr.brake_limit_mps2 = Some(v),
-        "drive.creep_speed_mps" => dr.creep_speed_mps = v,
-        "control.period_s" => ct.period_s = Some(v),
-        "control.transport_delay_s" => ct.transport_delay_s = v,
-        _ => return false,
-    }
-    true
 }
 
 /// A truck file (`--truck FILE`) as a run's changes: its `preset`, if it names one, and
@@ -134,8 +84,10 @@ pub fn truck_file_settings(
 }
 
 /// The sensors' timing under `preset`: the `ideal` truck is the bench's first one as it
-/// was sensed too, a NAV350 delivering each fix at once, scans taken in an instant and
-/// their estimates used at once; any other preset leaves the sensors as configured.
+/// was sensed too, a NAV350 delivering each fix at once, scans taken in an instant,
+/// their estimates used at once and the detector's own face taken unchecked (evidence
+/// threshold 0), so it reproduces the records made before these were modelled; any other
+/// preset leaves the sensors as configured.
 pub(crate) fn sensor_timing_for(
     preset: Option<&str>,
     nav350: &mut forkbench_sensors::Nav350Config,
@@ -146,10 +98,14 @@ pub(crate) fn sensor_timing_for(
     }
     nav350.latency_s = 0.0;
     if let crate::scenario::sensors::PalletSensing::Scanner {
-        sensors, latency_s, ..
+        sensors,
+        latency_s,
+        min_score,
+        ..
     } = sensing
     {
         *latency_s = 0.0;
+        *min_score = 0.0;
         for n in sensors {
             n.scanner.sweep_s = 0.0;
         }

@@ -6,26 +6,28 @@ use rand_chacha::ChaCha8Rng;
 
 use super::error::StageError;
 use super::streams::{self, stream};
+use super::uncertain_apply::Shift;
 use crate::scenario::{Case, Scenario};
 
 /// The physics world of a trial: the truck at its start (a mission's first place, else the
-/// case's start, or `start_at`), the pallet where it really stands (jittered on its own
-/// random stream).
+/// case's start, or `start_at`), the pallet where it really stands (the case's moved by
+/// the uncertain parameters' `shift`, then jittered on its own random stream).
 pub(super) fn build_world(
     scn: &Scenario,
     truck: &forkbench_core::ForkliftSpec,
     case: &Case,
-    seed: u64,
+    (seed, shift): (u64, &Shift),
     start_at: Option<Pose2>,
 ) -> Result<(Sim, Pose2, Pose2, Vec<forkbench_sim::Obstacle>), StageError> {
     let true_pallet = jitter(
-        &case.pallet,
+        &case.pallet.to_world(&shift.pallet),
         &scn.pallet_jitter,
         &mut stream(seed, streams::PALLET_JITTER),
     );
     let obstacles = scn.world.obstacles();
-    let start =
-        start_at.unwrap_or_else(|| scn.mission.as_ref().map_or(case.start, |m| m.start.pose));
+    let start = start_at
+        .unwrap_or_else(|| scn.mission.as_ref().map_or(case.start, |m| m.start.pose))
+        .to_world(&shift.start);
     let sim = Sim::new(
         truck,
         &start,

@@ -1,5 +1,7 @@
 //! The judged result of one trial, in SI units, serialisable as one JSON object.
 
+mod nan_as_null;
+
 use serde::{Deserialize, Serialize};
 
 /// The criteria a pick can fail, in the order they are checked.
@@ -235,6 +237,16 @@ pub struct TrialOutcome {
     /// when the bench can tell.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub likely_cause: Option<String>,
+    /// Signed margin to failure: the least over the pick's criteria of (limit −
+    /// measured) / limit, −1 for a broken criterion with no continuous measure; capped
+    /// at 0 when the trial failed on something no margin covers (a step criterion, a
+    /// phase, an error). Negative or 0 exactly when the trial failed; `None` when it
+    /// ended before anything was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robustness: Option<f64>,
+    /// The scenario's uncertain parameters as this trial drew them (or was given them).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub uncertain: std::collections::BTreeMap<String, f64>,
     /// A mission's legs before the pick, in order (empty for a pick trial).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub legs: Vec<LegOutcome>,
@@ -449,11 +461,21 @@ impl TrialOutcome {
             measures: std::collections::BTreeMap::new(),
             also_failed: Vec::new(),
             likely_cause: None,
+            robustness: None,
+            uncertain: Default::default(),
         }
     }
 }
 
 impl TrialOutcome {
+    /// Caps the robustness at 0 when the trial failed on something the pick's margins do
+    /// not cover (a step criterion, a phase, a leg, an error), so its sign is the verdict.
+    pub(crate) fn settle_robustness(&mut self) {
+        if !self.success {
+            self.robustness = self.robustness.map(|r| r.min(0.0));
+        }
+    }
+
     /// The outcome with its wall times zeroed (the trial's and each leg's planning time):
     /// all that may differ between two runs of the same trial.
     pub fn without_wall_times(&self) -> TrialOutcome {
@@ -475,21 +497,4 @@ impl TrialOutcome {
 
 fn default_tracker() -> String {
     "pure_pursuit".to_owned()
-}
-
-/// NaN (a trial that never ran far enough to measure) is written as JSON null and read back.
-mod nan_as_null {
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-        if v.is_nan() {
-            s.serialize_none()
-        } else {
-            s.serialize_f64(*v)
-        }
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
-    }
 }

@@ -1,0 +1,228 @@
+//! Rare failures over a scenario's uncertain parameters: `estimate` (P(event) with its interval) and `falsify` (the most likely failure), each trial one point of `forkbench_rare`'s standard-normal space.
+
+use std::convert::Infallible;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use forkbench_rare::{EstimateSettings, FalsifySettings, Outcome};
+use forkbench_trial::outcome::TrialOutcome;
+use forkbench_trial::trial::{Overrides, TrialOptions, run_trial};
+use forkbench_trial::{Case, Scenario};
+
+use crate::guard::guarded;
+use crate::{BatchError, TrialRecord, trial_seed};
+
+fn unknown(name: &str) -> BatchError {
+    BatchError::Invalid(format!(
+        "event {name:?}: failure, contact, or a criterion's name (lateral_error, \
+         heading_error, contact_force, pallet_displaced, collision, …)"
+    ))
+}
+
+/// The event whose probability is estimated or which a search looks for.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Event {
+    /// The trial failed, on any criterion.
+    Failure,
+    /// The trial broke this criterion (its verdict or one of `also_failed`).
+    Criterion(String),
+    /// The moving truck touched a person or vehicle.
+    Contact,
+}
+
+impl Event {
+    /// `failure`, `contact`, or a criterion's name.
+    pub fn parse(s: &str) -> Result<Event, BatchError> {
+        match s {
+            "failure" => Ok(Event::Failure),
+            "contact" => Ok(Event::Contact),
+            name => match forkbench_trial::outcome::Failure::from_name(name) {
+                // A name the bench itself gives a failure: a fixed criterion's or a
+                // built-in step criterion's (any other word could only be a registered
+                // phase's, which this command cannot tell from a typo).
+                Some(forkbench_trial::outcome::Failure::Criterion(n))
+                    if forkbench_trial::step_criteria::step_criterion_name(n).is_none() =>
+                {
+                    Err(unknown(name))
+                }
+                Some(f) => Ok(Event::Criterion(f.name().to_owned())),
+                None => Err(unknown(name)),
+            },
+        }
+    }
+
+    /// Whether `o` holds the event, and the trial's margin to it (≤ 0 when it does).
+    fn of(&self, o: &TrialOutcome) -> Outcome {
+        // A trial that ended before anything was measured stands on the boundary.
+        let margin = o.robustness.unwrap_or(0.0);
+        match self {
+            Event::Failure => Outcome {
+                event: !o.success,
+                robustness: margin,
+            },
+            Event::Criterion(name) => Outcome {
+                event: o.failure.is_some_and(|f| f.name() == name)
+                    || o.also_failed
+                        .iter()
+                        .any(|a| a.split(':').next() == Some(name)),
+                robustness: margin,
+            },
+            Event::Contact => {
+                let s = o.safety.as_ref();
+                Outcome {
+                    event: s.is_some_and(|s| s.person_contacts > 0),
+                    robustness: s.and_then(|s| s.closest_any_m()).unwrap_or(f64::INFINITY),
+                }
+            }
+        }
+    }
+}
+
+/// What a search or an estimate runs: one case of a scenario with its components and
+/// overrides, the batch seed the trials' other draws (sensor noise) come from, the event.
+#[derive(Debug, Clone)]
+pub struct RareSetup {
+    pub scenario: Scenario,
+    pub case: String,
+    pub planner: Option<String>,
+    pub tracker: Option<String>,
+    pub overrides: Overrides,
+    pub seed: u64,
+    pub event: Event,
+    pub jobs: usize,
+}
+
+/// Every trial run, in order, with its point.
+#[derive(Debug, Clone, Serialize)]
+pub struct Tried {
+    pub z: Vec<f64>,
+    #[serde(flatten)]
+    pub record: TrialRecord,
+}
+
+struct Runner<'a> {
+    setup: &'a RareSetup,
+    case: &'a Case,
+    pool: rayon::ThreadPool,
+    tried: Vec<Tried>,
+}
+
+impl Runner<'_> {
+    /// Runs one trial per point, in parallel; trial `k` (counted over the whole run) has
+    /// the seed a batch's trial `k` of this case would, so its sensor noise is its own.
+    fn eval(&mut self, points: &[Vec<f64>]) -> Vec<Outcome> {
+        let base = self.tried.len() as u64;
+        let s = self.setup;
+        let scn = &s.scenario;
+        let outcomes: Vec<TrialOutcome> = self.pool.install(|| {
+            points
+                .par_iter()
+                .with_max_len(1)
+                .enumerate()
+                .map(|(i, z)| {
+                    let seed = trial_seed(s.seed, &scn.name, &self.case.name, base + i as u64);
+                    let opts = TrialOptions {
+                        seed: Some(seed),
+                        planner: s.planner.clone(),
+                        tracker: s.tracker.clone(),
+                        overrides: s.overrides.clone(),
+                        uncertain: scn.uncertain.at(z),
+                        ..TrialOptions::default()
+                    };
+                    let names = (
+                        s.planner.as_deref().unwrap_or(&scn.planner.name),
+                        s.tracker.as_deref().unwrap_or(&scn.tracker.name),
+                    );
+                    guarded(scn, &self.case.name, names, seed, || {
+                        run_trial(scn, self.case, &opts)
+                    })
+                })
+                .collect()
+        });
+        let marks = outcomes.iter().map(|o| s.event.of(o)).collect();
+        for (i, (z, outcome)) in points.iter().zip(outcomes).enumerate() {
+            self.tried.push(Tried {
+                z: z.clone(),
+                record: TrialRecord {
+                    trial: base + i as u64,
+                    overrides: s.overrides.clone(),
+                    replan: None,
+                    outcome,
+                },
+            });
+        }
+        marks
+    }
+}
+
+/// Most trials a search or an estimate runs: each trial's record is kept to be written
+/// (about 1.3 KB a pick as JSON, more in memory), so this bounds its memory.
+pub const MAX_RARE_TRIALS: usize = 250_000;
+
+/// The runner of `setup`, its options and the scenario's parameters checked first.
+fn runner(setup: &RareSetup, budget: usize) -> Result<Runner<'_>, BatchError> {
+    if !(20..=MAX_RARE_TRIALS).contains(&budget) {
+        return Err(BatchError::Invalid(format!(
+            "budget {budget}: from 20 to {MAX_RARE_TRIALS} trials (every trial's record is kept)"
+        )));
+    }
+    let scn = &setup.scenario;
+    if scn.uncertain.is_empty() {
+        return Err(BatchError::Invalid(format!(
+            "{}: declares no [[uncertain]] parameters, so there is nothing to search or \
+             weigh (docs/scenario-format.md#uncertain)",
+            scn.file
+        )));
+    }
+    let case = scn.pick_case(Some(&setup.case))?;
+    scn.check_options(&TrialOptions {
+        planner: setup.planner.clone(),
+        tracker: setup.tracker.clone(),
+        overrides: setup.overrides.clone(),
+        ..TrialOptions::default()
+    })?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(setup.jobs.max(1))
+        .build()
+        .map_err(|e| BatchError::Invalid(format!("thread pool: {e}")))?;
+    Ok(Runner {
+        setup,
+        case,
+        pool,
+        tried: Vec::new(),
+    })
+}
+
+/// P(event) over the scenario's uncertain parameters, and every trial it ran.
+pub fn estimate(
+    setup: &RareSetup,
+    method: forkbench_rare::Method,
+    budget: usize,
+) -> Result<(forkbench_rare::Estimate, Vec<Tried>), BatchError> {
+    let mut r = runner(setup, budget)?;
+    let dims = setup.scenario.uncertain.0.len();
+    let s = EstimateSettings::new(method, dims, budget, setup.seed);
+    let e = forkbench_rare::estimate(&s, |p| Ok::<_, Infallible>(r.eval(p)))
+        .map_err(|e| BatchError::Invalid(e.to_string()))?;
+    Ok((e, r.tried))
+}
+
+/// The most likely failure (and the least robust trial) within `budget` trials; plain
+/// Monte Carlo over the same distributions with `monte_carlo`.
+pub fn falsify(
+    setup: &RareSetup,
+    budget: usize,
+    monte_carlo: bool,
+) -> Result<(forkbench_rare::Falsified, Vec<Tried>), BatchError> {
+    let mut r = runner(setup, budget)?;
+    let dims = setup.scenario.uncertain.0.len();
+    let s = FalsifySettings {
+        monte_carlo,
+        ..FalsifySettings::new(dims, budget, setup.seed)
+    };
+    let f = forkbench_rare::falsify(&s, |p| Ok::<_, Infallible>(r.eval(p)))
+        .map_err(|e| BatchError::Invalid(e.to_string()))?;
+    Ok((f, r.tried))
+}

@@ -1,0 +1,277 @@
+//! `forkbench estimate` and `forkbench falsify`: rare events over a scenario's uncertain parameters, their trials kept beside the result.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context as _, bail};
+use clap::{Args, ValueEnum};
+
+use forkbench_batch::rare::{Event, RareSetup, Tried};
+
+/// What `estimate` and `falsify` share: the scenario, its components, the event, the budget.
+#[derive(Debug, Args)]
+pub struct RareArgs {
+    /// A scenario with `[[uncertain]]` parameters.
+    scenario: PathBuf,
+    /// The case (needed when the scenario has several).
+    #[arg(long)]
+    case: Option<String>,
+    #[arg(long)]
+    planner: Option<String>,
+    #[arg(long)]
+    tracker: Option<String>,
+    /// Components file (external planners and trackers by name).
+    #[arg(long, value_name = "FILE")]
+    components: Option<PathBuf>,
+    /// `failure` (any criterion), `contact` (a person or vehicle touched), or a criterion's
+    /// name (`lateral_error`, `contact_force`, …).
+    #[arg(long, default_value = "failure")]
+    event: String,
+    /// Trials in all (every trial's record is kept to write trials.jsonl, about 1.3 KB a
+    /// pick, hence the bound; a plain batch streams larger counts to disk).
+    #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u64).range(20..=250_000))]
+    budget: u64,
+    /// Seed of every draw (the search's points and the trials' own noise).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: the machine's cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    jobs: Option<u64>,
+    /// Directory for trials.jsonl (every trial with its point) and the result's JSON.
+    #[arg(long)]
+    out: PathBuf,
+    /// Print the result as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `forkbench estimate`.
+#[derive(Debug, Args)]
+pub struct EstimateArgs {
+    #[command(flatten)]
+    common: RareArgs,
+    /// `ce`: cross-entropy adaptive importance sampling; `mc`: plain Monte Carlo.
+    #[arg(long, value_enum, default_value_t = MethodArg::Ce)]
+    method: MethodArg,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum MethodArg {
+    Ce,
+    Mc,
+}
+
+/// `forkbench falsify`.
+#[derive(Debug, Args)]
+pub struct FalsifyArgs {
+    #[command(flatten)]
+    common: RareArgs,
+    /// Plain Monte Carlo over the same distributions instead of the search (to compare).
+    #[arg(long)]
+    monte_carlo: bool,
+    #[command(flatten)]
+    record: crate::RecordFlags,
+}
+
+/// The files this writes in `--out`; a directory holding anything else is refused.
+const OURS: [&str; 3] = ["trials.jsonl", "estimate.json", "falsify.json"];
+
+impl RareArgs {
+    fn setup(&self) -> anyhow::Result<RareSetup> {
+        let scn = forkbench_trial::Scenario::load(&self.scenario)?;
+        let scenario = crate::with_components(scn, self.components.as_deref())?;
+        let case = scenario.pick_case(self.case.as_deref())?.name.clone();
+        let jobs = self.jobs.map_or_else(
+            || std::thread::available_parallelism().map_or(1, usize::from),
+            |j| j as usize,
+        );
+        Ok(RareSetup {
+            scenario,
+            case,
+            planner: self.planner.clone(),
+            tracker: self.tracker.clone(),
+            overrides: Default::default(),
+            seed: self.seed,
+            event: Event::parse(&self.event)?,
+            jobs,
+        })
+    }
+
+    /// `--out`, made if missing; one that holds files forkbench did not write here is refused.
+    fn out_dir(&self) -> anyhow::Result<&Path> {
+        let dir = self.out.as_path();
+        if dir.exists() {
+            for e in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
+                let name = e?.file_name();
+                if !OURS.iter().any(|o| name == *o) {
+                    bail!(
+                        "{}: holds {:?}, which estimate and falsify do not write; give an empty or new directory",
+                        dir.display(),
+                        name
+                    );
+                }
+            }
+        }
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        Ok(dir)
+    }
+
+    fn write(
+        &self,
+        tried: &[Tried],
+        name: &str,
+        result: &impl serde::Serialize,
+    ) -> anyhow::Result<()> {
+        let dir = self.out_dir()?;
+        let mut lines = String::new();
+        for t in tried {
+            lines += &serde_json::to_string(t)?;
+            lines.push('\n');
+        }
+        forkbench_batch::write_atomic(&dir.join("trials.jsonl"), lines.as_bytes())?;
+        forkbench_batch::write_atomic(
+            &dir.join(name),
+            serde_json::to_string_pretty(result)?.as_bytes(),
+        )?;
+        Ok(())
+    }
+}
+
+/// `forkbench estimate`: prints P(event) with its interval and what it cost.
+pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
+    let c = &a.common;
+    c.out_dir()?;
+    let setup = c.setup()?;
+    let method = match a.method {
+        MethodArg::Ce => forkbench_rare::Method::Ce,
+        MethodArg::Mc => forkbench_rare::Method::Mc,
+    };
+    let (e, tried) = forkbench_batch::rare::estimate(&setup, method, c.budget as usize)?;
+    c.write(&tried, "estimate.json", &e)?;
+    if c.json {
+        return crate::out::emit_json_line(&e);
+    }
+    let mut s = format!(
+        "P({}) over {} uncertain parameters of {} / case {}: {:.3e} ({} % CI {:.3e} to {:.3e})\n",
+        c.event,
+        setup.scenario.uncertain.0.len(),
+        setup.scenario.name,
+        setup.case,
+        e.p,
+        e.confidence * 100.0,
+        e.ci.0,
+        e.ci.1
+    );
+    let re = e
+        .relative_error
+        .map_or("—".into(), |r| format!("{:.1} %", r * 100.0));
+    let _ = writeln!(
+        s,
+        "method {}: {} trials ({} adapting in {} stages), {} with the event; relative error {re}, effective sample size {:.0}",
+        if method == forkbench_rare::Method::Ce {
+            "cross-entropy importance sampling"
+        } else {
+            "plain Monte Carlo"
+        },
+        e.trials,
+        e.adapting,
+        e.stages.len(),
+        e.events,
+        e.ess
+    );
+    let _ = writeln!(s, "trials in {}", c.out.join("trials.jsonl").display());
+    crate::emit(&s)
+}
+
+/// `forkbench falsify`: prints the most likely failure, the least robust trial, and the
+/// command that replays it; records it when asked. Exit 3 when a failure was found.
+pub fn falsify(a: FalsifyArgs) -> anyhow::Result<bool> {
+    let c = &a.common;
+    c.out_dir()?;
+    let setup = c.setup()?;
+    let (f, tried) = forkbench_batch::rare::falsify(&setup, c.budget as usize, a.monte_carlo)?;
+    c.write(&tried, "falsify.json", &f)?;
+    if c.json {
+        crate::out::emit_json_line(&f)?;
+    } else {
+        crate::emit(&falsify_text(c, &setup, &f, &tried))?;
+    }
+    let Some(found) = &f.most_likely else {
+        return Ok(false);
+    };
+    let line = line_of(&tried, &found.z);
+    let rec = a.record.args();
+    let asked = rec.rrd.is_some()
+        || rec.mcap.is_some()
+        || rec.ros2.is_some()
+        || rec.actuator_csv.is_some()
+        || rec.rerun
+        || rec.connect.is_some();
+    if asked {
+        let trials = c.out.join("trials.jsonl");
+        crate::replay_cmd::replay(
+            &trials,
+            line,
+            (Some(&c.scenario), c.components.as_deref()),
+            &rec,
+        )?;
+    }
+    Ok(true)
+}
+
+/// The 1-based line of the trial at `z`.
+fn line_of(tried: &[Tried], z: &[f64]) -> usize {
+    tried.iter().position(|t| t.z == z).map_or(1, |i| i + 1)
+}
+
+fn falsify_text(
+    c: &RareArgs,
+    setup: &RareSetup,
+    f: &forkbench_rare::Falsified,
+    tried: &[Tried],
+) -> String {
+    let mut s = format!(
+        "{} trials of {} / case {} searching for {}: {} with it\n",
+        f.trials, setup.scenario.name, setup.case, c.event, f.events
+    );
+    let describe = |s: &mut String, head: &str, z: &[f64]| {
+        let Some(t) = tried.iter().find(|t| t.z == z) else {
+            return;
+        };
+        let o = &t.record.outcome;
+        let _ = writeln!(
+            s,
+            "{head} (line {} of trials.jsonl, robustness {}): {}",
+            line_of(tried, z),
+            o.robustness.map_or("—".into(), |r| format!("{r:.3}")),
+            o.failure_detail.as_deref().unwrap_or("succeeded")
+        );
+        for (name, v) in &o.uncertain {
+            let sd = setup
+                .scenario
+                .uncertain
+                .0
+                .iter()
+                .position(|u| &u.name == name)
+                .map_or(0.0, |i| z[i]);
+            let _ = writeln!(s, "  {name} = {v:.4} ({sd:+.2} σ)");
+        }
+    };
+    match &f.most_likely {
+        Some(m) => {
+            describe(&mut s, "most likely failure found", &m.z);
+            let _ = writeln!(
+                s,
+                "replay: forkbench replay {} --line {} --scenario {} --rrd failure.rrd",
+                c.out.join("trials.jsonl").display(),
+                line_of(tried, &m.z),
+                c.scenario.display()
+            );
+        }
+        None => s += "no trial had the event\n",
+    }
+    if let Some(l) = &f.least_robust {
+        describe(&mut s, "least robust trial", &l.z);
+    }
+    s
+}

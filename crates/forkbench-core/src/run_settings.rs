@@ -1,0 +1,55 @@
+//! The truck settings a run may change (actuators and control timing), by their sweep names and dotted paths, and how one is set.
+
+use crate::ForkliftSpec;
+
+/// The truck settings a run may change, by their names in a sweep and their dotted paths
+/// in a truck file: the actuators and the control timing. The geometry is the scenario's.
+pub const TRUCK_KNOBS: [(&str, &str); 14] = [
+    ("steering_rate_limit_radps", "max_steer_rate_radps"),
+    ("steering_dead_time_s", "steering.dead_time_s"),
+    ("steering_time_constant_s", "steering.time_constant_s"),
+    ("steering_accel_limit_radps2", "steering.accel_limit_radps2"),
+    ("steering_deadband_rad", "steering.deadband_rad"),
+    ("steering_backlash_rad", "steering.backlash_rad"),
+    ("steering_offset_rad", "steering.offset_rad"),
+    ("drive_dead_time_s", "drive.dead_time_s"),
+    ("drive_time_constant_s", "drive.time_constant_s"),
+    ("drive_accel_limit_mps2", "drive.accel_limit_mps2"),
+    ("drive_brake_limit_mps2", "drive.brake_limit_mps2"),
+    ("drive_creep_speed_mps", "drive.creep_speed_mps"),
+    ("control_period_s", "control.period_s"),
+    ("control_transport_delay_s", "control.transport_delay_s"),
+];
+
+/// The dotted path of a sweep knob's name, or of a dotted path itself.
+pub fn truck_path(name: &str) -> Option<&'static str> {
+    TRUCK_KNOBS
+        .iter()
+        .find(|(k, p)| *k == name || *p == name)
+        .map(|(_, p)| *p)
+}
+
+/// Sets the truck's setting at `path` (one of [`TRUCK_KNOBS`]); false for another path.
+/// Set field by field, not through the serialised form, which leaves out what equals
+/// the first truck's.
+pub fn set(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
+    let (st, dr, ct) = (&mut t.steering, &mut t.drive, &mut t.control);
+    match path {
+        "max_steer_rate_radps" => t.max_steer_rate_radps = v,
+        "steering.dead_time_s" => st.dead_time_s = v,
+        "steering.time_constant_s" => st.time_constant_s = v,
+        "steering.accel_limit_radps2" => st.accel_limit_radps2 = Some(v),
+        "steering.deadband_rad" => st.deadband_rad = v,
+        "steering.backlash_rad" => st.backlash_rad = v,
+        "steering.offset_rad" => st.offset_rad = v,
+        "drive.dead_time_s" => dr.dead_time_s = v,
+        "drive.time_constant_s" => dr.time_constant_s = Some(v),
+        "drive.accel_limit_mps2" => dr.accel_limit_mps2 = Some(v),
+        "drive.brake_limit_mps2" => dr.brake_limit_mps2 = Some(v),
+        "drive.creep_speed_mps" => dr.creep_speed_mps = v,
+        "control.period_s" => ct.period_s = Some(v),
+        "control.transport_delay_s" => ct.transport_delay_s = v,
+        _ => return false,
+    }
+    true
+}

@@ -1,0 +1,228 @@
+//! P(event) with its confidence interval: plain Monte Carlo (an exact binomial interval) or cross-entropy adaptive importance sampling (a final stage at a fixed proposal, so its estimate is unbiased).
+
+use serde::Serialize;
+
+use crate::ce::{CeSettings, Stage, adapt};
+use crate::normal::upper_quantile;
+use crate::{Outcome, RareError, run};
+
+/// The estimator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Points from the nominal density; the Clopper–Pearson interval.
+    Mc,
+    /// Cross-entropy adaptive importance sampling with likelihood-ratio weights.
+    Ce,
+}
+
+/// What to estimate with, and how much to spend.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EstimateSettings {
+    pub method: Method,
+    /// Uncertain parameters (dimensions of z).
+    pub dims: usize,
+    /// Points (trials) in all, adaptation included.
+    pub budget: usize,
+    pub seed: u64,
+    /// Two-sided confidence of the interval.
+    pub confidence: f64,
+    /// Share of the budget kept for the final, unbiased stage (the rest adapts).
+    pub final_share: f64,
+    pub ce: CeSettings,
+}
+
+impl EstimateSettings {
+    pub fn new(method: Method, dims: usize, budget: usize, seed: u64) -> Self {
+        EstimateSettings {
+            method,
+            dims,
+            budget,
+            seed,
+            confidence: 0.95,
+            final_share: 0.5,
+            ce: CeSettings::default(),
+        }
+    }
+
+    fn check<E: std::error::Error>(&self) -> Result<(), RareError<E>> {
+        let bad = |field, reason: &str| {
+            Err(RareError::Setting {
+                field,
+                reason: reason.to_owned(),
+            })
+        };
+        if !(1..=64).contains(&self.dims) {
+            return bad("dims", "from 1 to 64 uncertain parameters");
+        }
+        if !(20..=10_000_000).contains(&self.budget) {
+            return bad("budget", "from 20 to 10,000,000 trials");
+        }
+        if !(0.5..=0.999_999).contains(&self.confidence) {
+            return bad("confidence", "from 0.5 to 0.999999");
+        }
+        if !(0.1..=0.9).contains(&self.final_share) {
+            return bad("final_share", "from 0.1 to 0.9");
+        }
+        self.ce.check()
+    }
+}
+
+/// An estimate of P(event).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Estimate {
+    pub method: Method,
+    pub p: f64,
+    /// The two-sided interval at `confidence`.
+    pub ci: (f64, f64),
+    pub confidence: f64,
+    /// Standard error of `p`.
+    pub std_error: f64,
+    /// `std_error / p` (None when no event was sampled).
+    pub relative_error: Option<f64>,
+    /// Effective sample size of the final stage's event weights, (Σw)² / Σw²: how many
+    /// plain draws of the event the estimate is worth (the event count for Monte Carlo).
+    pub ess: f64,
+    /// Points evaluated in all (adaptation and final stage).
+    pub trials: usize,
+    /// Of them, the adaptation's (not in the estimate).
+    pub adapting: usize,
+    /// Points on which the event happened, over every stage.
+    pub events: usize,
+    /// The adaptation's stages (none for Monte Carlo).
+    pub stages: Vec<Stage>,
+}
+
+/// Estimates P(event) over N(0, I) in `s.dims` dimensions by evaluating points with
+/// `eval` (a batch of trials at a time).
+pub fn estimate<E: std::error::Error + 'static>(
+    s: &EstimateSettings,
+    mut eval: impl FnMut(&[Vec<f64>]) -> Result<Vec<Outcome>, E>,
+) -> Result<Estimate, RareError<E>> {
+    s.check()?;
+    match s.method {
+        Method::Mc => monte_carlo(s, &mut eval),
+        Method::Ce => importance(s, &mut eval),
+    }
+}
+
+/// The stream the final stage (or plain Monte Carlo) draws from.
+const FINAL: u64 = 0xF1A1;
+
+fn monte_carlo<E: std::error::Error + 'static>(
+    s: &EstimateSettings,
+    eval: &mut impl FnMut(&[Vec<f64>]) -> Result<Vec<Outcome>, E>,
+) -> Result<Estimate, RareError<E>> {
+    let points = crate::ce::Proposal::nominal(s.dims).draw(s.budget, s.seed, FINAL);
+    let out = run(eval, &points)?;
+    let k = out.iter().filter(|o| o.event).count();
+    let n = out.len();
+    let p = k as f64 / n as f64;
+    let se = (p * (1.0 - p) / n as f64).sqrt();
+    Ok(Estimate {
+        method: Method::Mc,
+        p,
+        ci: clopper_pearson(k as u64, n as u64, s.confidence),
+        confidence: s.confidence,
+        std_error: se,
+        relative_error: (k > 0).then(|| se / p),
+        ess: k as f64,
+        trials: n,
+        adapting: 0,
+        events: k,
+        stages: Vec::new(),
+    })
+}
+
+fn importance<E: std::error::Error + 'static>(
+    s: &EstimateSettings,
+    eval: &mut impl FnMut(&[Vec<f64>]) -> Result<Vec<Outcome>, E>,
+) -> Result<Estimate, RareError<E>> {
+    let adapt_budget = ((1.0 - s.final_share) * s.budget as f64) as usize;
+    let (q, stages, seen) = adapt(s.dims, &s.ce, s.seed, adapt_budget, eval)?;
+    let n = s.budget - seen.len();
+    let points = q.draw(n, s.seed, FINAL);
+    let out = run(eval, &points)?;
+    // y_i = 1[event] · φ(z_i) / q(z_i): an unbiased draw of P(event) each.
+    let y: Vec<f64> = points
+        .iter()
+        .zip(&out)
+        .map(|(z, o)| if o.event { q.ln_weight(z).exp() } else { 0.0 })
+        .collect();
+    let nf = n as f64;
+    let p = y.iter().sum::<f64>() / nf;
+    let var = y.iter().map(|v| (v - p).powi(2)).sum::<f64>() / (nf - 1.0);
+    let se = (var / nf).sqrt();
+    let z = upper_quantile((1.0 - s.confidence) / 2.0);
+    let sum_sq: f64 = y.iter().map(|v| v * v).sum();
+    let events =
+        out.iter().filter(|o| o.event).count() + seen.iter().filter(|(_, o)| o.event).count();
+    Ok(Estimate {
+        method: Method::Ce,
+        p,
+        ci: ((p - z * se).max(0.0), (p + z * se).min(1.0)),
+        confidence: s.confidence,
+        std_error: se,
+        relative_error: (p > 0.0).then(|| se / p),
+        ess: if sum_sq > 0.0 {
+            (p * nf).powi(2) / sum_sq
+        } else {
+            0.0
+        },
+        trials: s.budget,
+        adapting: seen.len(),
+        events,
+        stages,
+    })
+}
+
+/// The exact (Clopper–Pearson) two-sided interval for `k` events in `n` draws.
+pub fn clopper_pearson(k: u64, n: u64, confidence: f64) -> (f64, f64) {
+    let tail = (1.0 - confidence) / 2.0;
+    let lower = if k == 0 {
+        0.0
+    } else {
+        // The p at which P(X ≥ k) = tail.
+        bisect(|p| 1.0 - binom_cdf(k - 1, n, p) - tail)
+    };
+    let upper = if k == n {
+        1.0
+    } else {
+        // The p at which P(X ≤ k) = tail.
+        bisect(|p| tail - binom_cdf(k, n, p))
+    };
+    (lower, upper)
+}
+
+/// The root in (0, 1) of an increasing function.
+fn bisect(f: impl Fn(f64) -> f64) -> f64 {
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// P(X ≤ k) for X ~ Binomial(n, p), summed in logs.
+fn binom_cdf(k: u64, n: u64, p: f64) -> f64 {
+    if p <= 0.0 {
+        return 1.0;
+    }
+    if p >= 1.0 {
+        return if k >= n { 1.0 } else { 0.0 };
+    }
+    let (lp, lq) = (p.ln(), (1.0 - p).ln());
+    let ln_n = libm::lgamma(n as f64 + 1.0);
+    (0..=k.min(n))
+        .map(|i| {
+            let c = ln_n - libm::lgamma(i as f64 + 1.0) - libm::lgamma((n - i) as f64 + 1.0);
+            (c + i as f64 * lp + (n - i) as f64 * lq).exp()
+        })
+        .sum::<f64>()
+        .min(1.0)
+}

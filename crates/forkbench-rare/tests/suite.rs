@@ -1,0 +1,3 @@
+//! The rare-event crate's tests, one binary.
+
+mod known_answer;

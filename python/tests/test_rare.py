@@ -1,0 +1,41 @@
+"""Rare events from Python: estimate and falsify equal the CLI's at the same seed, every trial comes back with its point, and bad arguments raise naming them."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from conftest import ROOT
+
+import forkbench
+
+TAILS = str(ROOT / "examples" / "rare" / "field-test-tails.toml")
+
+
+def test_an_estimate_equals_the_clis_and_carries_its_trials(cli, tmp_path):
+    scn = forkbench.load(TAILS)
+    got = forkbench.estimate(scn, method="mc", budget=60, seed=3, jobs=1)
+    want = json.loads(
+        cli("estimate", TAILS, "--method", "mc", "--budget", "60", "--seed", "3", "--out", str(tmp_path / "mc"), "--json")
+    )
+    assert got["p"] == want["p"] and got["ci"] == pytest.approx(want["ci"])
+    assert got["trials"] == 60 and len(got["records"]) == 60
+    first = got["records"][0]
+    assert len(first["z"]) == 4 and set(first["uncertain"]) >= {"pallet.y_m", "steering_time_constant_s"}
+    ce = forkbench.estimate(scn, budget=200, seed=3, jobs=1)
+    assert ce["method"] == "ce" and ce["adapting"] <= 100 and ce["trials"] == 200
+
+
+def test_a_search_returns_its_points_and_refuses_bad_arguments():
+    scn = forkbench.load(TAILS)
+    f = forkbench.falsify(scn, budget=60, seed=2, jobs=1)
+    assert f["trials"] == 60 and len(f["records"]) == 60
+    assert f["least_robust"] is not None
+    with pytest.raises(ValueError, match="method"):
+        forkbench.estimate(scn, method="splitting", budget=60)
+    with pytest.raises(ValueError, match="event"):
+        forkbench.falsify(scn, event="nonsense", budget=60)
+    with pytest.raises(forkbench.BatchError, match="budget"):
+        forkbench.estimate(scn, budget=10)
+    with pytest.raises(forkbench.BatchError, match="no \\[\\[uncertain\\]\\]"):
+        forkbench.estimate(forkbench.load("field-test"), budget=60)

@@ -1,0 +1,122 @@
+//! `forkbench estimate` and `forkbench falsify` end to end: results and every trial written, the found failure recorded and replayable, bad input refused with the reason and nothing of others overwritten.
+
+use crate::common::{forkbench, repo_root, s, text, tmp_in};
+
+fn tails() -> String {
+    repo_root()
+        .join("examples/rare/field-test-tails.toml")
+        .display()
+        .to_string()
+}
+
+#[test]
+fn falsify_records_the_failure_it_found_and_its_line_replays() {
+    let out = tmp_in("forkbench-rare", "falsify");
+    let rrd = tmp_in("forkbench-rare", "found.rrd");
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_file(&rrd);
+    let o = forkbench(&[
+        "falsify",
+        &tails(),
+        "--budget",
+        "200",
+        "--seed",
+        "1",
+        "--out",
+        s(&out),
+        "--rrd",
+        s(&rrd),
+    ]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{t}");
+    assert!(
+        t.contains("most likely failure found") && t.contains("steering_time_constant_s"),
+        "{t}"
+    );
+    assert!(rrd.exists(), "{t}");
+    let found: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("falsify.json")).expect("json"))
+            .expect("json");
+    assert!(
+        found["most_likely"]["outcome"]["event"]
+            .as_bool()
+            .expect("event")
+    );
+    let lines = std::fs::read_to_string(out.join("trials.jsonl")).expect("trials");
+    assert_eq!(lines.lines().count(), 200);
+    // The printed replay command's line repeats the failure exactly.
+    let line = t
+        .split("--line ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .expect("a replay line");
+    let r = forkbench(&[
+        "replay",
+        s(&out.join("trials.jsonl")),
+        "--line",
+        line,
+        "--scenario",
+        &tails(),
+    ]);
+    assert!(
+        text(&r).contains("identical to the recorded outcome"),
+        "{}",
+        text(&r)
+    );
+}
+
+#[test]
+fn an_estimate_writes_its_result_and_refuses_what_it_cannot_weigh() {
+    let out = tmp_in("forkbench-rare", "estimate");
+    let _ = std::fs::remove_dir_all(&out);
+    let o = forkbench(&[
+        "estimate",
+        &tails(),
+        "--method",
+        "mc",
+        "--budget",
+        "100",
+        "--out",
+        s(&out),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let e: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(e["trials"], 100);
+    assert!(out.join("estimate.json").exists());
+    // A directory holding someone else's file is refused, and the file kept.
+    let theirs = tmp_in("forkbench-rare", "theirs");
+    std::fs::create_dir_all(&theirs).expect("dir");
+    std::fs::write(theirs.join("notes.txt"), "mine").expect("write");
+    let o = forkbench(&["estimate", &tails(), "--budget", "100", "--out", s(&theirs)]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("notes.txt"), "{}", text(&o));
+    assert_eq!(
+        std::fs::read_to_string(theirs.join("notes.txt")).expect("kept"),
+        "mine"
+    );
+    let field = repo_root().join("scenarios/field-test.toml");
+    for (args, why) in [
+        (
+            vec!["estimate", s(&field), "--budget", "100"],
+            "no [[uncertain]]",
+        ),
+        (
+            vec!["estimate", &tails(), "--event", "wobble", "--budget", "100"],
+            "wobble",
+        ),
+        (vec!["falsify", &tails(), "--budget", "10"], "budget"),
+    ] {
+        let mut a = args.clone();
+        let dir = tmp_in("forkbench-rare", "refused");
+        a.extend(["--out", s(&dir)]);
+        let o = forkbench(&a);
+        // 1 from forkbench, 2 from the argument parser (the budget's range).
+        assert!(
+            matches!(o.status.code(), Some(1 | 2)),
+            "{args:?}: {}",
+            text(&o)
+        );
+        assert!(text(&o).contains(why), "{args:?}: {}", text(&o));
+    }
+}
