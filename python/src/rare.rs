@@ -57,7 +57,11 @@ pub fn estimate<'py>(
     let method = match method {
         "ce" => forkbench_rare::Method::Ce,
         "mc" => forkbench_rare::Method::Mc,
-        m => return Err(PyValueError::new_err(format!("method {m:?}: \"ce\" or \"mc\""))),
+        m => {
+            return Err(PyValueError::new_err(format!(
+                "method {m:?}: \"ce\" or \"mc\""
+            )));
+        }
     };
     let s = setup(py, scenario, case, (planner, tracker), (event, seed, jobs))?;
     let (e, tried) = py

@@ -16,12 +16,27 @@ def test_an_estimate_equals_the_clis_and_carries_its_trials(cli, tmp_path):
     scn = forkbench.load(TAILS)
     got = forkbench.estimate(scn, method="mc", budget=60, seed=3, jobs=1)
     want = json.loads(
-        cli("estimate", TAILS, "--method", "mc", "--budget", "60", "--seed", "3", "--out", str(tmp_path / "mc"), "--json")
+        cli(
+            "estimate",
+            TAILS,
+            "--method",
+            "mc",
+            "--budget",
+            "60",
+            "--seed",
+            "3",
+            "--out",
+            str(tmp_path / "mc"),
+            "--json",
+        )
     )
     assert got["p"] == want["p"] and got["ci"] == pytest.approx(want["ci"])
     assert got["trials"] == 60 and len(got["records"]) == 60
     first = got["records"][0]
-    assert len(first["z"]) == 4 and set(first["uncertain"]) >= {"pallet.y_m", "steering_time_constant_s"}
+    assert len(first["z"]) == 4 and set(first["uncertain"]) >= {
+        "pallet.y_m",
+        "steering_time_constant_s",
+    }
     ce = forkbench.estimate(scn, budget=200, seed=3, jobs=1)
     assert ce["method"] == "ce" and ce["adapting"] <= 100 and ce["trials"] == 200
 
@@ -29,7 +44,8 @@ def test_an_estimate_equals_the_clis_and_carries_its_trials(cli, tmp_path):
 def test_a_search_returns_its_points_and_refuses_bad_arguments():
     scn = forkbench.load(TAILS)
     f = forkbench.falsify(scn, budget=60, seed=2, jobs=1)
-    assert f["trials"] == 60 and len(f["records"]) == 60
+    # Eight of the budget are kept to refine a failure; without one they go unspent.
+    assert 52 <= f["trials"] == len(f["records"]) <= 60
     assert f["least_robust"] is not None
     with pytest.raises(ValueError, match="method"):
         forkbench.estimate(scn, method="splitting", budget=60)
