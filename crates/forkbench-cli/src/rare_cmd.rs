@@ -122,6 +122,7 @@ impl RareArgs {
         name: &str,
         result: &impl serde::Serialize,
     ) -> anyhow::Result<()> {
+        // Checked again: a long run leaves time for someone else's file to arrive.
         let dir = self.out_dir()?;
         let mut lines = String::new();
         for t in tried {

@@ -271,11 +271,7 @@ impl Scenario {
     ) -> Result<(), TrialError> {
         let d = super::uncertain_apply::draw(self, run.seed, pinned)?;
         if !d.truck.is_empty() {
-            run.truck = super::apply_truck(&run.truck, None, &d.truck)?;
-            run.truck
-                .control
-                .steps_per_tick(self.sim.dt_s)
-                .map_err(|e| invalid_setting(&self.file, "truck", &e))?;
+            run.truck = self.checked_truck(&run.truck, None, &d.truck)?;
         }
         if let Some(v) = d.detector_latency_s {
             run.pallet_sensing.set_latency_s(v);
@@ -294,7 +290,18 @@ impl Scenario {
         if o.truck_preset.is_none() && o.truck.is_empty() {
             return Ok(self.truck.clone());
         }
-        let truck = super::apply_truck(&self.truck, o.truck_preset.as_deref(), &o.truck)?;
+        self.checked_truck(&self.truck, o.truck_preset.as_deref(), &o.truck)
+    }
+
+    /// `base` with `preset` and `settings` applied, its control period checked against
+    /// the physics step.
+    fn checked_truck(
+        &self,
+        base: &forkbench_core::ForkliftSpec,
+        preset: Option<&str>,
+        settings: &BTreeMap<String, f64>,
+    ) -> Result<forkbench_core::ForkliftSpec, TrialError> {
+        let truck = super::apply_truck(base, preset, settings)?;
         truck
             .control
             .steps_per_tick(self.sim.dt_s)
