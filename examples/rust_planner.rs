@@ -155,6 +155,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         replan: None,
         compare_replanning: false,
         force_new: true,
+        success_run: Default::default(),
     };
     let summary = run_batch(&spec, &root.join("recordings/rust-planner"), 2, &|_| {})?;
     print!("{}", summary.markdown());

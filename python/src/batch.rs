@@ -139,6 +139,7 @@ pub fn run_batch<'py>(
     jobs: Option<usize>,
     out: Option<PathBuf>,
     force_new: bool,
+    success_run: Default::default(),
     truck_preset: Option<String>,
     truck: Option<BTreeMap<String, f64>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
@@ -173,6 +174,7 @@ pub fn run_batch<'py>(
         replan,
         compare_replanning,
         force_new,
+        success_run: Default::default(),
     };
     let bytes = records_bytes(&spec);
     if bytes > MAX_RECORDS_BYTES {

@@ -103,6 +103,8 @@ pub struct BatchSpec {
     /// Discard the output directory's trials when they were run with other settings,
     /// instead of refusing to resume.
     pub force_new: bool,
+    /// The confidence and reliability the summary states success runs at.
+    pub success_run: success_run::SuccessTarget,
 }
 
 /// Why a batch could not run or be read.
@@ -430,6 +432,7 @@ fn summarize_dir(
         .filter(|r| wanted.contains(&r.key()))
         .collect();
     let mut summary = summarize(&records);
+    summary.restate_success_run(spec.success_run);
     let provenance = Provenance::collect(Manifest::of(spec)?, jobs, started);
     summary.provenance = Some(provenance.with_runs(provenance::finish_runs(dir)));
     write_summary(dir, &summary)?;

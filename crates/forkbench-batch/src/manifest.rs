@@ -53,6 +53,10 @@ pub struct Manifest {
     /// Every trial run planning once and replanning.
     #[serde(default)]
     pub compare_replanning: bool,
+    /// The confidence and reliability its summary states success runs at: how the
+    /// results are read, not how they were run, so a resume may change it.
+    #[serde(default)]
+    pub success_run: crate::success_run::SuccessTarget,
     pub scenarios: Vec<ScenarioEntry>,
 }
 
@@ -170,6 +174,7 @@ impl Manifest {
             truck: spec.overrides.truck.clone(),
             replan: spec.replan,
             compare_replanning: spec.compare_replanning,
+            success_run: spec.success_run,
             scenarios,
         })
     }
@@ -251,6 +256,9 @@ impl Manifest {
 
     fn comparable(&self) -> Value {
         let mut v = serde_json::to_value(self).unwrap_or(Value::Null);
+        if let Some(map) = v.as_object_mut() {
+            map.remove("success_run");
+        }
         if let Some(list) = v.get_mut("scenarios").and_then(Value::as_array_mut) {
             for s in list {
                 if let Some(map) = s.as_object_mut() {

@@ -175,6 +175,7 @@ pub fn load_batch(dir: &Path) -> Result<(Summary, Vec<TrialRecord>, Manifest), B
     })?;
     let records = complete_records(dir, &m)?;
     let mut summary = summarize(&records);
+    summary.restate_success_run(m.success_run);
     summary.provenance = written_provenance(dir);
     Ok((summary, records, m))
 }
@@ -298,6 +299,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
     merged.write(out)?;
     rewrite_records(&path, &all)?;
     let mut summary = summarize(&all);
+    summary.restate_success_run(merged.success_run);
     // The merge's own provenance (this host, now); each shard's stays in its directory.
     let now = std::time::SystemTime::now();
     summary.provenance = Some(super::Provenance::collect(merged, 1, now));

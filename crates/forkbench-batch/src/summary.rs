@@ -215,7 +215,11 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 legs: leg_summaries(a.legs),
                 phases: leg_summaries(a.phases),
                 safety: a.safety.finish(),
-                success_run: Some(crate::success_run::success_run(a.k, a.n)),
+                success_run: Some(crate::success_run::success_run(
+                    a.k,
+                    a.n,
+                    Default::default(),
+                )),
             }
         })
         .collect();
@@ -299,6 +303,14 @@ impl Summary {
 }
 
 impl Summary {
+    /// States every row's success run at `t` (a batch's `--success-confidence` and
+    /// `--success-reliability`) instead of the defaults.
+    pub fn restate_success_run(&mut self, t: crate::success_run::SuccessTarget) {
+        for r in &mut self.rows {
+            r.success_run = Some(crate::success_run::success_run(r.successes, r.trials, t));
+        }
+    }
+
     /// The mission legs' success table (empty without missions).
     fn legs_markdown(&self) -> String {
         self.stages_markdown(

@@ -28,6 +28,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, seed: u64) -> BatchSpec {
         replan: Some(true),
         compare_replanning: false,
         force_new: false,
+        success_run: Default::default(),
     }
 }
 

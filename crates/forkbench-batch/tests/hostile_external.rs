@@ -65,6 +65,7 @@ fn spec(s: Scenario, trials: u64) -> BatchSpec {
         replan: None,
         compare_replanning: false,
         force_new: false,
+        success_run: Default::default(),
     }
 }
 

@@ -18,6 +18,7 @@ fn spec(scenario: &str, trials: u64, both: bool, force_new: bool) -> BatchSpec {
         replan: None,
         compare_replanning: both,
         force_new,
+        success_run: Default::default(),
     }
 }
 
@@ -82,6 +83,7 @@ fn force_new_deletes_only_what_a_batch_wrote() {
     // Nor does a new batch write into it (`out="/"` would have written into `/`).
     let spec = BatchSpec {
         force_new: false,
+        success_run: Default::default(),
         ..spec
     };
     let e = batch::run_batch(&spec, &dir, 1, &|_| {}).expect_err("refused");
@@ -98,6 +100,7 @@ fn force_new_deletes_only_what_a_batch_wrote() {
     std::fs::write(ours.join("recordings/notes.txt"), "n").expect("write");
     let spec = BatchSpec {
         force_new: true,
+        success_run: Default::default(),
         ..spec
     };
     batch::run_batch(&spec, &ours, 1, &|_| {}).expect("starts over");

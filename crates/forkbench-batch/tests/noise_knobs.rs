@@ -24,6 +24,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, overrides: Overrides) -> BatchSpe
         replan: None,
         compare_replanning: false,
         force_new: true,
+        success_run: Default::default(),
     }
 }
 

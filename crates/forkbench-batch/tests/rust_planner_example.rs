@@ -39,6 +39,7 @@ fn the_example_planner_runs_in_a_trial_and_a_batch() {
         replan: None,
         compare_replanning: false,
         force_new: true,
+        success_run: Default::default(),
     };
     let summary = run_batch(&spec, &dir, 2, &|_| {}).expect("batch");
     let rows: Vec<_> = summary

@@ -157,6 +157,12 @@ pub struct BatchArgs {
     /// run when a row has fewer trials than a paired gate needs for it.
     #[arg(long)]
     pub min_detectable_drop: Option<f64>,
+    /// The confidence (0.5–0.999999) the success-run figures are stated at.
+    #[arg(long, default_value_t = batch::success_run::CONFIDENCE)]
+    pub success_confidence: f64,
+    /// The reliability (0.5–0.999999) the success-run figures ask each row to show.
+    #[arg(long, default_value_t = batch::success_run::TARGET_RELIABILITY)]
+    pub success_reliability: f64,
 }
 
 fn progress(total: u64) -> ProgressBar {
@@ -250,6 +256,10 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         replan,
         compare_replanning,
         force_new: a.force_new,
+        success_run: batch::success_run::SuccessTarget::new(
+            a.success_confidence,
+            a.success_reliability,
+        )?,
     };
     Ok((spec, a))
 }

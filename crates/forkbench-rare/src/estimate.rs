@@ -157,10 +157,15 @@ fn importance<E: std::error::Error + 'static>(
     let sum_sq: f64 = y.iter().map(|v| v * v).sum();
     let events =
         out.iter().filter(|o| o.event).count() + seen.iter().filter(|(_, o)| o.event).count();
+    let ci = if y.iter().all(|v| *v == 0.0) {
+        no_event_interval(s, n)
+    } else {
+        ((p - z * se).max(0.0), (p + z * se).min(1.0))
+    };
     Ok(Estimate {
         method: Method::Ce,
         p,
-        ci: ((p - z * se).max(0.0), (p + z * se).min(1.0)),
+        ci,
         confidence: s.confidence,
         std_error: se,
         relative_error: (p > 0.0).then(|| se / p),
@@ -174,6 +179,20 @@ fn importance<E: std::error::Error + 'static>(
         events,
         stages,
     })
+}
+
+/// The interval when the final stage drew no event, where the normal one would collapse
+/// to a point. Each draw's weight is at most 1 / defensive (the proposal keeps that share
+/// of the nominal density), so P(event) ≤ P_q(event) / defensive, and P_q(event) is
+/// bounded by the exact interval of 0 events in `n` draws.
+fn no_event_interval(s: &EstimateSettings, n: usize) -> (f64, f64) {
+    let q_upper = clopper_pearson(0, n as u64, s.confidence).1;
+    let upper = if s.ce.defensive > 0.0 {
+        (q_upper / s.ce.defensive).min(1.0)
+    } else {
+        1.0
+    };
+    (0.0, upper)
 }
 
 /// The exact (Clopper–Pearson) two-sided interval for `k` events in `n` draws.

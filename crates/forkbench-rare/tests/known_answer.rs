@@ -77,6 +77,27 @@ fn monte_carlo_covers_and_is_no_match_for_a_rare_event() {
     assert!(e.ci.1 > 5e-4 && e.ci.1 < 1e-3, "{:?}", e.ci);
 }
 
+/// An event never drawn: the estimate is 0, and the interval stays open above, bounded by
+/// what no event in the final stage's draws can rule out (each weight at most
+/// 1 / defensive), so it still covers a truth too small to draw.
+#[test]
+fn importance_sampling_without_an_event_bounds_it_from_above() {
+    let s = EstimateSettings::new(Method::Ce, 3, 1000, 5);
+    // P = 1e-12: far beyond what 1,000 draws reach, however they adapt.
+    let e = estimate(&s, half_space(upper_quantile(1e-12), 3)).expect("runs");
+    assert_eq!((e.p, e.events), (0.0, 0));
+    let n = (e.trials - e.adapting) as u64;
+    let q_upper = forkbench_rare::clopper_pearson(0, n, 0.95).1;
+    assert_eq!(e.ci.0, 0.0);
+    assert!(
+        (e.ci.1 - q_upper / s.ce.defensive).abs() < 1e-12,
+        "upper {} against {}",
+        e.ci.1,
+        q_upper / s.ce.defensive
+    );
+    assert!(e.ci.1 > 1e-12 && e.ci.1 < 0.1, "upper {}", e.ci.1);
+}
+
 #[test]
 fn importance_sampling_reports_its_spread_and_stages() {
     let s = EstimateSettings::new(Method::Ce, 4, 4000, 7);

@@ -2,16 +2,15 @@
 
 use std::fmt::Write as _;
 
-use forkbench_batch::success_run::{CONFIDENCE, TARGET_RELIABILITY, success_run_length};
 use forkbench_batch::{self as batch, Summary};
 
 use super::svg::esc;
 
 /// The heading and table (empty when no row has the figures: a summary from before).
 pub fn table(s: &Summary) -> String {
-    if s.rows.iter().all(|r| r.success_run.is_none()) {
+    let Some(first) = s.rows.iter().find_map(|r| r.success_run) else {
         return String::new();
-    }
+    };
     let mut h = format!(
         "<h2>Success run (ASTM F3499 style)</h2><p>The reliability each row demonstrates at \
          {:.0} % confidence (the one-sided Clopper–Pearson lower bound of its success rate), \
@@ -19,10 +18,10 @@ pub fn table(s: &Summary) -> String {
          with no failure show it.</p><table><tr><th>scenario</th><th>planner</th>\
          <th>tracker</th><th>mode</th><th>successes</th><th>R demonstrated</th>\
          <th>more clean trials for R {}</th></tr>",
-        100.0 * CONFIDENCE,
-        TARGET_RELIABILITY,
-        success_run_length(TARGET_RELIABILITY, CONFIDENCE),
-        TARGET_RELIABILITY
+        100.0 * first.confidence,
+        first.target,
+        first.success_run_for_target,
+        first.target
     );
     for r in &s.rows {
         let Some(run) = r.success_run else { continue };
