@@ -77,7 +77,10 @@ fn the_confidence_and_target_are_chosen() {
     assert_eq!(figures["success_run_for_target"], 45, "{figures}");
     assert_eq!(figures["confidence"], 0.9, "{figures}");
     let md = std::fs::read_to_string(dir.join("summary.md")).expect("md");
-    assert!(md.contains("at 90 % confidence") && md.contains("for R 0.95"), "{md}");
+    assert!(
+        md.contains("at 90 % confidence") && md.contains("for R 0.95"),
+        "{md}"
+    );
     let page = tmp_in("success-run", "chosen.html");
     let o = forkbench(&["report", s(&dir), "--out", s(&page)]);
     assert!(o.status.success(), "{}", text(&o));
@@ -86,7 +89,10 @@ fn the_confidence_and_target_are_chosen() {
     // Resumed with another target: no trial reruns, the figures follow.
     let o = run("0.95", "0.99");
     assert!(o.status.success(), "{}", text(&o));
-    assert_eq!(read()["rows"][0]["success_run"]["success_run_for_target"], 299);
+    assert_eq!(
+        read()["rows"][0]["success_run"]["success_run_for_target"],
+        299
+    );
     let o = forkbench(&["report", s(&dir), "--out", s(&page)]);
     assert!(o.status.success(), "{}", text(&o));
     let html = std::fs::read_to_string(&page).expect("html");

@@ -48,3 +48,93 @@ fn the_search_finds_a_failure_where_monte_carlo_with_its_budget_finds_none() {
     assert_eq!((mc.events, tried.len()), (0, 200));
     assert!(mc.most_likely.is_none());
 }
+
+fn example(name: &str) -> (std::path::PathBuf, String) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/rare")
+        .join(name);
+    let text = std::fs::read_to_string(&path).expect("reads");
+    (path, text)
+}
+
+/// A file's settings: its lines without comments and blanks.
+fn settings(text: &str) -> Vec<&str> {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .collect()
+}
+
+/// The people-contact examples are the people cycle (`scenarios/warehouse-people.toml`)
+/// with uncertain movers, and differ from each other only in the protective fields'
+/// length; a contact estimate's trials carry the closest approach as their margin.
+#[test]
+fn the_people_contact_examples_are_the_people_cycle_with_uncertain_movers() {
+    let base = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenarios/warehouse-people.toml"),
+    )
+    .expect("reads");
+    let (path, sized) = example("people-contact.toml");
+    let (short_path, short) = example("people-contact-short.toml");
+    let differs = |a: &str, b: &str| -> Vec<String> {
+        let (a, b) = (settings(a), settings(b));
+        let ours = |l: &&str| {
+            !l.starts_with("name =") && !l.starts_with("description =") && !l.starts_with("world =")
+        };
+        let (a, b): (Vec<_>, Vec<_>) = (
+            a.into_iter().filter(ours).collect(),
+            b.into_iter().filter(ours).collect(),
+        );
+        let head = b
+            .iter()
+            .position(|l| *l == "[[uncertain]]")
+            .unwrap_or(b.len());
+        let mut out: Vec<String> = b[..head]
+            .iter()
+            .filter(|l| !a.contains(l))
+            .map(|l| l.to_string())
+            .collect();
+        out.extend(
+            a.iter()
+                .filter(|l| !b[..head].contains(l))
+                .map(|l| format!("-{l}")),
+        );
+        out
+    };
+    assert_eq!(differs(&base, &sized), Vec::<String>::new());
+    assert_eq!(
+        differs(&base, &short),
+        vec!["field_length_scale = 0.7".to_owned()]
+    );
+    assert_eq!(
+        settings(&sized)
+            .iter()
+            .filter(|l| l.starts_with("name = \"mover."))
+            .count(),
+        9
+    );
+    let tail = |t: &str| t[t.find("[[uncertain]]").expect("declared")..].to_owned();
+    assert_eq!(tail(&sized), tail(&short));
+    let scenario = Scenario::load(&short_path).expect("loads");
+    assert!(Scenario::load(&path).is_ok());
+    let setup = RareSetup {
+        scenario,
+        case: "default".into(),
+        planner: None,
+        tracker: None,
+        overrides: Default::default(),
+        seed: 1,
+        event: Event::Contact,
+        jobs: 2,
+    };
+    let (e, tried) = estimate(&setup, forkbench_rare::Method::Mc, 20).expect("runs");
+    assert_eq!((e.trials, tried.len()), (20, 20));
+    for t in &tried {
+        let safety = t.record.outcome.safety.as_ref().expect("monitored");
+        let closest = safety.closest_any_m().expect("measured");
+        assert!(closest.is_finite() && closest < 5.0, "{closest}");
+        assert_eq!(safety.person_contacts > 0, closest <= 0.0, "{closest}");
+        assert_eq!(t.record.outcome.uncertain.len(), 9);
+    }
+}
