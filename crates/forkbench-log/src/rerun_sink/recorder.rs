@@ -404,6 +404,14 @@ fn verdict_detail(o: &TrialOutcome) -> String {
     if !o.also_failed.is_empty() {
         detail += &format!("\n- ❌ **also** {}", o.also_failed.join(" · "));
     }
+    if !o.uncertain.is_empty() {
+        let drawn: Vec<String> = o
+            .uncertain
+            .iter()
+            .map(|(n, v)| format!("{n} {v:.4}"))
+            .collect();
+        detail += &format!("\n- **drawn:** {}", drawn.join(" · "));
+    }
     if let Some(leg) = o
         .legs
         .iter()
@@ -467,5 +475,21 @@ mod tests {
         );
         assert!(rows.contains("| heading at entry | 0.57° | 3° |"), "{rows}");
         assert!(rows.contains("| max contact force | 50 N |"), "{rows}");
+    }
+
+    /// A trial with uncertain parameters shows what was drawn beside its verdict, so a
+    /// searched failure's recording says which parameters it stands for.
+    #[test]
+    fn the_verdict_names_the_drawn_parameters() {
+        let mut o = TrialOutcome::blank("s", "c", ("p", "t"), 1, true);
+        o.fail(Failure::LateralError, "off".into());
+        assert!(!super::verdict_detail(&o).contains("drawn"));
+        o.uncertain.insert("steering_time_constant_s".into(), 0.47451);
+        o.uncertain.insert("pallet.y_m".into(), -0.012);
+        let d = super::verdict_detail(&o);
+        assert!(
+            d.contains("- **drawn:** pallet.y_m -0.0120 · steering_time_constant_s 0.4745"),
+            "{d}"
+        );
     }
 }

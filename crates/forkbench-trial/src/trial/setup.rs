@@ -138,6 +138,16 @@ fn record_scene<R: Recorder + ?Sized>(
         tolerances: &scn.tolerances,
     });
     record_reflectors(rec, &scn.world, &missing_reflectors(run));
+    if !run.uncertain.is_empty() {
+        // A reviewer of a searched or sampled trial sees what was drawn beside the verdict.
+        let drawn: Vec<String> = run
+            .uncertain
+            .iter()
+            .map(|(name, v)| format!("{name} = {v:.4}"))
+            .collect();
+        let text = format!("uncertain parameters drawn: {}", drawn.join(", "));
+        rec.event(0.0, Level::Info, &text);
+    }
 }
 
 impl<'a> Trial<'a> {
