@@ -180,6 +180,16 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
         e.events,
         e.ess
     );
+    if let Some(share) = e.not_rare() {
+        let _ = writeln!(
+            s,
+            "note: the first stage, drawn from the nominal distributions, already had the \
+             event in {:.1} % of its trials: it is not rare, and plain Monte Carlo \
+             (--method mc) is the safer estimate (importance sampling gains little here, and \
+             can undercover an event with several causes)",
+            100.0 * share
+        );
+    }
     let _ = writeln!(s, "trials in {}", c.out.join("trials.jsonl").display());
     crate::emit(&s)
 }

@@ -71,8 +71,9 @@ pub use crate::mixture::{Component, Proposal};
 pub struct Stage {
     /// The elite's robustness threshold (0 once the event itself is the elite).
     pub level: f64,
-    /// Points of this stage on which the event happened.
+    /// Points of this stage on which the event happened, and its points.
     pub events: usize,
+    pub points: usize,
     pub proposal: Proposal,
 }
 
@@ -100,11 +101,13 @@ pub(crate) fn adapt<E: std::error::Error + 'static>(
         let k = ((s.elite_fraction * levels.len() as f64).ceil() as usize).max(1);
         let level = levels[k - 1].max(0.0);
         let events = out.iter().filter(|o| o.event).count();
+        let drawn = points.len();
         let next = refit(&q, &points, &out, level, s);
         seen.extend(points.into_iter().zip(out));
         stages.push(Stage {
             level,
             events,
+            points: drawn,
             proposal: next.clone(),
         });
         q = next;

@@ -93,6 +93,20 @@ pub struct Estimate {
     pub stages: Vec<Stage>,
 }
 
+/// Events the nominal first stage must draw before the event counts as not rare.
+const NOT_RARE_EVENTS: usize = 10;
+
+impl Estimate {
+    /// The share of the event in the cross-entropy's first stage, drawn from the nominal
+    /// density, when it drew enough events to call it not rare: there importance sampling
+    /// gains little, and where the event has several causes its proposal follows one of
+    /// them and can undercover, so plain Monte Carlo is the safer estimate.
+    pub fn not_rare(&self) -> Option<f64> {
+        let first = self.stages.first()?;
+        (first.events >= NOT_RARE_EVENTS).then(|| first.events as f64 / first.points as f64)
+    }
+}
+
 /// Estimates P(event) over N(0, I) in `s.dims` dimensions by evaluating points with
 /// `eval` (a batch of trials at a time).
 pub fn estimate<E: std::error::Error + 'static>(

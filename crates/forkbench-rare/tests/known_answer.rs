@@ -106,6 +106,11 @@ fn importance_sampling_reports_its_spread_and_stages() {
     assert!(re > 0.0 && re < 0.2, "relative error {re}");
     assert!(e.ess > 50.0 && e.ess <= 2000.0, "ess {}", e.ess);
     assert!(!e.stages.is_empty() && e.stages.last().expect("a stage").level == 0.0);
+    assert_eq!(e.not_rare(), None);
+    // At P = 5 % the nominal first stage draws the event often: not rare, and said so.
+    let common = estimate(&s, half_space(upper_quantile(0.05), 4)).expect("runs");
+    let share = common.not_rare().expect("not rare");
+    assert!((0.02..0.09).contains(&share), "{share}");
     // The same seed, the same numbers; another seed, others.
     let again = estimate(&s, half_space(upper_quantile(1e-4), 4)).expect("runs");
     assert_eq!(e, again);

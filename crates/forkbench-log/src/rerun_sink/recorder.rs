@@ -484,7 +484,8 @@ mod tests {
         let mut o = TrialOutcome::blank("s", "c", ("p", "t"), 1, true);
         o.fail(Failure::LateralError, "off".into());
         assert!(!super::verdict_detail(&o).contains("drawn"));
-        o.uncertain.insert("steering_time_constant_s".into(), 0.47451);
+        o.uncertain
+            .insert("steering_time_constant_s".into(), 0.47451);
         o.uncertain.insert("pallet.y_m".into(), -0.012);
         let d = super::verdict_detail(&o);
         assert!(
