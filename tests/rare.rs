@@ -120,3 +120,74 @@ fn an_estimate_writes_its_result_and_refuses_what_it_cannot_weigh() {
         assert!(text(&o).contains(why), "{args:?}: {}", text(&o));
     }
 }
+
+/// A run stopped part-way resumes: the trials already in OUT are not run again (a line
+/// torn by the kill is dropped), and the result is the one an unbroken run gives; a run
+/// with other settings is refused, naming them, until --force-new.
+#[test]
+fn a_stopped_run_resumes_and_another_run_is_refused() {
+    let out = tmp_in("forkbench-rare", "resume");
+    let _ = std::fs::remove_dir_all(&out);
+    let t = tails();
+    let run = || {
+        forkbench(&[
+            "falsify",
+            &t,
+            "--budget",
+            "100",
+            "--seed",
+            "1",
+            "--out",
+            s(&out),
+        ])
+    };
+    let o = run();
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    let whole = std::fs::read(out.join("falsify.json")).expect("result");
+    let trials = std::fs::read_to_string(out.join("trials.jsonl")).expect("trials");
+    assert_eq!(trials.lines().count(), 100);
+    // As a kill leaves it: 40 trials, a torn 41st, no result.
+    let kept: Vec<&str> = trials.lines().collect();
+    let torn = format!("{}\n{}", kept[..40].join("\n"), &kept[40][..80]);
+    std::fs::write(out.join("trials.jsonl"), torn).expect("write");
+    std::fs::remove_file(out.join("falsify.json")).expect("remove");
+    let o = run();
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("resuming: 40 trials"), "{}", text(&o));
+    assert_eq!(
+        std::fs::read(out.join("falsify.json")).expect("result"),
+        whole
+    );
+    let again = std::fs::read_to_string(out.join("trials.jsonl")).expect("trials");
+    assert_eq!(again.lines().count(), 100);
+    // Another seed: refused, nothing changed; then started over.
+    let o = forkbench(&[
+        "falsify",
+        &tails(),
+        "--budget",
+        "100",
+        "--seed",
+        "2",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("seed: 1 → 2"), "{}", text(&o));
+    assert_eq!(
+        std::fs::read(out.join("falsify.json")).expect("kept"),
+        whole
+    );
+    let o = forkbench(&[
+        "falsify",
+        &tails(),
+        "--budget",
+        "100",
+        "--seed",
+        "2",
+        "--out",
+        s(&out),
+        "--force-new",
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
+    assert!(!text(&o).contains("resuming"), "{}", text(&o));
+}

@@ -65,7 +65,7 @@ pub fn estimate<'py>(
     };
     let s = setup(py, scenario, case, (planner, tracker), (event, seed, jobs))?;
     let (e, tried) = py
-        .detach(|| forkbench_batch::rare::estimate(&s, method, budget))
+        .detach(|| forkbench_batch::rare::estimate(&s, method, budget, None))
         .map_err(|e| BatchError::new_err(e.to_string()))?;
     let d = serde_to_py(py, &e)?;
     d.set_item("records", serde_to_py(py, &tried)?)?;
@@ -94,7 +94,7 @@ pub fn falsify<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let s = setup(py, scenario, case, (planner, tracker), (event, seed, jobs))?;
     let (f, tried) = py
-        .detach(|| forkbench_batch::rare::falsify(&s, budget, monte_carlo))
+        .detach(|| forkbench_batch::rare::falsify(&s, budget, monte_carlo, None))
         .map_err(|e| BatchError::new_err(e.to_string()))?;
     let d = serde_to_py(py, &f)?;
     d.set_item("records", serde_to_py(py, &tried)?)?;

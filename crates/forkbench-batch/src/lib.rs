@@ -29,6 +29,7 @@ mod outdir;
 pub mod prints;
 mod provenance;
 pub mod rare;
+mod rare_store;
 mod records_run;
 mod replay;
 mod safety_summary;

@@ -1,9 +1,7 @@
 //! Rare failures over a scenario's uncertain parameters: `estimate` (P(event) with its interval) and `falsify` (the most likely failure), each trial one point of `forkbench_rare`'s standard-normal space.
 
-use std::convert::Infallible;
-
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use forkbench_rare::{EstimateSettings, FalsifySettings, Outcome};
 use forkbench_trial::outcome::TrialOutcome;
@@ -11,6 +9,7 @@ use forkbench_trial::trial::{Overrides, TrialOptions, run_trial};
 use forkbench_trial::{Case, Scenario};
 
 use crate::guard::guarded;
+pub use crate::rare_store::RareStore;
 use crate::{BatchError, TrialRecord, trial_seed};
 
 fn unknown(name: &str) -> BatchError {
@@ -95,7 +94,7 @@ pub struct RareSetup {
 }
 
 /// Every trial run, in order, with its point.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Tried {
     pub z: Vec<f64>,
     #[serde(flatten)]
@@ -107,12 +106,50 @@ struct Runner<'a> {
     case: &'a Case,
     pool: rayon::ThreadPool,
     tried: Vec<Tried>,
+    store: Option<RareStore>,
+    /// The first error writing the store (the run stops at its next stage).
+    failed: Option<BatchError>,
 }
 
 impl Runner<'_> {
     /// Runs one trial per point, in parallel; trial `k` (counted over the whole run) has
     /// the seed a batch's trial `k` of this case would, so its sensor noise is its own.
-    fn eval(&mut self, points: &[Vec<f64>]) -> Vec<Outcome> {
+    fn eval(&mut self, points: &[Vec<f64>]) -> Result<Vec<Outcome>, StoreFailed> {
+        if self.failed.is_some() {
+            return Err(StoreFailed);
+        }
+        let base = self.tried.len();
+        // An earlier run of the same settings drew the same points: its trials stand.
+        let reused = self.store.as_ref().map_or(0, |st| {
+            st.prior[base.min(st.prior.len())..]
+                .iter()
+                .zip(points)
+                .take_while(|(t, z)| t.z == **z)
+                .count()
+        });
+        if reused > 0
+            && let Some(st) = &self.store
+        {
+            self.tried
+                .extend(st.prior[base..base + reused].iter().cloned());
+        }
+        let marks: Vec<Outcome> = self.tried[base..]
+            .iter()
+            .map(|t| self.setup.event.of(&t.record.outcome))
+            .collect();
+        let mut marks = marks;
+        marks.extend(self.run(&points[reused..]));
+        if let Some(st) = &mut self.store
+            && let Err(e) = st.append(&self.tried[base + reused..])
+        {
+            self.failed = Some(e);
+            return Err(StoreFailed);
+        }
+        Ok(marks)
+    }
+
+    /// Runs `points` as the next trials.
+    fn run(&mut self, points: &[Vec<f64>]) -> Vec<Outcome> {
         let base = self.tried.len() as u64;
         let s = self.setup;
         let scn = &s.scenario;
@@ -192,21 +229,44 @@ fn runner(setup: &RareSetup, budget: usize) -> Result<Runner<'_>, BatchError> {
         case,
         pool,
         tried: Vec::new(),
+        store: None,
+        failed: None,
     })
 }
 
-/// P(event) over the scenario's uncertain parameters, and every trial it ran.
+/// Writing a run's trials failed; the error is kept in the runner.
+#[derive(Debug, thiserror::Error)]
+#[error("writing the trials failed")]
+struct StoreFailed;
+
+impl Runner<'_> {
+    /// The run's result, or the store's error that stopped it.
+    fn finish<T>(
+        mut self,
+        r: Result<T, forkbench_rare::RareError<StoreFailed>>,
+    ) -> Result<(T, Vec<Tried>), BatchError> {
+        match (r, self.failed.take()) {
+            (_, Some(e)) => Err(e),
+            (Ok(v), None) => Ok((v, self.tried)),
+            (Err(e), None) => Err(BatchError::Invalid(e.to_string())),
+        }
+    }
+}
+
+/// P(event) over the scenario's uncertain parameters, and every trial it ran; with a
+/// store, its trials are appended as they finish and an earlier run's are reused.
 pub fn estimate(
     setup: &RareSetup,
     method: forkbench_rare::Method,
     budget: usize,
+    store: Option<RareStore>,
 ) -> Result<(forkbench_rare::Estimate, Vec<Tried>), BatchError> {
     let mut r = runner(setup, budget)?;
+    r.store = store;
     let dims = setup.scenario.uncertain.0.len();
     let s = EstimateSettings::new(method, dims, budget, setup.seed);
-    let e = forkbench_rare::estimate(&s, |p| Ok::<_, Infallible>(r.eval(p)))
-        .map_err(|e| BatchError::Invalid(e.to_string()))?;
-    Ok((e, r.tried))
+    let e = forkbench_rare::estimate(&s, |p| r.eval(p));
+    r.finish(e)
 }
 
 /// The most likely failure (and the least robust trial) within `budget` trials; plain
@@ -215,14 +275,40 @@ pub fn falsify(
     setup: &RareSetup,
     budget: usize,
     monte_carlo: bool,
+    store: Option<RareStore>,
 ) -> Result<(forkbench_rare::Falsified, Vec<Tried>), BatchError> {
     let mut r = runner(setup, budget)?;
+    r.store = store;
     let dims = setup.scenario.uncertain.0.len();
     let s = FalsifySettings {
         monte_carlo,
         ..FalsifySettings::new(dims, budget, setup.seed)
     };
-    let f = forkbench_rare::falsify(&s, |p| Ok::<_, Infallible>(r.eval(p)))
-        .map_err(|e| BatchError::Invalid(e.to_string()))?;
-    Ok((f, r.tried))
+    let f = forkbench_rare::falsify(&s, |p| r.eval(p));
+    r.finish(f)
+}
+
+impl RareSetup {
+    /// What a run of this setup is, for its directory's `rare.json`: the build, the
+    /// scenario's resolved settings, the case, components, overrides, seed, event and
+    /// `what` (the method and budget). A run with equal settings draws the same trials.
+    pub fn settings(&self, what: serde_json::Value) -> Result<serde_json::Value, BatchError> {
+        let mut scenario =
+            serde_json::to_value(crate::manifest::ScenarioEntry::of(&self.scenario)?)
+                .map_err(|e| BatchError::Invalid(e.to_string()))?;
+        if let Some(m) = scenario.as_object_mut() {
+            m.remove("file");
+        }
+        Ok(serde_json::json!({
+            "build": crate::build_commit(),
+            "scenario": scenario,
+            "case": self.case,
+            "planner": self.planner,
+            "tracker": self.tracker,
+            "overrides": self.overrides,
+            "seed": self.seed,
+            "event": self.event,
+            "run": what,
+        }))
+    }
 }

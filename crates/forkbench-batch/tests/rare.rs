@@ -25,7 +25,7 @@ fn setup(seed: u64) -> RareSetup {
 
 #[test]
 fn importance_sampling_covers_the_brute_force_value_with_a_tenth_of_its_trials() {
-    let (e, tried) = estimate(&setup(3), forkbench_rare::Method::Ce, 6000).expect("runs");
+    let (e, tried) = estimate(&setup(3), forkbench_rare::Method::Ce, 6000, None).expect("runs");
     assert_eq!(tried.len(), 6000);
     assert!(
         e.ci.0 <= BRUTE_FORCE_P && BRUTE_FORCE_P <= e.ci.1,
@@ -41,10 +41,10 @@ fn importance_sampling_covers_the_brute_force_value_with_a_tenth_of_its_trials()
 
 #[test]
 fn the_search_finds_a_failure_where_monte_carlo_with_its_budget_finds_none() {
-    let (f, _) = falsify(&setup(1), 200, false).expect("runs");
+    let (f, _) = falsify(&setup(1), 200, false, None).expect("runs");
     let m = f.most_likely.expect("a failure");
     assert!(m.outcome.event && m.outcome.robustness <= 0.0);
-    let (mc, tried) = falsify(&setup(1), 200, true).expect("runs");
+    let (mc, tried) = falsify(&setup(1), 200, true, None).expect("runs");
     assert_eq!((mc.events, tried.len()), (0, 200));
     assert!(mc.most_likely.is_none());
 }
@@ -128,7 +128,7 @@ fn the_people_contact_examples_are_the_people_cycle_with_uncertain_movers() {
         event: Event::Contact,
         jobs: 2,
     };
-    let (e, tried) = estimate(&setup, forkbench_rare::Method::Mc, 20).expect("runs");
+    let (e, tried) = estimate(&setup, forkbench_rare::Method::Mc, 20, None).expect("runs");
     assert_eq!((e.trials, tried.len()), (20, 20));
     for t in &tried {
         let safety = t.record.outcome.safety.as_ref().expect("monitored");

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, bail};
 use clap::{Args, ValueEnum};
 
-use forkbench_batch::rare::{Event, RareSetup, Tried};
+use forkbench_batch::rare::{Event, RareSetup, RareStore, Tried};
 
 /// What `estimate` and `falsify` share: the scenario, its components, the event, the budget.
 #[derive(Debug, Args)]
@@ -43,6 +43,10 @@ pub struct RareArgs {
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
+    /// Start over when OUT holds the trials of a run with other settings (a run with the
+    /// same settings resumes: its trials are not run again).
+    #[arg(long)]
+    force_new: bool,
 }
 
 /// `forkbench estimate`.
@@ -74,7 +78,7 @@ pub struct FalsifyArgs {
 }
 
 /// The files this writes in `--out`; a directory holding anything else is refused.
-const OURS: [&str; 3] = ["trials.jsonl", "estimate.json", "falsify.json"];
+const OURS: [&str; 4] = ["trials.jsonl", "estimate.json", "falsify.json", "rare.json"];
 
 impl RareArgs {
     fn setup(&self) -> anyhow::Result<RareSetup> {
@@ -116,6 +120,19 @@ impl RareArgs {
         Ok(dir)
     }
 
+    /// OUT's store for this run: its earlier trials resumed, new ones appended.
+    fn store(&self, setup: &RareSetup, what: serde_json::Value) -> anyhow::Result<RareStore> {
+        let store = RareStore::open(&self.out, &setup.settings(what)?, self.force_new)?;
+        if store.resumed() > 0 && !self.json {
+            eprintln!(
+                "resuming: {} trials of this run already in {}",
+                store.resumed(),
+                self.out.display()
+            );
+        }
+        Ok(store)
+    }
+
     fn write(
         &self,
         tried: &[Tried],
@@ -147,7 +164,10 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
         MethodArg::Ce => forkbench_rare::Method::Ce,
         MethodArg::Mc => forkbench_rare::Method::Mc,
     };
-    let (e, tried) = forkbench_batch::rare::estimate(&setup, method, c.budget as usize)?;
+    let what = serde_json::json!({ "estimate": method, "budget": c.budget });
+    let store = c.store(&setup, what)?;
+    let (e, tried) =
+        forkbench_batch::rare::estimate(&setup, method, c.budget as usize, Some(store))?;
     c.write(&tried, "estimate.json", &e)?;
     if c.json {
         return crate::out::emit_json_line(&e);
@@ -200,7 +220,10 @@ pub fn falsify(a: FalsifyArgs) -> anyhow::Result<bool> {
     let c = &a.common;
     c.out_dir()?;
     let setup = c.setup()?;
-    let (f, tried) = forkbench_batch::rare::falsify(&setup, c.budget as usize, a.monte_carlo)?;
+    let what = serde_json::json!({ "falsify": !a.monte_carlo, "budget": c.budget });
+    let store = c.store(&setup, what)?;
+    let (f, tried) =
+        forkbench_batch::rare::falsify(&setup, c.budget as usize, a.monte_carlo, Some(store))?;
     c.write(&tried, "falsify.json", &f)?;
     if c.json {
         crate::out::emit_json_line(&f)?;

@@ -1,0 +1,170 @@
+//! An estimate's or a search's directory: the run's settings (`rare.json`), its trials appended to `trials.jsonl` as each stage ends, and a resume that reruns none of them.
+
+use std::fs::{File, OpenOptions};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::rare::Tried;
+use crate::{BatchError, io};
+
+/// The run's settings, beside its trials.
+pub const SETTINGS_FILE: &str = "rare.json";
+/// Every trial, in the order it was run, with its point.
+pub const TRIALS_FILE: &str = "trials.jsonl";
+/// Largest `rare.json` read (a scenario's resolved settings, world included).
+const MAX_SETTINGS_BYTES: u64 = 64 << 20;
+/// The results a run writes at its end.
+pub const RESULT_FILES: [&str; 2] = ["estimate.json", "falsify.json"];
+
+/// The trials a directory already holds for this run, and where new ones are appended.
+#[derive(Debug)]
+pub struct RareStore {
+    /// The first trials of this run, from an earlier one that stopped.
+    pub(crate) prior: Vec<Tried>,
+    /// Where new trials go, once the run has started.
+    file: Option<File>,
+    dir: PathBuf,
+    settings: Value,
+}
+
+impl RareStore {
+    /// Opens `dir` for the run `settings` describes. A directory holding this run's
+    /// trials resumes them; one with another run's is refused unless `force_new`, which
+    /// starts over (deleting only the files a run writes).
+    pub fn open(dir: &Path, settings: &Value, force_new: bool) -> Result<Self, BatchError> {
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let (settings_path, path) = (dir.join(SETTINGS_FILE), dir.join(TRIALS_FILE));
+        if std::fs::metadata(&settings_path).is_ok_and(|m| m.len() > MAX_SETTINGS_BYTES) {
+            return Err(BatchError::Invalid(format!(
+                "{}: more than {MAX_SETTINGS_BYTES} bytes, not a run's settings",
+                settings_path.display()
+            )));
+        }
+        let have =
+            match std::fs::read(&settings_path) {
+                Ok(b) => Some(serde_json::from_slice::<Value>(&b).map_err(|e| {
+                    BatchError::Invalid(format!("{}: {e}", settings_path.display()))
+                })?),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+                Err(e) => return Err(io(&settings_path)(e)),
+            };
+        let has_trials = std::fs::metadata(&path).is_ok_and(|m| m.len() > 0);
+        let prior = match have {
+            _ if force_new => Vec::new(),
+            Some(h) if &h == settings => read_prior(&path)?,
+            Some(h) => return Err(other_run(dir, &h, settings)),
+            None if has_trials => {
+                return Err(BatchError::Invalid(format!(
+                    "{}: has trials.jsonl but no {SETTINGS_FILE} (written by an older \
+                     forkbench), so what it ran is unknown; use --force-new or another \
+                     directory",
+                    dir.display()
+                )));
+            }
+            None => Vec::new(),
+        };
+        Ok(RareStore {
+            prior,
+            file: None,
+            dir: dir.to_path_buf(),
+            settings: settings.clone(),
+        })
+    }
+
+    /// Makes the directory this run's, at its first trials (so a run refused before it
+    /// starts changes nothing): no earlier result beside them, its settings, the
+    /// resumed trials rewritten as they parsed (a line torn by a kill gone).
+    fn start(&mut self) -> Result<File, BatchError> {
+        for name in RESULT_FILES {
+            let p = self.dir.join(name);
+            match std::fs::remove_file(&p) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io(&p)(e)),
+                _ => {}
+            }
+        }
+        let settings = self.settings.to_string();
+        crate::write_atomic(&self.dir.join(SETTINGS_FILE), settings.as_bytes())?;
+        let path = self.dir.join(TRIALS_FILE);
+        crate::write_atomic(&path, lines(&self.prior)?.as_bytes())?;
+        OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .map_err(io(&path))
+    }
+
+    /// Trials already done, reused in order.
+    pub fn resumed(&self) -> usize {
+        self.prior.len()
+    }
+
+    /// Appends newly run trials and flushes them, so a kill loses at most a stage.
+    pub(crate) fn append(&mut self, new: &[Tried]) -> Result<(), BatchError> {
+        if self.file.is_none() {
+            self.file = Some(self.start()?);
+        }
+        let Some(file) = self.file.as_mut() else {
+            return Ok(());
+        };
+        file.write_all(lines(new)?.as_bytes())
+            .and_then(|()| file.flush())
+            .map_err(io(&self.dir.join(TRIALS_FILE)))
+    }
+}
+
+/// Trials as JSON lines.
+fn lines(trials: &[Tried]) -> Result<String, BatchError> {
+    let mut text = String::new();
+    for t in trials {
+        text += &serde_json::to_string(t).map_err(|e| BatchError::Invalid(e.to_string()))?;
+        text.push('\n');
+    }
+    Ok(text)
+}
+
+/// The trials of `path`, a torn last line dropped.
+fn read_prior(path: &Path) -> Result<Vec<Tried>, BatchError> {
+    let text = match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(io(path)(e)),
+        Ok(m) if m.len() > crate::MAX_RECORDS_BYTES => {
+            return Err(BatchError::Invalid(format!(
+                "{}: {} bytes, more than the {} bytes of trials read at once",
+                path.display(),
+                m.len(),
+                crate::MAX_RECORDS_BYTES
+            )));
+        }
+        Ok(_) => std::fs::read_to_string(path).map_err(io(path))?,
+    };
+    let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    let mut out = Vec::with_capacity(lines.len());
+    for (i, line) in lines.iter().enumerate() {
+        match serde_json::from_str::<Tried>(line) {
+            Ok(t) => out.push(t),
+            Err(_) if i + 1 == lines.len() => break,
+            Err(e) => {
+                return Err(BatchError::Record {
+                    path: path.display().to_string(),
+                    line: i + 1,
+                    message: e.to_string(),
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The refusal of a directory holding another run, naming what differs.
+fn other_run(dir: &Path, have: &Value, want: &Value) -> BatchError {
+    let mut diff = Vec::new();
+    crate::manifest::diff_values("", have, want, &mut diff);
+    BatchError::Invalid(format!(
+        "{}: holds the trials of another run ({} differences, directory → this run: {}); \
+         start over with --force-new, or choose another directory",
+        dir.display(),
+        diff.len(),
+        diff.iter().take(6).cloned().collect::<Vec<_>>().join("; ")
+    ))
+}
