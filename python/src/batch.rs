@@ -189,7 +189,17 @@ pub fn run_batch<'py>(
     if jobs == Some(0) {
         return Err(BatchError::new_err("jobs 0: at least one worker thread"));
     }
-    if out.as_ref().is_some_and(|p| p.as_os_str().is_empty()) {
+    check_out(out.as_deref(), force_new)?;
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let records = py
+        .detach(|| forkbench_batch::run_records(&spec, jobs, out.as_deref()))
+        .map_err(|e| BatchError::new_err(e.to_string()))?;
+    records.iter().map(|r| serde_to_py(py, r)).collect()
+}
+
+/// `out` names a directory when given, and `force_new` asks for one.
+fn check_out(out: Option<&std::path::Path>, force_new: bool) -> PyResult<()> {
+    if out.is_some_and(|p| p.as_os_str().is_empty()) {
         return Err(BatchError::new_err(
             "out \"\": name the batch directory (None keeps the records in memory)",
         ));
@@ -200,9 +210,5 @@ pub fn run_batch<'py>(
              records stay in memory and nothing is written)",
         ));
     }
-    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let records = py
-        .detach(|| forkbench_batch::run_records(&spec, jobs, out.as_deref()))
-        .map_err(|e| BatchError::new_err(e.to_string()))?;
-    records.iter().map(|r| serde_to_py(py, r)).collect()
+    Ok(())
 }
