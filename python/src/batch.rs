@@ -139,7 +139,6 @@ pub fn run_batch<'py>(
     jobs: Option<usize>,
     out: Option<PathBuf>,
     force_new: bool,
-    success_run: Default::default(),
     truck_preset: Option<String>,
     truck: Option<BTreeMap<String, f64>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
