@@ -129,19 +129,21 @@ fn a_stopped_run_resumes_and_another_run_is_refused() {
     let out = tmp_in("forkbench-rare", "resume");
     let _ = std::fs::remove_dir_all(&out);
     let t = tails();
-    let run = || {
-        forkbench(&[
+    let run = |seed: &str, extra: &[&str]| {
+        let mut a = vec![
             "falsify",
             &t,
             "--budget",
             "100",
             "--seed",
-            "1",
+            seed,
             "--out",
             s(&out),
-        ])
+        ];
+        a.extend(extra);
+        forkbench(&a)
     };
-    let o = run();
+    let o = run("1", &[]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     let whole = std::fs::read(out.join("falsify.json")).expect("result");
     let trials = std::fs::read_to_string(out.join("trials.jsonl")).expect("trials");
@@ -151,7 +153,7 @@ fn a_stopped_run_resumes_and_another_run_is_refused() {
     let torn = format!("{}\n{}", kept[..40].join("\n"), &kept[40][..80]);
     std::fs::write(out.join("trials.jsonl"), torn).expect("write");
     std::fs::remove_file(out.join("falsify.json")).expect("remove");
-    let o = run();
+    let o = run("1", &[]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("resuming: 40 trials"), "{}", text(&o));
     assert_eq!(
@@ -161,33 +163,14 @@ fn a_stopped_run_resumes_and_another_run_is_refused() {
     let again = std::fs::read_to_string(out.join("trials.jsonl")).expect("trials");
     assert_eq!(again.lines().count(), 100);
     // Another seed: refused, nothing changed; then started over.
-    let o = forkbench(&[
-        "falsify",
-        &tails(),
-        "--budget",
-        "100",
-        "--seed",
-        "2",
-        "--out",
-        s(&out),
-    ]);
+    let o = run("2", &[]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("seed: 1 → 2"), "{}", text(&o));
     assert_eq!(
         std::fs::read(out.join("falsify.json")).expect("kept"),
         whole
     );
-    let o = forkbench(&[
-        "falsify",
-        &tails(),
-        "--budget",
-        "100",
-        "--seed",
-        "2",
-        "--out",
-        s(&out),
-        "--force-new",
-    ]);
+    let o = run("2", &["--force-new"]);
     assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
     assert!(!text(&o).contains("resuming"), "{}", text(&o));
 }
