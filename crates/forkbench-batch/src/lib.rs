@@ -63,7 +63,7 @@ pub use safety_summary::SafetySummary;
 pub use seed::{SEED_SCHEME, trial_seed};
 pub use shard::{ShardArg, merge_inputs, parse_shard, resolve_shard, shard_dir};
 pub use store::{load_batch, load_results, merge, read_numbered, read_records};
-pub use summary::{LegSummary, Summary, SummaryRow, mode_name, summarize};
+pub use summary::{LegSummary, Summary, SummaryRow, mode_name, summarize, summarize_with};
 pub use sweep::{
     RecordChoice, RecordJob, Sweep, SweepPoint, SweepResult, read_sweep, sweep_markdown,
     sweep_points, trials_to_record, write_sweep,
@@ -432,8 +432,7 @@ fn summarize_dir(
         .into_iter()
         .filter(|r| wanted.contains(&r.key()))
         .collect();
-    let mut summary = summarize(&records);
-    summary.restate_success_run(spec.success_run);
+    let mut summary = summarize_with(&records, spec.success_run);
     let provenance = Provenance::collect(Manifest::of(spec)?, jobs, started);
     summary.provenance = Some(provenance.with_runs(provenance::finish_runs(dir)));
     write_summary(dir, &summary)?;

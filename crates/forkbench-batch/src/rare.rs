@@ -9,7 +9,7 @@ use forkbench_trial::trial::{Overrides, TrialOptions, run_trial};
 use forkbench_trial::{Case, Scenario};
 
 use crate::guard::guarded;
-pub use crate::rare_store::RareStore;
+pub use crate::rare_store::{OUT_FILES, RareStore, TRIALS_FILE};
 use crate::{BatchError, TrialRecord, trial_seed};
 
 fn unknown(name: &str) -> BatchError {
@@ -120,24 +120,20 @@ impl Runner<'_> {
         }
         let base = self.tried.len();
         // An earlier run of the same settings drew the same points: its trials stand.
-        let reused = self.store.as_ref().map_or(0, |st| {
-            st.prior[base.min(st.prior.len())..]
-                .iter()
-                .zip(points)
-                .take_while(|(t, z)| t.z == **z)
-                .count()
-        });
-        if reused > 0
-            && let Some(st) = &self.store
-        {
-            self.tried
-                .extend(st.prior[base..base + reused].iter().cloned());
-        }
-        let marks: Vec<Outcome> = self.tried[base..]
+        let prior: &[Tried] = self
+            .store
+            .as_ref()
+            .map_or(&[], |st| st.prior.get(base..).unwrap_or(&[]));
+        let reused = prior
+            .iter()
+            .zip(points)
+            .take_while(|(t, z)| t.z == **z)
+            .count();
+        self.tried.extend_from_slice(&prior[..reused]);
+        let mut marks: Vec<Outcome> = self.tried[base..]
             .iter()
             .map(|t| self.setup.event.of(&t.record.outcome))
             .collect();
-        let mut marks = marks;
         marks.extend(self.run(&points[reused..]));
         if let Some(st) = &mut self.store
             && let Err(e) = st.append(&self.tried[base + reused..])
@@ -194,8 +190,8 @@ impl Runner<'_> {
     }
 }
 
-/// Most trials a search or an estimate runs: each trial's record is kept to be written
-/// (about 1.3 KB a pick as JSON, more in memory), so this bounds its memory.
+/// Most trials a search or an estimate runs: each trial's record is kept in memory
+/// (about 1.3 KB a pick as JSON, more there), so this bounds its memory.
 pub const MAX_RARE_TRIALS: usize = 250_000;
 
 /// The runner of `setup`, its options and the scenario's parameters checked first.

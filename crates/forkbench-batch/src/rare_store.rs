@@ -10,13 +10,15 @@ use crate::rare::Tried;
 use crate::{BatchError, io};
 
 /// The run's settings, beside its trials.
-pub const SETTINGS_FILE: &str = "rare.json";
+const SETTINGS_FILE: &str = "rare.json";
 /// Every trial, in the order it was run, with its point.
 pub const TRIALS_FILE: &str = "trials.jsonl";
 /// Largest `rare.json` read (a scenario's resolved settings, world included).
 const MAX_SETTINGS_BYTES: u64 = 64 << 20;
 /// The results a run writes at its end.
-pub const RESULT_FILES: [&str; 2] = ["estimate.json", "falsify.json"];
+const RESULT_FILES: [&str; 2] = ["estimate.json", "falsify.json"];
+/// Every file a run writes in its directory.
+pub const OUT_FILES: [&str; 4] = [SETTINGS_FILE, TRIALS_FILE, RESULT_FILES[0], RESULT_FILES[1]];
 
 /// The trials a directory already holds for this run, and where new ones are appended.
 #[derive(Debug)]
@@ -123,37 +125,12 @@ fn lines(trials: &[Tried]) -> Result<String, BatchError> {
     Ok(text)
 }
 
-/// The trials of `path`, a torn last line dropped.
+/// The trials of `path`, read as a batch's records are (a torn last line dropped, each
+/// record consistent).
 fn read_prior(path: &Path) -> Result<Vec<Tried>, BatchError> {
-    let text = match std::fs::metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(io(path)(e)),
-        Ok(m) if m.len() > crate::MAX_RECORDS_BYTES => {
-            return Err(BatchError::Invalid(format!(
-                "{}: {} bytes, more than the {} bytes of trials read at once",
-                path.display(),
-                m.len(),
-                crate::MAX_RECORDS_BYTES
-            )));
-        }
-        Ok(_) => std::fs::read_to_string(path).map_err(io(path))?,
-    };
-    let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
-    let mut out = Vec::with_capacity(lines.len());
-    for (i, line) in lines.iter().enumerate() {
-        match serde_json::from_str::<Tried>(line) {
-            Ok(t) => out.push(t),
-            Err(_) if i + 1 == lines.len() => break,
-            Err(e) => {
-                return Err(BatchError::Record {
-                    path: path.display().to_string(),
-                    line: i + 1,
-                    message: e.to_string(),
-                });
-            }
-        }
-    }
-    Ok(out)
+    let (numbered, _) =
+        crate::store::read_jsonl(path, |t: &Tried| crate::store::contradiction(&t.record))?;
+    Ok(numbered.into_iter().map(|(_, t)| t).collect())
 }
 
 /// The refusal of a directory holding another run, naming what differs.

@@ -5,7 +5,9 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Read as _};
 use std::path::{Path, PathBuf};
 
-use super::{BatchError, DirLock, Manifest, Summary, TrialRecord, io, summarize, write_summary};
+use super::{
+    BatchError, DirLock, Manifest, Summary, TrialRecord, io, summarize_with, write_summary,
+};
 
 /// Reads `trials.jsonl`. A torn last line (a crash mid-write) is skipped; any other bad
 /// line is an error naming the file and line.
@@ -25,6 +27,15 @@ pub(super) fn read_records_torn(path: &Path) -> Result<(Vec<TrialRecord>, bool),
 }
 
 fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), BatchError> {
+    read_jsonl(path, contradiction)
+}
+
+/// The JSON lines of `path`, each with its 1-based line and checked by `check`, and
+/// whether a torn last line was skipped.
+pub(crate) fn read_jsonl<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    check: impl Fn(&T) -> Option<String>,
+) -> Result<(Vec<(usize, T)>, bool), BatchError> {
     let file = match std::fs::metadata(path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((Vec::new(), false)),
         Err(e) => return Err(io(path)(e)),
@@ -55,9 +66,9 @@ fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), 
         if line.trim().is_empty() {
             continue;
         }
-        match serde_json::from_str::<TrialRecord>(line) {
+        match serde_json::from_str::<T>(line) {
             Ok(r) => {
-                if let Some(why) = contradiction(&r) {
+                if let Some(why) = check(&r) {
                     return Err(BatchError::Record {
                         path: path.display().to_string(),
                         line: i + 1,
@@ -81,7 +92,7 @@ fn read_numbered_torn(path: &Path) -> Result<(Vec<(usize, TrialRecord)>, bool), 
 
 /// Why a parsed record contradicts itself (an edited or foreign file), if it does: a
 /// success has no failure, a failure names one.
-fn contradiction(r: &TrialRecord) -> Option<String> {
+pub(crate) fn contradiction(r: &TrialRecord) -> Option<String> {
     match (r.outcome.success, r.outcome.failure) {
         (true, Some(f)) => Some(format!(
             "success is true but failure is {:?}: a record is one or the other",
@@ -174,8 +185,7 @@ pub fn load_batch(dir: &Path) -> Result<(Summary, Vec<TrialRecord>, Manifest), B
         ))
     })?;
     let records = complete_records(dir, &m)?;
-    let mut summary = summarize(&records);
-    summary.restate_success_run(m.success_run);
+    let mut summary = summarize_with(&records, m.success_run);
     summary.provenance = written_provenance(dir);
     Ok((summary, records, m))
 }
@@ -298,8 +308,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
     remove_if_present(&out.join("summary.md"))?;
     merged.write(out)?;
     rewrite_records(&path, &all)?;
-    let mut summary = summarize(&all);
-    summary.restate_success_run(merged.success_run);
+    let mut summary = summarize_with(&all, merged.success_run);
     // The merge's own provenance (this host, now); each shard's stays in its directory.
     let now = std::time::SystemTime::now();
     summary.provenance = Some(super::Provenance::collect(merged, 1, now));

@@ -169,8 +169,18 @@ impl Acc {
     }
 }
 
-/// Summarises records; order-independent (values are sorted before any sum).
+/// Summarises records; order-independent (values are sorted before any sum). The
+/// success runs are stated at the default confidence and target.
 pub fn summarize(records: &[TrialRecord]) -> Summary {
+    summarize_with(records, Default::default())
+}
+
+/// [`summarize`], the success runs stated at `target` (a batch's
+/// `--success-confidence` and `--success-reliability`).
+pub fn summarize_with(
+    records: &[TrialRecord],
+    target: crate::success_run::SuccessTarget,
+) -> Summary {
     let mut groups: BTreeMap<(String, String, String, bool), Acc> = BTreeMap::new();
     for r in records {
         let o = &r.outcome;
@@ -215,11 +225,7 @@ pub fn summarize(records: &[TrialRecord]) -> Summary {
                 legs: leg_summaries(a.legs),
                 phases: leg_summaries(a.phases),
                 safety: a.safety.finish(),
-                success_run: Some(crate::success_run::success_run(
-                    a.k,
-                    a.n,
-                    Default::default(),
-                )),
+                success_run: Some(crate::success_run::success_run(a.k, a.n, target)),
             }
         })
         .collect();
@@ -303,14 +309,6 @@ impl Summary {
 }
 
 impl Summary {
-    /// States every row's success run at `t` (a batch's `--success-confidence` and
-    /// `--success-reliability`) instead of the defaults.
-    pub fn restate_success_run(&mut self, t: crate::success_run::SuccessTarget) {
-        for r in &mut self.rows {
-            r.success_run = Some(crate::success_run::success_run(r.successes, r.trials, t));
-        }
-    }
-
     /// The mission legs' success table (empty without missions).
     fn legs_markdown(&self) -> String {
         self.stages_markdown(

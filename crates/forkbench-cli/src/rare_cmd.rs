@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, bail};
 use clap::{Args, ValueEnum};
 
-use forkbench_batch::rare::{Event, RareSetup, RareStore, Tried};
+use forkbench_batch::rare::{Event, OUT_FILES, RareSetup, RareStore, TRIALS_FILE, Tried};
 
 /// What `estimate` and `falsify` share: the scenario, its components, the event, the budget.
 #[derive(Debug, Args)]
@@ -27,8 +27,9 @@ pub struct RareArgs {
     /// name (`lateral_error`, `contact_force`, …).
     #[arg(long, default_value = "failure")]
     event: String,
-    /// Trials in all (every trial's record is kept to write trials.jsonl, about 1.3 KB a
-    /// pick, hence the bound; a plain batch streams larger counts to disk).
+    /// Trials in all (every trial's record is also kept in memory, for the search and the
+    /// result, about 1.3 KB a pick, hence the bound; a plain batch streams larger counts
+    /// to disk).
     #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u64).range(20..=250_000))]
     budget: u64,
     /// Seed of every draw (the search's points and the trials' own noise).
@@ -77,9 +78,6 @@ pub struct FalsifyArgs {
     record: crate::RecordFlags,
 }
 
-/// The files this writes in `--out`; a directory holding anything else is refused.
-const OURS: [&str; 4] = ["trials.jsonl", "estimate.json", "falsify.json", "rare.json"];
-
 impl RareArgs {
     fn setup(&self) -> anyhow::Result<RareSetup> {
         let scn = forkbench_trial::Scenario::load(&self.scenario)?;
@@ -107,7 +105,7 @@ impl RareArgs {
         if dir.exists() {
             for e in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
                 let name = e?.file_name();
-                if !OURS.iter().any(|o| name == *o) {
+                if !OUT_FILES.iter().any(|o| name == *o) {
                     bail!(
                         "{}: holds {:?}, which estimate and falsify do not write; give an empty or new directory",
                         dir.display(),
@@ -133,20 +131,10 @@ impl RareArgs {
         Ok(store)
     }
 
-    fn write(
-        &self,
-        tried: &[Tried],
-        name: &str,
-        result: &impl serde::Serialize,
-    ) -> anyhow::Result<()> {
+    /// Writes the result beside the trials the store appended as they ran.
+    fn write(&self, name: &str, result: &impl serde::Serialize) -> anyhow::Result<()> {
         // Checked again: a long run leaves time for someone else's file to arrive.
         let dir = self.out_dir()?;
-        let mut lines = String::new();
-        for t in tried {
-            lines += &serde_json::to_string(t)?;
-            lines.push('\n');
-        }
-        forkbench_batch::write_atomic(&dir.join("trials.jsonl"), lines.as_bytes())?;
         forkbench_batch::write_atomic(
             &dir.join(name),
             serde_json::to_string_pretty(result)?.as_bytes(),
@@ -166,9 +154,8 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
     };
     let what = serde_json::json!({ "estimate": method, "budget": c.budget });
     let store = c.store(&setup, what)?;
-    let (e, tried) =
-        forkbench_batch::rare::estimate(&setup, method, c.budget as usize, Some(store))?;
-    c.write(&tried, "estimate.json", &e)?;
+    let (e, _) = forkbench_batch::rare::estimate(&setup, method, c.budget as usize, Some(store))?;
+    c.write("estimate.json", &e)?;
     if c.json {
         return crate::out::emit_json_line(&e);
     }
@@ -210,7 +197,7 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
             100.0 * share
         );
     }
-    let _ = writeln!(s, "trials in {}", c.out.join("trials.jsonl").display());
+    let _ = writeln!(s, "trials in {}", c.out.join(TRIALS_FILE).display());
     crate::emit(&s)
 }
 
@@ -224,7 +211,7 @@ pub fn falsify(a: FalsifyArgs) -> anyhow::Result<bool> {
     let store = c.store(&setup, what)?;
     let (f, tried) =
         forkbench_batch::rare::falsify(&setup, c.budget as usize, a.monte_carlo, Some(store))?;
-    c.write(&tried, "falsify.json", &f)?;
+    c.write("falsify.json", &f)?;
     if c.json {
         crate::out::emit_json_line(&f)?;
     } else {
@@ -242,7 +229,7 @@ pub fn falsify(a: FalsifyArgs) -> anyhow::Result<bool> {
         || rec.rerun
         || rec.connect.is_some();
     if asked {
-        let trials = c.out.join("trials.jsonl");
+        let trials = c.out.join(TRIALS_FILE);
         crate::replay_cmd::replay(
             &trials,
             line,
@@ -297,7 +284,7 @@ fn falsify_text(
             let _ = writeln!(
                 s,
                 "replay: forkbench replay {} --line {} --scenario {} --rrd failure.rrd",
-                c.out.join("trials.jsonl").display(),
+                c.out.join(TRIALS_FILE).display(),
                 line_of(tried, &m.z),
                 c.scenario.display()
             );
