@@ -161,7 +161,7 @@ impl Core {
         d.set_item("case", &self.case)?;
         if let Some((out, _)) = self.session.ended() {
             d.set_item("success", out.success)?;
-            d.set_item("failure", out.failure.map(|f| f.name()))?;
+            d.set_item("failure", out.failure.as_ref().map(|f| f.name()))?;
             d.set_item("outcome", serde_to_py(py, out)?)?;
         }
         Ok(d)

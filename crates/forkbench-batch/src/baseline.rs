@@ -69,7 +69,7 @@ impl BaselineTrial {
             trial: r.trial,
             seed: o.seed,
             success: o.success,
-            failure: o.failure.map(|f| f.name().to_owned()),
+            failure: o.failure.as_ref().map(|f| f.name().to_owned()),
         }
     }
 

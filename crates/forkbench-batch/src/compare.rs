@@ -200,7 +200,7 @@ fn tally(
                 trial: key.4,
                 seed: ra.outcome.seed,
                 winner: if ok_a { a } else { b }.to_owned(),
-                loser_failure: loser.outcome.failure.map(|f| f.name().to_owned()),
+                loser_failure: loser.outcome.failure.as_ref().map(|f| f.name().to_owned()),
                 a_line: *la,
                 b_line: *lb,
             });

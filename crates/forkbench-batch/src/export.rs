@@ -149,7 +149,7 @@ fn row<'a>(r: &'a TrialRecord, finite: impl Fn(f64) -> Option<f64>) -> Row<'a> {
         localization_noise_scale: r.overrides.localization_noise_scale,
         odometry_noise_scale: r.overrides.odometry_noise_scale,
         success: o.success,
-        failure: o.failure.map_or("", |f| f.name()),
+        failure: o.failure.as_ref().map_or("", |f| f.name()),
         failure_detail: csv_text(o.failure_detail.as_deref().unwrap_or("")),
         lateral_error_m: o.lateral_error_m,
         heading_error_rad: o.heading_error_rad,

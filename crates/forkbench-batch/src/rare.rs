@@ -42,7 +42,7 @@ impl Event {
                 // built-in step criterion's (any other word could only be a registered
                 // phase's, which this command cannot tell from a typo).
                 Some(forkbench_trial::outcome::Failure::Criterion(n))
-                    if forkbench_trial::step_criteria::step_criterion_name(n).is_none() =>
+                    if forkbench_trial::step_criteria::step_criterion_name(&n).is_none() =>
                 {
                     Err(unknown(name))
                 }
@@ -62,7 +62,7 @@ impl Event {
                 robustness: margin,
             },
             Event::Criterion(name) => Outcome {
-                event: o.failure.is_some_and(|f| f.name() == name)
+                event: o.failure.as_ref().is_some_and(|f| f.name() == name)
                     || o.also_failed
                         .iter()
                         .any(|a| a.split(':').next() == Some(name)),

@@ -93,7 +93,7 @@ pub(crate) fn read_jsonl<T: serde::de::DeserializeOwned>(
 /// Why a parsed record contradicts itself (an edited or foreign file), if it does: a
 /// success has no failure, a failure names one.
 pub(crate) fn contradiction(r: &TrialRecord) -> Option<String> {
-    match (r.outcome.success, r.outcome.failure) {
+    match (r.outcome.success, &r.outcome.failure) {
         (true, Some(f)) => Some(format!(
             "success is true but failure is {:?}: a record is one or the other",
             f.name()

@@ -139,7 +139,11 @@ impl Acc {
         if o.success {
             self.k += 1;
         } else {
-            let name = o.failure.map_or("unknown", Failure::name).to_owned();
+            let name = o
+                .failure
+                .as_ref()
+                .map_or("unknown", Failure::name)
+                .to_owned();
             *self.failures.entry(name).or_default() += 1;
         }
         if let Some(v) = o.lateral_error_m.filter(|v| v.is_finite()) {

@@ -240,7 +240,7 @@ pub fn trials_to_record<'a>(
 fn spread(records: Vec<&TrialRecord>, max: usize) -> Vec<&TrialRecord> {
     type Groups<'r> = BTreeMap<
         String,
-        BTreeMap<&'static str, BTreeMap<Option<bool>, BTreeMap<String, Vec<&'r TrialRecord>>>>,
+        BTreeMap<&'r str, BTreeMap<Option<bool>, BTreeMap<String, Vec<&'r TrialRecord>>>>,
     >;
     let mut groups: Groups = BTreeMap::new();
     for r in records {
@@ -248,7 +248,7 @@ fn spread(records: Vec<&TrialRecord>, max: usize) -> Vec<&TrialRecord> {
         groups
             .entry(o.scenario.clone())
             .or_default()
-            .entry(o.failure.map_or("success", |f| f.name()))
+            .entry(o.failure.as_ref().map_or("success", |f| f.name()))
             .or_default()
             .entry(r.replan)
             .or_default()

@@ -75,7 +75,7 @@ fn a_registered_step_criterion_is_measured_judged_and_exported() {
     // The built-in criterion still measures, and the new one is judged after it.
     assert!(out.measures.contains_key("fork_tip_clearance_mm"));
     assert!(!out.success);
-    assert_eq!(out.failure, Some(Failure::Criterion("pick_travel")));
+    assert_eq!(out.failure, Some(Failure::criterion("pick_travel")));
     let detail = out.failure_detail.clone().unwrap_or_default();
     assert!(detail.contains("the forks travelled"), "{detail}");
     // Everything else is the trial without it: the criterion only observes.

@@ -123,7 +123,7 @@ fn a_crashed_planner_is_restarted_and_the_batch_goes_on() {
     run_batch(&spec(scenario("crash_once", &dir), 3), &out, 1, &|_| {}).expect("finishes");
     let mut recs = read_records(&out.join("trials.jsonl")).expect("records");
     recs.sort_by_key(|r| r.trial);
-    let failures: Vec<_> = recs.iter().map(|r| r.outcome.failure).collect();
+    let failures: Vec<_> = recs.iter().map(|r| r.outcome.failure.clone()).collect();
     assert_eq!(failures[0], Some(Failure::PlanFailed), "{recs:?}");
     assert!(
         recs[1..]

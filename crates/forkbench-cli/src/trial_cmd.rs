@@ -165,11 +165,11 @@ fn phase_lines(out: &TrialOutcome) -> Vec<String> {
     out.phases
         .iter()
         .map(|p| {
-            let verdict = match (p.success, p.failure) {
+            let verdict = match (p.success, &p.failure) {
                 (true, _) => "done".to_owned(),
                 (false, f) => format!(
                     "FAILED: {}: {}",
-                    f.map_or("unknown", |f| f.name()),
+                    f.as_ref().map_or("unknown", |f| f.name()),
                     one_line(p.failure_detail.as_deref().unwrap_or(""))
                 ),
             };

@@ -48,7 +48,7 @@ impl Phase for Creep {
             t.record_measure("load_shift_m", on_forks(t).distance_to(&before));
             if crept < self.min_distance_m {
                 return Err::<(), Failed>((
-                    Failure::Criterion("creep_distance"),
+                    Failure::criterion("creep_distance"),
                     format!("crept {crept:.3} m (at least {} m)", self.min_distance_m),
                 ));
             }
@@ -115,7 +115,7 @@ fn a_registered_phase_runs_after_the_built_in_ones_and_is_judged() {
     let strict = scenario(registry, "time_s = 2.0\nmin_distance_m = 5.0").expect("loads");
     let out = run_trial(&strict, &strict.cases[0], &seed(3));
     assert!(!out.success);
-    assert_eq!(out.failure, Some(Failure::Criterion("creep_distance")));
+    assert_eq!(out.failure, Some(Failure::criterion("creep_distance")));
     assert!(
         out.failure_detail
             .as_deref()
@@ -155,8 +155,26 @@ fn a_custom_criterion_in_a_record_reads_back() {
     let line = serde_json::to_string(&out).expect("serialises");
     assert!(line.contains(r#""failure":"creep_distance""#), "{line}");
     let back: forkbench_trial::TrialOutcome = serde_json::from_str(&line).expect("reads back");
-    assert_eq!(back.failure, Some(Failure::Criterion("creep_distance")));
+    assert_eq!(back.failure, Some(Failure::criterion("creep_distance")));
     let bad = line.replace("creep_distance", "Creep Distance!");
     let err = serde_json::from_str::<forkbench_trial::TrialOutcome>(&bad).expect_err("refused");
     assert!(err.to_string().contains("unknown failure"), "{err}");
+}
+
+/// A failure's name is owned, not interned: records may carry any number of distinct
+/// criterion names (a long-lived process reading many batches), each read back as itself
+/// and written out again unchanged.
+#[test]
+fn any_number_of_criterion_names_read_back() {
+    for i in 0..2_000 {
+        let name = format!("site_check_{i}");
+        let json = format!("\"{name}\"");
+        let f: Failure = serde_json::from_str(&json).expect("a criterion name reads back");
+        assert_eq!(f, Failure::criterion(name.clone()));
+        assert_eq!(f.name(), name);
+        assert_eq!(serde_json::to_string(&f).expect("writes"), json);
+    }
+    let long = "a".repeat(65);
+    assert!(Failure::from_name(&long).is_none(), "a name over 64 bytes");
+    assert_eq!(Failure::from_name("timeout"), Some(Failure::Timeout));
 }

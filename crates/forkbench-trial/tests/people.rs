@@ -32,7 +32,7 @@ fn without_fields_the_truck_touches_a_person_in_its_way_and_the_verdict_names_it
     let out = run_trial(&scn, &scn.cases[0], &no_noise());
     assert!(!out.success);
     assert_eq!(
-        out.failure.map(|f| f.name()),
+        out.failure.as_ref().map(|f| f.name()),
         Some("person_contact"),
         "{out:?}"
     );
@@ -51,7 +51,11 @@ fn the_sized_fields_stop_the_truck_before_a_standing_person() {
     let s = out.safety.clone().expect("a safety outcome");
     assert_eq!(s.person_contacts, 0, "{out:?}");
     // Blocked for good: the pick runs out of time in front of the person.
-    assert_eq!(out.failure.map(|f| f.name()), Some("timeout"), "{out:?}");
+    assert_eq!(
+        out.failure.as_ref().map(|f| f.name()),
+        Some("timeout"),
+        "{out:?}"
+    );
     assert!(s.monitored && s.stops >= 1 && s.false_trips == 0, "{s:?}");
     let gap = s.closest_m[0].expect("measured");
     let sizing = scn.safety_fields().expect("sized");
@@ -187,7 +191,11 @@ fn in_200_cycles_the_sized_fields_touch_nobody_and_fields_30_percent_shorter_do(
         .iter()
         .filter(|o| o.safety.as_ref().is_some_and(|s| s.person_contacts > 0))
     {
-        assert_eq!(o.failure.map(|f| f.name()), Some("person_contact"), "{o:?}");
+        assert_eq!(
+            o.failure.as_ref().map(|f| f.name()),
+            Some("person_contact"),
+            "{o:?}"
+        );
         let detail = o.failure_detail.as_deref().unwrap_or_default();
         assert!(detail.contains("the truck touched"), "{detail}");
     }
@@ -221,7 +229,7 @@ fn fields_far_shorter_than_the_formula_let_the_truck_touch_a_standing_person() {
     let short = pick(&format!("{STANDING}[safety]\nfield_length_scale = 0.1\nwarning_margin_m = 0.0\nwarning_speed_mps = 2.0\n")).expect("loads");
     let out = run_trial(&short, &short.cases[0], &no_noise());
     assert_eq!(
-        out.failure.map(|f| f.name()),
+        out.failure.as_ref().map(|f| f.name()),
         Some("person_contact"),
         "{out:?}"
     );
@@ -278,7 +286,7 @@ fn a_drawn_field_set_is_the_one_monitored_and_one_too_short_lets_the_truck_touch
     let short = pick(&format!("{STANDING}{}", drawn(0.15))).expect("loads");
     let out = run_trial(&short, &short.cases[0], &no_noise());
     assert_eq!(
-        out.failure.map(|f| f.name()),
+        out.failure.as_ref().map(|f| f.name()),
         Some("person_contact"),
         "{out:?}"
     );

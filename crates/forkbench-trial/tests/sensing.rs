@@ -138,7 +138,7 @@ fn a_failed_trial_names_every_broken_criterion_and_the_likely_cause() {
     };
     let out = run_trial(&scn, &scn.cases[0], &opts);
     assert!(!out.success, "{out:?}");
-    let first = out.failure.expect("a failure").name();
+    let first = out.failure.as_ref().expect("a failure").name();
     assert!(!out.also_failed.is_empty(), "{out:?}");
     assert!(
         out.also_failed

@@ -120,7 +120,7 @@ fn every_failure_criterion_can_trigger() {
         let scn = straight_pick(extra);
         assert_eq!(
             failure_of(&scn),
-            Some(*expected),
+            Some(expected.clone()),
             "scenario extra:\n{extra}"
         );
     }

@@ -106,7 +106,7 @@ impl Focus {
     pub(super) const ALL: [Focus; 3] = [Focus::Lateral, Focus::Heading, Focus::ContactForce];
 
     /// The plot that shows why a trial failed on `failure`, when one does.
-    pub(super) fn of(failure: Option<forkbench_trial::Failure>) -> Option<Focus> {
+    pub(super) fn of(failure: Option<&forkbench_trial::Failure>) -> Option<Focus> {
         use forkbench_trial::Failure as F;
         match failure? {
             F::LateralError | F::ForkOutsidePocket => Some(Focus::Lateral),

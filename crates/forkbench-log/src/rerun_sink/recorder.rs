@@ -56,7 +56,7 @@ fn criteria_rows(o: &TrialOutcome, tol: &Limits) -> String {
         .iter()
         .filter_map(|c| {
             let r = c.reading(o, tol)?;
-            let value = if o.broke(c.failure) {
+            let value = if o.broke(&c.failure) {
                 format!("**{}** ❌", r.value)
             } else {
                 r.value
@@ -82,9 +82,9 @@ fn phases_table(o: &TrialOutcome) -> String {
     let mut s =
         String::from("| phase | verdict | time | distance | load |\n|---|---|---|---|---|\n");
     for p in &o.phases {
-        let verdict = match (p.success, p.failure) {
+        let verdict = match (p.success, &p.failure) {
             (true, _) => "✅ done".to_owned(),
-            (false, f) => format!("❌ **{}**", f.map_or("unknown", |f| f.name())),
+            (false, f) => format!("❌ **{}**", f.as_ref().map_or("unknown", |f| f.name())),
         };
         s += &format!(
             "| {} | {verdict} | {:.1} s | {:.2} m | {} |\n",
@@ -174,7 +174,7 @@ impl RerunRecorder {
 
     /// The verdict view's text: the outcome first, then what the map's colours mean.
     fn verdict_text(&self, o: &TrialOutcome) -> String {
-        let failure = o.failure.map_or("unknown", |f| f.name());
+        let failure = o.failure.as_ref().map_or("unknown", |f| f.name());
         let head = if o.success {
             "#### ✅ SUCCESS".to_owned()
         } else {
@@ -381,7 +381,7 @@ impl Recorder for RerunRecorder {
         self.log_verdict(text);
         // A failure opens on the plot of the quantity that failed: a layout with that
         // plot first in its tabs, made the active one.
-        let focus = super::layout::Focus::of(outcome.failure);
+        let focus = super::layout::Focus::of(outcome.failure.as_ref());
         if let Some(f) = focus.filter(|f| *f != super::layout::Focus::Lateral) {
             match super::blueprint_msgs(f) {
                 Ok(msgs) => msgs.iter().for_each(|m| self.rec.record_msg(m.clone())),

@@ -219,7 +219,7 @@ pub fn failed_trials(dir: &Path, records: &[(usize, TrialRecord)]) -> String {
             batch::mode_name(r.replan == Some(true)),
             r.trial,
             o.seed,
-            o.failure.map_or("?", |f| f.name()),
+            o.failure.as_ref().map_or("?", |f| f.name()),
             esc(o.failure_detail.as_deref().unwrap_or("")),
             if links.is_empty() {
                 "–".to_owned()

@@ -2,10 +2,12 @@
 
 mod nan_as_null;
 
+use std::borrow::Cow;
+
 use serde::{Deserialize, Serialize};
 
 /// The criteria a pick can fail, in the order they are checked.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum Failure {
     /// A mission leg before the pick failed (no drivable path, a collision, or the truck
     /// did not arrive).
@@ -45,8 +47,9 @@ pub enum Failure {
     /// tolerances allow.
     PlacementError,
     /// A criterion outside the fixed ones, by its name: one that measures while the pick
-    /// drives (`STEP_CRITERIA`), or a registered phase's own.
-    Criterion(&'static str),
+    /// drives (`STEP_CRITERIA`), or a registered phase's own. Built-in names are
+    /// borrowed; names read back from records are owned.
+    Criterion(Cow<'static, str>),
 }
 
 /// Every failure with a fixed name, for reading names back.
@@ -70,50 +73,32 @@ const NAMED: [Failure; 16] = [
 ];
 
 impl Failure {
-    /// The failure a name stands for: a fixed one, a step criterion's, or another
-    /// criterion's (a registered phase's) when the name is one a criterion can have.
+    /// The failure a name stands for: a fixed one, else a criterion's (a step criterion's
+    /// or a registered phase's) when the name is one a criterion can have.
     pub fn from_name(name: &str) -> Option<Failure> {
-        NAMED
-            .iter()
-            .copied()
-            .find(|f| f.name() == name)
-            .or_else(|| crate::step_criteria::step_criterion_name(name).map(Failure::Criterion))
-            .or_else(|| criterion_name(name).map(Failure::Criterion))
+        if let Some(f) = NAMED.iter().find(|f| f.name() == name) {
+            return Some(f.clone());
+        }
+        is_criterion_name(name).then(|| Failure::Criterion(Cow::Owned(name.to_owned())))
+    }
+
+    /// The failure of the criterion called `name`.
+    pub fn criterion(name: impl Into<Cow<'static, str>>) -> Failure {
+        Failure::Criterion(name.into())
     }
 }
-
-/// Most distinct criterion names outside the code that records may carry in one process.
-const MAX_CRITERION_NAMES: usize = 256;
 
 /// The longest criterion name.
 const MAX_CRITERION_NAME_BYTES: usize = 64;
 
-/// `name` as the `&'static str` a [`Failure::Criterion`] holds: a snake-case word of at
-/// most 64 bytes, kept once per process, at most 256 of them (so what records read back
-/// can hold stays bounded).
-fn criterion_name(name: &str) -> Option<&'static str> {
-    static NAMES: std::sync::Mutex<Vec<&'static str>> = std::sync::Mutex::new(Vec::new());
-    let word = !name.is_empty()
+/// Whether `name` can be a criterion's: a snake-case word of at most 64 bytes.
+fn is_criterion_name(name: &str) -> bool {
+    !name.is_empty()
         && name.len() <= MAX_CRITERION_NAME_BYTES
         && name.starts_with(|c: char| c.is_ascii_lowercase())
         && name
             .bytes()
-            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_');
-    if !word {
-        return None;
-    }
-    let mut names = NAMES
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    if let Some(n) = names.iter().find(|n| **n == name) {
-        return Some(n);
-    }
-    if names.len() >= MAX_CRITERION_NAMES {
-        return None;
-    }
-    let kept: &'static str = Box::leak(name.to_owned().into_boxed_str());
-    names.push(kept);
-    Some(kept)
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_')
 }
 
 impl Serialize for Failure {
@@ -128,15 +113,14 @@ impl<'de> Deserialize<'de> for Failure {
         Failure::from_name(&name).ok_or_else(|| {
             serde::de::Error::custom(format!(
                 "unknown failure `{name}` (a criterion's name is a snake-case word of at most \
-                 {MAX_CRITERION_NAME_BYTES} bytes; at most {MAX_CRITERION_NAMES} others than the \
-                 built-in ones)"
+                 {MAX_CRITERION_NAME_BYTES} bytes)"
             ))
         })
     }
 }
 
 impl Failure {
-    pub fn name(self) -> &'static str {
+    pub fn name(&self) -> &str {
         match self {
             Failure::LegFailed => "leg_failed",
             Failure::PlanFailed => "plan_failed",
@@ -373,7 +357,7 @@ pub struct LegOutcome {
 impl TrialOutcome {
     /// `SUCCESS`, or `FAILED: <criterion>`: the one short form of the verdict.
     pub fn verdict_word(&self) -> String {
-        match (self.success, self.failure) {
+        match (self.success, &self.failure) {
             (true, _) => "SUCCESS".to_owned(),
             (false, Some(f)) => format!("FAILED: {}", f.name()),
             (false, None) => "FAILED".to_owned(),
@@ -383,7 +367,7 @@ impl TrialOutcome {
     /// The verdict in one line: success with the entry errors, or the failed criterion
     /// with its value and limit (the recordings' last log line).
     pub fn verdict_line(&self) -> String {
-        match (self.success, self.failure, self.failure_detail.as_deref()) {
+        match (self.success, &self.failure, self.failure_detail.as_deref()) {
             (true, ..) => format!(
                 "SUCCESS: entry {:.3} m off the pocket centre line, {:.2}° off the pallet axis; forks {:.2} m deep",
                 self.lateral_error_m.unwrap_or(f64::NAN),

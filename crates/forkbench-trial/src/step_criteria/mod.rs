@@ -59,7 +59,7 @@ pub fn step_measures() -> Vec<&'static str> {
     build_all().iter().map(|c| c.measure()).collect()
 }
 
-/// The step criterion named `name`, as the static name a `Failure` holds.
+/// The built-in step criterion named `name`, if one is.
 pub fn step_criterion_name(name: &str) -> Option<&'static str> {
     build_all().iter().map(|c| c.name()).find(|n| *n == name)
 }

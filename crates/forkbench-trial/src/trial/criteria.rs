@@ -46,7 +46,7 @@ pub struct Reading {
 /// One criterion of the pick: the failure it names, what it measures (for documents and
 /// listings), whether a breach is final, the verdict's row (from a judged outcome), and
 /// its check (the value against the limit when broken).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Criterion {
     pub failure: Failure,
     pub measures: &'static str,
@@ -73,9 +73,9 @@ impl Criterion {
 
 impl TrialOutcome {
     /// Whether the trial broke `failure`: its verdict, or one of `also_failed`.
-    pub fn broke(&self, failure: Failure) -> bool {
+    pub fn broke(&self, failure: &Failure) -> bool {
         let name = failure.name();
-        self.failure == Some(failure)
+        self.failure.as_ref() == Some(failure)
             || self
                 .also_failed
                 .iter()
@@ -212,7 +212,7 @@ pub const PICK_CRITERIA: &[Criterion] = &[
 pub(super) fn broken(j: &Judged<'_>) -> Vec<(Failure, String)> {
     PICK_CRITERIA
         .iter()
-        .filter_map(|c| (c.check)(j).map(|why| (c.failure, why)))
+        .filter_map(|c| (c.check)(j).map(|why| (c.failure.clone(), why)))
         .collect()
 }
 

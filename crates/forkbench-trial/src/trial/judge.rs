@@ -36,7 +36,7 @@ impl Trial<'_> {
                 self.verdict.out.measures.insert(c.measure().to_owned(), v);
             }
             if let Some(why) = c.broken() {
-                broken.push((Failure::Criterion(c.name()), why));
+                broken.push((Failure::criterion(c.name()), why));
             }
         }
         let mut broken = broken.into_iter();

@@ -47,7 +47,7 @@ impl<'a> Trial<'a> {
         self.verdict.out.phases.push(PhaseOutcome {
             name: PICK.to_owned(),
             success: self.verdict.out.success,
-            failure: self.verdict.out.failure,
+            failure: self.verdict.out.failure.clone(),
             failure_detail: self.verdict.out.failure_detail.clone(),
             time_s: self.world.sim.time_s() - t0,
             distance_m: self.world.travelled_m - d0,
@@ -102,7 +102,7 @@ impl<'a> Trial<'a> {
                     Level::Error,
                     &format!("phase {} failed: {}: {why}", spec.name, failure.name()),
                 );
-                (done.failure, done.failure_detail) = (Some(failure), Some(why.clone()));
+                (done.failure, done.failure_detail) = (Some(failure.clone()), Some(why.clone()));
                 self.verdict
                     .out
                     .fail(failure, format!("{}: {why}", spec.name));

@@ -250,13 +250,13 @@ impl Trial<'_> {
         let report = s.outcome();
         let out = &mut self.verdict.out;
         if let Some(why) = &report.first_contact {
-            let before = out.failure.map(|f| {
+            let before = out.failure.as_ref().map(|f| {
                 let detail = out.failure_detail.clone().unwrap_or_default();
                 format!("{}: {detail}", f.name())
             });
             out.also_failed.splice(0..0, before);
             out.fail(
-                crate::outcome::Failure::Criterion(super::PERSON_CONTACT),
+                crate::outcome::Failure::criterion(super::PERSON_CONTACT),
                 why.clone(),
             );
         }
