@@ -131,14 +131,14 @@ impl Baseline {
             ..self.clone()
         };
         let mut text =
-            serde_json::to_string_pretty(&head).map_err(|e| BatchError::Invalid(e.to_string()))?;
+            serde_json::to_string_pretty(&head).map_err(|e| BatchError::Internal(e.to_string()))?;
         if !self.trials.is_empty() {
             text.truncate(text.trim_end().len() - 1);
             text.truncate(text.trim_end().len());
             text.push_str(",\n  \"trials\": [\n");
             for (i, t) in self.trials.iter().enumerate() {
                 let line =
-                    serde_json::to_string(t).map_err(|e| BatchError::Invalid(e.to_string()))?;
+                    serde_json::to_string(t).map_err(|e| BatchError::Internal(e.to_string()))?;
                 let sep = if i + 1 < self.trials.len() { "," } else { "" };
                 text.push_str(&format!("    {line}{sep}\n"));
             }
@@ -155,7 +155,7 @@ impl Baseline {
     fn write_capped(&self, path: &Path, max_bytes: u64) -> Result<(), BatchError> {
         let text = self.to_text()?;
         if text.len() as u64 > max_bytes {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Content(format!(
                 "{}: the baseline would be {} bytes, more than the {max_bytes} that regress \
                  reads; make it from fewer trials (or shards, one baseline each)",
                 path.display(),
@@ -173,7 +173,7 @@ impl Baseline {
             message: e.to_string(),
         })?;
         b.check()
-            .map_err(|reason| BatchError::Invalid(format!("{}: {reason}", path.display())))?;
+            .map_err(|reason| BatchError::Content(format!("{}: {reason}", path.display())))?;
         Ok(b)
     }
 

@@ -13,16 +13,17 @@ pub struct Mapping {
 }
 
 impl std::str::FromStr for Mapping {
-    type Err = String;
+    type Err = forkbench_core::UnknownChoice;
 
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.split_once('=') {
             Some((from, to)) if !from.trim().is_empty() && !to.trim().is_empty() => Ok(Self {
                 from: from.trim().to_owned(),
                 to: to.trim().to_owned(),
             }),
-            _ => Err(format!(
-                "{s:?}: give CANDIDATE=SHIPPED (e.g. mypp=pure_pursuit)"
+            _ => Err(forkbench_core::UnknownChoice::new(
+                s,
+                "give CANDIDATE=SHIPPED (e.g. mypp=pure_pursuit)",
             )),
         }
     }
@@ -42,7 +43,7 @@ pub fn map_components(
     let mut seen = BTreeSet::new();
     for m in mappings {
         let refuse = |why: String| {
-            Err(BatchError::Invalid(format!(
+            Err(BatchError::Setting(format!(
                 "--as {}={}: {why}",
                 m.from, m.to
             )))

@@ -12,19 +12,19 @@ impl BatchSpec {
     /// The batch's own arguments: trials, shard, worker threads and unique names.
     pub fn check(&self, jobs: usize) -> Result<(), BatchError> {
         if self.trials == 0 {
-            return Err(BatchError::Invalid("trials: must be at least 1".into()));
+            return Err(BatchError::Setting("trials: must be at least 1".into()));
         }
         self.overrides
             .validate()
-            .map_err(|e| BatchError::Invalid(e.to_string()))?;
+            .map_err(|e| BatchError::Setting(e.to_string()))?;
         if self.shard.1 == 0 || self.shard.0 >= self.shard.1 {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Setting(format!(
                 "shard {}/{}: the index must be below the shard count",
                 self.shard.0, self.shard.1
             )));
         }
         if !(1..=MAX_JOBS).contains(&jobs) {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Setting(format!(
                 "jobs {jobs}: at least 1 and at most {MAX_JOBS} worker threads"
             )));
         }
@@ -46,7 +46,7 @@ impl BatchSpec {
         if bytes <= MAX_RECORD_BYTES {
             return Ok(());
         }
-        Err(BatchError::Invalid(format!(
+        Err(BatchError::Setting(format!(
             "trials: this batch{} would run {mine} trials, about {:.1} GB of records held in \
              memory and written; at most {} trials ({:.1} GB) per process: lower --trials or \
              split it with --shard I/N",
@@ -61,13 +61,13 @@ impl BatchSpec {
     /// with 80 % power in every row (at the default α, Holm over the rows).
     pub fn check_power(&self, drop: f64) -> Result<(), BatchError> {
         if !(drop > 0.0 && drop <= 1.0) {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Setting(format!(
                 "min_detectable_drop {drop}: must be a drop in success rate in (0, 1]"
             )));
         }
         let rows = self.row_sizes();
         let need = paired_trials_needed(drop, DEFAULT_ALPHA, rows.len()).ok_or_else(|| {
-            BatchError::Invalid(format!(
+            BatchError::Setting(format!(
                 "min_detectable_drop {drop}: no trial count up to a million is enough"
             ))
         })?;
@@ -79,7 +79,7 @@ impl BatchSpec {
         if short.is_empty() {
             return Ok(());
         }
-        Err(BatchError::Invalid(format!(
+        Err(BatchError::Setting(format!(
             "min_detectable_drop {drop}: a paired gate over {} rows (α {DEFAULT_ALPHA} Holm) \
              needs at least {need} trials per row to see that drop with 80 % power (a change \
              that only breaks trials; more when it also fixes some), and these rows have fewer: \
@@ -98,15 +98,15 @@ impl BatchSpec {
                 ..Default::default()
             };
             s.check_options(&opts)
-                .map_err(|e| BatchError::Invalid(e.to_string()))?;
+                .map_err(|e| BatchError::Setting(e.to_string()))?;
             let (planners, trackers) = self.components_of(s);
             for p in &planners {
                 s.component(forkbench_trial::Role::Planner, Some(p))
-                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
+                    .map_err(|e| BatchError::Setting(e.to_string()))?;
             }
             for t in &trackers {
                 s.component(forkbench_trial::Role::Tracker, Some(t))
-                    .map_err(|e| BatchError::Invalid(e.to_string()))?;
+                    .map_err(|e| BatchError::Setting(e.to_string()))?;
             }
         }
         Ok(())
@@ -116,7 +116,7 @@ impl BatchSpec {
     fn check_names(&self) -> Result<(), BatchError> {
         for (i, a) in self.scenarios.iter().enumerate() {
             if let Some(b) = self.scenarios[..i].iter().find(|b| b.name == a.name) {
-                return Err(BatchError::Invalid(format!(
+                return Err(BatchError::Setting(format!(
                     "scenario name {:?} is used by both {} and {}: names identify result rows \
                      and seeds, so each scenario in a batch needs its own",
                     a.name, b.file, a.file

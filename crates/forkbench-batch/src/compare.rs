@@ -135,7 +135,7 @@ fn kind_of((ra, rb): (Numbered<'_>, Numbered<'_>), a: &str, b: &str) -> Result<A
         .map(|(_, r)| r.outcome.tracker.as_str())
         .collect();
     if a == b {
-        return Err(BatchError::Invalid(format!("A and B are both {a:?}")));
+        return Err(BatchError::Setting(format!("A and B are both {a:?}")));
     }
     if planners.contains(a) && planners.contains(b) {
         Ok(Axis::Planner)
@@ -145,7 +145,7 @@ fn kind_of((ra, rb): (Numbered<'_>, Numbered<'_>), a: &str, b: &str) -> Result<A
         Ok(Axis::Mode)
     } else {
         let list = |s: &BTreeSet<&str>| s.iter().copied().collect::<Vec<_>>().join(", ");
-        Err(BatchError::Invalid(format!(
+        Err(BatchError::Setting(format!(
             "{a:?} and {b:?} are not two planners, two trackers or the two modes (plan_once, \
              replan) of this batch (planners: {}; trackers: {})",
             list(&planners),
@@ -242,7 +242,7 @@ pub fn compare_apart(
             Axis::Mode => "`--modes both`".to_owned(),
             _ => format!("`--{kind} {a} {b}`"),
         };
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Content(format!(
             "{a} and {b} share no trial at the same seed: run them in one batch ({how}) by a \
              forkbench whose seeds leave the components and the mode out"
         )));

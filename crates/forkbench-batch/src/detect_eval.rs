@@ -57,7 +57,7 @@ struct LabelFile {
 /// The labels of a JSON file `{"scans": [{"index": 0, "present": true, "face": {"x_m": …,
 /// "y_m": …, "heading_deg": …}}, …]}`, by scan index; `file` names it in errors.
 pub fn parse_labels(text: &str, file: &str) -> Result<BTreeMap<usize, Label>, BatchError> {
-    let bad = |why: String| BatchError::Invalid(format!("{file}: {why}"));
+    let bad = |why: String| BatchError::Content(format!("{file}: {why}"));
     let f: LabelFile = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
     let mut out = BTreeMap::new();
     for l in f.scans {

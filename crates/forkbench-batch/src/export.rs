@@ -92,7 +92,7 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
     }
     let bytes = w
         .into_inner()
-        .map_err(|e| BatchError::Invalid(format!("{}: {e}", path.display())))?;
+        .map_err(|e| BatchError::Internal(format!("{}: {e}", path.display())))?;
     super::write_atomic(path, &bytes)
 }
 
@@ -179,5 +179,5 @@ fn row<'a>(r: &'a TrialRecord, finite: impl Fn(f64) -> Option<f64>) -> Row<'a> {
 }
 
 fn csv_error(path: &Path, e: csv::Error) -> BatchError {
-    BatchError::Invalid(format!("{}: writing CSV: {e}", path.display()))
+    BatchError::Internal(format!("{}: writing CSV: {e}", path.display()))
 }

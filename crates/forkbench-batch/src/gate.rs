@@ -38,7 +38,7 @@ impl GateOptions {
         crate::check_alpha(self.alpha)?;
         crate::check_floor(self.floor)?;
         match self.min_detectable_drop {
-            Some(d) if !(d > 0.0 && d <= 1.0) => Err(crate::BatchError::Invalid(format!(
+            Some(d) if !(d > 0.0 && d <= 1.0) => Err(crate::BatchError::Setting(format!(
                 "min_detectable_drop {d}: must be a drop in success rate in (0, 1]"
             ))),
             _ => Ok(()),

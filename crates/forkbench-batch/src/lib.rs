@@ -120,8 +120,26 @@ pub enum BatchError {
         line: usize,
         message: String,
     },
+    /// A setting, flag or argument out of its range or malformed (trials, shard, jobs,
+    /// a gate's drop, a sweep, an event, a replay's line).
     #[error("{0}")]
-    Invalid(String),
+    Setting(String),
+    /// A batch directory not in a state the command can use: not empty and not a batch's,
+    /// another batch's results, locked by another process, a merge's inputs that do not
+    /// belong together.
+    #[error("{0}")]
+    Directory(String),
+    /// A file whose content is not what it should be: records that contradict their
+    /// manifest, over a size cap, a file of another kind.
+    #[error("{0}")]
+    Content(String),
+    /// The rare-event estimator stopped (see `forkbench_rare::RareError`).
+    #[error("{0}")]
+    Rare(String),
+    /// Something that should not fail did, before any output was written (serialising a
+    /// result, starting the thread pool).
+    #[error("{0}")]
+    Internal(String),
     #[error(transparent)]
     File(#[from] forkbench_core::files::FileError),
     /// A scenario the batch names could not be loaded or has no such case.
@@ -137,7 +155,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), BatchError> {
 /// A success rate given as a floor must lie in [0, 1].
 pub fn check_floor(floor: Option<f64>) -> Result<(), BatchError> {
     match floor {
-        Some(f) if !(0.0..=1.0).contains(&f) => Err(BatchError::Invalid(format!(
+        Some(f) if !(0.0..=1.0).contains(&f) => Err(BatchError::Setting(format!(
             "floor {f}: must be a success rate between 0 and 1"
         ))),
         _ => Ok(()),
@@ -149,7 +167,7 @@ pub fn check_alpha(alpha: f64) -> Result<(), BatchError> {
     if alpha > 0.0 && alpha < 1.0 {
         Ok(())
     } else {
-        Err(BatchError::Invalid(format!(
+        Err(BatchError::Setting(format!(
             "alpha {alpha}: must lie strictly between 0 and 1"
         )))
     }
@@ -354,7 +372,7 @@ pub fn run_batch(
     spec.check(jobs)?;
     let started = std::time::SystemTime::now();
     if dir.exists() && !dir.is_dir() {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Directory(format!(
             "{}: exists and is not a directory (the output is a directory)",
             dir.display()
         )));
@@ -386,7 +404,7 @@ pub fn run_batch(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs.max(1))
         .build()
-        .map_err(|e| BatchError::Invalid(format!("thread pool: {e}")))?;
+        .map_err(|e| BatchError::Internal(format!("thread pool: {e}")))?;
     let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
     pool.install(|| {
         // One job per task: rayon's default leaves are long runs of jobs that a thread

@@ -81,7 +81,7 @@ impl ScenarioEntry {
     /// The entry of `s`: its resolved settings (without the path) and their hash.
     pub fn of(s: &forkbench_trial::Scenario) -> Result<Self, BatchError> {
         let mut settings =
-            serde_json::to_value(s).map_err(|e| BatchError::Invalid(e.to_string()))?;
+            serde_json::to_value(s).map_err(|e| BatchError::Internal(e.to_string()))?;
         if let Some(map) = settings.as_object_mut() {
             map.remove("file");
         }
@@ -213,7 +213,7 @@ impl Manifest {
     pub fn write(&self, dir: &Path) -> Result<(), BatchError> {
         let path = dir.join(FILE);
         let text =
-            serde_json::to_string_pretty(self).map_err(|e| BatchError::Invalid(e.to_string()))?;
+            serde_json::to_string_pretty(self).map_err(|e| BatchError::Internal(e.to_string()))?;
         super::write_atomic(&path, (text + "\n").as_bytes())
     }
 
@@ -386,7 +386,7 @@ impl DirLock {
         let file = File::create(&path).map_err(io(&path))?;
         match file.try_lock() {
             Ok(()) => Ok(DirLock { _file: file, path }),
-            Err(std::fs::TryLockError::WouldBlock) => Err(BatchError::Invalid(format!(
+            Err(std::fs::TryLockError::WouldBlock) => Err(BatchError::Directory(format!(
                 "{}: another forkbench process is writing this directory (lock held on {}); \
                  wait for it to finish or choose another --out",
                 dir.display(),

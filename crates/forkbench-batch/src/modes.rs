@@ -34,16 +34,17 @@ impl ReplanModes {
 }
 
 impl std::str::FromStr for ReplanModes {
-    type Err = String;
+    type Err = forkbench_core::UnknownChoice;
 
     /// `scenario`, `replan` or `both`; the error quotes the text and names the three.
-    fn from_str(text: &str) -> Result<Self, String> {
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
         match text {
             "scenario" => Ok(Self::Scenario),
             "replan" => Ok(Self::Replan),
             "both" => Ok(Self::Both),
-            other => Err(format!(
-                "{other:?}: expected \"scenario\", \"replan\" or \"both\""
+            other => Err(forkbench_core::UnknownChoice::new(
+                other,
+                "expected \"scenario\", \"replan\" or \"both\"",
             )),
         }
     }

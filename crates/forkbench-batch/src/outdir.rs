@@ -55,7 +55,7 @@ impl BatchSpec {
             .chain(rec.exists().then_some("recordings/"))
             .collect();
         if !ours && !present.is_empty() {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Directory(format!(
                 "{}: force_new starts over only a directory a batch wrote, and this one has no \
                  manifest.json, yet holds {}; nothing was deleted: move them away or choose \
                  another output directory",
@@ -96,7 +96,7 @@ impl BatchSpec {
         match Manifest::read(dir)? {
             Some(have) => {
                 if have.build != want.build {
-                    return Err(BatchError::Invalid(format!(
+                    return Err(BatchError::Directory(format!(
                         "{}: its trials were run by {}, and this run is {}: a directory's \
                          results come from one build, so they are not resumed; start over with \
                          `batch --force-new` (`force_new=True` in Python), or choose another \
@@ -108,7 +108,7 @@ impl BatchSpec {
                 }
                 let diff = have.differences(&want);
                 if !diff.is_empty() {
-                    return Err(BatchError::Invalid(format!(
+                    return Err(BatchError::Directory(format!(
                         "{}: holds trials of a different batch ({} differences, directory → \
                          this run: {}); start over with `batch --force-new` \
                          (`force_new=True` in Python), or choose another output directory",
@@ -126,7 +126,7 @@ impl BatchSpec {
                 Ok(())
             }
             None if std::fs::metadata(&trials).is_ok_and(|m| m.len() > 0) => {
-                Err(BatchError::Invalid(format!(
+                Err(BatchError::Directory(format!(
                     "{}: has trials.jsonl but no manifest.json (written by an older forkbench, or \
                      not by forkbench), so its settings are unknown; move it away or choose \
                      another output directory",
@@ -156,7 +156,7 @@ fn refuse_foreign_dir(dir: &Path) -> Result<(), BatchError> {
         return Ok(());
     }
     others.sort();
-    Err(BatchError::Invalid(format!(
+    Err(BatchError::Directory(format!(
         "{}: is not empty ({}{}) and has no manifest.json, so no batch wrote it; a batch \
          writes into a new or empty directory, or resumes one it wrote; nothing was written \
          or deleted: choose another output directory",

@@ -65,7 +65,7 @@ pub(super) fn log_run(
     };
     let path = dir.join(RUNS_FILE);
     let line =
-        serde_json::to_string(&entry).map_err(|e| super::BatchError::Invalid(e.to_string()))?;
+        serde_json::to_string(&entry).map_err(|e| super::BatchError::Internal(e.to_string()))?;
     std::fs::OpenOptions::new()
         .create(true)
         .append(true)

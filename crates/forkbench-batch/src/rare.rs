@@ -13,7 +13,7 @@ pub use crate::rare_store::{OUT_FILES, RareStore, TRIALS_FILE};
 use crate::{BatchError, TrialRecord, trial_seed};
 
 fn unknown(name: &str) -> BatchError {
-    BatchError::Invalid(format!(
+    BatchError::Setting(format!(
         "event {name:?}: failure, contact, or a criterion's name (lateral_error, \
          heading_error, contact_force, pallet_displaced, collision, …)"
     ))
@@ -197,13 +197,13 @@ pub const MAX_RARE_TRIALS: usize = 250_000;
 /// The runner of `setup`, its options and the scenario's parameters checked first.
 fn runner(setup: &RareSetup, budget: usize) -> Result<Runner<'_>, BatchError> {
     if !(20..=MAX_RARE_TRIALS).contains(&budget) {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Setting(format!(
             "budget {budget}: from 20 to {MAX_RARE_TRIALS} trials (every trial's record is kept)"
         )));
     }
     let scn = &setup.scenario;
     if scn.uncertain.is_empty() {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Setting(format!(
             "{}: declares no [[uncertain]] parameters, so there is nothing to search or \
              weigh (docs/scenario-format.md#uncertain)",
             scn.file
@@ -219,7 +219,7 @@ fn runner(setup: &RareSetup, budget: usize) -> Result<Runner<'_>, BatchError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(setup.jobs.max(1))
         .build()
-        .map_err(|e| BatchError::Invalid(format!("thread pool: {e}")))?;
+        .map_err(|e| BatchError::Internal(format!("thread pool: {e}")))?;
     Ok(Runner {
         setup,
         case,
@@ -244,7 +244,7 @@ impl Runner<'_> {
         match (r, self.failed.take()) {
             (_, Some(e)) => Err(e),
             (Ok(v), None) => Ok((v, self.tried)),
-            (Err(e), None) => Err(BatchError::Invalid(e.to_string())),
+            (Err(e), None) => Err(BatchError::Rare(e.to_string())),
         }
     }
 }
@@ -291,7 +291,7 @@ impl RareSetup {
     pub fn settings(&self, what: serde_json::Value) -> Result<serde_json::Value, BatchError> {
         let mut scenario =
             serde_json::to_value(crate::manifest::ScenarioEntry::of(&self.scenario)?)
-                .map_err(|e| BatchError::Invalid(e.to_string()))?;
+                .map_err(|e| BatchError::Internal(e.to_string()))?;
         if let Some(m) = scenario.as_object_mut() {
             m.remove("file");
         }

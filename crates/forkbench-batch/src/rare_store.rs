@@ -39,7 +39,7 @@ impl RareStore {
         std::fs::create_dir_all(dir).map_err(io(dir))?;
         let (settings_path, path) = (dir.join(SETTINGS_FILE), dir.join(TRIALS_FILE));
         if std::fs::metadata(&settings_path).is_ok_and(|m| m.len() > MAX_SETTINGS_BYTES) {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Content(format!(
                 "{}: more than {MAX_SETTINGS_BYTES} bytes, not a run's settings",
                 settings_path.display()
             )));
@@ -47,7 +47,7 @@ impl RareStore {
         let have =
             match std::fs::read(&settings_path) {
                 Ok(b) => Some(serde_json::from_slice::<Value>(&b).map_err(|e| {
-                    BatchError::Invalid(format!("{}: {e}", settings_path.display()))
+                    BatchError::Content(format!("{}: {e}", settings_path.display()))
                 })?),
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
                 Err(e) => return Err(io(&settings_path)(e)),
@@ -58,7 +58,7 @@ impl RareStore {
             Some(h) if &h == settings => read_prior(&path)?,
             Some(h) => return Err(other_run(dir, &h, settings)),
             None if has_trials => {
-                return Err(BatchError::Invalid(format!(
+                return Err(BatchError::Directory(format!(
                     "{}: has trials.jsonl but no {SETTINGS_FILE} (written by an older \
                      forkbench), so what it ran is unknown; use --force-new or another \
                      directory",
@@ -119,7 +119,7 @@ impl RareStore {
 fn lines(trials: &[Tried]) -> Result<String, BatchError> {
     let mut text = String::new();
     for t in trials {
-        text += &serde_json::to_string(t).map_err(|e| BatchError::Invalid(e.to_string()))?;
+        text += &serde_json::to_string(t).map_err(|e| BatchError::Internal(e.to_string()))?;
         text.push('\n');
     }
     Ok(text)
@@ -137,7 +137,7 @@ fn read_prior(path: &Path) -> Result<Vec<Tried>, BatchError> {
 fn other_run(dir: &Path, have: &Value, want: &Value) -> BatchError {
     let mut diff = Vec::new();
     crate::manifest::diff_values("", have, want, &mut diff);
-    BatchError::Invalid(format!(
+    BatchError::Directory(format!(
         "{}: holds the trials of another run ({} differences, directory → this run: {}); \
          start over with --force-new, or choose another directory",
         dir.display(),

@@ -21,7 +21,7 @@ pub fn run_records(
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs)
             .build()
-            .map_err(|e| BatchError::Invalid(format!("thread pool: {e}")))?;
+            .map_err(|e| BatchError::Internal(format!("thread pool: {e}")))?;
         let records = pool.install(|| {
             todo.par_iter()
                 .with_max_len(1)

@@ -25,13 +25,13 @@ impl Replay {
     /// The trial record on line `line` (1-based) of `file`.
     pub fn read_record(file: &Path, line: usize) -> Result<TrialRecord, BatchError> {
         if line == 0 {
-            return Err(BatchError::Invalid(
+            return Err(BatchError::Setting(
                 "line 0: lines are numbered from 1".into(),
             ));
         }
         let text = crate::read_regular(file, crate::MAX_RECORDS_BYTES)?;
         let Some(raw) = text.lines().nth(line - 1) else {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Setting(format!(
                 "{}: has no line {line}",
                 file.display()
             )));
@@ -63,7 +63,7 @@ impl Replay {
             .into_iter()
             .find(|s| &s.name == name)
             .ok_or_else(|| {
-                BatchError::Invalid(format!(
+                BatchError::Setting(format!(
                     "no scenario named {name:?} among the embedded ones{where_}; pass its \
                      file with --scenario"
                 ))
@@ -110,7 +110,7 @@ fn candidates(records: &Path, name: &str) -> Result<Vec<Scenario>, BatchError> {
     }
     let file = Path::new(&entry.file);
     let named = |why: &str| {
-        BatchError::Invalid(format!(
+        BatchError::Setting(format!(
             "{}'s manifest names {} for scenario {name:?}, {why}; pass its file with --scenario",
             dir.display(),
             forkbench_trial::text::visible(&entry.file)

@@ -16,7 +16,7 @@ pub enum ShardArg {
 
 /// Parses `I/N` or `auto`.
 pub fn parse_shard(text: &str, count: Option<u64>) -> Result<ShardArg, BatchError> {
-    let bad = |why: &str| BatchError::Invalid(format!("shard {text:?}: {why}"));
+    let bad = |why: &str| BatchError::Setting(format!("shard {text:?}: {why}"));
     if text.trim() == "auto" {
         return Ok(ShardArg::Auto { count });
     }
@@ -44,7 +44,7 @@ fn var(env: &dyn Fn(&str) -> Option<String>, name: &str) -> Result<Option<u64>, 
     env(name)
         .map(|v| {
             v.trim().parse::<u64>().map_err(|_| {
-                BatchError::Invalid(format!("shard auto: {name}={v:?} is not a whole number"))
+                BatchError::Setting(format!("shard auto: {name}={v:?} is not a whole number"))
             })
         })
         .transpose()
@@ -64,7 +64,7 @@ fn slurm(
     if let Some(n) = given {
         let top = max.unwrap_or(id).max(id);
         if top >= n {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Setting(format!(
                 "shard auto: the array reaches task {top} but shard_count is {n}; number \
                  the tasks 0…{} (--array=0-{})",
                 n - 1,
@@ -76,18 +76,18 @@ fn slurm(
     let min = var(env, "SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
     let step = var(env, "SLURM_ARRAY_TASK_STEP")?.unwrap_or(1).max(1);
     let count = var(env, "SLURM_ARRAY_TASK_COUNT")?.ok_or_else(|| {
-        BatchError::Invalid(
+        BatchError::Setting(
             "shard auto: SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not".into(),
         )
     })?;
     if id < min || (id - min) % step != 0 {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Setting(format!(
             "shard auto: array task {id} is not on the range {min}, {min}+{step}, …"
         )));
     }
     let i = (id - min) / step;
     if i >= count || max.is_some_and(|m| (m - min) / step + 1 != count) {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Setting(format!(
             "shard auto: array task {id} (min {min}, step {step}, max {max:?}) does not fit \
              SLURM_ARRAY_TASK_COUNT={count}; submit a contiguous range such as --array=0-{}",
             count.saturating_sub(1)
@@ -109,14 +109,14 @@ pub fn resolve_shard(
     let from_slurm = slurm(env, count)?;
     let from_k8s = match (k8s, count) {
         (Some(_), None) => {
-            return Err(BatchError::Invalid(
+            return Err(BatchError::Setting(
                 "shard auto: JOB_COMPLETION_INDEX is set; give the Job's completions as \
                  shard_count N (Kubernetes does not export it)"
                     .into(),
             ));
         }
         (Some(i), Some(n)) if i >= n => {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Setting(format!(
                 "shard auto: JOB_COMPLETION_INDEX={i} is not below shard_count {n}"
             )));
         }
@@ -124,13 +124,13 @@ pub fn resolve_shard(
         (None, _) => None,
     };
     match (from_slurm, from_k8s) {
-        (Some(s), Some(k)) if s != k => Err(BatchError::Invalid(format!(
+        (Some(s), Some(k)) if s != k => Err(BatchError::Setting(format!(
             "shard auto: Slurm says shard {}/{} but JOB_COMPLETION_INDEX says {}/{}",
             s.0, s.1, k.0, k.1
         ))),
         (Some(s), _) => Ok(s),
         (None, Some(k)) => Ok(k),
-        (None, None) => Err(BatchError::Invalid(
+        (None, None) => Err(BatchError::Setting(
             "shard auto: no scheduler shard in the environment (SLURM_ARRAY_TASK_ID for a \
              Slurm job array, JOB_COMPLETION_INDEX for a Kubernetes Indexed Job)"
                 .into(),
@@ -169,7 +169,7 @@ pub fn merge_inputs(args: &[PathBuf]) -> Result<Vec<PathBuf>, BatchError> {
             })
             .collect();
         if found.is_empty() {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Directory(format!(
                 "{}: neither a batch directory nor a directory of shard directories",
                 a.display()
             )));

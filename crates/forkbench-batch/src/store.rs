@@ -40,7 +40,7 @@ pub(crate) fn read_jsonl<T: serde::de::DeserializeOwned>(
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((Vec::new(), false)),
         Err(e) => return Err(io(path)(e)),
         Ok(m) if !m.is_file() => {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Content(format!(
                 "{}: not a regular file",
                 path.display()
             )));
@@ -48,7 +48,7 @@ pub(crate) fn read_jsonl<T: serde::de::DeserializeOwned>(
         // Every reader of records (regress, baseline, merge, resume, replay) holds them all
         // in memory: the file's size bounds that, not its line count.
         Ok(m) if m.len() > super::MAX_RECORDS_BYTES => {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Content(format!(
                 "{}: {} bytes, more than the {} bytes of trial records read at once; shard \
                  the batch (--shard I/N) and gate the shards, or lower --trials",
                 path.display(),
@@ -138,7 +138,7 @@ pub(super) fn check_unique(records: &[TrialRecord], path: &Path) -> Result<(), B
     let mut seen = HashSet::new();
     let dups: Vec<_> = records.iter().filter(|r| !seen.insert(r.key())).collect();
     if let Some(first) = dups.first() {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Content(format!(
             "{}: {} duplicate trial records (first: {:?}); two processes wrote here at once? \
              Start over with --force-new",
             path.display(),
@@ -154,7 +154,7 @@ pub(super) fn check_unique(records: &[TrialRecord], path: &Path) -> Result<(), B
 pub(super) fn rewrite_records(path: &Path, records: &[TrialRecord]) -> Result<(), BatchError> {
     let mut text = String::new();
     for r in records {
-        text.push_str(&serde_json::to_string(r).map_err(|e| BatchError::Invalid(e.to_string()))?);
+        text.push_str(&serde_json::to_string(r).map_err(|e| BatchError::Internal(e.to_string()))?);
         text.push('\n');
     }
     super::write_atomic(path, text.as_bytes())
@@ -178,7 +178,7 @@ pub fn load_results(dir: &Path) -> Result<Summary, BatchError> {
 /// against, read once.
 pub fn load_batch(dir: &Path) -> Result<(Summary, Vec<TrialRecord>, Manifest), BatchError> {
     let m = Manifest::read(dir)?.ok_or_else(|| {
-        BatchError::Invalid(format!(
+        BatchError::Directory(format!(
             "{}: no manifest.json, so not a forkbench batch directory (or one from an older \
              version: run the batch again)",
             dir.display()
@@ -206,7 +206,7 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
     check_unique(&records, &path)?;
     let expected = m.expected_trials();
     if records.len() as u64 > expected {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Content(format!(
             "{}: holds {} trials, more than the {expected} its manifest names: records were \
              added or the manifest edited; rerun the batch into a new directory",
             dir.display(),
@@ -214,7 +214,7 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
         )));
     }
     if records.len() as u64 != expected || expected == 0 {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Directory(format!(
             "{}: holds {} of the {expected} trials its manifest names (interrupted?); \
              resume it with the batch's own arguments (its manifest.json says them)",
             dir.display(),
@@ -225,7 +225,7 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
     if let Some(keys) = m.expected_keys()
         && let Some(stray) = records.iter().find(|r| !keys.contains(&r.key()))
     {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Content(format!(
             "{}: holds a trial its manifest does not name ({}); the file was edited or \
              mixed with another batch's",
             path.display(),
@@ -241,19 +241,19 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
     let first = dirs
         .first()
-        .ok_or_else(|| BatchError::Invalid("merge needs at least one input directory".into()))?;
+        .ok_or_else(|| BatchError::Setting("merge needs at least one input directory".into()))?;
     let out_real = std::fs::canonicalize(out).ok();
     let manifests = dirs
         .iter()
         .map(|d| {
             if out_real.is_some() && std::fs::canonicalize(d).ok() == out_real {
-                return Err(BatchError::Invalid(format!(
+                return Err(BatchError::Directory(format!(
                     "{}: is both an input and the output; merge into a new directory",
                     d.display()
                 )));
             }
             Manifest::read(d)?.ok_or_else(|| {
-                BatchError::Invalid(format!(
+                BatchError::Directory(format!(
                     "{}: no manifest.json (not a batch directory?)",
                     d.display()
                 ))
@@ -266,7 +266,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
     for (d, m) in dirs.iter().zip(&manifests) {
         let diff = m0.batch_differences(m);
         if !diff.is_empty() {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Directory(format!(
                 "{} and {} are shards of different batches ({})",
                 first.display(),
                 d.display(),
@@ -274,7 +274,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
             )));
         }
         if let Some(other) = by_index.insert(m.shard[0], d) {
-            return Err(BatchError::Invalid(format!(
+            return Err(BatchError::Directory(format!(
                 "shard {}/{n} given twice: {} and {}",
                 m.shard[0],
                 other.display(),
@@ -287,7 +287,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
         .map(|i| i.to_string())
         .collect();
     if !missing.is_empty() {
-        return Err(BatchError::Invalid(format!(
+        return Err(BatchError::Directory(format!(
             "shards {} of {n} are missing",
             missing.join(", ")
         )));

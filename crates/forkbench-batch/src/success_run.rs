@@ -36,7 +36,7 @@ impl SuccessTarget {
             ("--success-reliability", reliability),
         ] {
             if !(0.5..=0.999_999).contains(&v) {
-                return Err(BatchError::Invalid(format!(
+                return Err(BatchError::Setting(format!(
                     "{flag} {v}: a probability from 0.5 to 0.999999"
                 )));
             }

@@ -377,7 +377,7 @@ pub(super) fn pure_pursuit() -> String {
 
 pub(super) fn write_summary(dir: &Path, s: &Summary) -> Result<(), BatchError> {
     let text =
-        serde_json::to_string_pretty(s).map_err(|e| BatchError::Invalid(e.to_string()))? + "\n";
+        serde_json::to_string_pretty(s).map_err(|e| BatchError::Internal(e.to_string()))? + "\n";
     super::write_atomic(&dir.join("summary.json"), text.as_bytes())?;
     super::write_atomic(&dir.join("summary.md"), s.markdown().as_bytes())
 }

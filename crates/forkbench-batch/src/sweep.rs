@@ -39,7 +39,7 @@ pub struct Sweep {
 impl Sweep {
     /// `knob=v1,v2,…` as `--sweep` takes it, every value in the knob's range.
     pub fn parse(text: &str) -> Result<Self, super::BatchError> {
-        let bad = |why: String| super::BatchError::Invalid(format!("--sweep {text:?}: {why}"));
+        let bad = |why: String| super::BatchError::Setting(format!("--sweep {text:?}: {why}"));
         let (knob, values) = text
             .split_once('=')
             .ok_or_else(|| bad("expected KNOB=V1,V2,…".into()))?;
@@ -91,7 +91,7 @@ pub fn write_sweep(
         })
         .collect();
     let json = serde_json::to_string_pretty(&results)
-        .map_err(|e| super::BatchError::Invalid(format!("serialising the sweep: {e}")))?;
+        .map_err(|e| super::BatchError::Internal(format!("serialising the sweep: {e}")))?;
     super::write_atomic(&out.join("sweep.json"), (json + "\n").as_bytes())?;
     Ok(text)
 }
@@ -101,7 +101,7 @@ pub fn read_sweep(dir: &Path) -> Result<(String, Vec<(f64, Summary)>), super::Ba
     let path = dir.join("sweep.json");
     let text = super::read_regular(&path, MAX_SWEEP_BYTES)?;
     let results: Vec<SweepResult> = serde_json::from_str(&text)
-        .map_err(|e| super::BatchError::Invalid(format!("{}: not a sweep: {e}", path.display())))?;
+        .map_err(|e| super::BatchError::Content(format!("{}: not a sweep: {e}", path.display())))?;
     let knob = results
         .first()
         .map_or_else(pallet_noise, |r| r.knob.clone());

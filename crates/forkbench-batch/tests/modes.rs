@@ -76,6 +76,8 @@ fn force_new_deletes_only_what_a_batch_wrote() {
     let spec = spec("field-test", 1, false, true);
     let e = batch::run_batch(&spec, &dir, 1, &|_| {}).expect_err("refused");
     assert!(e.to_string().contains("no manifest.json"), "{e}");
+    // The error says what failed by its type: the directory, not a setting.
+    assert!(matches!(e, batch::BatchError::Directory(_)), "{e:?}");
     assert!(
         mine.join("thesis.txt").is_file(),
         "the user's file was deleted"
@@ -88,6 +90,13 @@ fn force_new_deletes_only_what_a_batch_wrote() {
     };
     let e = batch::run_batch(&spec, &dir, 1, &|_| {}).expect_err("refused");
     assert!(e.to_string().contains("is not empty (recordings)"), "{e}");
+    assert!(matches!(e, batch::BatchError::Directory(_)), "{e:?}");
+    let zero = BatchSpec {
+        trials: 0,
+        ..spec.clone()
+    };
+    let e = batch::run_batch(&zero, &dir, 1, &|_| {}).expect_err("refused");
+    assert!(matches!(e, batch::BatchError::Setting(_)), "{e:?}");
     assert!(!dir.join("manifest.json").exists() && !dir.join("trials.jsonl").exists());
     // A batch's own directory: its recording goes, the user's file stays.
     let ours = dir.join("batch");
@@ -127,7 +136,9 @@ fn a_records_file_past_the_byte_cap_is_refused_before_reading() {
         .expect("open");
     f.set_len(batch::MAX_RECORDS_BYTES + 1).expect("sparse");
     let t0 = std::time::Instant::now();
-    let e = batch::load_results(&dir).expect_err("refused").to_string();
+    let e = batch::load_results(&dir).expect_err("refused");
+    assert!(matches!(e, batch::BatchError::Content(_)), "{e:?}");
+    let e = e.to_string();
     assert!(
         e.contains("trials.jsonl") && e.contains("read at once"),
         "{e}"

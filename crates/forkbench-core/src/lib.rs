@@ -18,6 +18,6 @@ pub mod vehicle;
 pub use pallet::PalletSpec;
 pub use path::{Path, PathMetrics, PathSample};
 pub use pose::{Pose2, PoseParseError};
-pub use settings::{Settings, SettingsError};
+pub use settings::{Settings, SettingsError, UnknownChoice};
 pub use signal::{Signal, Style};
 pub use vehicle::{ForkliftSpec, SpecError};

@@ -22,6 +22,24 @@ impl SettingsError {
     }
 }
 
+/// A word that is none of the choices a setting or flag takes, with what it takes.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{given:?}: {expected}")]
+pub struct UnknownChoice {
+    pub given: String,
+    /// What is taken instead, as a phrase (`expected "scenario", "replan" or "both"`).
+    pub expected: String,
+}
+
+impl UnknownChoice {
+    pub fn new(given: &str, expected: impl Into<String>) -> Self {
+        Self {
+            given: given.to_owned(),
+            expected: expected.into(),
+        }
+    }
+}
+
 /// Checks every `(field, value, lo, hi)`: each value finite and within `[lo, hi]`; the
 /// error names the first field outside its range, the range and the value.
 pub fn in_ranges(fields: &[(&str, f64, f64, f64)]) -> Result<(), SettingsError> {

@@ -119,9 +119,25 @@ fn field(line: &str, package: &str) -> Result<Option<Field>, String> {
     }))
 }
 
+/// Why a ROS 2 message definition or a message in it could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CdrError {
+    /// The definition text (`ros2msg`) is not one this reader understands.
+    #[error("{0}")]
+    Definition(String),
+    /// A message's bytes do not match its definition (short, nested too deeply, not
+    /// little-endian).
+    #[error("{0}")]
+    Message(String),
+}
+
 impl Schema {
     /// The schema of a channel whose messages are `name` (`pkg/msg/Type`).
-    pub fn parse(name: &str, text: &str) -> Result<Self, String> {
+    pub fn parse(name: &str, text: &str) -> Result<Self, CdrError> {
+        Self::parse_text(name, text).map_err(CdrError::Definition)
+    }
+
+    fn parse_text(name: &str, text: &str) -> Result<Self, String> {
         let root = full_name(name, "");
         let mut types = HashMap::new();
         let mut current = root.clone();
@@ -161,7 +177,11 @@ impl Schema {
     }
 
     /// A message's CDR bytes (with their encapsulation header) as JSON.
-    pub fn decode(&self, bytes: &[u8]) -> Result<Value, String> {
+    pub fn decode(&self, bytes: &[u8]) -> Result<Value, CdrError> {
+        self.decode_bytes(bytes).map_err(CdrError::Message)
+    }
+
+    fn decode_bytes(&self, bytes: &[u8]) -> Result<Value, String> {
         let body = bytes.get(4..).ok_or("shorter than the CDR header")?;
         if bytes[1] != 0x01 {
             return Err("not little-endian CDR".into());

@@ -74,12 +74,15 @@ impl CollisionModel {
 }
 
 impl std::str::FromStr for CollisionModel {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = forkbench_core::UnknownChoice;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s {
             "inflate" => Ok(Self::Inflate),
             "footprint" => Ok(Self::Footprint),
-            other => Err(format!("{other:?}: expected `inflate` or `footprint`")),
+            other => Err(forkbench_core::UnknownChoice::new(
+                other,
+                "expected `inflate` or `footprint`",
+            )),
         }
     }
 }

@@ -13,6 +13,7 @@ use super::Failed;
 use crate::outcome::LegOutcome;
 use crate::recorder::Recorder;
 use crate::tolerances::Limits;
+use crate::trial::StageError;
 
 /// What a phase's settings are checked against when the scenario loads: the world's
 /// slots, stations and fixed obstacles, the pallet, and the mission.
@@ -73,19 +74,28 @@ pub trait PhaseHost: Send {
         rec: &'s mut dyn Recorder,
         command: &'s mut Steer<'_>,
     ) -> DriveRun<'s>;
-    /// The localiser's reading now, as the controller's pose. Err: why it has none.
-    fn sense(&mut self, rec: &mut dyn Recorder) -> Result<Pose2, String>;
+    /// The localiser's reading now, as the controller's pose. Err: what stopped the
+    /// trial (a non-finite state, a wall-time budget spent).
+    fn sense(&mut self, rec: &mut dyn Recorder) -> Result<Pose2, StageError>;
     /// A plan by the scenario's pick planner from `pose` (path curvature `curvature`) to
     /// insert the forks into a pallet face at `face`.
-    fn plan_to_face(&mut self, pose: Pose2, curvature: f64, face: &Pose2) -> Result<Plan, String>;
-    /// Why the truck body swept along `path` would hit a rack or wall, if it would.
-    fn clash(&self, path: &Path) -> Option<String>;
+    /// Err: the planner refused ([`StageError::Plan`]).
+    fn plan_to_face(
+        &mut self,
+        pose: Pose2,
+        curvature: f64,
+        face: &Pose2,
+    ) -> Result<Plan, StageError>;
+    /// Where the truck body swept along `path` would hit a rack or wall, if it would
+    /// ([`StageError::Clash`]).
+    fn clash(&self, path: &Path) -> Option<StageError>;
     /// How many plans the trial has recorded after its first (to number the next).
     fn replans(&self) -> u32;
     /// Follows `path` with the scenario's tracker from now on.
     fn follow(&mut self, path: Path);
-    /// The tracker's command at the measured `pose`. Err: it failed.
-    fn tracker_command(&mut self, pose: Pose2) -> Result<Command, String>;
+    /// The tracker's command at the measured `pose`. Err: it failed
+    /// ([`StageError::Tracker`]).
+    fn tracker_command(&mut self, pose: Pose2) -> Result<Command, StageError>;
     /// The room between `footprint` at `at` and the nearest rack or wall, up to `max_m`.
     fn clearance_m(&self, footprint: &Footprint, at: &Pose2, max_m: f64) -> f64;
     /// Drives a mission leg (the mission's global planner and tracker) from where the

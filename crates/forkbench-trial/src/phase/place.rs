@@ -9,6 +9,7 @@ use super::reverse_out::back_straight;
 use super::{
     Context, Failed, Phase, PhaseHost, PhaseRun, criteria, positive_at_most, settings, stand_for,
 };
+use crate::StageError;
 use crate::footprints::pallet_footprint;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
@@ -138,10 +139,10 @@ impl Place {
         let root_goal = aim.to_world(&root_on_pallet);
         // The face a pick would aim at to end with the fork root at `root_goal`.
         let face = root_goal.to_world(&Pose2::new(truck.fork_length_m - t.insertion_m(), 0.0, 0.0));
-        let pose = t.sense(rec).map_err(|e| (Failure::Error, e))?;
+        let pose = t.sense(rec).map_err(|e| (Failure::Error, e.to_string()))?;
         let k0 = t.sim().steer_rad().tan() / truck.wheelbase_m;
         let time = t.sim().time_s();
-        let refused = |why: String| {
+        let refused = |why: StageError| {
             (
                 Failure::PlanFailed,
                 format!("to slot {:?}: {why}", self.slot),
@@ -173,7 +174,9 @@ impl Place {
         let timeout_s = self.cfg.timeout_s;
         let arrived = t
             .drive_under(timeout_s, rec, &mut |t, pose| {
-                let cmd = t.tracker_command(pose).map_err(|e| (Failure::Error, e))?;
+                let cmd = t
+                    .tracker_command(pose)
+                    .map_err(|e| (Failure::Error, e.to_string()))?;
                 Ok((!(cmd.done && t.stands())).then_some(cmd))
             })
             .await?;

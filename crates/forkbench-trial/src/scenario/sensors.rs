@@ -118,11 +118,19 @@ impl PalletSensing {
 
     /// The scanner of model `name`: this sensing's own settings for it when it has that
     /// scanner, else the model's preset; `Err` lists the models known.
-    pub fn scanner_or_preset(&self, name: &str) -> Result<ScannerConfig, String> {
+    pub fn scanner_or_preset(
+        &self,
+        name: &str,
+    ) -> Result<ScannerConfig, forkbench_core::UnknownChoice> {
         self.scanner(name)
             .cloned()
             .or_else(|| ScannerConfig::preset(name))
-            .ok_or_else(|| format!("{name:?}: unknown (known: {})", SCANNER_PRESETS.join(", ")))
+            .ok_or_else(|| {
+                forkbench_core::UnknownChoice::new(
+                    name,
+                    format!("unknown (known: {})", SCANNER_PRESETS.join(", ")),
+                )
+            })
     }
 
     /// The pocket detector's settings, when this sensing uses it or the face fit on it

@@ -44,6 +44,7 @@ use crate::scenario::{Case, Scenario};
 use state::Trial;
 
 pub use crate::scenario::APPROACH_GAP_M;
+pub use error::{LegError, StageError};
 
 /// The criterion a trial fails when the moving truck touches a person or vehicle
 /// (critical: it is the verdict whatever else the trial did).

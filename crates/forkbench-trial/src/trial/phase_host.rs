@@ -12,6 +12,7 @@ use crate::phase::{DriveRun, LegRun, PhaseHost, Steer};
 use crate::recorder::Recorder;
 use crate::scenario::mission::Waypoint;
 use crate::tolerances::Limits;
+use crate::trial::StageError;
 use crate::trial::state::Trial;
 
 impl<'a> PhaseHost for Trial<'a> {
@@ -56,19 +57,21 @@ impl<'a> PhaseHost for Trial<'a> {
         Box::pin(self.drive_phase(limit_s, rec, command))
     }
 
-    fn sense(&mut self, rec: &mut dyn Recorder) -> Result<Pose2, String> {
-        Trial::sense(self, rec)
-            .map(|(_, pose)| pose)
-            .map_err(|e| e.to_string())
+    fn sense(&mut self, rec: &mut dyn Recorder) -> Result<Pose2, StageError> {
+        Trial::sense(self, rec).map(|(_, pose)| pose)
     }
 
-    fn plan_to_face(&mut self, pose: Pose2, curvature: f64, face: &Pose2) -> Result<Plan, String> {
+    fn plan_to_face(
+        &mut self,
+        pose: Pose2,
+        curvature: f64,
+        face: &Pose2,
+    ) -> Result<Plan, StageError> {
         self.plan_from(pose, curvature, face)
-            .map_err(|e| e.to_string())
     }
 
-    fn clash(&self, path: &Path) -> Option<String> {
-        Trial::clash(self, path).map(|e| e.to_string())
+    fn clash(&self, path: &Path) -> Option<StageError> {
+        Trial::clash(self, path)
     }
 
     fn replans(&self) -> u32 {
@@ -80,8 +83,8 @@ impl<'a> PhaseHost for Trial<'a> {
         self.set_path(path);
     }
 
-    fn tracker_command(&mut self, pose: Pose2) -> Result<Command, String> {
-        Trial::tracker_command(self, pose).map_err(|e| e.to_string())
+    fn tracker_command(&mut self, pose: Pose2) -> Result<Command, StageError> {
+        Trial::tracker_command(self, pose)
     }
 
     fn clearance_m(&self, footprint: &Footprint, at: &Pose2, max_m: f64) -> f64 {
