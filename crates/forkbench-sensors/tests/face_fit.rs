@@ -188,7 +188,7 @@ fn worst(pallet: &PalletSpec, range_m: f64) -> ((f64, f64), (f64, f64), usize, u
 fn every_kind_from_every_face_is_found_where_it_stands() {
     let faces = [PalletFace::Front, PalletFace::Left];
     let mut report = Vec::new();
-    for name in PalletModel::BUILTIN {
+    for name in PalletModel::builtin_names() {
         for face in faces {
             let pallet = PalletModel::builtin(name)
                 .expect("a built-in kind")

@@ -111,7 +111,8 @@ fn bad_pallets_are_refused_naming_file_line_and_field() {
         ),
         (
             "pallet_kind = \"pallet-9000\"\n".to_owned(),
-            "pallet_kind",
+            "\"pallet-9000\": no such pallet kind (known: field-1200, sim-1000, epal-1, \
+             iso-1200x1000, gma-48x40)",
         ),
     ] {
         let e = refused(&extra);

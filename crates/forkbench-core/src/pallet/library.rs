@@ -26,18 +26,80 @@ fn block_grid(rows: [(f64, f64); 3], cols: [(f64, f64); 3]) -> Vec<PalletBlock> 
         .collect()
 }
 
-impl PalletModel {
-    /// The names [`PalletModel::builtin`] knows.
-    pub const BUILTIN: [&'static str; 3] = ["epal-1", "iso-1200x1000", "gma-48x40"];
+/// How a built-in kind is made: the papers' two-way stringer pallets as a plain spec, the
+/// standards' pallets as a model of parts entered from a face.
+#[derive(Debug, Clone, Copy)]
+pub enum PalletBuild {
+    Stringers(fn() -> super::PalletSpec),
+    Parts(fn() -> PalletModel),
+}
 
-    /// A built-in pallet kind by name.
+/// One built-in pallet kind: its name in scenario files, what it is, how it is made.
+#[derive(Debug, Clone, Copy)]
+pub struct PalletKind {
+    pub name: &'static str,
+    pub describe: &'static str,
+    pub build: PalletBuild,
+}
+
+/// Every built-in pallet kind, once: a scenario's `pallet_kind` names one of these.
+/// Adding a kind is a row here.
+pub const PALLET_KINDS: &[PalletKind] = &[
+    PalletKind {
+        name: "field-1200",
+        describe: "1.2 × 1.2 m, 0.405 m pockets, two-way stringers (the field test)",
+        build: PalletBuild::Stringers(super::PalletSpec::field_1200),
+    },
+    PalletKind {
+        name: "sim-1000",
+        describe: "1.0 × 1.0 m, 0.35 m pockets, two-way stringers (the papers' simulations)",
+        build: PalletBuild::Stringers(super::PalletSpec::sim_1000),
+    },
+    PalletKind {
+        name: "epal-1",
+        describe: "EUR/EPAL 1, 1200 × 800 mm, nine blocks, four-way",
+        build: PalletBuild::Parts(PalletModel::epal_1),
+    },
+    PalletKind {
+        name: "iso-1200x1000",
+        describe: "ISO 1200 × 1000 mm, nine blocks, four-way",
+        build: PalletBuild::Parts(PalletModel::iso_1200x1000),
+    },
+    PalletKind {
+        name: "gma-48x40",
+        describe: "GMA 48 × 40 in, three notched stringers, partial four-way",
+        build: PalletBuild::Parts(PalletModel::gma_48x40),
+    },
+];
+
+impl PalletKind {
+    /// The built-in kind `name`; refused with the known names.
+    pub fn by_name(name: &str) -> Result<&'static PalletKind, crate::UnknownChoice> {
+        PALLET_KINDS.iter().find(|k| k.name == name).ok_or_else(|| {
+            let known: Vec<_> = PALLET_KINDS.iter().map(|k| k.name).collect();
+            crate::UnknownChoice::new(
+                name,
+                format!("no such pallet kind (known: {})", known.join(", ")),
+            )
+        })
+    }
+}
+
+impl PalletModel {
+    /// A built-in kind made of parts, by name (a stringer kind has no parts model).
     pub fn builtin(name: &str) -> Option<Self> {
-        match name {
-            "epal-1" => Some(Self::epal_1()),
-            "iso-1200x1000" => Some(Self::iso_1200x1000()),
-            "gma-48x40" => Some(Self::gma_48x40()),
-            _ => None,
+        match PalletKind::by_name(name).ok()?.build {
+            PalletBuild::Parts(model) => Some(model()),
+            PalletBuild::Stringers(_) => None,
         }
+    }
+
+    /// The names of the built-in kinds made of parts, in the table's order.
+    pub fn builtin_names() -> impl Iterator<Item = &'static str> {
+        PALLET_KINDS
+            .iter()
+            .filter(|k| matches!(k.build, PalletBuild::Parts(_)))
+            .map(|k| k.name)
     }
 
     /// EUR/EPAL 1 (EN 13698-1): 1200 × 800 mm, nine blocks, four-way. The front is the
@@ -150,7 +212,7 @@ mod tests {
 
     #[test]
     fn every_face_of_every_builtin_is_a_pallet() {
-        for name in PalletModel::BUILTIN {
+        for name in PalletModel::builtin_names() {
             let m = PalletModel::builtin(name).expect("built in");
             for face in ALL_FACES {
                 let p = m.entered_from(face).expect("a valid pallet");

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::Pose2;
 
+pub use library::{PALLET_KINDS, PalletBuild, PalletKind};
 pub use model::{PalletFace, PalletModel, PalletNotch};
 
 /// One solid part of a pallet where the scan plane cuts it (a stringer, a block, or a

@@ -22,35 +22,44 @@ pub enum PalletPlacement {
     Pose(PoseDeg),
 }
 
-/// Which pallet.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum PalletKind {
-    /// 1.2 × 1.2 m, 0.405 m pockets (the field test).
-    #[serde(rename = "field-1200")]
-    Field1200,
-    /// 1.0 × 1.0 m (the papers' simulations).
-    #[serde(rename = "sim-1000")]
-    Sim1000,
-    /// EUR/EPAL 1, 1200 × 800 mm, nine blocks, four-way.
-    #[serde(rename = "epal-1")]
-    Epal1,
-    /// ISO 1200 × 1000 mm, nine blocks, four-way.
-    #[serde(rename = "iso-1200x1000")]
-    Iso1200x1000,
-    /// GMA 48 × 40 in, three notched stringers, partial four-way.
-    #[serde(rename = "gma-48x40")]
-    Gma48x40,
-}
+/// Which built-in pallet: a row of [`forkbench_core::pallet::PALLET_KINDS`], by its name.
+#[derive(Debug, Clone, Copy)]
+pub struct PalletKind(pub &'static forkbench_core::pallet::PalletKind);
 
 impl PalletKind {
+    /// The default kind (the field test's pallet).
+    pub fn field_1200() -> Self {
+        Self::by_name("field-1200").expect("field-1200 is a built-in kind")
+    }
+
+    /// The built-in kind `name`; refused with the known names.
+    pub fn by_name(name: &str) -> Result<Self, forkbench_core::UnknownChoice> {
+        forkbench_core::pallet::PalletKind::by_name(name).map(Self)
+    }
+
     pub fn name(self) -> &'static str {
-        match self {
-            Self::Field1200 => "field-1200",
-            Self::Sim1000 => "sim-1000",
-            Self::Epal1 => "epal-1",
-            Self::Iso1200x1000 => "iso-1200x1000",
-            Self::Gma48x40 => "gma-48x40",
-        }
+        self.0.name
+    }
+}
+
+impl PartialEq for PalletKind {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
+    }
+}
+
+impl Eq for PalletKind {}
+
+impl Serialize for PalletKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for PalletKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        Self::by_name(&name).map_err(serde::de::Error::custom)
     }
 }
 

@@ -1,7 +1,7 @@
 //! The scenario's pallet: a built-in kind or a `[pallet_model]`, entered from one face.
 
 use forkbench_core::PalletSpec;
-use forkbench_core::pallet::{PalletFace, PalletModel};
+use forkbench_core::pallet::{PalletBuild, PalletFace};
 
 use super::checks::at_line;
 use super::file::{PalletKind, ScenarioFile};
@@ -24,11 +24,13 @@ pub(super) fn resolve(
         }
         (Some(m), None) => (m.clone(), format!("pallet_model {}", m.name)),
         (None, kind) => {
-            let kind = kind.unwrap_or(PalletKind::Field1200);
+            let kind = kind.unwrap_or_else(PalletKind::field_1200);
             let label = format!("pallet_kind {}", kind.name());
-            match PalletModel::builtin(kind.name()) {
-                Some(m) => (m, label),
-                None => return stringer_kind(f, kind, face, label, (file, text)),
+            match kind.0.build {
+                PalletBuild::Parts(model) => (model(), label),
+                PalletBuild::Stringers(spec) => {
+                    return stringer_kind(f, spec(), face, label, (file, text));
+                }
             }
         }
     };
@@ -55,7 +57,7 @@ pub(super) fn resolve(
 /// (the same by symmetry).
 fn stringer_kind(
     f: &ScenarioFile,
-    kind: PalletKind,
+    spec: PalletSpec,
     face: PalletFace,
     label: String,
     (file, text): (&str, &str),
@@ -70,10 +72,6 @@ fn stringer_kind(
             ),
         ));
     }
-    let spec = match kind {
-        PalletKind::Sim1000 => PalletSpec::sim_1000(),
-        _ => PalletSpec::field_1200(),
-    };
     let label = format!("{label}, {} face", face.name());
     Ok((spec.with_payload(f.payload_kg), label))
 }
