@@ -14,6 +14,7 @@ mod outputs;
 mod papercuts;
 mod rare;
 mod ros2;
+mod run_options;
 mod scenario_fuzz;
 mod shards;
 mod success_run;

@@ -13,6 +13,7 @@ from typing import Any
 
 from ._forkbench import (
     OBSERVATION_FIELDS,
+    RUN_OPTIONS,
     STAGE_FIELD,
     BatchError,
     PickEnv,
@@ -32,6 +33,7 @@ from ._forkbench import (
 
 __all__ = [
     "OBSERVATION_FIELDS",
+    "RUN_OPTIONS",
     "STAGE_FIELD",
     "BatchError",
     "PickEnv",

@@ -7,11 +7,25 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from typing_extensions import TypeAlias
+from typing_extensions import TypeAlias, TypedDict, Unpack
 
 __version__: str
 OBSERVATION_FIELDS: list[str]
+RUN_OPTIONS: list[str]
 STAGE_FIELD: str
+
+class RunOptions(TypedDict, total=False):
+    """A run's options, each a keyword of `run_trial`, `run_batch`, `estimate`,
+    `falsify` and the environments (the names are `RUN_OPTIONS`, the CLI's flags)."""
+
+    pallet_noise_scale: float | None
+    localization_noise_scale: float | None
+    odometry_noise_scale: float | None
+    localizer: str | None
+    pallet_sensing: str | None
+    missing_reflectors: Sequence[str] | None
+    truck_preset: str | None
+    truck: Mapping[str, float] | None
 
 Outcome: TypeAlias = dict[str, Any]
 """A judged trial: the CLI's `trial --json` record (a batch's also has `trial`, `replan`)."""
@@ -71,17 +85,10 @@ def run_trial(
     planner: str | None = None,
     tracker: str | None = None,
     noise: bool = True,
-    pallet_noise_scale: float | None = None,
-    localization_noise_scale: float | None = None,
-    odometry_noise_scale: float | None = None,
-    pallet_sensing: str | None = None,
-    localizer: str | None = None,
-    missing_reflectors: Sequence[str] | None = None,
     replan: bool | None = None,
     mcap: str | os.PathLike[str] | None = None,
     force: bool = False,
-    truck_preset: str | None = None,
-    truck: Mapping[str, float] | None = None,
+    **options: Unpack[RunOptions],
 ) -> Outcome: ...
 def run_batch(
     scenarios: Sequence[Scenario] | None = None,
@@ -91,14 +98,10 @@ def run_batch(
     planners: Sequence[str] | None = None,
     trackers: Sequence[str] | None = None,
     modes: str | None = None,
-    pallet_noise_scale: float | None = None,
-    localization_noise_scale: float | None = None,
-    odometry_noise_scale: float | None = None,
     jobs: int | None = None,
     out: str | os.PathLike[str] | None = None,
     force_new: bool = False,
-    truck_preset: str | None = None,
-    truck: Mapping[str, float] | None = None,
+    **options: Unpack[RunOptions],
 ) -> list[Outcome]: ...
 def estimate(
     scenario: Scenario,
@@ -111,6 +114,7 @@ def estimate(
     jobs: int | None = None,
     planner: str | None = None,
     tracker: str | None = None,
+    **options: Unpack[RunOptions],
 ) -> dict[str, Any]: ...
 def falsify(
     scenario: Scenario,
@@ -123,6 +127,7 @@ def falsify(
     jobs: int | None = None,
     planner: str | None = None,
     tracker: str | None = None,
+    **options: Unpack[RunOptions],
 ) -> dict[str, Any]: ...
 def report(
     dir: str | os.PathLike[str],
@@ -159,6 +164,7 @@ class PickEnv:
         render_size: tuple[int, int] | None = None,
         episode: str = "pick",
         phase_reward: float | None = None,
+        **options: Unpack[RunOptions],
     ) -> None: ...
     @property
     def observation_size(self) -> int: ...
@@ -188,6 +194,7 @@ class PickVecEnv:
         threads: int | None = None,
         episode: str = "pick",
         phase_reward: float | None = None,
+        **options: Unpack[RunOptions],
     ) -> None: ...
     @property
     def num_envs(self) -> int: ...

@@ -70,13 +70,18 @@ from __future__ import annotations
 import os
 import threading
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gymnasium
 import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
+
+if TYPE_CHECKING:
+    from typing_extensions import Unpack
+
+    from ._forkbench import RunOptions
 
 from . import _forkbench
 from ._forkbench import Scenario
@@ -194,7 +199,9 @@ class PalletPickEnv(gymnasium.Env):
     ``scenario``: a `Scenario`, an embedded scenario's name or a scenario file;
     ``case``: a fixed case (default: each episode draws one); ``planner``, ``tracker``,
     ``noise``, ``replan``: as for `run_trial` (the tracker drives `expert_step` and the
-    residual mode).
+    residual mode). Further keywords are the run's options (``forkbench.RUN_OPTIONS``:
+    noise scales, sensing models, missing reflectors, the truck's actuators), as for
+    `run_trial`.
     """
 
     # Gymnasium declares metadata per instance; a class attribute is its convention.
@@ -220,6 +227,7 @@ class PalletPickEnv(gymnasium.Env):
         residual_limits: Sequence[float] = (0.3, 0.3),
         episode: str = "pick",
         phase_reward: float | None = None,
+        **options: Unpack[RunOptions],
     ) -> None:
         modes = _render_modes()
         if render_mode is not None and render_mode not in modes:
@@ -247,6 +255,7 @@ class PalletPickEnv(gymnasium.Env):
             render_size=None if render_mode is None else _render_size(render_size),
             episode=episode,
             phase_reward=phase_reward,
+            **options,
         )
         # After the core has checked ticks_per_step (at least 1).
         self.metadata = {"render_modes": modes, "render_fps": 100 / ticks_per_step}
@@ -370,6 +379,7 @@ class PalletPickVectorEnv(VectorEnv):
         residual_limits: Sequence[float] = (0.3, 0.3),
         episode: str = "pick",
         phase_reward: float | None = None,
+        **options: Unpack[RunOptions],
     ) -> None:
         self.scenario = _scenario(scenario)
         self._actions = _Actions(self.scenario, action_mode, normalize_actions, residual_limits)
@@ -389,6 +399,7 @@ class PalletPickVectorEnv(VectorEnv):
             threads=threads,
             episode=episode,
             phase_reward=phase_reward,
+            **options,
         )
         self.num_envs = num_envs
         self.single_observation_space, self.single_action_space = _spaces(

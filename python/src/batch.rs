@@ -1,27 +1,23 @@
 //! `run_trial` and `run_batch`: one trial (optionally recorded to MCAP) or a parallel batch, with the CLI's seeds and outcomes, as Python dicts.
 
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use forkbench_batch::{BatchSpec, ReplanModes};
 use forkbench_trial::TrialOptions;
-use forkbench_trial::trial::Overrides;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::convert::{BatchError, RecordingError, scenario_error, serde_to_py};
 use crate::scenario::Scenario;
 
 /// Runs one case of `scenario` to its judged outcome (a dict: the CLI's `trial --json`).
 /// `case` may be omitted when the scenario has one case. `mcap` records the trial to
-/// that file (Foxglove schemas; .rrd recordings come from the CLI). `truck_preset`
-/// (`ideal`, `realistic`) and `truck` (settings by dotted path, `steering.dead_time_s`)
-/// change the truck's actuators and timing, as the CLI's `--truck`.
+/// that file (Foxglove schemas; .rrd recordings come from the CLI). Further keywords are
+/// the run's options (`RUN_OPTIONS`: noise scales, sensing models, missing reflectors,
+/// `truck_preset` and `truck` settings by dotted path), as the CLI's flags.
 #[pyfunction]
 #[pyo3(signature = (scenario, case=None, *, seed=None, planner=None, tracker=None,
-                    noise=true, pallet_noise_scale=None, localization_noise_scale=None,
-                    odometry_noise_scale=None, pallet_sensing=None, localizer=None,
-                    missing_reflectors=None, replan=None, mcap=None, force=false,
-                    truck_preset=None, truck=None))]
+                    noise=true, replan=None, mcap=None, force=false, **options))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_trial<'py>(
     py: Python<'py>,
@@ -31,17 +27,10 @@ pub fn run_trial<'py>(
     planner: Option<String>,
     tracker: Option<String>,
     noise: bool,
-    pallet_noise_scale: Option<f64>,
-    localization_noise_scale: Option<f64>,
-    odometry_noise_scale: Option<f64>,
-    pallet_sensing: Option<String>,
-    localizer: Option<String>,
-    missing_reflectors: Option<Vec<String>>,
     replan: Option<bool>,
     mcap: Option<PathBuf>,
     force: bool,
-    truck_preset: Option<String>,
-    truck: Option<BTreeMap<String, f64>>,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let scn = &scenario.inner;
     let case = scn.pick_case(case).map_err(|e| scenario_error(py, &e))?;
@@ -51,16 +40,7 @@ pub fn run_trial<'py>(
         tracker,
         no_noise: !noise,
         replan,
-        overrides: Overrides {
-            pallet_noise_scale,
-            localization_noise_scale,
-            odometry_noise_scale,
-            localizer,
-            pallet_sensing,
-            missing_reflectors,
-            truck_preset,
-            truck: truck.unwrap_or_default(),
-        },
+        overrides: crate::options::overrides(py, options)?,
         wall_budget_s: None,
         uncertain: Default::default(),
     };
@@ -121,9 +101,7 @@ fn records_bytes(spec: &BatchSpec) -> u64 {
 /// starts that directory over (a batch's own files only), as the CLI's `--force-new`.
 #[pyfunction]
 #[pyo3(signature = (scenarios=None, *, trials=20, seed=1, planners=None, trackers=None,
-                    modes=None, pallet_noise_scale=None, localization_noise_scale=None,
-                    odometry_noise_scale=None, jobs=None, out=None, force_new=false,
-                    truck_preset=None, truck=None))]
+                    modes=None, jobs=None, out=None, force_new=false, **options))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_batch<'py>(
     py: Python<'py>,
@@ -133,15 +111,12 @@ pub fn run_batch<'py>(
     planners: Option<Vec<String>>,
     trackers: Option<Vec<String>>,
     modes: Option<&str>,
-    pallet_noise_scale: Option<f64>,
-    localization_noise_scale: Option<f64>,
-    odometry_noise_scale: Option<f64>,
     jobs: Option<usize>,
     out: Option<PathBuf>,
     force_new: bool,
-    truck_preset: Option<String>,
-    truck: Option<BTreeMap<String, f64>>,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let overrides = crate::options::overrides(py, options)?;
     let embedded = scenarios.is_none();
     let scenarios = match scenarios {
         Some(s) => s.iter().map(|s| (*s.inner).clone()).collect(),
@@ -162,14 +137,7 @@ pub fn run_batch<'py>(
         trials,
         seed,
         shard: (0, 1),
-        overrides: Overrides {
-            pallet_noise_scale,
-            localization_noise_scale,
-            odometry_noise_scale,
-            truck_preset,
-            truck: truck.unwrap_or_default(),
-            ..Overrides::default()
-        },
+        overrides,
         replan,
         compare_replanning,
         force_new,

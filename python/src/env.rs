@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use forkbench_trial::trial::{Control, Episode, Session, SessionEnd, Stage};
+use forkbench_trial::trial::{Control, Episode, Overrides, Session, SessionEnd, Stage};
 use forkbench_trial::{Scenario as Inner, TrialError, TrialOptions};
 use numpy::{IntoPyArray, PyArray1, PyArray3};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -181,7 +181,7 @@ pub(crate) fn setup(
     path_points: usize,
     path_spacing_m: f64,
     reward: (f64, f64, f64, f64),
-    (episode, phase_reward): (&str, Option<f64>),
+    (episode, phase_reward, overrides): (&str, Option<f64>, Overrides),
 ) -> PyResult<Setup> {
     let scn = scenario.inner.clone();
     if let Some(c) = &case {
@@ -192,9 +192,12 @@ pub(crate) fn setup(
         tracker,
         no_noise: !noise,
         replan,
+        overrides,
         ..TrialOptions::default()
     };
-    scn.resolve(&opts).map_err(|e| scenario_error(py, &e))?;
+    // The run's own check: values in range, and every option acting on this scenario.
+    scn.check_options(&opts)
+        .map_err(|e| scenario_error(py, &e))?;
     if ticks_per_step == 0 || !(path_spacing_m.is_finite() && path_spacing_m > 0.0) {
         return Err(PyValueError::new_err(
             "ticks_per_step must be at least 1 and path_spacing_m a positive length",
@@ -314,7 +317,7 @@ impl PickEnv {
     #[pyo3(signature = (scenario, *, case=None, planner=None, tracker=None, noise=true,
                         replan=None, ticks_per_step=1, path_points=0, path_spacing_m=0.5,
                         reward=(10.0, 10.0, 0.1, 1.0), render_size=None, episode="pick",
-                        phase_reward=None))]
+                        phase_reward=None, **options))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -331,7 +334,9 @@ impl PickEnv {
         render_size: Option<(u32, u32)>,
         episode: &str,
         phase_reward: Option<f64>,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let overrides = crate::options::overrides(py, options)?;
         let mut setup = setup(
             py,
             scenario,
@@ -344,7 +349,7 @@ impl PickEnv {
             path_points,
             path_spacing_m,
             reward,
-            (episode, phase_reward),
+            (episode, phase_reward, overrides),
         )?;
         if let Some((w, h)) = render_size {
             let (lo, hi) = RENDER_PX;

@@ -4,6 +4,7 @@ mod batch;
 mod convert;
 mod env;
 mod obs;
+mod options;
 mod rare;
 mod render;
 mod report;
@@ -31,6 +32,10 @@ fn _forkbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(report::replay, m)?)?;
     m.add("OBSERVATION_FIELDS", obs::FIELDS.to_vec())?;
+    m.add(
+        "RUN_OPTIONS",
+        forkbench_trial::trial::Overrides::field_names().to_vec(),
+    )?;
     m.add("STAGE_FIELD", obs::STAGE_FIELD)?;
     Ok(())
 }

@@ -3,6 +3,7 @@
 use forkbench_batch::rare::{Event, RareSetup};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::convert::{BatchError, scenario_error, serde_to_py};
 use crate::scenario::Scenario;
@@ -13,7 +14,9 @@ fn setup(
     case: Option<&str>,
     (planner, tracker): (Option<String>, Option<String>),
     (event, seed, jobs): (&str, u64, Option<usize>),
+    options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<RareSetup> {
+    let overrides = crate::options::overrides(py, options)?;
     let scn = scenario.inner.as_ref().clone();
     let case = scn
         .pick_case(case)
@@ -27,7 +30,7 @@ fn setup(
         case,
         planner,
         tracker,
-        overrides: Default::default(),
+        overrides,
         seed,
         event,
         jobs,
@@ -40,7 +43,7 @@ fn setup(
 /// `stages`; and `records`, every trial's record with its standard-normal point `z`.
 #[pyfunction]
 #[pyo3(signature = (scenario, case=None, *, event="failure", method="ce", budget=2000,
-                    seed=1, jobs=None, planner=None, tracker=None))]
+                    seed=1, jobs=None, planner=None, tracker=None, **options))]
 #[allow(clippy::too_many_arguments)]
 pub fn estimate<'py>(
     py: Python<'py>,
@@ -53,6 +56,7 @@ pub fn estimate<'py>(
     jobs: Option<usize>,
     planner: Option<String>,
     tracker: Option<String>,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let method = match method {
         "ce" => forkbench_rare::Method::Ce,
@@ -63,7 +67,14 @@ pub fn estimate<'py>(
             )));
         }
     };
-    let s = setup(py, scenario, case, (planner, tracker), (event, seed, jobs))?;
+    let s = setup(
+        py,
+        scenario,
+        case,
+        (planner, tracker),
+        (event, seed, jobs),
+        options,
+    )?;
     let (e, tried) = py
         .detach(|| forkbench_batch::rare::estimate(&s, method, budget, None))
         .map_err(|e| BatchError::new_err(e.to_string()))?;
@@ -78,7 +89,7 @@ pub fn estimate<'py>(
 /// None), `trials`, `events`, `stages`, and `records`.
 #[pyfunction]
 #[pyo3(signature = (scenario, case=None, *, event="failure", budget=2000, seed=1,
-                    monte_carlo=false, jobs=None, planner=None, tracker=None))]
+                    monte_carlo=false, jobs=None, planner=None, tracker=None, **options))]
 #[allow(clippy::too_many_arguments)]
 pub fn falsify<'py>(
     py: Python<'py>,
@@ -91,8 +102,16 @@ pub fn falsify<'py>(
     jobs: Option<usize>,
     planner: Option<String>,
     tracker: Option<String>,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let s = setup(py, scenario, case, (planner, tracker), (event, seed, jobs))?;
+    let s = setup(
+        py,
+        scenario,
+        case,
+        (planner, tracker),
+        (event, seed, jobs),
+        options,
+    )?;
     let (f, tried) = py
         .detach(|| forkbench_batch::rare::falsify(&s, budget, monte_carlo, None))
         .map_err(|e| BatchError::new_err(e.to_string()))?;

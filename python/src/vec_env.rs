@@ -104,7 +104,7 @@ impl PickVecEnv {
     #[pyo3(signature = (scenario, num_envs, *, case=None, planner=None, tracker=None,
                         noise=true, replan=None, ticks_per_step=1, path_points=0,
                         path_spacing_m=0.5, reward=(10.0, 10.0, 0.1, 1.0), threads=None,
-                        episode="pick", phase_reward=None))]
+                        episode="pick", phase_reward=None, **options))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -122,7 +122,9 @@ impl PickVecEnv {
         threads: Option<usize>,
         episode: &str,
         phase_reward: Option<f64>,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let overrides = crate::options::overrides(py, options)?;
         let bytes = (num_envs as u64).saturating_mul(env_bytes(&scenario.inner));
         if num_envs == 0 || bytes > MAX_ENVS_BYTES {
             return Err(PyValueError::new_err(format!(
@@ -145,7 +147,7 @@ impl PickVecEnv {
             path_points,
             path_spacing_m,
             reward,
-            (episode, phase_reward),
+            (episode, phase_reward, overrides),
         )?;
         let threads =
             threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));

@@ -6,10 +6,11 @@ use serde::Serialize;
 
 use super::{BatchError, TrialRecord};
 use forkbench_trial::text::csv_text;
+use forkbench_trial::trial::Overrides;
 
-/// One CSV row (column names carry their units).
+/// A CSV row's first columns: the trial's identity.
 #[derive(Debug, Serialize)]
-struct Row<'a> {
+struct Head {
     scenario: String,
     case: String,
     planner: String,
@@ -18,9 +19,11 @@ struct Row<'a> {
     seed: u64,
     noise: bool,
     replan: Option<bool>,
-    pallet_noise_scale: Option<f64>,
-    localization_noise_scale: Option<f64>,
-    odometry_noise_scale: Option<f64>,
+}
+
+/// The rest of a CSV row, after the run's options (column names carry their units).
+#[derive(Debug, Serialize)]
+struct Row<'a> {
     success: bool,
     failure: &'a str,
     failure_detail: String,
@@ -70,7 +73,8 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
     let finite = |v: f64| v.is_finite().then_some(v);
     for r in sorted {
         let o = &r.outcome;
-        let (header, mut record) = fields(&row(r, finite)).map_err(|e| csv_error(path, e))?;
+        let (header, record) = cells(r, finite).map_err(|e| csv_error(path, e))?;
+        let mut record = record;
         if !header_written {
             let mut h = header;
             h.extend(measures.iter().copied());
@@ -123,8 +127,58 @@ fn safety_cells(s: Option<&forkbench_trial::SafetyOutcome>) -> [String; 7] {
     ]
 }
 
+/// A trial's column names and cells before the measures: its identity, the run's options
+/// (one column per field of [`Overrides`], by its name), then its outcome.
+fn cells(
+    r: &TrialRecord,
+    finite: impl Fn(f64) -> Option<f64>,
+) -> Result<(csv::StringRecord, csv::StringRecord), csv::Error> {
+    let o = &r.outcome;
+    let head = Head {
+        scenario: csv_text(&o.scenario),
+        case: csv_text(&o.case),
+        planner: csv_text(&o.planner),
+        tracker: csv_text(&o.tracker),
+        trial: r.trial,
+        seed: o.seed,
+        noise: o.noise,
+        replan: r.replan,
+    };
+    let (mut header, mut record) = fields(&head)?;
+    let options = serde_json::to_value(&r.overrides).unwrap_or_default();
+    for name in Overrides::field_names() {
+        header.push_field(name);
+        record.push_field(&option_cell(options.get(name)));
+    }
+    let (h, rest) = fields(&row(r, finite))?;
+    header.extend(h.iter());
+    record.extend(rest.iter());
+    Ok((header, record))
+}
+
+/// One option's cell: empty when unset; a list joined by `;`, settings as `key=value;…`.
+fn option_cell(v: Option<&serde_json::Value>) -> String {
+    use serde_json::Value;
+    match v {
+        None | Some(Value::Null) => String::new(),
+        Some(Value::String(s)) => csv_text(s),
+        Some(Value::Array(items)) => {
+            let parts: Vec<String> = items.iter().map(|i| option_cell(Some(i))).collect();
+            parts.join(";")
+        }
+        Some(Value::Object(map)) => {
+            let parts: Vec<String> = map
+                .iter()
+                .map(|(k, v)| format!("{}={}", csv_text(k), option_cell(Some(v))))
+                .collect();
+            parts.join(";")
+        }
+        Some(other) => other.to_string(),
+    }
+}
+
 /// A row's column names and values, as csv writes them.
-fn fields(row: &Row<'_>) -> Result<(csv::StringRecord, csv::StringRecord), csv::Error> {
+fn fields<T: Serialize>(row: &T) -> Result<(csv::StringRecord, csv::StringRecord), csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.serialize(row)?;
     let bytes = w.into_inner().map_err(|e| e.into_error())?;
@@ -137,17 +191,6 @@ fn fields(row: &Row<'_>) -> Result<(csv::StringRecord, csv::StringRecord), csv::
 fn row<'a>(r: &'a TrialRecord, finite: impl Fn(f64) -> Option<f64>) -> Row<'a> {
     let o = &r.outcome;
     Row {
-        scenario: csv_text(&o.scenario),
-        case: csv_text(&o.case),
-        planner: csv_text(&o.planner),
-        tracker: csv_text(&o.tracker),
-        trial: r.trial,
-        seed: o.seed,
-        noise: o.noise,
-        replan: r.replan,
-        pallet_noise_scale: r.overrides.pallet_noise_scale,
-        localization_noise_scale: r.overrides.localization_noise_scale,
-        odometry_noise_scale: r.overrides.odometry_noise_scale,
         success: o.success,
         failure: o.failure.as_ref().map_or("", |f| f.name()),
         failure_detail: csv_text(o.failure_detail.as_deref().unwrap_or("")),

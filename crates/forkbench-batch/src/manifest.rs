@@ -32,23 +32,11 @@ pub struct Manifest {
     /// Trackers every case ran with; empty = each scenario's own.
     #[serde(default)]
     pub trackers: Vec<String>,
-    pub pallet_noise_scale: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub localization_noise_scale: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub odometry_noise_scale: Option<f64>,
-    /// Sensing models every scenario ran with instead of its own.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub localizer: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pallet_sensing: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub missing_reflectors: Option<Vec<String>>,
-    /// The truck's actuators and timing every scenario ran with: a preset, then settings.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub truck_preset: Option<String>,
-    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
-    pub truck: std::collections::BTreeMap<String, f64>,
+    /// What the run changed of each scenario (noise scales, sensing models, the truck's
+    /// actuators), under the options' own names: the one definition
+    /// ([`forkbench_trial::trial::Overrides`]), not a copy.
+    #[serde(flatten)]
+    pub overrides: forkbench_trial::trial::Overrides,
     pub replan: Option<bool>,
     /// Every trial run planning once and replanning.
     #[serde(default)]
@@ -164,14 +152,7 @@ impl Manifest {
             shard: [spec.shard.0, spec.shard.1],
             planners: spec.planners.clone(),
             trackers: spec.trackers.clone(),
-            pallet_noise_scale: spec.overrides.pallet_noise_scale,
-            localization_noise_scale: spec.overrides.localization_noise_scale,
-            odometry_noise_scale: spec.overrides.odometry_noise_scale,
-            localizer: spec.overrides.localizer.clone(),
-            pallet_sensing: spec.overrides.pallet_sensing.clone(),
-            missing_reflectors: spec.overrides.missing_reflectors.clone(),
-            truck_preset: spec.overrides.truck_preset.clone(),
-            truck: spec.overrides.truck.clone(),
+            overrides: spec.overrides.clone(),
             replan: spec.replan,
             compare_replanning: spec.compare_replanning,
             success_run: spec.success_run,
@@ -181,16 +162,7 @@ impl Manifest {
 
     /// The overrides its trials ran with.
     pub fn overrides(&self) -> forkbench_trial::trial::Overrides {
-        forkbench_trial::trial::Overrides {
-            pallet_noise_scale: self.pallet_noise_scale,
-            localization_noise_scale: self.localization_noise_scale,
-            odometry_noise_scale: self.odometry_noise_scale,
-            localizer: self.localizer.clone(),
-            pallet_sensing: self.pallet_sensing.clone(),
-            missing_reflectors: self.missing_reflectors.clone(),
-            truck_preset: self.truck_preset.clone(),
-            truck: self.truck.clone(),
-        }
+        self.overrides.clone()
     }
 
     /// The manifest in `dir`, if there is one.
@@ -419,5 +391,54 @@ mod tests {
             "the forkbench built from commit 0123456789ab"
         );
         assert!(build_name(None).contains("recorded no commit"));
+    }
+}
+
+#[cfg(test)]
+mod flatten_tests {
+    use super::*;
+
+    fn manifest() -> Manifest {
+        Manifest {
+            forkbench_version: "0".into(),
+            build: None,
+            seed: 1,
+            seed_scheme: 2,
+            trials: 3,
+            shard: [0, 1],
+            planners: vec![],
+            trackers: vec![],
+            overrides: forkbench_trial::trial::Overrides {
+                pallet_noise_scale: Some(0.5),
+                truck_preset: Some("realistic".into()),
+                ..Default::default()
+            },
+            replan: None,
+            compare_replanning: false,
+            success_run: Default::default(),
+            scenarios: vec![],
+        }
+    }
+
+    /// The run's options sit in the manifest under their own names, as before they were
+    /// one type; an unknown key is still refused, and a manifest that wrote a missing
+    /// scale as null still reads.
+    #[test]
+    fn the_options_are_the_manifests_own_keys_and_unknown_keys_are_refused() {
+        let m = manifest();
+        let text = serde_json::to_string(&m).expect("writes");
+        assert!(text.contains(r#""pallet_noise_scale":0.5"#), "{text}");
+        assert!(text.contains(r#""truck_preset":"realistic""#), "{text}");
+        assert!(!text.contains("overrides"), "{text}");
+        assert_eq!(serde_json::from_str::<Manifest>(&text).expect("reads"), m);
+        let old = text.replace(
+            r#""pallet_noise_scale":0.5"#,
+            r#""pallet_noise_scale":null"#,
+        );
+        let back: Manifest = serde_json::from_str(&old).expect("an older manifest reads");
+        assert_eq!(back.overrides.pallet_noise_scale, None);
+        let extra = text.replacen('{', r#"{"pallet_noise":2.0,"#, 1);
+        let e = serde_json::from_str::<Manifest>(&extra).expect_err("an unknown key");
+        assert!(e.to_string().contains("pallet_noise"), "{e}");
     }
 }

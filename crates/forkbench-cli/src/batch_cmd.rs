@@ -53,25 +53,8 @@ pub struct BatchArgs {
     /// Trials per scenario × case × planner × tracker.
     #[arg(long, default_value_t = 20)]
     pub trials: u64,
-    /// Estimate the pallet with this sensing in every scenario, at its default settings:
-    /// gaussian (the range-scaled Gaussian around the truth), tim561, kinect2 or
-    /// tim561+kinect2 (default: each scenario's own [sensors.pallet]).
-    #[arg(long, value_name = "KIND")]
-    pub pallet_sensing: Option<String>,
-    /// Localise every scenario with this kind at its default settings: gaussian (σ
-    /// around the truth) or nav350 (the world's reflectors) (default: each scenario's
-    /// own [sensors.localizer]).
-    #[arg(long, value_name = "KIND")]
-    pub localizer: Option<String>,
-    /// Reflectors (comma-separated names) missing from every scenario's world while the
-    /// NAV350's map keeps them.
-    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
-    pub missing_reflectors: Option<Vec<String>>,
-    /// The truck's actuators and control timing: a preset (`ideal`, `realistic`) or a
-    /// truck file (`[steering]`, `[drive]`, `[control]`, `max_steer_rate_radps`, and an
-    /// optional `preset`), applied over each scenario's `[truck]`.
-    #[arg(long, value_name = "PRESET|FILE")]
-    pub truck: Option<String>,
+    #[command(flatten)]
+    pub options: crate::run_options::RunOptionArgs,
     /// Batch seed; each trial's seed derives from it and the trial's identity.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -103,17 +86,6 @@ pub struct BatchArgs {
     pub out: PathBuf,
     #[arg(long)]
     pub json: bool,
-    /// Scale of every pallet-sensing error (Gaussian estimate σ, scanner range noise and
-    /// bias) for every trial; 0 = exact returns.
-    #[arg(long, allow_hyphen_values = true)]
-    pub pallet_noise_scale: Option<f64>,
-    /// Scale of the localiser's noise (Gaussian σ, or the NAV350's reflector range and
-    /// bearing σ); 0 = exact fixes.
-    #[arg(long, allow_hyphen_values = true)]
-    pub localization_noise_scale: Option<f64>,
-    /// Scale of the odometry's speed-scale and steering-offset σ; 0 = exact odometry.
-    #[arg(long, allow_hyphen_values = true)]
-    pub odometry_noise_scale: Option<f64>,
     /// Re-estimate the pallet and replan on the way in (short for --modes replan).
     #[arg(long, conflicts_with = "modes")]
     pub replan: bool,
@@ -235,7 +207,6 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     let modes =
         batch::ReplanModes::choose(a.replan, a.modes.map(Into::into), a.scenarios.is_empty());
     let (replan, compare_replanning) = modes.spec_fields();
-    let (truck_preset, truck) = crate::truck_cmd::truck_settings(a.truck.as_deref())?;
     let spec = BatchSpec {
         scenarios,
         planners: a.planners.clone(),
@@ -243,16 +214,7 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         trials: a.trials,
         seed: a.seed,
         shard,
-        overrides: forkbench_trial::trial::Overrides {
-            pallet_noise_scale: a.pallet_noise_scale,
-            localization_noise_scale: a.localization_noise_scale,
-            odometry_noise_scale: a.odometry_noise_scale,
-            localizer: a.localizer.clone(),
-            pallet_sensing: a.pallet_sensing.clone(),
-            missing_reflectors: a.missing_reflectors.clone(),
-            truck_preset,
-            truck,
-        },
+        overrides: a.options.overrides()?,
         replan,
         compare_replanning,
         force_new: a.force_new,

@@ -17,6 +17,7 @@ mod rare_cmd;
 mod replay_cmd;
 mod reproduce_cmd;
 mod route_cmd;
+mod run_options;
 mod safety_cmd;
 mod scan_cmd;
 mod trial_cmd;
@@ -117,37 +118,11 @@ struct TrialCli {
     /// Ideal sensors everywhere: no localisation, pallet-sensing or odometry error.
     #[arg(long)]
     no_noise: bool,
-    /// Scale of every pallet-sensing error (Gaussian estimate σ, scanner range noise and
-    /// bias); 0 = exact returns, the other noise kept.
-    #[arg(long, allow_hyphen_values = true)]
-    pallet_noise_scale: Option<f64>,
-    /// Scale of the localiser's noise (Gaussian σ, or the NAV350's reflector range and
-    /// bearing σ); 0 = exact fixes.
-    #[arg(long, allow_hyphen_values = true)]
-    localization_noise_scale: Option<f64>,
-    /// Scale of the odometry's speed-scale and steering-offset σ; 0 = exact odometry.
-    #[arg(long, allow_hyphen_values = true)]
-    odometry_noise_scale: Option<f64>,
-    /// Estimate the pallet with this sensing at its default settings (gaussian, tim561,
-    /// kinect2, tim561+kinect2) instead of the scenario's [sensors.pallet].
-    #[arg(long, value_name = "KIND")]
-    pallet_sensing: Option<String>,
     /// Re-estimate the pallet at the configured ranges and replan when it moved.
     #[arg(long)]
     replan: bool,
-    /// Localise with this kind at its default settings (`gaussian`, `nav350`) instead of
-    /// the scenario's [sensors.localizer].
-    #[arg(long)]
-    localizer: Option<String>,
-    /// Reflectors (comma-separated names) missing from the world while the NAV350's map
-    /// keeps them: which legs suffer if they go.
-    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
-    missing_reflectors: Option<Vec<String>>,
-    /// The truck's actuators and control timing: a preset (`ideal`, `realistic`) or a
-    /// truck file (`[steering]`, `[drive]`, `[control]`, `max_steer_rate_radps`, and an
-    /// optional `preset`), applied over the scenario's `[truck]`.
-    #[arg(long, value_name = "PRESET|FILE")]
-    truck: Option<String>,
+    #[command(flatten)]
+    options: run_options::RunOptionArgs,
     #[arg(long)]
     json: bool,
     #[command(flatten)]
@@ -156,17 +131,7 @@ struct TrialCli {
 
 impl TrialCli {
     fn run(self, mission: bool) -> anyhow::Result<Done> {
-        let (truck_preset, truck) = truck_cmd::truck_settings(self.truck.as_deref())?;
-        let overrides = forkbench_trial::trial::Overrides {
-            pallet_noise_scale: self.pallet_noise_scale,
-            localization_noise_scale: self.localization_noise_scale,
-            odometry_noise_scale: self.odometry_noise_scale,
-            localizer: self.localizer,
-            pallet_sensing: self.pallet_sensing,
-            missing_reflectors: self.missing_reflectors,
-            truck_preset,
-            truck,
-        };
+        let overrides = self.options.overrides()?;
         let opts = trial_cmd::options(
             self.seed,
             (self.planner, self.tracker),

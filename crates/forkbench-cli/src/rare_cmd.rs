@@ -23,6 +23,8 @@ pub struct RareArgs {
     /// Components file (external planners and trackers by name).
     #[arg(long, value_name = "FILE")]
     components: Option<PathBuf>,
+    #[command(flatten)]
+    options: crate::run_options::RunOptionArgs,
     /// `failure` (any criterion), `contact` (a person or vehicle touched), or a criterion's
     /// name (`lateral_error`, `contact_force`, …).
     #[arg(long, default_value = "failure")]
@@ -92,7 +94,7 @@ impl RareArgs {
             case,
             planner: self.planner.clone(),
             tracker: self.tracker.clone(),
-            overrides: Default::default(),
+            overrides: self.options.overrides()?,
             seed: self.seed,
             event: Event::parse(&self.event)?,
             jobs,

@@ -75,7 +75,7 @@ fn the_mission_degrades_measurably_when_the_west_reflectors_go() {
 }
 
 #[test]
-fn the_gaussian_localiser_never_misses_a_fix() {
+fn the_gaussian_localizer_never_misses_a_fix() {
     let scn = Scenario::load(&data("data/scenarios/warehouse-mission.toml"))
         .expect("loads")
         .with_localizer("gaussian")
@@ -92,7 +92,7 @@ fn the_gaussian_localiser_never_misses_a_fix() {
 }
 
 #[test]
-fn bad_localiser_settings_name_the_file_line_and_field() {
+fn bad_localizer_settings_name_the_file_line_and_field() {
     let text = std::fs::read_to_string(data("data/scenarios/rack-pick.toml")).expect("reads");
     let world = |p: &Path| forkbench_trial::World::load(&data("data/scenarios").join(p));
     assert!(text.contains("kind = \"nav350\"\n"));

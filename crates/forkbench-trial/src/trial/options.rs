@@ -55,6 +55,13 @@ pub struct Overrides {
 pub const NOISE_KNOBS: [&str; 3] = ["pallet_noise", "localization_noise", "odometry_noise"];
 
 impl Overrides {
+    /// Every option's name, as the struct defines it: the manifest's keys, Python's
+    /// keywords and (with dashes, `--truck` for the truck's two) the CLI's flags, which
+    /// tests check against this list.
+    pub fn field_names() -> &'static [&'static str] {
+        serde_aux::serde_introspection::serde_introspect::<Overrides>()
+    }
+
     /// The scale of a knob ([`NOISE_KNOBS`]).
     pub fn scale(&self, knob: &str) -> Option<f64> {
         match knob {

@@ -8,7 +8,7 @@ use forkbench_track::{PosePredictor, Tracker};
 
 use super::loc_stats::LocStats;
 use super::localize::record_reflectors;
-use super::state::{Localisation, Perception, ScannerState, Trial, Verdict, WorldState};
+use super::state::{Localization, Perception, ScannerState, Trial, Verdict, WorldState};
 use super::streams::{self, stream};
 use super::world::build_world;
 use super::{Resolved, target_insertion_m};
@@ -204,7 +204,7 @@ impl<'a> Trial<'a> {
                 travelled_loaded_m: 0.0,
                 trail: Default::default(),
             },
-            loc: localisation(localizer, run, start),
+            loc: localization(localizer, run, start),
             sense: perception(scn, run, detector, true_pallet),
             verdict: Verdict::new(out, scn.registry.step_criteria()),
             planner,
@@ -231,8 +231,8 @@ impl<'a> Trial<'a> {
 }
 
 /// The localisation at the start: the localiser, its stream, odometry from `start`.
-fn localisation(localizer: Box<dyn Localizer>, run: &Resolved, start: Pose2) -> Localisation {
-    Localisation {
+fn localization(localizer: Box<dyn Localizer>, run: &Resolved, start: Pose2) -> Localization {
+    Localization {
         localizer,
         nav_rng: stream(run.seed, streams::LOCALISATION),
         predictor: PosePredictor::new(),

@@ -75,7 +75,7 @@ impl WorldState {
 }
 
 /// Where the truck believes it is: the localiser, the odometry and their record.
-pub(crate) struct Localisation {
+pub(crate) struct Localization {
     pub(crate) localizer: Box<dyn Localizer>,
     pub(crate) nav_rng: ChaCha8Rng,
     pub(crate) predictor: PosePredictor,
@@ -86,7 +86,7 @@ pub(crate) struct Localisation {
     pub(crate) first_fix: Pose2,
     /// The odometry's speed-scale error and steering offset for this trial.
     pub(crate) odometry_error: (f64, f64),
-    /// Localisation over the whole trial, and over the current mission leg.
+    /// Localization over the whole trial, and over the current mission leg.
     pub(crate) stats: LocStats,
     pub(crate) leg_stats: LocStats,
     /// The last reading gave no pose (the log says so once, and again when one returns).
@@ -150,7 +150,7 @@ pub(crate) struct Trial<'a> {
     pub(super) scn: &'a Scenario,
     pub(super) run: &'a Resolved,
     pub(super) world: WorldState,
-    pub(super) loc: Localisation,
+    pub(super) loc: Localization,
     pub(super) sense: Perception,
     pub(super) verdict: Verdict,
     pub(super) planner: Box<dyn Planner>,

@@ -1,0 +1,41 @@
+//! A run's options from Python keywords: every field of the library's `Overrides`, by its name, read through serde, so nothing here spells them.
+
+use forkbench_trial::trial::Overrides;
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The options `kwargs` set (`None` values are unset). A keyword that is not an option is
+/// refused with the option names, and a value of the wrong type with the option's name.
+pub fn overrides(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Overrides> {
+    let Some(kwargs) = kwargs else {
+        return Ok(Overrides::default());
+    };
+    let names = Overrides::field_names();
+    let json = py.import("json")?;
+    let mut map = serde_json::Map::new();
+    for (k, v) in kwargs.iter() {
+        let key: String = k.extract()?;
+        if !names.contains(&key.as_str()) {
+            return Err(PyTypeError::new_err(format!(
+                "unexpected keyword argument {key:?} (a run's options: {})",
+                names.join(", ")
+            )));
+        }
+        if v.is_none() {
+            continue;
+        }
+        let bad = |why: String| PyTypeError::new_err(format!("{key}: {why}"));
+        let text: String = json
+            .call_method1("dumps", (&v,))
+            .and_then(|t| t.extract())
+            .map_err(|e| bad(e.to_string()))?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(format!("{text}: {e}")))?;
+        let one = serde_json::Value::Object([(key.clone(), value.clone())].into_iter().collect());
+        serde_json::from_value::<Overrides>(one).map_err(|e| bad(e.to_string()))?;
+        map.insert(key, value);
+    }
+    serde_json::from_value(serde_json::Value::Object(map))
+        .map_err(|e| PyTypeError::new_err(e.to_string()))
+}
