@@ -23,8 +23,8 @@ impl StepCriterion for PickTravel {
     fn name(&self) -> &'static str {
         "pick_travel"
     }
-    fn measure(&self) -> &'static str {
-        "pick_travel_m"
+    fn measure(&self) -> Option<&'static str> {
+        Some("pick_travel_m")
     }
     fn describe(&self) -> &'static str {
         "how far the fork root travels during the pick"

@@ -11,6 +11,7 @@ pub mod pose_deg;
 pub mod prm_study;
 pub mod recorder;
 pub mod scenario;
+pub mod stage_error;
 pub mod step_criteria;
 pub mod text;
 pub mod tolerances;

@@ -288,7 +288,7 @@ impl Registry {
     }
 
     /// Adds a criterion every pick of a scenario on this registry measures at each step,
-    /// judged after the ones before it (replacing one of its name).
+    /// judged after the ones before it (replacing one of its name, a fixed one's too).
     pub fn with_step_criterion(mut self, ctor: crate::step_criteria::StepCtor) -> Self {
         let name = ctor().name();
         self.step_criteria.retain(|c| c().name() != name);
@@ -296,7 +296,8 @@ impl Registry {
         self
     }
 
-    /// The step criteria, fresh for one trial, in the order of blame.
+    /// The pick's criteria, fresh for one trial, in the order of blame: the fixed ones
+    /// ([`crate::step_criteria::PICK_CRITERIA`]), then those that measure at each step.
     pub fn step_criteria(&self) -> Vec<Box<dyn crate::step_criteria::StepCriterion>> {
         self.step_criteria.iter().map(|c| c()).collect()
     }

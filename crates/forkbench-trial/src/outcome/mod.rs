@@ -122,6 +122,14 @@ impl<'de> Deserialize<'de> for Failure {
 impl Failure {
     pub fn name(&self) -> &str {
         match self {
+            Failure::Criterion(name) => name,
+            fixed => fixed.fixed_name().unwrap_or_default(),
+        }
+    }
+
+    /// A fixed failure's name (`None`: a criterion's own, by its name).
+    pub fn fixed_name(&self) -> Option<&'static str> {
+        Some(match self {
             Failure::LegFailed => "leg_failed",
             Failure::PlanFailed => "plan_failed",
             Failure::Collision => "collision",
@@ -138,8 +146,8 @@ impl Failure {
             Failure::LiftFailed => "lift_failed",
             Failure::LoadShifted => "load_shifted",
             Failure::PlacementError => "placement_error",
-            Failure::Criterion(name) => name,
-        }
+            Failure::Criterion(_) => return None,
+        })
     }
 }
 

@@ -12,8 +12,8 @@ use forkbench_track::Command;
 use super::Failed;
 use crate::outcome::LegOutcome;
 use crate::recorder::Recorder;
+use crate::stage_error::StageError;
 use crate::tolerances::Limits;
-use crate::trial::StageError;
 
 /// What a phase's settings are checked against when the scenario loads: the world's
 /// slots, stations and fixed obstacles, the pallet, and the mission.

@@ -9,10 +9,10 @@ use super::reverse_out::back_straight;
 use super::{
     Context, Failed, Phase, PhaseHost, PhaseRun, criteria, positive_at_most, settings, stand_for,
 };
-use crate::StageError;
 use crate::footprints::pallet_footprint;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
+use crate::stage_error::StageError;
 
 /// The slot's outline in recordings: cyan, so the placed (orange) pallet reads against it.
 const SLOT: Style = Style {

@@ -29,8 +29,8 @@ impl StepCriterion for ForkTipClearance {
         "fork_tip_clearance"
     }
 
-    fn measure(&self) -> &'static str {
-        "fork_tip_clearance_mm"
+    fn measure(&self) -> Option<&'static str> {
+        Some("fork_tip_clearance_mm")
     }
 
     fn describe(&self) -> &'static str {

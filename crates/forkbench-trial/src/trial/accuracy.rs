@@ -6,12 +6,12 @@ use forkbench_sensors::detector::detect_in;
 use forkbench_sensors::scan::{Errors, scan};
 use serde::Serialize;
 
-use super::error::StageError;
 use super::streams::{ACCURACY, stream};
 use super::world::build_world;
 use crate::TrialError;
 use crate::scenario::sensors::{NamedScanner, PalletSensing};
 use crate::scenario::{Case, Scenario};
+use crate::stage_error::StageError;
 
 /// Ranges (fork root to face, m), pallet angles (rad) and lateral offsets (m) studied.
 pub const RANGES_M: [f64; 9] = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 6.5, 7.0, 8.0];

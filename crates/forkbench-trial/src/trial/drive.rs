@@ -5,12 +5,12 @@ use forkbench_core::units::wrap_angle;
 use forkbench_track::{Command, TrackerInput};
 
 use super::engine::Steering;
-use super::error::StageError;
 use super::judge::in_pallet_frame;
 use super::link::Control;
 use super::link::Stage;
 use super::state::Trial;
 use crate::recorder::{Level, Recorder, StepRecord};
+use crate::stage_error::StageError;
 use forkbench_core::{Signal, Style};
 
 /// The pick's approach and insertion as a drive: the re-estimates due on the way (a
@@ -292,10 +292,10 @@ impl<'a> Trial<'a> {
         };
         let record =
             ((t_s / self.world.sim.dt_s()).round() as u64).is_multiple_of(SIGNAL_EVERY_STEPS);
-        for c in &mut self.verdict.step_criteria {
+        for c in &mut self.verdict.criteria {
             c.observe(&view);
-            if let (true, Some(v)) = (record, c.value()) {
-                let path = format!("criteria/{}", c.measure());
+            if let (true, Some(v), Some(key)) = (record, c.value(), c.measure()) {
+                let path = format!("criteria/{key}");
                 rec.signal(t_s, &path, &Signal::Scalar(v), Style::default());
             }
         }
@@ -375,14 +375,13 @@ impl Trial<'_> {
     /// required depth.
     fn settled(&self) -> bool {
         let now = self.standing();
-        let m = self.pick_measures(&now, false);
-        let step_broken = self
+        let judged = self.judged(self.pick_measures(&now, false));
+        let for_good = self
             .verdict
-            .step_criteria
+            .criteria
             .iter()
-            .any(|c| c.irreversible() && c.broken().is_some());
-        super::criteria::broken_for_good(&self.judged(m))
-            || step_broken
+            .any(|c| c.irreversible() && c.judge(&judged).is_some());
+        for_good
             || (self.stands() && now.insertion_depth_m >= self.scn.tolerances.insertion_depth_m)
     }
 }

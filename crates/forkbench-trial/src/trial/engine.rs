@@ -7,11 +7,11 @@ use std::task::{Context, Poll};
 use forkbench_core::Pose2;
 use forkbench_track::Command;
 
-use super::error::StageError;
 use super::goal_for;
 use super::link::{Control, Link, Observation, Truth};
 use super::state::Trial;
 use crate::recorder::Recorder;
+use crate::stage_error::StageError;
 
 /// A drive's command source, its stop condition and its per-step criteria.
 pub(crate) trait Steering<'a, E> {

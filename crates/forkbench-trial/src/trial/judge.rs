@@ -3,9 +3,9 @@
 use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 
-use super::criteria::{Judged, PickMeasures};
 use super::state::Trial;
 use crate::outcome::Failure;
+use crate::step_criteria::{Judged, PickMeasures};
 use crate::text::compact_numbers;
 
 /// Fork-root pose in the pallet frame: x < 0 before the face, y the lateral offset.
@@ -24,21 +24,28 @@ pub(crate) struct Standing {
     pub worst_pocket_miss_m: f64,
 }
 
-impl Trial<'_> {
+impl<'a> Trial<'a> {
     /// Writes the final measurements and the verdict into the outcome.
     pub(super) fn conclude(&mut self) {
         let now = self.measure();
         let m = self.pick_measures(&now, self.verdict.timed_out);
-        let mut broken = super::criteria::broken(&self.judged(m));
-        self.verdict.out.robustness = super::criteria::robustness(&self.judged(m));
-        for c in &self.verdict.step_criteria {
-            if let Some(v) = c.value() {
-                self.verdict.out.measures.insert(c.measure().to_owned(), v);
+        let judged = self.judged(m);
+        let (mut broken, mut robustness) = (Vec::new(), None::<f64>);
+        for c in &self.verdict.criteria {
+            if let (Some(key), Some(v)) = (c.measure(), c.value()) {
+                self.verdict.out.measures.insert(key.to_owned(), v);
             }
-            if let Some(why) = c.broken() {
-                broken.push((Failure::criterion(c.name()), why));
+            if let Some(why) = c.judge(&judged) {
+                let name = c.name();
+                let failure = Failure::from_name(name).unwrap_or_else(|| Failure::criterion(name));
+                broken.push((failure, why));
+            }
+            if let Some(margin) = c.margin(&judged) {
+                robustness = Some(robustness.map_or(margin, |r| r.min(margin)));
             }
         }
+        // The least margin over the criteria that keep one; negative when one is broken.
+        self.verdict.out.robustness = robustness;
         let mut broken = broken.into_iter();
         match broken.next() {
             Some((f, why)) => {
@@ -53,13 +60,14 @@ impl Trial<'_> {
     }
 
     /// The pick's measurements with the scenario's limits, truck and pallet.
-    pub(super) fn judged(&self, m: PickMeasures) -> Judged<'_> {
+    pub(super) fn judged(&self, m: PickMeasures) -> Judged<'a> {
+        let scn = self.scn;
         Judged {
             m,
-            tol: &self.scn.tolerances,
-            truck: &self.scn.truck,
-            pallet: &self.scn.pallet,
-            timeout_s: self.scn.timeout_s,
+            tol: &scn.tolerances,
+            truck: &scn.truck,
+            pallet: &scn.pallet,
+            timeout_s: scn.timeout_s,
         }
     }
 

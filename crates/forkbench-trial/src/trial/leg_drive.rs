@@ -4,12 +4,12 @@ use forkbench_core::{Path, Pose2};
 use forkbench_track::{Command, DelayCompensated, PurePursuit, Tracker, TrackerInput};
 
 use super::engine::Steering;
-use super::error::LegError;
 use super::link::Control;
 use super::mission::DriveStats;
 use super::state::Trial;
 use crate::recorder::Recorder;
 use crate::scenario::mission::MissionSpec;
+use crate::stage_error::LegError;
 
 impl Trial<'_> {
     /// Follows `path` (forward or reverse) with the mission's pure pursuit, steering from

@@ -3,9 +3,9 @@
 use forkbench_core::{Pose2, Signal, Style};
 use forkbench_sensors::{LocalizerInput, Reading};
 
-use super::error::StageError;
 use super::state::Trial;
 use crate::recorder::{Level, Recorder};
+use crate::stage_error::StageError;
 
 const REFLECTOR: Style = Style::rgb(250, 250, 250).width(0.3);
 const MISSING: Style = Style::rgba([255, 60, 60, 220]).width(0.3);

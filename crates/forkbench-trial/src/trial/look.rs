@@ -9,10 +9,10 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use super::error::StageError;
 use super::world::build_world;
 use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Case, Scenario};
+use crate::stage_error::StageError;
 
 /// One scan and what the detector made of it.
 #[derive(Debug, Clone, Serialize)]

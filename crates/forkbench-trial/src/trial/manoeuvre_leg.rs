@@ -7,12 +7,12 @@ use forkbench_nav::NavMap;
 use forkbench_nav::hybrid::{HybridQuery, Manoeuvre, plan_hybrid_from_here};
 use forkbench_track::SegmentFollower;
 
-use super::error::LegError;
 use super::mission::{DriveStats, REVERSE, SMOOTHED, path_points};
 use super::state::Trial;
 use crate::outcome::LegOutcome;
 use crate::recorder::Recorder;
 use crate::scenario::mission::{MissionSpec, Waypoint};
+use crate::stage_error::LegError;
 
 /// Most plans one leg makes (one per cusp reached, and the first).
 const MAX_PLANS: u32 = 16;

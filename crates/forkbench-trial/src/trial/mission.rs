@@ -7,11 +7,11 @@ use forkbench_core::{Path, Pose2, Signal, Style};
 use forkbench_nav::smooth::{SmoothParams, smooth};
 use forkbench_nav::{GlobalPlan, GlobalQuery, NavMap, plan_global, truck_parts};
 
-use super::error::{LegError, StageError};
 use super::state::Trial;
 use crate::outcome::LegOutcome;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::mission::{GlobalPlannerKind, MissionSpec, Waypoint};
+use crate::stage_error::{LegError, StageError};
 
 /// How a mission's navigation layer is drawn: blocked cells, the roadmap, a leg's A*
 /// polyline, its smoothed path and its backing out.

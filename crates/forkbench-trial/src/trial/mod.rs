@@ -1,10 +1,8 @@
 //! One pick trial as named stages: setup, plan, drive (with replans), judge.
 
 pub mod accuracy;
-mod criteria;
 mod drive;
 mod engine;
-mod error;
 mod judge;
 mod leg_drive;
 mod link;
@@ -44,7 +42,7 @@ use crate::scenario::{Case, Scenario};
 use state::Trial;
 
 pub use crate::scenario::APPROACH_GAP_M;
-pub use error::{LegError, StageError};
+pub use crate::stage_error::{LegError, StageError};
 
 /// The criterion a trial fails when the moving truck touches a person or vehicle
 /// (critical: it is the verdict whatever else the trial did).
@@ -53,9 +51,9 @@ pub const PERSON_CONTACT: &str = "person_contact";
 /// where it begins (a mission's own legs may end at a waypoint called "staging").
 pub const STAGING_LEG: &str = "pick start → staging";
 pub use crate::step_criteria::{
-    STEP_CRITERIA, StepCriterion, StepCtor, StepView, step_criterion_name, step_measures,
+    Criterion, Judged, PICK_CRITERIA, PickMeasures, Reading, STEP_CRITERIA, StepCriterion,
+    StepCtor, StepView, step_criterion_name, step_measures,
 };
-pub use criteria::{Criterion, PICK_CRITERIA, Reading};
 pub use link::{Control, Episode, Observation, Stage, Truth};
 pub use look::{ScanReport, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};

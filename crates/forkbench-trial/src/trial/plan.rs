@@ -3,12 +3,12 @@
 use forkbench_core::{Path, Pose2};
 use forkbench_plan::{Plan, PlanRequest};
 
-use super::error::StageError;
 use super::goal_for;
 use super::state::Trial;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{ReplanMethod, truck_footprint};
+use crate::stage_error::StageError;
 
 /// Arc-length spacing of the footprint checks along a plan (its samples are 1 cm apart):
 /// between two checks the fork root moves 2 cm and a body corner a few cm more in a turn,

@@ -8,11 +8,11 @@ use forkbench_sensors::evidence::verified;
 use forkbench_sensors::scan::{Errors, WorldView, scan_swept};
 use rand_chacha::ChaCha8Rng;
 
-use super::error::StageError;
 use super::movers_view::WithMovers;
 use super::state::Trial;
 use crate::recorder::Recorder;
 use crate::scenario::sensors::{NamedScanner, PalletSensing};
+use crate::stage_error::StageError;
 
 /// How scans (a colour per sensor, in the order sensors are listed) and a detection are
 /// drawn in recordings.

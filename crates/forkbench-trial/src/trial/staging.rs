@@ -6,13 +6,13 @@ use forkbench_geom::Obstacles;
 use forkbench_nav::{GlobalPlannerKind, NavMap, OccupancyGrid};
 use forkbench_track::SegmentFollower;
 
-use super::error::StageError;
 use super::mission::DriveStats;
 use super::state::Trial;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::mission::{GlobalFile, MissionSpec, Waypoint, mission_tracker};
 use crate::scenario::{BetweenLooks, WhenNotSeen};
+use crate::stage_error::StageError;
 
 /// Cell of the staging leg's map.
 const RESOLUTION_M: f64 = 0.1;

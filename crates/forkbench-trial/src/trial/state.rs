@@ -115,8 +115,9 @@ pub(crate) struct Perception {
 /// The outcome being built and what judges it.
 pub(crate) struct Verdict {
     pub(crate) out: TrialOutcome,
-    /// The pick's criteria that measure at every step.
-    pub(crate) step_criteria: Vec<Box<dyn StepCriterion>>,
+    /// The pick's criteria in the order of blame: the fixed ones, then those that measure
+    /// at every step.
+    pub(crate) criteria: Vec<Box<dyn StepCriterion>>,
     /// The pick's drive ran out of time (until it docks or settles).
     pub(crate) timed_out: bool,
     /// Simulated time and distance travelled when the pick's drive began.
@@ -129,10 +130,10 @@ pub(crate) struct Verdict {
 
 impl Verdict {
     /// A verdict not yet reached: the pick not started, its drive timed out until it ends.
-    pub(crate) fn new(out: TrialOutcome, step_criteria: Vec<Box<dyn StepCriterion>>) -> Self {
+    pub(crate) fn new(out: TrialOutcome, criteria: Vec<Box<dyn StepCriterion>>) -> Self {
         Self {
             out,
-            step_criteria,
+            criteria,
             timed_out: true,
             pick_started: (0.0, 0.0),
             pick_waited_s: 0.0,

@@ -4,10 +4,10 @@ use forkbench_core::Pose2;
 use forkbench_sim::Sim;
 use rand_chacha::ChaCha8Rng;
 
-use super::error::StageError;
 use super::streams::{self, stream};
 use super::uncertain_apply::Shift;
 use crate::scenario::{Case, Scenario};
+use crate::stage_error::StageError;
 
 /// The physics world of a trial: the truck at its start (a mission's first place, else the
 /// case's start, or `start_at`), the pallet where it really stands (the case's moved by

@@ -1,37 +1,8 @@
-//! The pick's criteria, each once: its failure, what it measures, whether a breach is final, the verdict's row, and its check against its limit, in the order of blame.
+//! The pick's fixed criteria, each a row: its failure, what it measures, whether a breach is final, the verdict's row, its check against its limit and its margin; each row is a `StepCriterion` judged on the pick's measurements, first in the order of blame.
 
-use forkbench_core::{ForkliftSpec, PalletSpec};
-
+use super::{Judged, StepCriterion, StepView};
 use crate::outcome::{Failure, TrialOutcome};
-use crate::scenario::Limits;
-
-/// The pick's measurements the criteria judge: at the end of the drive, or as they stand
-/// at a step (a caller-driven pick ends on the first final breach).
-#[derive(Debug, Clone, Copy)]
-pub(super) struct PickMeasures {
-    pub collision: bool,
-    pub timed_out: bool,
-    pub max_contact_force_n: f64,
-    pub pallet_displacement_m: f64,
-    pub pallet_rotation_rad: f64,
-    /// At entry (`None`: the tips have not reached the face).
-    pub lateral_error_m: Option<f64>,
-    pub heading_error_rad: Option<f64>,
-    pub insertion_depth_m: f64,
-    /// The fork middle farthest from its pocket's centre line, laterally.
-    pub worst_pocket_miss_m: f64,
-}
-
-/// What the pick's criteria read: the measurements, the limits, the truck and pallet.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Judged<'a> {
-    pub m: PickMeasures,
-    pub tol: &'a Limits,
-    pub truck: &'a ForkliftSpec,
-    pub pallet: &'a PalletSpec,
-    /// The scenario's time limit.
-    pub timeout_s: f64,
-}
+use crate::tolerances::Limits;
 
 /// One line of a verdict's table: what a criterion measured against its limit.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,6 +42,42 @@ impl Criterion {
     }
 }
 
+/// The row as a criterion of every pick: it measures nothing itself (its measurements
+/// are the outcome's own fields, `PickMeasures`), so it judges what it is handed.
+impl StepCriterion for Criterion {
+    fn name(&self) -> &'static str {
+        self.failure.fixed_name().unwrap_or("criterion")
+    }
+    fn measure(&self) -> Option<&'static str> {
+        None
+    }
+    fn describe(&self) -> &'static str {
+        self.measures
+    }
+    fn observe(&mut self, _view: &StepView<'_>) {}
+    fn value(&self) -> Option<f64> {
+        None
+    }
+    fn broken(&self) -> Option<String> {
+        None
+    }
+    fn irreversible(&self) -> bool {
+        self.irreversible
+    }
+    fn judge(&self, judged: &Judged<'_>) -> Option<String> {
+        (self.check)(judged)
+    }
+    fn margin(&self, judged: &Judged<'_>) -> Option<f64> {
+        (self.margin)(judged)
+    }
+}
+
+/// Row `I` of [`PICK_CRITERIA`], fresh for one trial (a registry lists criteria by their
+/// constructors).
+pub(super) fn row<const I: usize>() -> Box<dyn StepCriterion> {
+    Box::new(PICK_CRITERIA[I].clone())
+}
+
 impl TrialOutcome {
     /// Whether the trial broke `failure`: its verdict, or one of `also_failed`.
     pub fn broke(&self, failure: &Failure) -> bool {
@@ -83,9 +90,9 @@ impl TrialOutcome {
     }
 }
 
-/// The pick's criteria in the order of blame: the first broken one is the verdict.
-/// Adding one is a `Failure` variant and a row here (a criterion that measures at each
-/// step is a [`crate::step_criteria::StepCriterion`] instead).
+/// The pick's fixed criteria in the order of blame, before every other
+/// [`StepCriterion`]: the first broken one is the verdict. Adding one is a `Failure`
+/// variant, a row here and its constructor in [`super::STEP_CRITERIA`].
 pub const PICK_CRITERIA: &[Criterion] = &[
     Criterion {
         failure: Failure::Collision,
@@ -208,23 +215,6 @@ pub const PICK_CRITERIA: &[Criterion] = &[
     },
 ];
 
-/// Every broken criterion, in the order of blame, each with its value and limit.
-pub(super) fn broken(j: &Judged<'_>) -> Vec<(Failure, String)> {
-    PICK_CRITERIA
-        .iter()
-        .filter_map(|c| (c.check)(j).map(|why| (c.failure.clone(), why)))
-        .collect()
-}
-
-/// The pick's robustness: the least of its criteria's margins (see [`Criterion`]),
-/// negative when one is broken; `None` when no criterion measured anything.
-pub(super) fn robustness(j: &Judged<'_>) -> Option<f64> {
-    PICK_CRITERIA
-        .iter()
-        .filter_map(|c| (c.margin)(j))
-        .reduce(f64::min)
-}
-
 /// (limit − measured) / limit, for a limit above zero (else the sign alone).
 fn ratio(limit: f64, measured: f64) -> f64 {
     if limit > 0.0 {
@@ -234,13 +224,6 @@ fn ratio(limit: f64, measured: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// Whether a criterion whose breach is final is broken by the measurements now.
-pub(super) fn broken_for_good(j: &Judged<'_>) -> bool {
-    PICK_CRITERIA
-        .iter()
-        .any(|c| c.irreversible && (c.check)(j).is_some())
 }
 
 fn collision(j: &Judged<'_>) -> Option<String> {
@@ -316,7 +299,24 @@ fn fork_outside_pocket(j: &Judged<'_>) -> Option<String> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::PickMeasures;
     use super::*;
+    use forkbench_core::{ForkliftSpec, PalletSpec};
+
+    /// Every broken row, in the order of blame.
+    fn broken(j: &Judged<'_>) -> Vec<(Failure, String)> {
+        PICK_CRITERIA
+            .iter()
+            .filter_map(|c| c.judge(j).map(|why| (c.failure.clone(), why)))
+            .collect()
+    }
+
+    /// Whether a row whose breach is final is broken.
+    fn broken_for_good(j: &Judged<'_>) -> bool {
+        PICK_CRITERIA
+            .iter()
+            .any(|c| c.irreversible && c.judge(j).is_some())
+    }
 
     /// The order of blame the README and ARCHITECTURE.md give, each criterion once.
     #[test]
@@ -335,6 +335,18 @@ mod tests {
                 "fork_outside_pocket"
             ]
         );
+    }
+
+    /// Every row is registered, in its order, at the head of the built-in criteria.
+    #[test]
+    fn the_rows_lead_the_registered_criteria() {
+        let built: Vec<_> = super::super::STEP_CRITERIA
+            .iter()
+            .map(|c| c().name())
+            .collect();
+        let rows: Vec<_> = PICK_CRITERIA.iter().map(|c| c.name()).collect();
+        assert_eq!(built[..rows.len()], rows[..]);
+        assert_eq!(built.len(), rows.len() + 1, "{built:?}");
     }
 
     /// Measurements of a pick well inside every limit, mid-approach: standing off the
