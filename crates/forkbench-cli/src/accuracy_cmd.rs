@@ -43,7 +43,9 @@ pub fn run(
         forkbench_trial::scenario::sensors::PalletSensing::Scanner { detector, .. } => {
             detector.name.clone()
         }
-        forkbench_trial::scenario::sensors::PalletSensing::Gaussian => "pockets".to_owned(),
+        forkbench_trial::scenario::sensors::PalletSensing::Gaussian => {
+            forkbench_trial::components::POCKET_DETECTOR.to_owned()
+        }
     };
     let text = if json {
         let paper = rows.iter().find(|r| is_paper_cell(r));

@@ -30,7 +30,9 @@ pub fn run(a: &CheckArgs) -> anyhow::Result<()> {
 /// The pallet sensing in one line: scanners, detector, latency and threshold.
 fn sensing_line(scn: &Scenario) -> String {
     match &scn.pallet_sensing {
-        forkbench_trial::scenario::sensors::PalletSensing::Gaussian => "gaussian".to_owned(),
+        forkbench_trial::scenario::sensors::PalletSensing::Gaussian => {
+            forkbench_trial::scenario::sensors::GAUSSIAN_SENSING.to_owned()
+        }
         forkbench_trial::scenario::sensors::PalletSensing::Scanner {
             sensors,
             detector,

@@ -68,6 +68,13 @@ pub struct LocalizerContext<'a> {
 pub type EstimatorCtor =
     Arc<dyn Fn(&PalletEstimateConfig) -> Box<dyn PalletEstimator> + Send + Sync>;
 
+/// The localiser a scenario without `[sensors.localizer]` uses (σ around the truth).
+pub const DEFAULT_LOCALIZER: &str = "gaussian";
+
+/// The pocket detector: a scanner's default detector, and the one the Gaussian sensing's
+/// `scan` shows.
+pub const POCKET_DETECTOR: &str = "pockets";
+
 /// Planners and trackers by name, and the sensor models.
 #[derive(Clone)]
 pub struct Registry {
@@ -77,6 +84,10 @@ pub struct Registry {
     localizers: BTreeMap<String, LocalizerCtor>,
     /// Localiser kinds that apply `LocalizerContext::noise_scale`.
     scaled_localizers: std::collections::BTreeSet<String>,
+    /// Localiser kinds that measure the world's reflectors (so a run may take some away).
+    reflector_localizers: std::collections::BTreeSet<String>,
+    /// Detector kinds whose settings are the pocket detector's (`DetectorConfig`).
+    pocket_detectors: std::collections::BTreeSet<String>,
     estimator: EstimatorCtor,
     /// The phases a scenario may list after the pick, in registration order.
     phases: Vec<crate::phase::PhaseKind>,
@@ -158,11 +169,13 @@ impl Registry {
             detectors: BTreeMap::new(),
             localizers: BTreeMap::new(),
             scaled_localizers: std::collections::BTreeSet::new(),
+            reflector_localizers: std::collections::BTreeSet::new(),
+            pocket_detectors: std::collections::BTreeSet::new(),
             estimator: Arc::new(|cfg| Box::new(cfg.clone())),
             phases: crate::phase::builtin_phases(),
             step_criteria: crate::step_criteria::STEP_CRITERIA.to_vec(),
         }
-        .with_scaled_localizer("gaussian", |s, cx| {
+        .with_scaled_localizer(DEFAULT_LOCALIZER, |s, cx| {
             forkbench_core::settings::parse::<Empty>(s)?;
             let cfg = Nav350Config {
                 position_sigma_m: cx.nav350.position_sigma_m * cx.noise_scale,
@@ -184,7 +197,10 @@ impl Registry {
                 if cx.noise { cx.noise_scale } else { 0.0 },
             )))
         })
-        .with_detector("pockets", |s, _| {
+        .measuring_reflectors("nav350")
+        .with_pocket_settings_detector(POCKET_DETECTOR)
+        .with_pocket_settings_detector("face_fit")
+        .with_detector(POCKET_DETECTOR, |s, _| {
             let cfg: forkbench_sensors::detect::DetectorConfig =
                 forkbench_core::settings::parse(s)?;
             cfg.validate()?;
@@ -272,6 +288,31 @@ impl Registry {
         self = self.with_localizer(kind, ctor);
         self.scaled_localizers.insert(kind.to_owned());
         self
+    }
+
+    /// Marks a localiser kind as one that measures the world's reflectors (a run's
+    /// `missing_reflectors` acts on it).
+    pub fn measuring_reflectors(mut self, kind: &str) -> Self {
+        self.reflector_localizers.insert(kind.to_owned());
+        self
+    }
+
+    /// Whether a localiser kind measures the world's reflectors.
+    pub fn localizer_measures_reflectors(&self, kind: &str) -> bool {
+        self.reflector_localizers.contains(kind)
+    }
+
+    /// Marks a detector kind as one whose settings are the pocket detector's
+    /// (`DetectorConfig`), which the sensing's other users (the Gaussian model's detector
+    /// for `scan`) take from it.
+    pub fn with_pocket_settings_detector(mut self, kind: &str) -> Self {
+        self.pocket_detectors.insert(kind.to_owned());
+        self
+    }
+
+    /// Whether a detector kind's settings are the pocket detector's.
+    pub fn detector_takes_pocket_settings(&self, kind: &str) -> bool {
+        self.pocket_detectors.contains(kind)
     }
 
     /// Whether a localiser kind applies a localisation noise scale.

@@ -23,7 +23,7 @@ use forkbench_sim::SimConfig;
 use serde::Serialize;
 
 use crate::TrialError;
-use crate::components::{ComponentSpec, Registry, Role};
+use crate::components::{ComponentSpec, DEFAULT_LOCALIZER, Registry, Role};
 
 pub use crate::footprints::{pallet_footprint, shrunk, truck_footprint};
 pub use crate::pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
@@ -307,7 +307,7 @@ impl Scenario {
             pick: f.pick,
             tolerances: f.tolerances.into(),
             pallet_sensing,
-            localizer: ComponentSpec::of_kind(Role::Localizer, "gaussian"),
+            localizer: ComponentSpec::of_kind(Role::Localizer, DEFAULT_LOCALIZER),
             estimate_bias: f.estimate_bias.map_or(zero, PoseDeg::to_pose),
             pallet_jitter: f.pallet_jitter.map_or(zero, PoseDeg::to_pose),
             world,
@@ -388,7 +388,7 @@ impl Scenario {
 }
 
 fn is_gaussian_localizer(spec: &ComponentSpec) -> bool {
-    spec.kind == "gaussian" && spec.settings.is_empty()
+    spec.kind == DEFAULT_LOCALIZER && spec.settings.is_empty()
 }
 
 /// A `[sensors.localizer]` error at its line, its field under `sensors.`.

@@ -11,6 +11,10 @@ use super::{invalid, invalid_setting};
 use crate::TrialError;
 use crate::components::{ComponentSpec, Role};
 
+/// `[sensors.pallet] kind` of the range-scaled Gaussian estimate around the truth; every
+/// other kind names scanner models (`SCANNER_PRESETS`, joined by `+`).
+pub const GAUSSIAN_SENSING: &str = "gaussian";
+
 /// `[sensors]` as written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -133,12 +137,12 @@ impl PalletSensing {
             })
     }
 
-    /// The pocket detector's settings, when this sensing uses it or the face fit on it
-    /// (else its defaults).
-    pub fn pocket_settings(&self) -> DetectorConfig {
+    /// The pocket detector's settings, when this sensing's detector takes them (the
+    /// registry says which kinds do; else their defaults).
+    pub fn pocket_settings(&self, registry: &crate::Registry) -> DetectorConfig {
         match self {
             PalletSensing::Scanner { detector, .. }
-                if detector.kind == "pockets" || detector.kind == "face_fit" =>
+                if registry.detector_takes_pocket_settings(&detector.kind) =>
             {
                 forkbench_core::settings::parse(&detector.settings).unwrap_or_default()
             }
@@ -160,7 +164,7 @@ pub(super) fn resolve(
     };
     let latency_s = latency_of(p, file)?;
     let min_score = min_score_of(p, file)?;
-    if p.kind == "gaussian" {
+    if p.kind == GAUSSIAN_SENSING {
         return Ok(PalletSensing::Gaussian);
     }
     let names: Vec<&str> = p.kind.split('+').map(str::trim).collect();
@@ -221,8 +225,13 @@ pub(super) fn resolve(
         (a.scanner.range_max_m.total_cmp(&b.scanner.range_max_m)).then_with(|| a.name.cmp(&b.name))
     });
     let table = toml::Value::Table(p.detector.clone().unwrap_or_default());
-    let detector = ComponentSpec::from_value(Role::Detector, &table, Some("pockets"), ".".into())
-        .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))?;
+    let detector = ComponentSpec::from_value(
+        Role::Detector,
+        &table,
+        Some(crate::components::POCKET_DETECTOR),
+        ".".into(),
+    )
+    .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))?;
     Ok(PalletSensing::Scanner {
         sensors,
         detector,
@@ -270,7 +279,7 @@ fn scanning_setting(
     gaussian_why: &str,
 ) -> Result<f64, TrialError> {
     let field = format!("sensors.pallet.{key}");
-    if p.kind == "gaussian" && value.is_some() {
+    if p.kind == GAUSSIAN_SENSING && value.is_some() {
         return Err(invalid(file, &field, gaussian_why));
     }
     let v = value.unwrap_or(default);

@@ -85,8 +85,9 @@ pub fn scenario_detector(
             Ok((detector.name.clone(), d))
         }
         PalletSensing::Gaussian => {
-            let cfg = scn.pallet_sensing.pocket_settings();
-            Ok(("pockets".to_owned(), Box::new(Pockets { cfg })))
+            let cfg = scn.pallet_sensing.pocket_settings(&scn.registry);
+            let name = crate::components::POCKET_DETECTOR.to_owned();
+            Ok((name, Box::new(Pockets { cfg })))
         }
     }
 }

@@ -372,7 +372,7 @@ impl Scenario {
             None => self.localizer.clone(),
         };
         if let Some(names) = &o.missing_reflectors {
-            if spec.kind != "nav350" {
+            if !self.registry.localizer_measures_reflectors(&spec.kind) {
                 return Err(invalid(
                     &self.file,
                     "sensors.localizer.missing_reflectors",
