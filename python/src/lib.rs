@@ -3,10 +3,8 @@
 mod batch;
 mod convert;
 mod env;
-mod obs;
 mod options;
 mod rare;
-mod render;
 mod report;
 mod scenario;
 mod vec_env;
@@ -31,11 +29,11 @@ fn _forkbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rare::falsify, m)?)?;
     m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(report::replay, m)?)?;
-    m.add("OBSERVATION_FIELDS", obs::FIELDS.to_vec())?;
+    m.add("OBSERVATION_FIELDS", forkbench_gym::obs::FIELDS.to_vec())?;
     m.add(
         "RUN_OPTIONS",
         forkbench_trial::trial::Overrides::field_names().to_vec(),
     )?;
-    m.add("STAGE_FIELD", obs::STAGE_FIELD)?;
+    m.add("STAGE_FIELD", forkbench_gym::obs::STAGE_FIELD)?;
     Ok(())
 }

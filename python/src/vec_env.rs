@@ -9,8 +9,9 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::env::{Core, Setup, StepOut, command, setup};
+use crate::env::{command, info, setup};
 use crate::scenario::Scenario;
+use forkbench_gym::{Core, EnvSpec, Setup, StepOut};
 use forkbench_trial::trial::Control;
 
 /// One environment of the vector: its episode, and the stream its episodes' seeds and
@@ -135,20 +136,22 @@ impl PickVecEnv {
                 env_bytes(&scenario.inner) / 1000
             )));
         }
-        let setup = setup(
-            py,
-            scenario,
+        let spec = EnvSpec {
             case,
             planner,
             tracker,
             noise,
             replan,
+            overrides,
             ticks_per_step,
             path_points,
             path_spacing_m,
             reward,
-            (episode, phase_reward, overrides),
-        )?;
+            episode: episode.to_owned(),
+            phase_reward,
+            render_size: None,
+        };
+        let setup = setup(py, scenario, spec)?;
         let threads =
             threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
         let pool = rayon::ThreadPoolBuilder::new()
@@ -200,7 +203,7 @@ impl PickVecEnv {
             .slots()
             .iter()
             .map(|s| match &s.core {
-                Some(core) => core.info(py),
+                Some(core) => info(py, core),
                 None => Ok(PyDict::new(py)),
             })
             .collect::<PyResult<_>>()?;
@@ -248,7 +251,7 @@ impl PickVecEnv {
             .iter()
             .enumerate()
             .filter_map(|(i, s)| match &s.core {
-                Some(core) if s.pending_reset => Some(core.info(py).map(|d| (i, d))),
+                Some(core) if s.pending_reset => Some(info(py, core).map(|d| (i, d))),
                 _ => None,
             })
             .collect::<PyResult<_>>()?;
