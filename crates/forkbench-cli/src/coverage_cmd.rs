@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use forkbench_sensors::reflectors::ReflectorNavConfig;
-use forkbench_trial::coverage::{Coverage, coverage};
+use forkbench_studies::coverage::{Coverage, coverage};
 
 #[derive(Debug, clap::Args)]
 pub struct CoverageArgs {
@@ -46,7 +46,7 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
             world: &'a str,
             resolution_m: f64,
             reflectors: &'a [forkbench_sensors::reflectors::Reflector],
-            cells: &'a [forkbench_trial::coverage::CoverageCell],
+            cells: &'a [forkbench_studies::coverage::CoverageCell],
         }
         let out = Out {
             world: &world.name,

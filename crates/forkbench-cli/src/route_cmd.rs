@@ -88,7 +88,7 @@ impl RouteArgs {
 /// Plans `a.runs` times; whether every run found a path (a search that ran and found
 /// none is a verdict, exit 3, for every planner alike; bad input is an error).
 pub fn run(a: &RouteArgs) -> anyhow::Result<bool> {
-    let map = forkbench_trial::prm_study::load_map(&a.map, a.resolution_m)?;
+    let map = forkbench_studies::prm_study::load_map(&a.map, a.resolution_m)?;
     let mut a = a.clone();
     let mut all_found = true;
     for run in 0..a.runs.max(1) {
@@ -293,11 +293,11 @@ fn manoeuvre_text(plan: &GlobalPlan) -> String {
 
 /// `reproduce prm`: Luo's studies on the embedded warehouse over `runs` seeds.
 pub fn reproduce(runs: u64, json: bool, plot: Option<&Path>) -> anyhow::Result<()> {
-    let forkbench_trial::prm_study::PrmStudy {
+    let forkbench_studies::prm_study::PrmStudy {
         ends,
         inflate_m,
         rows,
-    } = forkbench_trial::prm_study::run(runs)?;
+    } = forkbench_studies::prm_study::run(runs)?;
     if let Some(file) = plot {
         forkbench_report::prm::draw(file, &rows)?;
     }

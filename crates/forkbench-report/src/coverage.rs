@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
+use forkbench_studies::coverage::Coverage;
 use forkbench_trial::World;
-use forkbench_trial::coverage::Coverage;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

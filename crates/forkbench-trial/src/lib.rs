@@ -1,14 +1,12 @@
 //! One pick trial end to end: scenario and world files, noisy estimate → plan → tracker in rapier2d → judged outcome, with components from a registry.
 
 pub mod components;
-pub mod coverage;
 pub mod defaults;
 pub mod footprints;
 pub mod mission_summary;
 pub mod outcome;
 pub mod phase;
 pub mod pose_deg;
-pub mod prm_study;
 pub mod recorder;
 pub mod scenario;
 pub mod stage_error;

@@ -19,8 +19,6 @@ const LAYERS: &[&str] = &[
     "components",
     "scenario",
     "defaults",
-    "coverage",
-    "prm_study",
     "trial",
 ];
 

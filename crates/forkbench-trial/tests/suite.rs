@@ -4,7 +4,6 @@ mod common;
 
 mod builtin_outcomes;
 mod components;
-mod coverage;
 mod custom_phase;
 mod default_outcomes;
 mod external_detector;

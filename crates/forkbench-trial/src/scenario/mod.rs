@@ -43,7 +43,7 @@ use file::ScenarioFile;
 /// Most cases one scenario file may list.
 pub const MAX_CASES: usize = 10_000;
 
-pub(crate) fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
+pub fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
     TrialError::Invalid {
         file: file.to_owned(),
         field: field.to_owned(),

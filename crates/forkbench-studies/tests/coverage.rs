@@ -1,8 +1,8 @@
 //! Reflector coverage: the warehouse's layout gives most free cells a fix with millimetre σ, removing an aisle's reflectors leaves it without one, and bad reflectors are refused at load naming the field.
 
 use forkbench_sensors::reflectors::ReflectorNavConfig;
+use forkbench_studies::coverage::coverage;
 use forkbench_trial::World;
-use forkbench_trial::coverage::coverage;
 use forkbench_trial::defaults::embedded_world;
 
 #[test]
@@ -17,7 +17,7 @@ fn the_warehouse_layout_covers_its_aisles_and_losing_one_aisles_reflectors_shows
         cov.cells.len()
     );
     // The aisle between rows 1 and 2 (y 5.75–11.75 m, x 10–35 m) is covered everywhere.
-    let aisle = |c: &&forkbench_trial::coverage::CoverageCell| {
+    let aisle = |c: &&forkbench_studies::coverage::CoverageCell| {
         (10.0..35.0).contains(&c.x_m) && (6.5..11.0).contains(&c.y_m)
     };
     assert!(
@@ -35,7 +35,7 @@ fn the_warehouse_layout_covers_its_aisles_and_losing_one_aisles_reflectors_shows
             || r.name.starts_with("shelf-frame0"))
     });
     let cov = coverage(&degraded, 0.5, &cfg).expect("coverage");
-    let middle = |c: &&forkbench_trial::coverage::CoverageCell| {
+    let middle = |c: &&forkbench_studies::coverage::CoverageCell| {
         (14.0..31.0).contains(&c.x_m) && (7.5..10.0).contains(&c.y_m)
     };
     let lost = cov
@@ -125,7 +125,7 @@ fn a_reflector_on_a_face_is_accepted_and_seen_from_its_side_only() {
     let world = World::parse(&text, "w.toml").expect("a reflector on the face loads");
     let cfg = ReflectorNavConfig::default();
     let cov = coverage(&world, 0.25, &cfg).expect("coverage");
-    let side = |c: &forkbench_trial::coverage::CoverageCell| {
+    let side = |c: &forkbench_studies::coverage::CoverageCell| {
         let l = wall.to_local(&forkbench_core::Pose2::new(c.x_m, c.y_m, 0.0));
         (l.x_m.abs() < 1.5).then_some(l.y_m)
     };

@@ -5,8 +5,8 @@ use forkbench_sensors::sight::Sight;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::TrialError;
-use crate::scenario::World;
+use forkbench_trial::TrialError;
+use forkbench_trial::World;
 
 /// Most cells a coverage map may have (bounded work and memory on any world file).
 pub const MAX_CELLS: usize = 4_000_000;

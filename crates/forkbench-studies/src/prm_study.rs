@@ -6,7 +6,7 @@ use forkbench_core::ForkliftSpec;
 use forkbench_nav::reproduce::StudyRow;
 use forkbench_nav::{GridError, MapError, NavError, NavMap};
 
-use crate::TrialError;
+use forkbench_trial::TrialError;
 
 /// The station the studied leg starts at, the rack slot it ends before, and how far in
 /// front of the slot's face (south, in the aisle) it ends: the paper's longest leg,
@@ -44,7 +44,7 @@ pub struct PrmStudy {
 /// `reproduce prm`: both studies and an RRT row over `runs` seeds, on the embedded
 /// warehouse rasterised once and inflated by 0.5 × wheelbase.
 pub fn run(runs: u64) -> Result<PrmStudy, NavStudyError> {
-    let world = crate::defaults::embedded_world(STUDY_WORLD)?;
+    let world = forkbench_trial::defaults::embedded_world(STUDY_WORLD)?;
     let inflate_m = forkbench_nav::luo_inflation_m(&ForkliftSpec::default());
     let grid = NavMap::from_world(&world.obstacles(), STUDY_RESOLUTION_M)
         .map_err(|reason| NavStudyError::Grid {
@@ -63,14 +63,14 @@ pub fn run(runs: u64) -> Result<PrmStudy, NavStudyError> {
 }
 
 /// The studied leg's ends: the station, and the aisle in front of the slot.
-fn study_leg(world: &crate::World) -> Result<([f64; 2], [f64; 2]), TrialError> {
-    let place = |list: &[crate::scenario::PalletSlot], name: &str| {
+fn study_leg(world: &forkbench_trial::World) -> Result<([f64; 2], [f64; 2]), TrialError> {
+    let place = |list: &[forkbench_trial::scenario::PalletSlot], name: &str| {
         list.iter()
             .find(|p| p.name == name)
             .map(|p| [p.x_m, p.y_m])
             .ok_or_else(|| {
                 let file = format!("worlds/{STUDY_WORLD}");
-                crate::scenario::invalid(&file, "place", &format!("no place {name:?}"))
+                forkbench_trial::scenario::invalid(&file, "place", &format!("no place {name:?}"))
             })
     };
     let start = place(&world.station, STUDY_STATION)?;
@@ -81,9 +81,9 @@ fn study_leg(world: &crate::World) -> Result<([f64; 2], [f64; 2]), TrialError> {
 /// A planning map: a ROS map_server YAML, or a world TOML rasterised at `resolution_m`.
 pub fn load_map(map: &Path, resolution_m: f64) -> Result<NavMap, NavStudyError> {
     if map.extension().is_some_and(|e| e == "yaml" || e == "yml") {
-        return Ok(NavMap::from_grid(crate::World::read_grid(map)?));
+        return Ok(NavMap::from_grid(forkbench_trial::World::read_grid(map)?));
     }
-    let world = crate::World::load(map)?;
+    let world = forkbench_trial::World::load(map)?;
     NavMap::from_world(&world.obstacles(), resolution_m).map_err(|reason| NavStudyError::Grid {
         file: map.display().to_string(),
         reason,

@@ -1,0 +1,4 @@
+//! Studies the CLI runs beside the trials, on the scenario format's public types only (no engine internals): a world's reflector coverage and Luo's PRM study on the embedded warehouse.
+
+pub mod coverage;
+pub mod prm_study;

@@ -1,0 +1,3 @@
+//! The studies' tests as one binary: each file a module.
+
+mod coverage;
