@@ -1,4 +1,4 @@
-//! The one drive loop every part of a trial runs through (the mission legs, staging, the pick, each phase), and the yield point where a session's caller takes each tick.
+//! The one drive loop every part of a trial runs through (the mission legs, staging, the pick, each phase) and its tick in order: sense, the steering's re-estimate, the caller's turn (the yield point where a session's caller takes the tick), command, safety gate, the physics step with odometry and record, the steering's judgement.
 
 use std::future::Future;
 use std::pin::Pin;
@@ -7,11 +7,13 @@ use std::task::{Context, Poll};
 use forkbench_core::Pose2;
 use forkbench_track::Command;
 
+use super::drive::SIGNAL_EVERY_STEPS;
 use super::goal_for;
 use super::link::{Control, Link, Observation, Truth};
 use super::state::Trial;
-use crate::recorder::Recorder;
+use crate::recorder::{Level, Recorder, StepRecord};
 use crate::stage_error::StageError;
+use forkbench_core::{Signal, Style};
 
 /// A drive's command source, its stop condition and its per-step criteria.
 pub(crate) trait Steering<'a, E> {
@@ -192,6 +194,98 @@ impl<'a> Trial<'a> {
                     .collect(),
             );
         }
+    }
+}
+
+impl Trial<'_> {
+    /// One physics step under `cmd`, the odometry update, collisions and the record.
+    pub(super) fn physics_step<R: Recorder + ?Sized>(
+        &mut self,
+        cmd: &Command,
+        fix: Option<Pose2>,
+        pose: Pose2,
+        rec: &mut R,
+    ) {
+        let truck = &self.scn.truck;
+        let before = self.world.sim.fork_root_pose();
+        self.world.sim.step(cmd.speed_mps, cmd.steer_rad);
+        let moved_m = before.distance_to(&self.world.sim.fork_root_pose());
+        self.world.mark();
+        self.world.travelled_m += moved_m;
+        if self.world.sim.carrying() {
+            self.world.travelled_loaded_m += moved_m;
+        }
+        let (scale, offset) = self.loc.odometry_error;
+        let (v, steer) = (
+            self.world.sim.speed_mps() * (1.0 + scale),
+            self.world.sim.steer_rad() + offset,
+        );
+        for p in [&mut self.loc.predictor, &mut self.loc.odometry] {
+            p.propagate(
+                v,
+                steer,
+                truck.wheelbase_m,
+                truck.fork_root_ahead_of_front_axle_m,
+                self.world.sim.dt_s(),
+            );
+        }
+        self.verdict.out.max_steer_rad = self
+            .verdict
+            .out
+            .max_steer_rad
+            .max(self.world.sim.steer_rad().abs());
+        if self.world.sim.obstacle_contact() && !self.world.collision {
+            rec.event(
+                self.world.sim.time_s(),
+                Level::Error,
+                "truck touched a rack or wall",
+            );
+        }
+        self.world.collision |= self.world.sim.obstacle_contact();
+        self.safety_step(rec);
+        self.record_signals(cmd, pose, rec);
+        rec.step(&StepRecord {
+            t_s: self.world.sim.time_s(),
+            truth: self.world.sim.fork_root_pose(),
+            fix,
+            estimate: pose,
+            pallet: self.world.sim.pallet_pose(),
+            pallet_estimate: self.sense.pallet_est,
+            steer_cmd_rad: cmd.steer_rad,
+            steer_rad: self.world.sim.steer_rad(),
+            speed_cmd_mps: cmd.speed_mps,
+            speed_mps: self.world.sim.speed_mps(),
+            lookahead: cmd.lookahead_point,
+            cross_track_m: cmd.cross_track_m,
+            path_curvature_per_m: cmd.path_curvature_per_m,
+            contact_force_n: self.world.sim.fork_contact_force_n(),
+        });
+    }
+
+    /// What a failed entry is most often traced to: how far off the localisation was,
+    /// and how far off the path the tracker let the truck run; at 10 Hz, which shows both
+    /// and costs a recording a tenth of the control rate.
+    fn record_signals<R: Recorder + ?Sized>(&self, cmd: &Command, pose: Pose2, rec: &mut R) {
+        let t = self.world.sim.time_s();
+        let step = (t / self.world.sim.dt_s()).round() as u64;
+        if !step.is_multiple_of(SIGNAL_EVERY_STEPS) {
+            return;
+        }
+        let truth = self.world.sim.fork_root_pose();
+        let loc_error = (pose.x_m - truth.x_m).hypot(pose.y_m - truth.y_m);
+        let none = Style::default();
+        rec.signal(
+            t,
+            "localisation/position_error_m",
+            &Signal::Scalar(loc_error),
+            none,
+        );
+        rec.signal(
+            t,
+            "track/cross_track_m",
+            &Signal::Scalar(cmd.cross_track_m),
+            none,
+        );
     }
 }
 
