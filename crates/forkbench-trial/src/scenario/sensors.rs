@@ -224,20 +224,20 @@ pub(super) fn resolve(
     sensors.sort_by(|a, b| {
         (a.scanner.range_max_m.total_cmp(&b.scanner.range_max_m)).then_with(|| a.name.cmp(&b.name))
     });
-    let table = toml::Value::Table(p.detector.clone().unwrap_or_default());
-    let detector = ComponentSpec::from_value(
-        Role::Detector,
-        &table,
-        Some(crate::components::POCKET_DETECTOR),
-        ".".into(),
-    )
-    .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))?;
     Ok(PalletSensing::Scanner {
         sensors,
-        detector,
+        detector: detector_of(p, file)?,
         latency_s,
         min_score,
     })
+}
+
+/// `[sensors.pallet.detector]`: its kind (the pocket detector by default) and settings.
+fn detector_of(p: &PalletSensorFile, file: &str) -> Result<ComponentSpec, TrialError> {
+    let table = toml::Value::Table(p.detector.clone().unwrap_or_default());
+    let default = Some(crate::components::POCKET_DETECTOR);
+    ComponentSpec::from_value(Role::Detector, &table, default, ".".into())
+        .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))
 }
 
 /// `[sensors.pallet] min_score`, in 0–1 (default `detect`'s threshold, so a trial's
