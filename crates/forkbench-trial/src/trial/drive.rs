@@ -4,6 +4,7 @@ use forkbench_core::Pose2;
 use forkbench_core::units::wrap_angle;
 use forkbench_track::{Command, TrackerInput};
 
+use super::SIGNAL_EVERY_STEPS;
 use super::engine::Steering;
 use super::judge::in_pallet_frame;
 use super::link::Control;
@@ -20,9 +21,6 @@ pub(super) struct PickDrive {
     /// Re-estimate ranges still ahead, nearest last.
     reestimates: Vec<f64>,
 }
-
-/// The trial's own scalar signals go out every this many control steps.
-pub(in crate::trial) const SIGNAL_EVERY_STEPS: u64 = 10;
 
 impl<'a> Steering<'a, StageError> for PickDrive {
     fn sensed<R: Recorder + ?Sized>(

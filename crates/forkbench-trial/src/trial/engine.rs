@@ -7,10 +7,11 @@ use std::task::{Context, Poll};
 use forkbench_core::Pose2;
 use forkbench_track::Command;
 
-use super::drive::SIGNAL_EVERY_STEPS;
-use super::goal_for;
 use super::link::{Control, Link, Observation, Truth};
-use super::state::Trial;
+use super::safety;
+use super::state::{Localization, Trial, WorldState};
+use super::{SIGNAL_EVERY_STEPS, goal_for};
+use crate::outcome::TrialOutcome;
 use crate::recorder::{Level, Recorder, StepRecord};
 use crate::stage_error::StageError;
 use forkbench_core::{Signal, Style};
@@ -79,7 +80,7 @@ impl<'a> Trial<'a> {
             {
                 *since += 1;
                 let (mut cmd, control) = (*cmd, *control);
-                cmd.speed_mps = self.safety_gate(cmd.speed_mps, rec);
+                cmd.speed_mps = safety::gate(&mut self.safety, &self.world.sim, cmd.speed_mps, rec);
                 self.physics_step(&cmd, None, pose, rec);
                 match steering.stepped(self, control, &cmd, rec) {
                     Ok(false) => continue,
@@ -102,7 +103,7 @@ impl<'a> Trial<'a> {
                 Err(e) => break Err(e),
             };
             let mut cmd = asked;
-            cmd.speed_mps = self.safety_gate(asked.speed_mps, rec);
+            cmd.speed_mps = safety::gate(&mut self.safety, &self.world.sim, asked.speed_mps, rec);
             self.physics_step(&cmd, fix, pose, rec);
             held = Some((asked, control, 1));
             match steering.stepped(self, control, &cmd, rec) {
@@ -198,7 +199,8 @@ impl<'a> Trial<'a> {
 }
 
 impl Trial<'_> {
-    /// One physics step under `cmd`, the odometry update, collisions and the record.
+    /// One physics step under `cmd`: the world and the odometry move, the people and
+    /// the safety fields follow, the step is recorded.
     pub(super) fn physics_step<R: Recorder + ?Sized>(
         &mut self,
         cmd: &Command,
@@ -207,86 +209,102 @@ impl Trial<'_> {
         rec: &mut R,
     ) {
         let truck = &self.scn.truck;
-        let before = self.world.sim.fork_root_pose();
-        self.world.sim.step(cmd.speed_mps, cmd.steer_rad);
-        let moved_m = before.distance_to(&self.world.sim.fork_root_pose());
-        self.world.mark();
-        self.world.travelled_m += moved_m;
-        if self.world.sim.carrying() {
-            self.world.travelled_loaded_m += moved_m;
-        }
-        let (scale, offset) = self.loc.odometry_error;
-        let (v, steer) = (
-            self.world.sim.speed_mps() * (1.0 + scale),
-            self.world.sim.steer_rad() + offset,
+        step_world(
+            &mut self.world,
+            &mut self.loc,
+            &mut self.verdict.out,
+            truck,
+            cmd,
+            rec,
         );
-        for p in [&mut self.loc.predictor, &mut self.loc.odometry] {
-            p.propagate(
-                v,
-                steer,
-                truck.wheelbase_m,
-                truck.fork_root_ahead_of_front_axle_m,
-                self.world.sim.dt_s(),
-            );
-        }
-        self.verdict.out.max_steer_rad = self
-            .verdict
-            .out
-            .max_steer_rad
-            .max(self.world.sim.steer_rad().abs());
-        if self.world.sim.obstacle_contact() && !self.world.collision {
-            rec.event(
-                self.world.sim.time_s(),
-                Level::Error,
-                "truck touched a rack or wall",
-            );
-        }
-        self.world.collision |= self.world.sim.obstacle_contact();
         self.safety_step(rec);
-        self.record_signals(cmd, pose, rec);
-        rec.step(&StepRecord {
-            t_s: self.world.sim.time_s(),
-            truth: self.world.sim.fork_root_pose(),
-            fix,
-            estimate: pose,
-            pallet: self.world.sim.pallet_pose(),
-            pallet_estimate: self.sense.pallet_est,
-            steer_cmd_rad: cmd.steer_rad,
-            steer_rad: self.world.sim.steer_rad(),
-            speed_cmd_mps: cmd.speed_mps,
-            speed_mps: self.world.sim.speed_mps(),
-            lookahead: cmd.lookahead_point,
-            cross_track_m: cmd.cross_track_m,
-            path_curvature_per_m: cmd.path_curvature_per_m,
-            contact_force_n: self.world.sim.fork_contact_force_n(),
-        });
+        let pallet_est = self.sense.pallet_est;
+        record_step(&self.world, pallet_est, cmd, (fix, pose), rec);
     }
+}
 
-    /// What a failed entry is most often traced to: how far off the localisation was,
-    /// and how far off the path the tracker let the truck run; at 10 Hz, which shows both
-    /// and costs a recording a tenth of the control rate.
-    fn record_signals<R: Recorder + ?Sized>(&self, cmd: &Command, pose: Pose2, rec: &mut R) {
-        let t = self.world.sim.time_s();
-        let step = (t / self.world.sim.dt_s()).round() as u64;
-        if !step.is_multiple_of(SIGNAL_EVERY_STEPS) {
-            return;
-        }
-        let truth = self.world.sim.fork_root_pose();
+/// The world's physics step under `cmd`, the truck's odometry (`loc`) propagated on its
+/// own errors, and what the outcome keeps of the step (the largest steering, a rack or
+/// wall touched).
+fn step_world<R: Recorder + ?Sized>(
+    world: &mut WorldState,
+    loc: &mut Localization,
+    out: &mut TrialOutcome,
+    truck: &forkbench_core::ForkliftSpec,
+    cmd: &Command,
+    rec: &mut R,
+) {
+    let before = world.sim.fork_root_pose();
+    world.sim.step(cmd.speed_mps, cmd.steer_rad);
+    let moved_m = before.distance_to(&world.sim.fork_root_pose());
+    world.mark();
+    world.travelled_m += moved_m;
+    if world.sim.carrying() {
+        world.travelled_loaded_m += moved_m;
+    }
+    let (scale, offset) = loc.odometry_error;
+    let (v, steer) = (
+        world.sim.speed_mps() * (1.0 + scale),
+        world.sim.steer_rad() + offset,
+    );
+    for p in [&mut loc.predictor, &mut loc.odometry] {
+        p.propagate(
+            v,
+            steer,
+            truck.wheelbase_m,
+            truck.fork_root_ahead_of_front_axle_m,
+            world.sim.dt_s(),
+        );
+    }
+    out.max_steer_rad = out.max_steer_rad.max(world.sim.steer_rad().abs());
+    if world.sim.obstacle_contact() && !world.collision {
+        rec.event(
+            world.sim.time_s(),
+            Level::Error,
+            "truck touched a rack or wall",
+        );
+    }
+    world.collision |= world.sim.obstacle_contact();
+}
+
+/// The step as recorded: the truth, the fix and the controller's `pose`, the pallet and
+/// its estimate, the command and the response; at 10 Hz also the localisation and
+/// cross-track errors (what a failed entry is most often traced to, at a tenth of the
+/// control rate).
+fn record_step<R: Recorder + ?Sized>(
+    world: &WorldState,
+    pallet_est: Pose2,
+    cmd: &Command,
+    (fix, pose): (Option<Pose2>, Pose2),
+    rec: &mut R,
+) {
+    let sim = &world.sim;
+    let t = sim.time_s();
+    let truth = sim.fork_root_pose();
+    if ((t / sim.dt_s()).round() as u64).is_multiple_of(SIGNAL_EVERY_STEPS) {
         let loc_error = (pose.x_m - truth.x_m).hypot(pose.y_m - truth.y_m);
         let none = Style::default();
-        rec.signal(
-            t,
-            "localisation/position_error_m",
-            &Signal::Scalar(loc_error),
-            none,
-        );
-        rec.signal(
-            t,
-            "track/cross_track_m",
-            &Signal::Scalar(cmd.cross_track_m),
-            none,
-        );
+        let error = Signal::Scalar(loc_error);
+        rec.signal(t, "localisation/position_error_m", &error, none);
+        let cross = Signal::Scalar(cmd.cross_track_m);
+        rec.signal(t, "track/cross_track_m", &cross, none);
     }
+    rec.step(&StepRecord {
+        t_s: t,
+        truth,
+        fix,
+        estimate: pose,
+        pallet: sim.pallet_pose(),
+        pallet_estimate: pallet_est,
+        steer_cmd_rad: cmd.steer_rad,
+        steer_rad: sim.steer_rad(),
+        speed_cmd_mps: cmd.speed_mps,
+        speed_mps: sim.speed_mps(),
+        lookahead: cmd.lookahead_point,
+        cross_track_m: cmd.cross_track_m,
+        path_curvature_per_m: cmd.path_curvature_per_m,
+        contact_force_n: sim.fork_contact_force_n(),
+    });
 }
 
 /// The tick's command under the caller's `control`.

@@ -41,6 +41,9 @@ use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
 use state::Trial;
 
+/// The trial's own scalar signals go out every this many control steps.
+pub(in crate::trial) const SIGNAL_EVERY_STEPS: u64 = 10;
+
 pub use crate::scenario::APPROACH_GAP_M;
 pub use crate::stage_error::{LegError, StageError};
 

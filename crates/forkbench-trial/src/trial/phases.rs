@@ -148,7 +148,7 @@ impl<'a> Steering<'a, Failed> for PhaseDrive<'_, '_> {
         every_step(t)?;
         let now = t.world.sim.time_s();
         let step = (now / t.world.sim.dt_s()).round() as u64;
-        if step.is_multiple_of(crate::trial::drive::SIGNAL_EVERY_STEPS) {
+        if step.is_multiple_of(crate::trial::SIGNAL_EVERY_STEPS) {
             let [front, rear] = t.world.sim.axle_loads_n();
             let none = Style::default();
             rec.signal(now, "load/front_axle_n", &Signal::Scalar(front), none);

@@ -13,34 +13,39 @@ use crate::recorder::{Level, Recorder};
 
 const PERSON: Style = Style::rgba([255, 120, 200, 255]).width(0.04);
 
-impl Trial<'_> {
-    /// The speed the safety function lets the truck drive at, for the controller's
-    /// `speed_mps` this step.
-    pub(super) fn safety_gate<R: Recorder + ?Sized>(&mut self, speed_mps: f64, rec: &mut R) -> f64 {
-        let (t, dt) = (self.world.sim.time_s(), self.world.sim.dt_s());
-        let Some(s) = self.safety.as_mut() else {
-            return speed_mps;
-        };
-        s.requested_mps = speed_mps;
-        let Some(m) = s.monitor.as_mut() else {
-            return speed_mps;
-        };
-        let (was, held) = (m.function.stopped(), m.function.stats.stop_time_s);
-        let standing = self.world.sim.speed_mps().abs() < STANDING_MPS;
-        let v = m.function.gate(t, dt, speed_mps, standing);
-        if was && !m.function.stopped() {
-            let this_s = m.stop_began_s.take().map_or(0.0, |b| t - b);
-            let why = format!(
-                "safety: fields clear, driving on after {this_s:.1} s ({held:.1} s stopped in all)"
-            );
-            rec.event(t, Level::Info, &why);
-        } else if !was && m.function.stopped() {
-            m.stop_began_s = Some(t);
-            rec.event(t, Level::Warn, "safety: protective stop (braking)");
-        }
-        v
+/// The tick's safety gate: the speed the safety function (`safety`, reading the world's
+/// `sim`) lets the truck drive at, for the controller's `speed_mps` this step.
+pub(super) fn gate<R: Recorder + ?Sized>(
+    safety: &mut Option<SafetyRun>,
+    sim: &forkbench_sim::Sim,
+    speed_mps: f64,
+    rec: &mut R,
+) -> f64 {
+    let (t, dt) = (sim.time_s(), sim.dt_s());
+    let Some(s) = safety.as_mut() else {
+        return speed_mps;
+    };
+    s.requested_mps = speed_mps;
+    let Some(m) = s.monitor.as_mut() else {
+        return speed_mps;
+    };
+    let (was, held) = (m.function.stopped(), m.function.stats.stop_time_s);
+    let standing = sim.speed_mps().abs() < STANDING_MPS;
+    let v = m.function.gate(t, dt, speed_mps, standing);
+    if was && !m.function.stopped() {
+        let this_s = m.stop_began_s.take().map_or(0.0, |b| t - b);
+        let why = format!(
+            "safety: fields clear, driving on after {this_s:.1} s ({held:.1} s stopped in all)"
+        );
+        rec.event(t, Level::Info, &why);
+    } else if !was && m.function.stopped() {
+        m.stop_began_s = Some(t);
+        rec.event(t, Level::Warn, "safety: protective stop (braking)");
     }
+    v
+}
 
+impl Trial<'_> {
     /// After a physics step: the movers walk on, contacts and closest approaches are
     /// judged, and at each safety scan the fields are read.
     pub(super) fn safety_step<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
@@ -122,7 +127,7 @@ impl Trial<'_> {
             }
             s.touching[i] = touching;
         }
-        if ((t / dt).round() as u64).is_multiple_of(super::drive::SIGNAL_EVERY_STEPS) {
+        if ((t / dt).round() as u64).is_multiple_of(super::SIGNAL_EVERY_STEPS) {
             for (i, m) in s.movers.iter().enumerate().filter(|(_, m)| !m.gone()) {
                 let (p, l, w) = m.body();
                 let outline = forkbench_core::geometry::rect_outline(&p, l, w);
