@@ -1,6 +1,6 @@
 //! `estimate` and `falsify`: rare events over a scenario's `[[uncertain]]` parameters, as the CLI's commands compute them, returned as dicts.
 
-use forkbench_batch::rare::{Event, RareSetup};
+use forkbench_batch::rare::{Event, RareSetup, Tried};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -75,12 +75,9 @@ pub fn estimate<'py>(
         (event, seed, jobs),
         options,
     )?;
-    let (e, tried) = py
-        .detach(|| forkbench_batch::rare::estimate(&s, method, budget, None))
-        .map_err(|e| BatchError::new_err(e.to_string()))?;
-    let d = serde_to_py(py, &e)?;
-    d.set_item("records", serde_to_py(py, &tried)?)?;
-    Ok(d)
+    with_records(py, &s, |s| {
+        forkbench_batch::rare::estimate(s, method, budget, None)
+    })
 }
 
 /// The most likely failure (the failing point of highest nominal density) within `budget`
@@ -112,10 +109,22 @@ pub fn falsify<'py>(
         (event, seed, jobs),
         options,
     )?;
-    let (f, tried) = py
-        .detach(|| forkbench_batch::rare::falsify(&s, budget, monte_carlo, None))
+    with_records(py, &s, |s| {
+        forkbench_batch::rare::falsify(s, budget, monte_carlo, None)
+    })
+}
+
+/// A rare-event run on `s` without the GIL, as a dict: its result and `records`, every
+/// trial run with its point.
+fn with_records<'py, T: serde::Serialize + Send>(
+    py: Python<'py>,
+    s: &RareSetup,
+    run: impl FnOnce(&RareSetup) -> Result<(T, Vec<Tried>), forkbench_batch::BatchError> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (result, tried) = py
+        .detach(|| run(s))
         .map_err(|e| BatchError::new_err(e.to_string()))?;
-    let d = serde_to_py(py, &f)?;
+    let d = serde_to_py(py, &result)?;
     d.set_item("records", serde_to_py(py, &tried)?)?;
     Ok(d)
 }
