@@ -17,37 +17,53 @@ pub const MAX_NOISE_SCALE: f64 = 100.0;
 /// What a run changes of a scenario besides its seed, components and replanning: the
 /// noise scales and sensing models. A batch records them with every trial, so `replay`
 /// rebuilds the trial exactly.
+///
+/// With the `clap` feature it is the CLI's flag set (each field's flag is its name with
+/// dashes, its help its doc), so a knob is one field here; the truck's preset and settings
+/// come from the CLI's `--truck PRESET|FILE` instead.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct Overrides {
-    /// Scales every pallet-sensing error: the Gaussian estimate's σ, and each scanner's
-    /// random range error and systematic bias (0 = exact returns; a spot straddling a
-    /// depth edge still mixes ranges, which is geometry, not noise).
+    /// Scales every pallet-sensing error, 0–100: the Gaussian estimate's σ, and each
+    /// scanner's random range error and systematic bias (0 = exact returns; a spot
+    /// straddling a depth edge still mixes ranges, which is geometry, not noise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
     pub pallet_noise_scale: Option<f64>,
-    /// Scales the localiser's noise: the Gaussian σ or the NAV350's reflector range and
-    /// bearing σ.
+    /// Scales the localiser's noise, 0–100: the Gaussian σ or the NAV350's reflector
+    /// range and bearing σ (0 = exact fixes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
     pub localization_noise_scale: Option<f64>,
-    /// Scales the odometry's speed-scale and steering-offset σ.
+    /// Scales the odometry's speed-scale and steering-offset σ, 0–100 (0 = exact
+    /// odometry).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "clap", arg(long, allow_hyphen_values = true))]
     pub odometry_noise_scale: Option<f64>,
-    /// Localise with this kind at its default settings instead of `[sensors.localizer]`.
+    /// Localise with this kind at its default settings (gaussian: σ around the truth;
+    /// nav350: the world's reflectors) instead of each scenario's `[sensors.localizer]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "clap", arg(long, value_name = "KIND"))]
     pub localizer: Option<String>,
-    /// Estimate the pallet with this sensing kind at its default settings instead of
-    /// `[sensors.pallet]`.
+    /// Estimate the pallet with this sensing at its default settings (gaussian, tim561,
+    /// kinect2 or tim561+kinect2) instead of each scenario's `[sensors.pallet]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "clap", arg(long, value_name = "KIND"))]
     pub pallet_sensing: Option<String>,
-    /// Reflectors missing from the world while the NAV350's map keeps them.
+    /// Reflectors (comma-separated names) missing from the world while the NAV350's map
+    /// keeps them: which legs suffer if they go.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "clap", arg(long, value_delimiter = ',', value_name = "NAMES"))]
     pub missing_reflectors: Option<Vec<String>>,
     /// Take this preset's actuators and control timing (`ideal`, `realistic`) instead
     /// of the scenario's `[truck]` ones.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub truck_preset: Option<String>,
     /// Actuator and timing settings by dotted path (`steering.dead_time_s`; see
     /// [`super::TRUCK_KNOBS`]), after the preset: a `--truck` file, a sweep's point.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[cfg_attr(feature = "clap", arg(skip))]
     pub truck: BTreeMap<String, f64>,
 }
 
