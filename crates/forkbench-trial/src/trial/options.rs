@@ -53,7 +53,10 @@ pub struct Overrides {
     /// Reflectors (comma-separated names) missing from the world while the NAV350's map
     /// keeps them: which legs suffer if they go.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[cfg_attr(feature = "clap", arg(long, value_delimiter = ',', value_name = "NAMES"))]
+    #[cfg_attr(
+        feature = "clap",
+        arg(long, value_delimiter = ',', value_name = "NAMES")
+    )]
     pub missing_reflectors: Option<Vec<String>>,
     /// Take this preset's actuators and control timing (`ideal`, `realistic`) instead
     /// of the scenario's `[truck]` ones.
