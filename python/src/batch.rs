@@ -40,7 +40,7 @@ pub fn run_trial<'py>(
         tracker,
         no_noise: !noise,
         replan,
-        overrides: crate::options::overrides(py, options)?,
+        overrides: crate::options::overrides(options)?,
         wall_budget_s: None,
         uncertain: Default::default(),
     };
@@ -116,7 +116,7 @@ pub fn run_batch<'py>(
     force_new: bool,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
-    let overrides = crate::options::overrides(py, options)?;
+    let overrides = crate::options::overrides(options)?;
     let embedded = scenarios.is_none();
     let scenarios = match scenarios {
         Some(s) => s.iter().map(|s| (*s.inner).clone()).collect(),

@@ -89,6 +89,14 @@ pub fn to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
     })
 }
 
+/// A Python object as JSON text, as `json.dumps` writes it (the way back from [`to_py`]).
+pub fn json_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    obj.py()
+        .import("json")?
+        .call_method1("dumps", (obj,))?
+        .extract()
+}
+
 /// Any serialisable result as its Python object.
 pub fn serde_to_py<'py, T: serde::Serialize>(
     py: Python<'py>,

@@ -95,7 +95,7 @@ impl PickEnv {
             tracker,
             noise,
             replan,
-            overrides: crate::options::overrides(py, options)?,
+            overrides: crate::options::overrides(options)?,
             ticks_per_step,
             path_points,
             path_spacing_m,

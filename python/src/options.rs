@@ -7,12 +7,11 @@ use pyo3::types::PyDict;
 
 /// The options `kwargs` set (`None` values are unset). A keyword that is not an option is
 /// refused with the option names, and a value of the wrong type with the option's name.
-pub fn overrides(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Overrides> {
+pub fn overrides(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Overrides> {
     let Some(kwargs) = kwargs else {
         return Ok(Overrides::default());
     };
     let names = Overrides::field_names();
-    let json = py.import("json")?;
     let mut map = serde_json::Map::new();
     for (k, v) in kwargs.iter() {
         let key: String = k.extract()?;
@@ -26,10 +25,7 @@ pub fn overrides(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult
             continue;
         }
         let bad = |why: String| PyTypeError::new_err(format!("{key}: {why}"));
-        let text: String = json
-            .call_method1("dumps", (&v,))
-            .and_then(|t| t.extract())
-            .map_err(|e| bad(e.to_string()))?;
+        let text = crate::convert::json_text(&v).map_err(|e| bad(e.to_string()))?;
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| bad(format!("{text}: {e}")))?;
         let one = serde_json::Value::Object([(key.clone(), value.clone())].into_iter().collect());

@@ -16,7 +16,7 @@ fn setup(
     (event, seed, jobs): (&str, u64, Option<usize>),
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<RareSetup> {
-    let overrides = crate::options::overrides(py, options)?;
+    let overrides = crate::options::overrides(options)?;
     let scn = scenario.inner.as_ref().clone();
     let case = scn
         .pick_case(case)

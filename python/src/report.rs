@@ -52,10 +52,7 @@ pub fn replay<'py>(
         })
         .map_err(fail)?
     } else {
-        let text: String = py
-            .import("json")?
-            .call_method1("dumps", (record,))?
-            .extract()?;
+        let text = crate::convert::json_text(record)?;
         let rec: TrialRecord = serde_json::from_str(&text)
             .map_err(|e| BatchError::new_err(format!("not a trial record: {e}")))?;
         Replay::find(rec, given, None).map_err(fail)?

@@ -125,7 +125,7 @@ impl PickVecEnv {
         phase_reward: Option<f64>,
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let overrides = crate::options::overrides(py, options)?;
+        let overrides = crate::options::overrides(options)?;
         let bytes = (num_envs as u64).saturating_mul(env_bytes(&scenario.inner));
         if num_envs == 0 || bytes > MAX_ENVS_BYTES {
             return Err(PyValueError::new_err(format!(

@@ -73,8 +73,7 @@ pub fn write_csv(records: &[TrialRecord], path: &Path) -> Result<(), BatchError>
     let finite = |v: f64| v.is_finite().then_some(v);
     for r in sorted {
         let o = &r.outcome;
-        let (header, record) = cells(r, finite).map_err(|e| csv_error(path, e))?;
-        let mut record = record;
+        let (header, mut record) = cells(r, finite).map_err(|e| csv_error(path, e))?;
         if !header_written {
             let mut h = header;
             h.extend(measures.iter().copied());

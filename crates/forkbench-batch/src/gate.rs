@@ -366,12 +366,12 @@ pub fn regress(
 ) -> GateReport {
     let mut differences = manifest.map_or_else(Vec::new, |m| base.setting_differences(m));
     if let (Some(then), Some(now)) = (base.provenance.as_ref().map(|p| &p.manifest), manifest)
-        && then.overrides() != now.overrides()
+        && then.overrides != now.overrides
     {
         differences.push(format!(
             "the run's overrides: {} → {}",
-            overrides_text(&then.overrides()),
-            overrides_text(&now.overrides())
+            overrides_text(&then.overrides),
+            overrides_text(&now.overrides)
         ));
     }
     let index: HashMap<TrialKey, (u64, bool)> = records

@@ -160,11 +160,6 @@ impl Manifest {
         })
     }
 
-    /// The overrides its trials ran with.
-    pub fn overrides(&self) -> forkbench_trial::trial::Overrides {
-        self.overrides.clone()
-    }
-
     /// The manifest in `dir`, if there is one.
     pub fn read(dir: &Path) -> Result<Option<Self>, BatchError> {
         let path = dir.join(FILE);

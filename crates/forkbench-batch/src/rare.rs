@@ -62,10 +62,7 @@ impl Event {
                 robustness: margin,
             },
             Event::Criterion(name) => Outcome {
-                event: o.failure.as_ref().is_some_and(|f| f.name() == name)
-                    || o.also_failed
-                        .iter()
-                        .any(|a| a.split(':').next() == Some(name)),
+                event: o.broke_named(name),
                 robustness: margin,
             },
             Event::Contact => {

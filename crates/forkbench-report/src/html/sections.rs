@@ -366,7 +366,7 @@ fn batch_in_words(m: &Manifest) -> String {
             v.join(", ")
         }
     };
-    let o = m.overrides();
+    let o = &m.overrides;
     let mut noise: Vec<String> = forkbench_trial::trial::NOISE_KNOBS
         .iter()
         .filter_map(|k| o.scale(k).map(|x| format!("{} × {x}", k.replace('_', " "))))

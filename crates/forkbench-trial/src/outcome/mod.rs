@@ -76,15 +76,23 @@ impl Failure {
     /// The failure a name stands for: a fixed one, else a criterion's (a step criterion's
     /// or a registered phase's) when the name is one a criterion can have.
     pub fn from_name(name: &str) -> Option<Failure> {
-        if let Some(f) = NAMED.iter().find(|f| f.name() == name) {
-            return Some(f.clone());
-        }
-        is_criterion_name(name).then(|| Failure::Criterion(Cow::Owned(name.to_owned())))
+        Self::fixed(name)
+            .or_else(|| is_criterion_name(name).then(|| Failure::Criterion(name.to_owned().into())))
     }
 
     /// The failure of the criterion called `name`.
     pub fn criterion(name: impl Into<Cow<'static, str>>) -> Failure {
         Failure::Criterion(name.into())
+    }
+
+    /// The failure a criterion's `name` stands for: the fixed one so named, else its own.
+    pub fn of_criterion(name: &'static str) -> Failure {
+        Self::fixed(name).unwrap_or(Failure::Criterion(Cow::Borrowed(name)))
+    }
+
+    /// The fixed failure called `name`, if one is.
+    fn fixed(name: &str) -> Option<Failure> {
+        NAMED.iter().find(|f| f.name() == name).cloned()
     }
 }
 

@@ -190,8 +190,8 @@ pub(super) fn resolve(
                 file,
                 "sensors.pallet.kind",
                 &format!(
-                    "{name:?} is not a pallet sensing kind (known: gaussian, {}, or scanners \
-                     joined by '+')",
+                    "{name:?} is not a pallet sensing kind (known: {GAUSSIAN_SENSING}, {}, or \
+                     scanners joined by '+')",
                     SCANNER_PRESETS.join(", ")
                 ),
             ));

@@ -81,8 +81,13 @@ pub(super) fn row<const I: usize>() -> Box<dyn StepCriterion> {
 impl TrialOutcome {
     /// Whether the trial broke `failure`: its verdict, or one of `also_failed`.
     pub fn broke(&self, failure: &Failure) -> bool {
-        let name = failure.name();
-        self.failure.as_ref() == Some(failure)
+        self.broke_named(failure.name())
+    }
+
+    /// Whether the trial broke the criterion called `name` (a failure's name stands for
+    /// one failure): its verdict, or one of `also_failed`.
+    pub fn broke_named(&self, name: &str) -> bool {
+        self.failure.as_ref().is_some_and(|f| f.name() == name)
             || self
                 .also_failed
                 .iter()

@@ -36,9 +36,7 @@ impl<'a> Trial<'a> {
                 self.verdict.out.measures.insert(key.to_owned(), v);
             }
             if let Some(why) = c.judge(&judged) {
-                let name = c.name();
-                let failure = Failure::from_name(name).unwrap_or_else(|| Failure::criterion(name));
-                broken.push((failure, why));
+                broken.push((Failure::of_criterion(c.name()), why));
             }
             if let Some(margin) = c.margin(&judged) {
                 robustness = Some(robustness.map_or(margin, |r| r.min(margin)));

@@ -11,8 +11,8 @@ use crate::outcome::Failure;
 use crate::phase::{DriveRun, LegRun, PhaseHost, Steer};
 use crate::recorder::Recorder;
 use crate::scenario::mission::Waypoint;
+use crate::stage_error::StageError;
 use crate::tolerances::Limits;
-use crate::trial::StageError;
 use crate::trial::state::Trial;
 
 impl<'a> PhaseHost for Trial<'a> {
