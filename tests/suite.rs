@@ -4,6 +4,7 @@ mod cli;
 mod common;
 mod components_file;
 mod dataset;
+mod doc_numbers;
 mod external_planner;
 mod external_tracker;
 mod gate_candidate;
