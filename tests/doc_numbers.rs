@@ -61,9 +61,8 @@ fn a_number_changed_by_hand_fails_naming_it_and_rewrite_restores_it() {
     let o = doc_numbers(&numbers, &doc, &[]);
     let out = text(&o);
     assert_eq!(o.status.code(), Some(1), "{out}");
-    let want = format!(
-        "page.md:3: field.lateral_mm: the document says 99.9, a fresh run gives {fresh}"
-    );
+    let want =
+        format!("page.md:3: field.lateral_mm: the document says 99.9, a fresh run gives {fresh}");
     assert!(out.contains(&want), "wanted `{want}` in:\n{out}");
     assert!(!out.contains("field.sim_s: the document says"), "{out}");
     // Rewritten, the document is what it was and passes again.
@@ -86,7 +85,10 @@ fn a_marker_without_its_key_or_its_number_is_refused() {
     let o = doc_numbers(&numbers, &doc, &[]);
     let out = text(&o);
     assert_eq!(o.status.code(), Some(1), "{out}");
-    assert!(out.contains("page.md:1: field.nowhere: no such key"), "{out}");
+    assert!(
+        out.contains("page.md:1: field.nowhere: no such key"),
+        "{out}"
+    );
     assert!(
         out.contains("page.md:1: field.sim_s: a marker with no number right before it"),
         "{out}"

@@ -22,5 +22,6 @@ mod sensing;
 mod session;
 mod settings_ranges;
 mod staging;
+mod state_owners;
 mod trial;
 mod uncertain;

@@ -8,7 +8,6 @@ use super::SIGNAL_EVERY_STEPS;
 use super::engine::Steering;
 use super::judge::in_pallet_frame;
 use super::link::Control;
-use super::link::Stage;
 use super::state::Trial;
 use crate::recorder::{Level, Recorder};
 use crate::stage_error::StageError;
@@ -17,9 +16,11 @@ use forkbench_core::{Signal, Style};
 /// The pick's approach and insertion as a drive: the re-estimates due on the way (a
 /// replan when the estimate moved), the scenario's tracker, the entry checks; it ends
 /// docked, or for a caller's own commands once settled.
+#[derive(Default)]
 pub(super) struct PickDrive {
-    /// Re-estimate ranges still ahead, nearest last.
-    reestimates: Vec<f64>,
+    /// Re-estimate ranges still ahead, nearest last: read from the trial when the drive
+    /// begins (its first tick).
+    reestimates: Option<Vec<f64>>,
 }
 
 impl<'a> Steering<'a, StageError> for PickDrive {
@@ -29,27 +30,28 @@ impl<'a> Steering<'a, StageError> for PickDrive {
         pose: Pose2,
         rec: &mut R,
     ) -> Result<(), StageError> {
-        if let Some((due_s, est)) = t.sense.in_flight
-            && t.world.sim.time_s() + 1e-9 >= due_s
-        {
-            t.sense.in_flight = None;
+        let reestimates = self
+            .reestimates
+            .get_or_insert_with(|| reestimate_schedule(t));
+        if let Some(est) = t.estimate_arrived() {
             t.take_estimate(&pose, est, rec);
         }
         if t.sense.on_prior {
             if t.frame_due() {
                 let missed = t.verdict.out.estimates_missed;
                 t.reestimate(&pose, rec)?;
-                t.sense.on_prior = t.verdict.out.estimates_missed > missed;
+                if t.verdict.out.estimates_missed == missed {
+                    t.leave_prior();
+                }
             }
             return Ok(());
         }
         if t.run.replan
-            && self
-                .reestimates
+            && reestimates
                 .first()
                 .is_some_and(|r| pose.distance_to(&t.sense.pallet_est) <= *r)
         {
-            self.reestimates.remove(0);
+            reestimates.remove(0);
             t.reestimate(&pose, rec)?;
         }
         Ok(())
@@ -89,32 +91,20 @@ impl<'a> Steering<'a, StageError> for PickDrive {
     }
 }
 
+/// The re-estimate ranges still ahead of the truck when its pick begins (nearest last).
+fn reestimate_schedule(t: &Trial<'_>) -> Vec<f64> {
+    let start_range = t.loc.first_fix.distance_to(&t.sense.pallet_est);
+    let schedule = t.scn.replan.reestimate_at_m.clone();
+    let mut reestimates: Vec<f64> = schedule
+        .unwrap_or_else(|| t.sense.estimator.reestimate_at_m())
+        .into_iter()
+        .filter(|r| *r < start_range)
+        .collect();
+    reestimates.sort_by(|a, b| b.total_cmp(a));
+    reestimates
+}
+
 impl<'a> Trial<'a> {
-    /// Drives until the tracker reports the goal reached and the truck stands, or the
-    /// scenario's time limit. Err: the state went non-finite, or the tracker failed.
-    pub(super) async fn drive<R: Recorder + ?Sized>(
-        &mut self,
-        rec: &mut R,
-    ) -> Result<(), StageError> {
-        let mut pick = self.pick_drive();
-        self.stage = Stage::Pick;
-        self.drive_by(self.scn.timeout_s, &mut pick, rec).await?;
-        Ok(())
-    }
-
-    /// The re-estimate ranges still ahead of the truck (nearest last).
-    fn pick_drive(&self) -> PickDrive {
-        let start_range = self.loc.first_fix.distance_to(&self.sense.pallet_est);
-        let schedule = self.scn.replan.reestimate_at_m.clone();
-        let mut reestimates: Vec<f64> = schedule
-            .unwrap_or_else(|| self.sense.estimator.reestimate_at_m())
-            .into_iter()
-            .filter(|r| *r < start_range)
-            .collect();
-        reestimates.sort_by(|a, b| b.total_cmp(a));
-        PickDrive { reestimates }
-    }
-
     /// The scenario's tracker's command at the measured `pose`. Err: it failed.
     pub(super) fn tracker_command(&mut self, pose: Pose2) -> Result<Command, StageError> {
         let cmd = self.tracker.command(&self.tracker_input(pose));
@@ -228,8 +218,7 @@ impl<'a> Trial<'a> {
         };
         let latency_s = self.run.pallet_sensing.latency_s();
         if latency_s > 0.0 {
-            // The detector's answer reaches the controller later: a newer one replaces it.
-            self.sense.in_flight = Some((self.world.sim.time_s() + latency_s, new_est));
+            self.send_estimate(latency_s, new_est);
         } else {
             self.take_estimate(pose, new_est, rec);
         }

@@ -122,6 +122,11 @@ impl<'a> Trial<'a> {
         ended
     }
 
+    /// The part of the cycle the trial drives from now on, as a session's caller sees it.
+    pub(super) fn enter(&mut self, stage: super::link::Stage) {
+        self.stage = stage;
+    }
+
     /// Physics steps per control tick (`[truck.control] period_s`, checked at load).
     fn control_steps_per_tick(&self) -> u32 {
         self.run

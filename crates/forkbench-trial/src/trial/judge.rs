@@ -88,10 +88,15 @@ impl<'a> Trial<'a> {
         }
     }
 
+    /// The outcome's simulated time: now.
+    pub(super) fn stamp_time(&mut self) {
+        self.verdict.out.sim_time_s = self.world.sim.time_s();
+    }
+
     /// The simulated time and the localisation so far: all a trial that ended before its
     /// drive to the pallet measured (the forks were never brought to it).
     pub(crate) fn measure_time(&mut self) {
-        self.verdict.out.sim_time_s = self.world.sim.time_s();
+        self.stamp_time();
         let period_s = self.loc.localizer.period_s();
         self.loc
             .stats

@@ -13,6 +13,13 @@ const REFLECTOR: Style = Style::rgb(250, 250, 250).width(0.3);
 const MISSING: Style = Style::rgba([255, 60, 60, 220]).width(0.3);
 const RAY: Style = Style::rgba([120, 255, 140, 150]).width(0.02);
 
+impl Localization {
+    /// The localisation's record of a new mission leg, from `t0_s`.
+    pub(super) fn begin_leg(&mut self, t0_s: f64) {
+        self.leg_stats = super::loc_stats::LocStats::new(t0_s);
+    }
+}
+
 impl Trial<'_> {
     /// The tick's sensing: within the wall-time budget, the localiser's reading at this
     /// instant (if one is due) into the controller's pose, recorded; Err when the budget

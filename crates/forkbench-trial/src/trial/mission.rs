@@ -98,14 +98,7 @@ impl Trial<'_> {
         let targets: Vec<&Waypoint> = m.via.iter().chain(std::iter::once(staging)).collect();
         for (i, to) in targets.into_iter().enumerate() {
             let leg = self.leg(&map, m, (i, &from, to), rec).await;
-            let ok = leg.success;
-            let why = leg.failure_detail.clone();
-            rec.event(
-                self.world.sim.time_s(),
-                if ok { Level::Info } else { Level::Error },
-                &format!("leg {}: {}", leg.name, why.as_deref().unwrap_or("arrived")),
-            );
-            self.verdict.out.legs.push(leg);
+            let (ok, why) = self.record_leg(leg, rec);
             if !ok {
                 return Err(StageError::Leg {
                     number: i + 1,
@@ -118,6 +111,23 @@ impl Trial<'_> {
         Ok(())
     }
 
+    /// A driven leg into the outcome, and its end into the log: whether it arrived, and
+    /// why not.
+    pub(super) fn record_leg<R: Recorder + ?Sized>(
+        &mut self,
+        leg: LegOutcome,
+        rec: &mut R,
+    ) -> (bool, Option<String>) {
+        let (ok, why) = (leg.success, leg.failure_detail.clone());
+        rec.event(
+            self.world.sim.time_s(),
+            if ok { Level::Info } else { Level::Error },
+            &format!("leg {}: {}", leg.name, why.as_deref().unwrap_or("arrived")),
+        );
+        self.verdict.out.legs.push(leg);
+        (ok, why)
+    }
+
     /// One leg: back out of the place it starts at (all but the first), plan from where
     /// the truck stands, drive, and measure the arrival.
     pub(super) async fn leg<R: Recorder + ?Sized>(
@@ -128,7 +138,7 @@ impl Trial<'_> {
         rec: &mut R,
     ) -> LegOutcome {
         let t0 = self.world.sim.time_s();
-        self.loc.leg_stats = super::loc_stats::LocStats::new(t0);
+        self.loc.begin_leg(t0);
         let mut leg = blank_leg(format!("{} → {}", from.name, to.name));
         let mut stats = DriveStats::default();
         let result = self

@@ -186,7 +186,9 @@ async fn stages<R: Recorder + ?Sized>(
         Ok(t) => t,
         Err(out) => return *out,
     };
-    if let Err(why) = trial.drive(rec).await {
+    trial.enter(link::Stage::Pick);
+    let mut pick = drive::PickDrive::default();
+    if let Err(why) = trial.drive_by(scn.timeout_s, &mut pick, rec).await {
         let why = why.to_string();
         rec.event(trial.world.sim.time_s(), Level::Error, &why);
         trial.measure();

@@ -15,6 +15,13 @@ use crate::stage_error::StageError;
 use crate::tolerances::Limits;
 use crate::trial::state::Trial;
 
+impl Trial<'_> {
+    /// What the running phase recorded with `record_measure`, handed over and cleared.
+    pub(super) fn take_phase_measures(&mut self) -> std::collections::BTreeMap<String, f64> {
+        std::mem::take(&mut self.verdict.phase_measures)
+    }
+}
+
 impl<'a> PhaseHost for Trial<'a> {
     fn sim(&self) -> &Sim {
         &self.world.sim

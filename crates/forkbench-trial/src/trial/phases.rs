@@ -60,10 +60,10 @@ impl<'a> Trial<'a> {
             if !self.verdict.out.success {
                 break;
             }
-            self.stage = Stage::Phase(u16::try_from(i + 1).unwrap_or(u16::MAX));
+            self.enter(Stage::Phase(u16::try_from(i + 1).unwrap_or(u16::MAX)));
             self.run_phase(spec, &mut rec).await;
         }
-        self.verdict.out.sim_time_s = self.world.sim.time_s();
+        self.stamp_time();
         self.verdict.out.cycle = Some(crate::outcome::CycleTotals {
             time_s: self.world.sim.time_s(),
             distance_loaded_m: self.world.travelled_loaded_m,
@@ -78,7 +78,7 @@ impl<'a> Trial<'a> {
             self.world.travelled_m,
             self.world.sim.carrying(),
         );
-        self.verdict.phase_measures.clear();
+        self.take_phase_measures();
         rec.event(t0, Level::Info, &format!("phase {}: start", spec.name));
         rec.signal(t0, "phase", &Signal::Text(&spec.name), Style::default());
         let result = spec.phase.run(self, rec).await;
@@ -91,7 +91,7 @@ impl<'a> Trial<'a> {
             time_s: t - t0,
             distance_m: self.world.travelled_m - d0,
             loaded: loaded || self.world.sim.carrying(),
-            measures: std::mem::take(&mut self.verdict.phase_measures),
+            measures: self.take_phase_measures(),
         };
         match result {
             Ok(()) => rec.event(t, Level::Info, &format!("phase {}: done", spec.name)),

@@ -213,6 +213,33 @@ impl Trial<'_> {
         Ok(Some(face.to_world(&self.scn.estimate_bias)))
     }
 
+    /// The estimate on its way from the detector, once it has reached the controller.
+    pub(super) fn estimate_arrived(&mut self) -> Option<Pose2> {
+        let (due_s, est) = self.sense.in_flight?;
+        (self.world.sim.time_s() + 1e-9 >= due_s).then(|| {
+            self.sense.in_flight = None;
+            est
+        })
+    }
+
+    /// The detector's answer reaches the controller `latency_s` later: a newer one
+    /// replaces it on its way.
+    pub(super) fn send_estimate(&mut self, latency_s: f64, est: Pose2) {
+        self.sense.in_flight = Some((self.world.sim.time_s() + latency_s, est));
+    }
+
+    /// Plans on the pallet's prior (`[pick] when_not_seen = "prior"`): every frame is
+    /// looked at until the face is found.
+    pub(super) fn aim_at_prior(&mut self) {
+        self.sense.pallet_est = self.world.pallet_nominal;
+        self.sense.on_prior = true;
+    }
+
+    /// The face was found while aiming at the prior: the re-estimates go by range again.
+    pub(super) fn leave_prior(&mut self) {
+        self.sense.on_prior = false;
+    }
+
     /// Makes `est` the estimate the truck aims at, and records its error against the
     /// true face `truth`.
     pub(super) fn adopt_estimate(&mut self, est: Pose2, truth: &Pose2) {

@@ -43,8 +43,7 @@ impl Trial<'_> {
                     Level::Warn,
                     "no pallet seen from the start: planning on the prior, looking at every frame",
                 );
-                self.sense.pallet_est = self.world.pallet_nominal;
-                self.sense.on_prior = true;
+                self.aim_at_prior();
                 return Ok(());
             }
             WhenNotSeen::Stage => {}
@@ -64,7 +63,7 @@ impl Trial<'_> {
                 pick.staging_distance_m
             ),
         );
-        self.stage = super::link::Stage::Staging;
+        self.enter(super::link::Stage::Staging);
         self.staging_leg(staging, rec)
             .await
             .map_err(|why| (Failure::StagingUnreachable, why))?;
@@ -119,13 +118,7 @@ impl Trial<'_> {
         };
         let i = self.verdict.out.legs.len();
         let leg = self.leg(&map, &m, (i, &m.start, &to), rec).await;
-        let (ok, why) = (leg.success, leg.failure_detail.clone());
-        rec.event(
-            self.world.sim.time_s(),
-            if ok { Level::Info } else { Level::Error },
-            &format!("leg {}: {}", leg.name, why.as_deref().unwrap_or("arrived")),
-        );
-        self.verdict.out.legs.push(leg);
+        let (ok, why) = self.record_leg(leg, rec);
         if ok {
             Ok(())
         } else {
