@@ -116,10 +116,10 @@ fn written(text: &str) -> Vec<(usize, String)> {
                 }
                 _ => continue,
             };
-            if let Some(w) = writes(&key, after) {
-                if w.contains('.') {
-                    out.push((n + 1, w));
-                }
+            if let Some(w) = writes(&key, after)
+                && w.contains('.')
+            {
+                out.push((n + 1, w));
             }
         }
     }
