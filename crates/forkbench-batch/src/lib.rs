@@ -18,7 +18,6 @@ pub mod detect_curve;
 pub mod detect_eval;
 mod export;
 mod gate;
-mod gate_text;
 mod guard;
 pub mod junit;
 mod manifest;

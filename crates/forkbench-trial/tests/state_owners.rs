@@ -27,7 +27,7 @@ const OWNERS: &[(&str, &str)] = &[
     ("trial.path_version", "plan.rs"),
     ("trial.stage", "engine.rs"),
     ("trial.link", "mod.rs"),
-    ("trial.safety", "safety.rs"),
+    ("trial.safety", "safety/mod.rs"),
 ];
 
 /// The trial's own fields, written as `self.F`, `t.F` or `trial.F`.
@@ -134,22 +134,31 @@ fn owner(path: &str) -> Option<&'static str> {
         .map(|(_, file)| *file)
 }
 
+/// Every `.rs` file under `dir`, named by its path below `root` (`safety/mod.rs`).
+fn sources(root: &Path, dir: &Path, out: &mut Vec<(String, String)>) {
+    for entry in fs::read_dir(dir).expect("a source folder") {
+        let path = entry.expect("entry").path();
+        if path.is_dir() {
+            sources(root, &path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let name = path.strip_prefix(root).expect("below root").to_string_lossy();
+            let text = fs::read_to_string(&path).expect("source");
+            out.push((name.replace('\\', "/"), text));
+        }
+    }
+}
+
 #[test]
 fn every_field_of_trial_state_is_written_by_its_owner_only() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/trial");
+    let mut files = Vec::new();
+    sources(&dir, &dir, &mut files);
     let mut wrong = Vec::new();
     let mut seen = 0;
-    for entry in fs::read_dir(&dir).expect("src/trial") {
-        let path = entry.expect("entry").path();
-        let file = path
-            .file_name()
-            .and_then(|f| f.to_str())
-            .expect("name")
-            .to_owned();
+    for (file, text) in &files {
         if file == "state.rs" || file == "setup.rs" {
             continue; // the state's definition and its one construction
         }
-        let text = fs::read_to_string(&path).expect("source");
         let text = text.split("#[cfg(test)]").next().unwrap_or_default();
         for (line, field) in written(text) {
             seen += 1;

@@ -17,7 +17,6 @@ mod phase_host;
 mod phases;
 mod plan;
 mod safety;
-mod safety_record;
 mod safety_run;
 mod sense;
 mod session;

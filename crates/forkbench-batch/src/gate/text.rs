@@ -1,7 +1,7 @@
 //! The gate's report in words: the Markdown table `regress` prints, and each row's numbers for JUnit and HTML.
 
-use super::gate::{GateReport, Pairing, RegressRow, Verdict};
-use super::summary::mode_name;
+use super::{GateReport, Pairing, RegressRow, Verdict};
+use crate::summary::mode_name;
 use forkbench_trial::text::md_cell;
 
 fn pct(v: f64) -> String {

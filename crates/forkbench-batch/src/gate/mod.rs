@@ -1,5 +1,7 @@
 //! The regression gate: each result row against its baseline row, paired on common random numbers when the seeds match, with multiplicity control and stated power.
 
+mod text;
+
 use std::collections::HashMap;
 
 use serde::{Deserialize, Serialize};

@@ -6,10 +6,11 @@ use forkbench_sensors::scan::WorldView as _;
 
 use super::link::Stage;
 use super::movers_view::WithMovers;
-use super::safety_record::{STOPPED, local, record_reading};
+mod record;
 use super::safety_run::{Monitor, SafetyRun, gap_to, truck_parts};
 use super::state::Trial;
 use crate::recorder::{Level, Recorder};
+use record::{STOPPED, local, record_reading};
 
 const PERSON: Style = Style::rgba([255, 120, 200, 255]).width(0.04);
 
