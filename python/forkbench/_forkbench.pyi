@@ -13,6 +13,7 @@ __version__: str
 OBSERVATION_FIELDS: list[str]
 RUN_OPTIONS: list[str]
 STAGE_FIELD: str
+ENV_DEFAULTS: dict[str, object]
 
 class RunOptions(TypedDict, total=False):
     """A run's options, each a keyword of `run_trial`, `run_batch`, `estimate`,

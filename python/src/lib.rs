@@ -35,5 +35,9 @@ fn _forkbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
         forkbench_trial::trial::Overrides::field_names().to_vec(),
     )?;
     m.add("STAGE_FIELD", forkbench_gym::obs::STAGE_FIELD)?;
+    m.add(
+        "ENV_DEFAULTS",
+        convert::serde_to_py(py, &forkbench_gym::EnvSpec::default())?,
+    )?;
     Ok(())
 }

@@ -17,8 +17,10 @@ pub const DEFAULT_PHASE_REWARD: f64 = 2.0;
 /// Frame sizes a drawn environment may ask for, in pixels a side.
 pub const RENDER_PX: (u32, u32) = (16, 4096);
 
-/// An environment as its constructor is given it (the Python keywords, one field each).
-#[derive(Debug, Clone)]
+/// An environment as its constructor is given it (the Python keywords, one field each,
+/// the run's options aside). Serialised, its default is the Python module's
+/// `ENV_DEFAULTS`, against which a test checks the constructors' keywords and the stub.
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct EnvSpec {
     /// The case every episode runs; `None`: drawn per episode.
     pub case: Option<String>,
@@ -27,6 +29,7 @@ pub struct EnvSpec {
     pub noise: bool,
     pub replan: Option<bool>,
     /// The run's options (noise scales, sensing models, the truck's actuators).
+    #[serde(skip)]
     pub overrides: Overrides,
     pub ticks_per_step: u32,
     pub path_points: usize,

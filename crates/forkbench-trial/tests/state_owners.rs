@@ -141,7 +141,10 @@ fn sources(root: &Path, dir: &Path, out: &mut Vec<(String, String)>) {
         if path.is_dir() {
             sources(root, &path, out);
         } else if path.extension().is_some_and(|e| e == "rs") {
-            let name = path.strip_prefix(root).expect("below root").to_string_lossy();
+            let name = path
+                .strip_prefix(root)
+                .expect("below root")
+                .to_string_lossy();
             let text = fs::read_to_string(&path).expect("source");
             out.push((name.replace('\\', "/"), text));
         }
