@@ -62,6 +62,8 @@ pub trait PhaseHost: Send {
     /// The scenario's tolerances (a pallet left standing may be dragged only within the
     /// pick's displacement and rotation limits).
     fn tolerances(&self) -> &Limits;
+    /// The truth now, as a step criterion sees it after a physics step.
+    fn step_view(&self) -> crate::step_criteria::StepView<'_>;
     /// Records `value` as the running phase's measure `name` (its outcome's `measures`).
     fn record_measure(&mut self, name: &str, value: f64);
     /// The truck stands (how a drive ends).

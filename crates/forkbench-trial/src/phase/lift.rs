@@ -42,7 +42,7 @@ impl Phase for Lift {
                 .lift()
                 .map_err(|e| (Failure::LiftFailed, e.to_string()))?;
             stand_for(t, self.time_s, rec).await?;
-            criteria::load_held(t.sim())
+            criteria::load_held(t)
         })
     }
 }

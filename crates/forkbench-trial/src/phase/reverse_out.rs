@@ -50,7 +50,7 @@ impl Phase for ReverseOut {
             let (pallet0, carrying) = (t.sim().pallet_pose(), t.sim().carrying());
             back_straight(t, (self.distance_m, self.speed_mps, self.timeout_s), rec).await?;
             if carrying {
-                criteria::load_held(t.sim())
+                criteria::load_held(t)
             } else {
                 criteria::pallet_stayed(t, &pallet0)
             }

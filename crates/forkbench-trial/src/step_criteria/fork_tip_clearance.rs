@@ -130,6 +130,8 @@ mod tests {
             pallet: &pallet,
             fork_root: Pose2::new(tips_in - truck.fork_length_m, offset_m, heading_rad),
             pallet_pose: Pose2::new(0.0, 0.0, 0.0),
+            collision: false,
+            load: crate::step_criteria::LoadView::default(),
         });
         c
     }
@@ -160,6 +162,8 @@ mod tests {
             pallet: &pallet,
             fork_root: Pose2::new(-2.0, 0.0, 0.0),
             pallet_pose: Pose2::new(0.0, 0.0, 0.0),
+            collision: false,
+            load: crate::step_criteria::LoadView::default(),
         });
         assert_eq!(c.value(), None);
     }

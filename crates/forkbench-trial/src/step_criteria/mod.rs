@@ -1,12 +1,14 @@
 //! The pick's criteria, one mechanism: each a `StepCriterion` with its name, measurement, limit, whether a breach is final and the signal it records; the fixed ones judge the pick's measurements, the others measure at every step. The outcome's `measures`, the CSV's columns, the MCAP outcome and the recordings' verdict list them from here.
 
 mod fork_tip_clearance;
+mod phase;
 mod pick;
 
 use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
 
 use crate::tolerances::Limits;
 
+pub use phase::{LoadHeld, NoCollision, PHASE_CRITERIA, PalletStayed};
 pub use pick::{Criterion, PICK_CRITERIA, Reading};
 
 /// The pick's measurements the fixed criteria judge: at the end of the drive, or as they
@@ -48,6 +50,30 @@ pub struct StepView<'a> {
     pub fork_root: Pose2,
     /// The true pallet face pose.
     pub pallet_pose: Pose2,
+    /// The truck has touched a rack or wall.
+    pub collision: bool,
+    /// The carried load as the physics last stepped it.
+    pub load: LoadView,
+}
+
+/// The carried load as the physics last stepped it: whether it shifted on the forks, the
+/// hardest the truck accelerated it, and what its friction on them holds.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LoadView {
+    pub shifted: bool,
+    pub peak_accel_mps2: f64,
+    pub grip_mps2: f64,
+}
+
+impl LoadView {
+    /// The load as `sim` holds it now.
+    pub fn of(sim: &forkbench_sim::Sim) -> Self {
+        Self {
+            shifted: sim.load_shifted(),
+            peak_accel_mps2: sim.peak_load_accel_mps2(),
+            grip_mps2: sim.load_grip_mps2(),
+        }
+    }
 }
 
 /// A criterion of the pick: it may measure at every step (`observe`, `value`) and is

@@ -187,6 +187,8 @@ impl<'a> Trial<'a> {
             pallet: &self.scn.pallet,
             fork_root,
             pallet_pose,
+            collision: self.world.collision,
+            load: crate::step_criteria::LoadView::of(&self.world.sim),
         };
         let record =
             ((t_s / self.world.sim.dt_s()).round() as u64).is_multiple_of(SIGNAL_EVERY_STEPS);

@@ -16,6 +16,20 @@ use crate::tolerances::Limits;
 use crate::trial::state::Trial;
 
 impl Trial<'_> {
+    /// The truth now, as a step criterion sees it.
+    pub(super) fn step_view(&self) -> crate::step_criteria::StepView<'_> {
+        let sim = &self.world.sim;
+        crate::step_criteria::StepView {
+            t_s: sim.time_s(),
+            truck: &self.scn.truck,
+            pallet: &self.scn.pallet,
+            fork_root: sim.fork_root_pose(),
+            pallet_pose: sim.pallet_pose(),
+            collision: self.world.collision,
+            load: crate::step_criteria::LoadView::of(sim),
+        }
+    }
+
     /// What the running phase recorded with `record_measure`, handed over and cleared.
     pub(super) fn take_phase_measures(&mut self) -> std::collections::BTreeMap<String, f64> {
         std::mem::take(&mut self.verdict.phase_measures)
@@ -41,6 +55,10 @@ impl<'a> PhaseHost for Trial<'a> {
 
     fn insertion_m(&self) -> f64 {
         self.insertion_m
+    }
+
+    fn step_view(&self) -> crate::step_criteria::StepView<'_> {
+        Trial::step_view(self)
     }
 
     fn tolerances(&self) -> &Limits {

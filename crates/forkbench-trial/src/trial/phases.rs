@@ -8,6 +8,7 @@ use forkbench_track::Command;
 use crate::outcome::{Failure, PhaseOutcome};
 use crate::phase::{Failed, PICK, PhaseSpec, Steer};
 use crate::recorder::{Level, Recorder};
+use crate::step_criteria::StepCriterion;
 use crate::trial::engine::Steering;
 use crate::trial::link::{Control, Stage};
 use crate::trial::state::Trial;
@@ -120,13 +121,18 @@ impl<'a> Trial<'a> {
         rec: &mut R,
         command: &mut Steer<'_>,
     ) -> Result<bool, Failed> {
-        self.drive_by(limit_s, &mut PhaseDrive(command), rec).await
+        let criteria = crate::step_criteria::PHASE_CRITERIA
+            .iter()
+            .map(|c| c())
+            .collect();
+        self.drive_by(limit_s, &mut PhaseDrive(command, criteria), rec)
+            .await
     }
 }
 
-/// A phase's drive: its commands, the criteria every phase holds at every step, and the
-/// axle loads recorded.
-struct PhaseDrive<'c, 's>(&'c mut Steer<'s>);
+/// A phase's drive: its commands, the criteria every phase holds at every step
+/// (`PHASE_CRITERIA`, fresh for the drive), and the axle loads recorded.
+struct PhaseDrive<'c, 's>(&'c mut Steer<'s>, Vec<Box<dyn StepCriterion>>);
 
 impl<'a> Steering<'a, Failed> for PhaseDrive<'_, '_> {
     fn command(
@@ -145,7 +151,13 @@ impl<'a> Steering<'a, Failed> for PhaseDrive<'_, '_> {
         _cmd: &Command,
         rec: &mut R,
     ) -> Result<bool, Failed> {
-        every_step(t)?;
+        let view = t.step_view();
+        for c in &mut self.1 {
+            c.observe(&view);
+            if let Some(why) = c.broken() {
+                return Err((Failure::of_criterion(c.name()), why));
+            }
+        }
         let now = t.world.sim.time_s();
         let step = (now / t.world.sim.dt_s()).round() as u64;
         if step.is_multiple_of(crate::trial::SIGNAL_EVERY_STEPS) {
@@ -156,16 +168,4 @@ impl<'a> Steering<'a, Failed> for PhaseDrive<'_, '_> {
         }
         Ok(false)
     }
-}
-
-/// What every phase holds at every step: no rack or wall touched, the load still on the
-/// forks.
-fn every_step(t: &Trial<'_>) -> Result<(), Failed> {
-    if t.world.collision {
-        return Err((
-            Failure::Collision,
-            "truck touched a rack or wall".to_owned(),
-        ));
-    }
-    crate::phase::load_held(&t.world.sim)
 }
