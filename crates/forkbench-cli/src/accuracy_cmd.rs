@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::path::Path as FsPath;
 
-use forkbench_trial::trial::accuracy::{AccuracyRow, accuracy_study};
+use forkbench_studies::accuracy::{AccuracyRow, accuracy_study};
 use forkbench_trial::{Scenario, defaults};
 use serde_json::json;
 
@@ -71,7 +71,7 @@ fn sensor_names(scn: &Scenario) -> Vec<String> {
     }
 }
 
-fn mm(s: &forkbench_trial::trial::accuracy::Spread) -> String {
+fn mm(s: &forkbench_studies::accuracy::Spread) -> String {
     format!("{:+.0} ± {:.0}", 1e3 * s.bias, 1e3 * s.sigma)
 }
 

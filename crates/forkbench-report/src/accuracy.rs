@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use forkbench_trial::trial::accuracy::{ANGLES_DEG, AccuracyRow};
+use forkbench_studies::accuracy::{ANGLES_DEG, AccuracyRow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -1,3 +1,4 @@
 //! The studies' tests as one binary: each file a module.
 
+mod accuracy;
 mod coverage;

@@ -92,39 +92,6 @@ fn bad_sensor_settings_are_refused_naming_the_field() {
 }
 
 #[test]
-fn the_accuracy_study_sees_the_camera_near_and_the_lasers_bias_far() {
-    use forkbench_trial::trial::accuracy::accuracy_study;
-    let scn = scenario("[sensors.pallet]\nkind = \"tim561+kinect2\"\n", NEAR).expect("loads");
-    let rows = accuracy_study(&scn, 40, 3).expect("study");
-    assert_eq!(rows.len(), 9 * 3 * 3);
-    let cell = |r: f64, a: f64, l: f64| {
-        rows.iter()
-            .find(|x| {
-                x.range_m == r && (x.angle_rad.to_degrees() - a).abs() < 1e-9 && x.lateral_m == l
-            })
-            .expect("cell")
-    };
-    // Sensors are listed shortest reach first: the camera decides at 3 m, head-on, to
-    // millimetres.
-    let near = cell(3.0, 0.0, 0.0);
-    assert_eq!((near.missed, near.by_sensor[0]), (0, 40), "{near:?}");
-    assert!(
-        near.lateral.bound() < 0.01 && near.along.bound() < 0.01,
-        "{near:?}"
-    );
-    // Beyond the camera's 4.5 m the laser decides, and its along-axis error is its
-    // systematic range error: uniform within ±60 mm, σ = 60/√3 ≈ 34.6 mm.
-    let far = cell(6.5, 0.0, 0.0);
-    assert_eq!(far.by_sensor[1], 40 - far.missed, "{far:?}");
-    assert!(far.missed <= 2, "{far:?}");
-    assert!(
-        (0.026..0.044).contains(&far.along.sigma),
-        "along σ {} m",
-        far.along.sigma
-    );
-}
-
-#[test]
 fn a_failed_trial_names_every_broken_criterion_and_the_likely_cause() {
     // The estimate 0.3 m to the side of the pallet: the truck aims beside the pockets.
     let scn = scenario(

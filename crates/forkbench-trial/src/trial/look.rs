@@ -14,6 +14,18 @@ use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Case, Scenario};
 use crate::stage_error::StageError;
 
+/// The physics world a trial seeded `seed` starts in for `case`, as a one-off look or a
+/// study sees it: the simulation, the truck's fork-root start and the pallet's true pose.
+pub fn look_world(
+    scn: &Scenario,
+    case: &Case,
+    seed: u64,
+) -> Result<(forkbench_sim::Sim, Pose2, Pose2), StageError> {
+    let (sim, root, truth, _) =
+        build_world(scn, &scn.truck, case, (seed, &Default::default()), None)?;
+    Ok((sim, root, truth))
+}
+
 /// One scan and what the detector made of it.
 #[derive(Debug, Clone, Serialize)]
 pub struct ScanReport {

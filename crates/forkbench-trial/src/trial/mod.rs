@@ -1,6 +1,5 @@
 //! One pick trial as named stages: setup, plan, drive (with replans), judge.
 
-pub mod accuracy;
 mod drive;
 mod engine;
 mod judge;
@@ -57,10 +56,11 @@ pub use crate::step_criteria::{
     StepCtor, StepView, step_criterion_name, step_measures,
 };
 pub use link::{Control, Episode, Observation, Stage, Truth};
-pub use look::{ScanReport, scan_once, scenario_detector};
+pub use look::{ScanReport, look_world, scan_once, scenario_detector};
 pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOptions};
 pub use session::{Session, SessionEnd};
 pub use session_view::SceneView;
+pub use streams::accuracy_stream;
 pub use truck_knobs::{TRUCK_KNOBS, apply_truck, truck_file_settings, truck_path};
 pub use uncertain_apply::Shift;
 

@@ -43,6 +43,11 @@ pub(super) fn stream(seed: u64, salt: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed ^ salt.wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
 
+/// The detector accuracy study's stream for its `draw`-th scan of a study seeded `seed`.
+pub fn accuracy_stream(seed: u64, draw: u64) -> ChaCha8Rng {
+    stream(seed ^ draw.wrapping_mul(0xA24B_AED4_963E_E407), ACCURACY)
+}
+
 /// A mission leg's planner seed: leg `i` (0-based) of a trial seeded `seed`.
 pub(super) fn leg_seed(seed: u64, i: usize) -> u64 {
     seed ^ ((i as u64 + 1) << 32)

@@ -6,12 +6,10 @@ use forkbench_sensors::detector::detect_in;
 use forkbench_sensors::scan::{Errors, scan};
 use serde::Serialize;
 
-use super::streams::{ACCURACY, stream};
-use super::world::build_world;
-use crate::TrialError;
-use crate::scenario::sensors::{NamedScanner, PalletSensing};
-use crate::scenario::{Case, Scenario};
-use crate::stage_error::StageError;
+use forkbench_trial::TrialError;
+use forkbench_trial::scenario::sensors::{NamedScanner, PalletSensing};
+use forkbench_trial::scenario::{Case, Scenario};
+use forkbench_trial::trial::{StageError, accuracy_stream, look_world, scenario_detector};
 
 /// Ranges (fork root to face, m), pallet angles (rad) and lateral offsets (m) studied.
 pub const RANGES_M: [f64; 9] = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 6.5, 7.0, 8.0];
@@ -77,7 +75,7 @@ pub fn accuracy_study(
     seed: u64,
 ) -> Result<Vec<AccuracyRow>, TrialError> {
     let PalletSensing::Scanner { sensors, .. } = &scn.pallet_sensing else {
-        return Err(crate::scenario::invalid(
+        return Err(forkbench_trial::scenario::invalid(
             &scn.file,
             "sensors.pallet.kind",
             "the accuracy study needs scanners (tim561, kinect2, tim561+kinect2), not gaussian",
@@ -109,14 +107,13 @@ fn study_cell(
     case: &Case,
     (draws, seed): (u32, u64),
 ) -> Result<AccuracyRow, StageError> {
-    let (sim, root, truth, _) =
-        build_world(scn, &scn.truck, case, (seed, &Default::default()), None)?;
+    let (sim, root, truth) = look_world(scn, case, seed)?;
     // The scenario's own detector (the pocket detector where it senses without scans).
-    let (_, mut detector) = super::look::scenario_detector(scn)?;
+    let (_, mut detector) = scenario_detector(scn)?;
     let (mut lat, mut along, mut head) = (Vec::new(), Vec::new(), Vec::new());
     let mut by_sensor = vec![0u32; sensors.len()];
     for k in 0..u64::from(draws) {
-        let mut rng = stream(seed ^ k.wrapping_mul(0xA24B_AED4_963E_E407), ACCURACY);
+        let mut rng = accuracy_stream(seed, k);
         let scans: Vec<(&str, forkbench_core::signal::Scan)> = sensors
             .iter()
             .filter(|s| s.scanner.reaches(&s.scanner.sensor_pose(&root), &truth))
