@@ -13,6 +13,7 @@ use crate::footprints::pallet_footprint;
 use crate::outcome::Failure;
 use crate::recorder::{Level, Recorder};
 use crate::stage_error::StageError;
+use crate::step_criteria::{StepCriterion, StepView};
 
 /// The slot's outline in recordings: cyan, so the placed (orange) pallet reads against it.
 const SLOT: Style = Style {
@@ -119,9 +120,14 @@ impl Phase for Place {
             t.sim_mut().lower();
             stand_for(t, self.cfg.lower_time_s, rec).await?;
             let placed = t.sim().pallet_pose();
-            let off = self.measure(t, &placed);
+            self.measure(t, &placed);
+            // Judged where the pallet was set down, before the forks pull out of it.
+            let mut on_slot = self.on_slot();
+            on_slot.observe(&t.step_view());
             back_straight(t, (self.cfg.retract_m, 0.5, 30.0), rec).await?;
-            self.placement(off)?;
+            if let Some(why) = on_slot.broken() {
+                return Err((Failure::of_criterion(on_slot.name()), why));
+            }
             criteria::pallet_stayed(t, &placed)
         })
     }
@@ -190,35 +196,118 @@ impl Place {
         }
     }
 
-    /// The placed pallet against the slot (recorded, and returned as its distance and
-    /// heading off it), and the room left around it.
-    fn measure(&self, t: &mut dyn PhaseHost, placed: &Pose2) -> (f64, f64) {
+    /// The placed pallet against the slot, recorded, and the room left around it.
+    fn measure(&self, t: &mut dyn PhaseHost, placed: &Pose2) {
         let clearance = t.clearance_m(&pallet_footprint(t.pallet()), placed, 1.0);
-        let off = (
-            placed.distance_to(&self.at),
+        t.record_measure("position_error_m", placed.distance_to(&self.at));
+        t.record_measure(
+            "heading_error_rad",
             wrap_angle(placed.heading_rad - self.at.heading_rad),
         );
-        t.record_measure("position_error_m", off.0);
-        t.record_measure("heading_error_rad", off.1);
         t.record_measure("clearance_m", clearance);
-        off
     }
 
-    /// The pallet set down within the place tolerances of its slot (`(d, h)`: its
-    /// distance and heading off it).
-    fn placement(&self, (d, h): (f64, f64)) -> Result<(), Failed> {
-        if d > self.cfg.position_m || h.abs() > self.cfg.heading_deg.to_radians() {
-            return Err((
-                Failure::PlacementError,
-                format!(
-                    "placed {d:.3} m and {:.2}° off slot {:?} (limits {} m, {}°)",
-                    h.to_degrees(),
-                    self.slot,
-                    self.cfg.position_m,
-                    self.cfg.heading_deg
-                ),
-            ));
+    /// The criterion the set-down pallet is judged by: its slot and the place tolerances.
+    fn on_slot(&self) -> PlacedOnSlot {
+        PlacedOnSlot {
+            slot: self.slot.clone(),
+            at: self.at,
+            limits: (self.cfg.position_m, self.cfg.heading_deg),
+            placed: None,
         }
-        Ok(())
+    }
+}
+
+/// The pallet set down within the place tolerances of its slot: its distance and heading
+/// off the slot, where it was set down.
+#[derive(Debug)]
+struct PlacedOnSlot {
+    slot: String,
+    at: Pose2,
+    /// Position (m) and heading (°) tolerances.
+    limits: (f64, f64),
+    placed: Option<Pose2>,
+}
+
+impl PlacedOnSlot {
+    fn off(&self) -> Option<(f64, f64)> {
+        let placed = self.placed?;
+        Some((
+            placed.distance_to(&self.at),
+            wrap_angle(placed.heading_rad - self.at.heading_rad),
+        ))
+    }
+}
+
+impl StepCriterion for PlacedOnSlot {
+    fn name(&self) -> &'static str {
+        "placement_error"
+    }
+    fn measure(&self) -> Option<&'static str> {
+        None
+    }
+    fn describe(&self) -> &'static str {
+        "how far from its slot, and how turned, the pallet was set down"
+    }
+    fn observe(&mut self, view: &StepView<'_>) {
+        self.placed = Some(view.pallet_pose);
+    }
+    fn value(&self) -> Option<f64> {
+        self.off().map(|(d, _)| d)
+    }
+    fn broken(&self) -> Option<String> {
+        let (d, h) = self.off()?;
+        let (position_m, heading_deg) = self.limits;
+        (d > position_m || h.abs() > heading_deg.to_radians()).then(|| {
+            format!(
+                "placed {d:.3} m and {:.2}° off slot {:?} (limits {position_m} m, {heading_deg}°)",
+                h.to_degrees(),
+                self.slot,
+            )
+        })
+    }
+}
+
+#[cfg(test)]
+mod placed_tests {
+    use super::*;
+    use crate::step_criteria::LoadView;
+    use forkbench_core::{ForkliftSpec, PalletSpec};
+
+    fn judged_at(pallet_pose: Pose2) -> PlacedOnSlot {
+        let (truck, pallet) = (ForkliftSpec::default(), PalletSpec::field_1200());
+        let mut c = PlacedOnSlot {
+            slot: "drop-1".into(),
+            at: Pose2::new(10.0, 5.0, 0.0),
+            limits: (0.05, 2.0),
+            placed: None,
+        };
+        c.observe(&StepView {
+            t_s: 0.0,
+            truck: &truck,
+            pallet: &pallet,
+            fork_root: Pose2::new(8.0, 5.0, 0.0),
+            pallet_pose,
+            collision: false,
+            load: LoadView::default(),
+        });
+        c
+    }
+
+    #[test]
+    fn a_pallet_set_down_off_its_slot_breaks_the_placement_with_both_figures() {
+        assert!(judged_at(Pose2::new(10.03, 5.0, 0.01)).broken().is_none());
+        let why = judged_at(Pose2::new(10.08, 5.0, 0.0))
+            .broken()
+            .expect("8 cm off");
+        assert_eq!(
+            why,
+            "placed 0.080 m and 0.00° off slot \"drop-1\" (limits 0.05 m, 2°)"
+        );
+        assert!(judged_at(Pose2::new(10.0, 5.0, 0.1)).broken().is_some());
+        assert_eq!(
+            Failure::of_criterion("placement_error"),
+            Failure::PlacementError
+        );
     }
 }
