@@ -6,13 +6,18 @@ use super::{Failed, PhaseHost};
 use crate::outcome::Failure;
 use crate::step_criteria::{LoadHeld, PalletStayed, StepCriterion};
 
-/// `criterion` judged on the truth now: its failure and why, when it is broken.
-pub fn judge_now(host: &dyn PhaseHost, mut criterion: impl StepCriterion) -> Result<(), Failed> {
-    criterion.observe(&host.step_view());
+/// A criterion as a phase's result: its failure, by its name, and why, when it is broken.
+pub fn held(criterion: &dyn StepCriterion) -> Result<(), Failed> {
     match criterion.broken() {
         Some(why) => Err((Failure::of_criterion(criterion.name()), why)),
         None => Ok(()),
     }
+}
+
+/// `criterion` judged on the truth now: its failure and why, when it is broken.
+pub fn judge_now(host: &dyn PhaseHost, mut criterion: impl StepCriterion) -> Result<(), Failed> {
+    criterion.observe(&host.step_view());
+    held(&criterion)
 }
 
 /// The carried load stayed on the forks ([`LoadHeld`]).

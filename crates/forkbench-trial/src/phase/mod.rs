@@ -7,7 +7,7 @@ mod place;
 mod return_leg;
 mod reverse_out;
 
-pub use criteria::{judge_now, load_held};
+pub use criteria::{held, judge_now, load_held};
 pub use host::{Context, DriveRun, LegRun, PhaseHost, Steer, open_loop, stand_for};
 
 use forkbench_core::SettingsError;

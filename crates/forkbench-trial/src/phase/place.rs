@@ -120,14 +120,13 @@ impl Phase for Place {
             t.sim_mut().lower();
             stand_for(t, self.cfg.lower_time_s, rec).await?;
             let placed = t.sim().pallet_pose();
-            self.measure(t, &placed);
-            // Judged where the pallet was set down, before the forks pull out of it.
+            // Measured and judged where the pallet was set down, before the forks pull
+            // out of it.
             let mut on_slot = self.on_slot();
             on_slot.observe(&t.step_view());
+            Self::measure(t, &placed, &on_slot);
             back_straight(t, (self.cfg.retract_m, 0.5, 30.0), rec).await?;
-            if let Some(why) = on_slot.broken() {
-                return Err((Failure::of_criterion(on_slot.name()), why));
-            }
+            criteria::held(&on_slot)?;
             criteria::pallet_stayed(t, &placed)
         })
     }
@@ -196,14 +195,14 @@ impl Place {
         }
     }
 
-    /// The placed pallet against the slot, recorded, and the room left around it.
-    fn measure(&self, t: &mut dyn PhaseHost, placed: &Pose2) {
+    /// The placed pallet against the slot (as `on_slot` measured it), recorded, and the
+    /// room left around it.
+    fn measure(t: &mut dyn PhaseHost, placed: &Pose2, on_slot: &PlacedOnSlot) {
         let clearance = t.clearance_m(&pallet_footprint(t.pallet()), placed, 1.0);
-        t.record_measure("position_error_m", placed.distance_to(&self.at));
-        t.record_measure(
-            "heading_error_rad",
-            wrap_angle(placed.heading_rad - self.at.heading_rad),
-        );
+        if let Some((d, h)) = on_slot.off() {
+            t.record_measure("position_error_m", d);
+            t.record_measure("heading_error_rad", h);
+        }
         t.record_measure("clearance_m", clearance);
     }
 

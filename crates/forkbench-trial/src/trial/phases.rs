@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use forkbench_core::{Pose2, Signal, Style};
 use forkbench_track::Command;
 
-use crate::outcome::{Failure, PhaseOutcome};
+use crate::outcome::PhaseOutcome;
 use crate::phase::{Failed, PICK, PhaseSpec, Steer};
 use crate::recorder::{Level, Recorder};
 use crate::step_criteria::StepCriterion;
@@ -154,9 +154,7 @@ impl<'a> Steering<'a, Failed> for PhaseDrive<'_, '_> {
         let view = t.step_view();
         for c in &mut self.1 {
             c.observe(&view);
-            if let Some(why) = c.broken() {
-                return Err((Failure::of_criterion(c.name()), why));
-            }
+            crate::phase::held(c.as_ref())?;
         }
         let now = t.world.sim.time_s();
         let step = (now / t.world.sim.dt_s()).round() as u64;
