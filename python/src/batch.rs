@@ -45,8 +45,8 @@ pub fn run_trial<'py>(
         uncertain: Default::default(),
     };
     // The CLI's own check: values in range, and every override acting on this scenario.
-    let run = scn
-        .check_options(&opts)
+    let run = opts
+        .check_against(scn)
         .map_err(|e| scenario_error(py, &e))?;
     let out = match mcap {
         None => py.detach(|| forkbench_trial::run_trial(scn, case, &opts)),

@@ -1,6 +1,6 @@
 //! Rust results into Python objects, and Rust errors into Python exceptions that name the file, field and reason.
 
-use forkbench_trial::TrialError;
+use forkbench_trial::ScenarioError as FileError;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -28,21 +28,21 @@ create_exception!(
 
 /// A scenario error as a `ScenarioError` carrying `file`, `field` (None when the whole
 /// file is at fault) and `reason`.
-pub fn scenario_error(py: Python<'_>, e: &TrialError) -> PyErr {
+pub fn scenario_error(py: Python<'_>, e: &FileError) -> PyErr {
     let (file, field, reason) = match e {
-        TrialError::Read { file, cause } => (file.clone(), None, cause.to_string()),
-        TrialError::Parse { file, message } => (file.clone(), None, message.clone()),
-        TrialError::Invalid {
+        FileError::Read { file, cause } => (file.clone(), None, cause.to_string()),
+        FileError::Parse { file, message } => (file.clone(), None, message.clone()),
+        FileError::Invalid {
             file,
             field,
             reason,
         } => (file.clone(), Some(field.clone()), reason.clone()),
-        TrialError::CaseNeeded { file, count, known } => (
+        FileError::CaseNeeded { file, count, known } => (
             file.clone(),
             Some("case".to_owned()),
             format!("{count} cases; choose one (cases: {known})"),
         ),
-        TrialError::UnknownCase { file, case, known } => (
+        FileError::UnknownCase { file, case, known } => (
             file.clone(),
             Some("case".to_owned()),
             format!("no case named {case:?} (cases: {known})"),

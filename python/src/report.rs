@@ -59,9 +59,8 @@ pub fn replay<'py>(
     };
     let case = job.case().map_err(fail)?;
     let opts = job.options();
-    let run = job
-        .scenario
-        .resolve(&opts)
+    let run = opts
+        .resolve(&job.scenario)
         .map_err(|e| scenario_error(py, &e))?;
     let targets = forkbench_log::RecordTargets {
         mcap,

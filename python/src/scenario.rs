@@ -36,7 +36,7 @@ impl Scenario {
             .find(|s| s.name == name)
             .map(|s| Scenario { inner: Arc::new(s) })
             .ok_or_else(|| {
-                let e = forkbench_trial::TrialError::Invalid {
+                let e = forkbench_trial::ScenarioError::Invalid {
                     file: "(embedded scenarios)".into(),
                     field: "name".into(),
                     reason: format!(

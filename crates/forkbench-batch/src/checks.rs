@@ -97,7 +97,7 @@ impl BatchSpec {
                 overrides: self.overrides.clone(),
                 ..Default::default()
             };
-            s.check_options(&opts)
+            opts.check_against(s)
                 .map_err(|e| BatchError::Setting(e.to_string()))?;
             let (planners, trackers) = self.components_of(s);
             for p in &planners {

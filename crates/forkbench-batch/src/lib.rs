@@ -143,7 +143,7 @@ pub enum BatchError {
     File(#[from] forkbench_core::files::FileError),
     /// A scenario the batch names could not be loaded or has no such case.
     #[error(transparent)]
-    Trial(#[from] forkbench_trial::TrialError),
+    Trial(#[from] forkbench_trial::ScenarioError),
 }
 
 /// Writes an output file atomically (see [`forkbench_core::files::write_atomic`]).

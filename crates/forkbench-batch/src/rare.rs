@@ -207,12 +207,13 @@ fn runner(setup: &RareSetup, budget: usize) -> Result<Runner<'_>, BatchError> {
         )));
     }
     let case = scn.pick_case(Some(&setup.case))?;
-    scn.check_options(&TrialOptions {
+    TrialOptions {
         planner: setup.planner.clone(),
         tracker: setup.tracker.clone(),
         overrides: setup.overrides.clone(),
         ..TrialOptions::default()
-    })?;
+    }
+    .check_against(scn)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(setup.jobs.max(1))
         .build()

@@ -113,7 +113,7 @@ fn knobs_that_cannot_act_are_refused_naming_the_component_and_the_knob() {
             overrides: o,
             ..Default::default()
         };
-        scn.check_options(&opts).expect_err("refused").to_string()
+        opts.check_against(&scn).expect_err("refused").to_string()
     };
     let e = refuse(
         Overrides {
@@ -158,7 +158,7 @@ fn knobs_that_cannot_act_are_refused_naming_the_component_and_the_knob() {
         },
         ..Default::default()
     };
-    let e = own.check_options(&opts).expect_err("refused").to_string();
+    let e = opts.check_against(&own).expect_err("refused").to_string();
     assert!(
         e.contains("\"mine\"") && e.contains("localization_noise_scale"),
         "{e}"

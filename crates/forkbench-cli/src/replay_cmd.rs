@@ -42,7 +42,7 @@ pub fn replay(
     let mut job = forkbench_batch::Replay::load(file, line, scenario)?;
     job.scenario = crate::with_components(job.scenario, components)?;
     let opts = job.options();
-    let run = job.scenario.resolve(&opts)?;
+    let run = opts.resolve(&job.scenario)?;
     let r = forkbench_log::run_recorded((&job.scenario, job.case()?), (&opts, &run), rec)?;
     if let Some(e) = &r.viewer_error {
         eprintln!(

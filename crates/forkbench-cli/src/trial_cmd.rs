@@ -26,7 +26,7 @@ pub fn run(
     let case = scn.pick_case(case)?;
     // Unknown planner or tracker names, and overrides that cannot act, stop here, before
     // any recording file is made.
-    let run = scn.check_options(opts)?;
+    let run = opts.check_against(&scn)?;
     // File targets are checked before the run; a viewer that cannot be reached is
     // reported and the trial runs anyway.
     let forkbench_log::Recorded {

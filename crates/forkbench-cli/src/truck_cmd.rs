@@ -23,7 +23,7 @@ pub(crate) fn truck_settings(
         );
     }
     let text = crate::read_input(&path)?;
-    let named = |e: forkbench_trial::TrialError| anyhow::anyhow!("{}: {e}", path.display());
+    let named = |e: forkbench_trial::ScenarioError| anyhow::anyhow!("{}: {e}", path.display());
     let (preset, settings) = forkbench_trial::trial::truck_file_settings(&text).map_err(named)?;
     // Names and ranges checked here, so an error names the file it is in.
     let a30 = forkbench_core::ForkliftSpec::default();

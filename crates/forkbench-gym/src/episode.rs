@@ -1,7 +1,7 @@
 //! One episode: a trial `Session` stepped tick by tick under a caller's control, its shaped reward (the truth's progress, the phases passed, the verdict) and its observation.
 
 use forkbench_trial::trial::{Control, Episode, Session, SessionEnd, Stage};
-use forkbench_trial::{TrialError, TrialOptions, TrialOutcome};
+use forkbench_trial::{ScenarioError, TrialOptions, TrialOutcome};
 
 use crate::obs;
 use crate::render::Window;
@@ -29,7 +29,7 @@ pub struct StepOut {
 }
 
 impl Core {
-    pub fn start(s: &Setup, seed: u64, case: &str) -> Result<Self, TrialError> {
+    pub fn start(s: &Setup, seed: u64, case: &str) -> Result<Self, ScenarioError> {
         let opts = TrialOptions {
             seed: Some(seed),
             ..s.opts.clone()

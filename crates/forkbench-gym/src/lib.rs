@@ -13,7 +13,7 @@ pub use setup::{DEFAULT_PHASE_REWARD, EnvSpec, MAX_PATH_POINTS, RENDER_PX, Setup
 pub enum GymError {
     /// The scenario refused the run (an unknown case, component or option out of range).
     #[error(transparent)]
-    Scenario(#[from] forkbench_trial::TrialError),
+    Scenario(#[from] forkbench_trial::ScenarioError),
     /// An environment setting out of its range, or an action that is not a number.
     #[error("{0}")]
     Setting(String),

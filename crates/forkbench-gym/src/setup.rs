@@ -94,7 +94,7 @@ impl Setup {
             overrides: spec.overrides,
             ..TrialOptions::default()
         };
-        scn.check_options(&opts)?;
+        opts.check_against(&scn)?;
         let bad = |why: String| Err(GymError::Setting(why));
         if spec.ticks_per_step == 0
             || !(spec.path_spacing_m.is_finite() && spec.path_spacing_m > 0.0)

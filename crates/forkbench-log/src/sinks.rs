@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use forkbench_trial::{
-    Case, Recorder, Resolved, Scenario, Tee, TrialError, TrialOptions, TrialOutcome,
+    Case, Recorder, Resolved, Scenario, ScenarioError, Tee, TrialOptions, TrialOutcome,
 };
 
 use crate::{ActuatorCsv, LogError, McapRecorder, Ros2Recorder, check_writable};
@@ -32,7 +32,7 @@ pub struct RecordTargets {
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
     #[error(transparent)]
-    Trial(#[from] TrialError),
+    Trial(#[from] ScenarioError),
     #[error(transparent)]
     Log(#[from] LogError),
 }
@@ -233,7 +233,7 @@ pub fn record_trial(
     dir: &Path,
     ros2: bool,
 ) -> Result<(TrialOutcome, PathBuf), RecordError> {
-    let run = scn.resolve(opts)?;
+    let run = opts.resolve(scn)?;
     // Names are free text: the stem keeps only letters, digits, '-' and '_', so a name
     // can neither leave `dir` nor fail the write (the real names are in the files).
     let names = (run.planner.name.as_str(), run.tracker.name.as_str());

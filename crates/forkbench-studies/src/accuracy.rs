@@ -6,7 +6,7 @@ use forkbench_sensors::detector::detect_in;
 use forkbench_sensors::scan::{Errors, scan};
 use serde::Serialize;
 
-use forkbench_trial::TrialError;
+use forkbench_trial::ScenarioError;
 use forkbench_trial::scenario::sensors::{NamedScanner, PalletSensing};
 use forkbench_trial::scenario::{Case, Scenario};
 use forkbench_trial::trial::{StageError, accuracy_stream, look_world, scenario_detector};
@@ -73,7 +73,7 @@ pub fn accuracy_study(
     scn: &Scenario,
     draws: u32,
     seed: u64,
-) -> Result<Vec<AccuracyRow>, TrialError> {
+) -> Result<Vec<AccuracyRow>, ScenarioError> {
     let PalletSensing::Scanner { sensors, .. } = &scn.pallet_sensing else {
         return Err(forkbench_trial::scenario::invalid(
             &scn.file,
@@ -87,7 +87,7 @@ pub fn accuracy_study(
             for &lateral_m in &LATERALS_M {
                 let case = placement(range_m, angle_deg.to_radians(), lateral_m);
                 let row = study_cell(scn, sensors, &case, (draws, seed)).map_err(|e| {
-                    TrialError::Invalid {
+                    ScenarioError::Invalid {
                         file: scn.file.clone(),
                         field: "world".into(),
                         reason: e.to_string(),

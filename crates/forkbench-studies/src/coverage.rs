@@ -5,7 +5,7 @@ use forkbench_sensors::sight::Sight;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use forkbench_trial::TrialError;
+use forkbench_trial::ScenarioError;
 use forkbench_trial::World;
 
 /// Most cells a coverage map may have (bounded work and memory on any world file).
@@ -56,8 +56,8 @@ pub fn coverage(
     world: &World,
     resolution_m: f64,
     cfg: &ReflectorNavConfig,
-) -> Result<Coverage, TrialError> {
-    let bad = |reason: &str| TrialError::Invalid {
+) -> Result<Coverage, ScenarioError> {
+    let bad = |reason: &str| ScenarioError::Invalid {
         file: world.name.clone(),
         field: "resolution_m".into(),
         reason: reason.into(),
@@ -66,7 +66,7 @@ pub fn coverage(
         return Err(bad("must be a positive finite length"));
     }
     let Some([lo, hi]) = bounds(world) else {
-        return Err(TrialError::Invalid {
+        return Err(ScenarioError::Invalid {
             file: world.name.clone(),
             field: "rack".into(),
             reason: "the world has no racks, walls or reflectors to span an area".into(),

@@ -6,7 +6,7 @@ use forkbench_core::ForkliftSpec;
 use forkbench_nav::reproduce::StudyRow;
 use forkbench_nav::{GridError, MapError, NavError, NavMap};
 
-use forkbench_trial::TrialError;
+use forkbench_trial::ScenarioError;
 
 /// The station the studied leg starts at, the rack slot it ends before, and how far in
 /// front of the slot's face (south, in the aisle) it ends: the paper's longest leg,
@@ -23,7 +23,7 @@ const STUDY_RESOLUTION_M: f64 = 0.05;
 #[derive(Debug, thiserror::Error)]
 pub enum NavStudyError {
     #[error(transparent)]
-    World(#[from] TrialError),
+    World(#[from] ScenarioError),
     #[error(transparent)]
     Map(#[from] MapError),
     /// The grid error is the message's end, not a source: a chain printer would say it twice.
@@ -63,7 +63,7 @@ pub fn run(runs: u64) -> Result<PrmStudy, NavStudyError> {
 }
 
 /// The studied leg's ends: the station, and the aisle in front of the slot.
-fn study_leg(world: &forkbench_trial::World) -> Result<([f64; 2], [f64; 2]), TrialError> {
+fn study_leg(world: &forkbench_trial::World) -> Result<([f64; 2], [f64; 2]), ScenarioError> {
     let place = |list: &[forkbench_trial::scenario::PalletSlot], name: &str| {
         list.iter()
             .find(|p| p.name == name)

@@ -5,7 +5,7 @@ use std::path::Path;
 use forkbench_studies::accuracy::accuracy_study;
 use forkbench_trial::{Scenario, World};
 
-fn scenario(extra: &str, pallet: &str) -> Result<Scenario, forkbench_trial::TrialError> {
+fn scenario(extra: &str, pallet: &str) -> Result<Scenario, forkbench_trial::ScenarioError> {
     let text = format!(
         "name = \"s\"\nplanner = \"bspline\"\npallet_kind = \"field-1200\"\n\
          start = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\npallet = {pallet}\n{extra}"

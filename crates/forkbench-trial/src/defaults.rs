@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::TrialError;
+use crate::ScenarioError;
 use crate::scenario::{Scenario, World};
 
 const SCENARIOS: [(&str, &str); 8] = [
@@ -60,12 +60,12 @@ const WORLDS: [(&str, &str); 4] = [
 ];
 
 /// An embedded world by file name (`warehouse.toml`), as `worlds/` holds it.
-pub fn embedded_world(name: &str) -> Result<World, TrialError> {
+pub fn embedded_world(name: &str) -> Result<World, ScenarioError> {
     let (file, text) =
         WORLDS
             .iter()
             .find(|(f, _)| *f == name)
-            .ok_or_else(|| TrialError::Invalid {
+            .ok_or_else(|| ScenarioError::Invalid {
                 file: name.to_owned(),
                 field: "world".into(),
                 reason: format!("no embedded world {name:?}"),
@@ -74,7 +74,7 @@ pub fn embedded_world(name: &str) -> Result<World, TrialError> {
 }
 
 /// Loads the embedded default scenarios (worlds resolved among the embedded worlds).
-pub fn default_scenarios() -> Result<Vec<Scenario>, TrialError> {
+pub fn default_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
     SCENARIOS
         .iter()
         .map(|(file, text)| {
@@ -84,7 +84,7 @@ pub fn default_scenarios() -> Result<Vec<Scenario>, TrialError> {
                     .and_then(|n| n.to_str())
                     .unwrap_or_default();
                 embedded_world(name).map_err(|e| match e {
-                    TrialError::Invalid { reason, .. } => TrialError::Invalid {
+                    ScenarioError::Invalid { reason, .. } => ScenarioError::Invalid {
                         file: (*file).to_owned(),
                         field: "world".into(),
                         reason,
@@ -97,12 +97,12 @@ pub fn default_scenarios() -> Result<Vec<Scenario>, TrialError> {
 }
 
 /// An embedded default scenario by its name (`field-test`).
-pub fn embedded_scenario(name: &str) -> Result<Scenario, TrialError> {
+pub fn embedded_scenario(name: &str) -> Result<Scenario, ScenarioError> {
     let all = default_scenarios()?;
     let known: Vec<String> = all.iter().map(|s| s.name.clone()).collect();
     all.into_iter()
         .find(|s| s.name == name)
-        .ok_or_else(|| TrialError::Invalid {
+        .ok_or_else(|| ScenarioError::Invalid {
             file: name.to_owned(),
             field: "scenario".into(),
             reason: format!(
@@ -114,7 +114,7 @@ pub fn embedded_scenario(name: &str) -> Result<Scenario, TrialError> {
 
 /// A scenario as a user names it: a file when one exists at `arg` (or the name ends in
 /// `.toml`), else an embedded default by name. The CLI and Python share this rule.
-pub fn load_scenario(arg: &Path) -> Result<Scenario, TrialError> {
+pub fn load_scenario(arg: &Path) -> Result<Scenario, ScenarioError> {
     let is_file = arg.exists() || arg.extension().is_some_and(|e| e == "toml");
     match arg.to_str() {
         Some(name) if !is_file && !name.contains(std::path::MAIN_SEPARATOR) => {

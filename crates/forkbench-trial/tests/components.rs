@@ -3,12 +3,12 @@
 
 use std::path::Path;
 
-use forkbench_trial::{Scenario, TrialError, World};
+use forkbench_trial::{Scenario, ScenarioError, World};
 
 const LAYOUT: &str = "name = \"c\"\nstart = { x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }\n\
                       pallet = { x_m = 8.0, y_m = 0.0, heading_deg = 0.0 }\n";
 
-fn parse(body: &str) -> Result<Scenario, TrialError> {
+fn parse(body: &str) -> Result<Scenario, ScenarioError> {
     let text = format!("{LAYOUT}{body}");
     Scenario::parse(&text, "c.toml", |_: &Path| Ok(World::default()))
 }

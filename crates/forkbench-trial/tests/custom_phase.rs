@@ -47,7 +47,7 @@ impl Phase for Creep {
             t.record_measure("crept_m", crept);
             t.record_measure("load_shift_m", on_forks(t).distance_to(&before));
             if crept < self.min_distance_m {
-                return Err::<(), Failed>((
+                return Err::<(), Failed>(Failed::new(
                     Failure::criterion("creep_distance"),
                     format!("crept {crept:.3} m (at least {} m)", self.min_distance_m),
                 ));

@@ -6,10 +6,6 @@ use std::path::{Path, PathBuf};
 
 /// The top-level modules, lowest first: each may name only those before it.
 const LAYERS: &[&str] = &[
-    "text",
-    "tolerances",
-    "pose_deg",
-    "footprints",
     "outcome",
     "stage_error",
     "step_criteria",

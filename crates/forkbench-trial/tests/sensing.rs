@@ -4,7 +4,7 @@ use std::path::Path;
 
 use forkbench_trial::{Failure, Scenario, TrialOptions, World, run_trial};
 
-fn scenario(extra: &str, pallet: &str) -> Result<Scenario, forkbench_trial::TrialError> {
+fn scenario(extra: &str, pallet: &str) -> Result<Scenario, forkbench_trial::ScenarioError> {
     let text = format!(
         "name = \"s\"\nplanner = \"bspline\"\npallet_kind = \"field-1200\"\n\
          start = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\npallet = {pallet}\n{extra}"

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use forkbench_trial::{Failure, Scenario, TrialError, TrialOptions, World, run_trial};
+use forkbench_trial::{Failure, Scenario, ScenarioError, TrialOptions, World, run_trial};
 
 fn repo() -> &'static Path {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
@@ -262,7 +262,7 @@ fn unknown_case_lists_the_known_ones() {
     let scn = Scenario::load(&repo().join("scenarios/bspline-table2.toml")).expect("loads");
     assert_eq!(scn.cases.len(), 18);
     match scn.case("19") {
-        Err(TrialError::UnknownCase { known, .. }) => assert!(known.starts_with("1, 2, 3")),
+        Err(ScenarioError::UnknownCase { known, .. }) => assert!(known.starts_with("1, 2, 3")),
         other => panic!("{other:?}"),
     }
 }

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use forkbench_trial::trial::{TrialOptions, run_trial};
-use forkbench_trial::{Scenario, TrialError};
+use forkbench_trial::{Scenario, ScenarioError};
 
 fn dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("forkbench-uncertain-{}", std::process::id()));
@@ -13,7 +13,7 @@ fn dir() -> PathBuf {
 }
 
 /// The field test with `extra` appended, written as `name`.toml and loaded.
-fn field_test_with(name: &str, extra: &str) -> Result<Scenario, TrialError> {
+fn field_test_with(name: &str, extra: &str) -> Result<Scenario, ScenarioError> {
     let base = std::fs::read_to_string(
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/field-test.toml"),
     )
@@ -81,7 +81,7 @@ fn a_pinned_value_is_the_one_run_and_a_slow_steering_fails_the_pick() {
     );
     // A pin the scenario does not declare, or beyond its reach, is refused by name.
     opts.uncertain.insert("pallet.x_m".into(), 0.1);
-    let e = scn.resolve(&opts).expect_err("undeclared").to_string();
+    let e = opts.resolve(&scn).expect_err("undeclared").to_string();
     assert!(
         e.contains("pallet.x_m") && e.contains("steering_time_constant_s"),
         "{e}"
@@ -89,7 +89,7 @@ fn a_pinned_value_is_the_one_run_and_a_slow_steering_fails_the_pick() {
     opts.uncertain.remove("pallet.x_m");
     opts.uncertain
         .insert("steering_time_constant_s".into(), 90.0);
-    let e = scn.resolve(&opts).expect_err("too far").to_string();
+    let e = opts.resolve(&scn).expect_err("too far").to_string();
     assert!(e.contains("outside what its distribution reaches"), "{e}");
 }
 

@@ -1,9 +1,8 @@
 //! The component registry: planners, trackers, pallet detectors and localisers by name, built from their scenario settings tables.
 
-mod spec;
+mod catalogue;
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
 use forkbench_core::ForkliftSpec;
@@ -22,17 +21,9 @@ use forkbench_track::{
     DelayCompensated, ExternalTracker, PurePursuit, RegulatedPurePursuit, Tracker,
 };
 
-pub use spec::{ComponentSpec, Role};
-
-/// What a constructor knows besides the settings: the component's name and where the
-/// defining file lives.
-#[derive(Debug, Clone, Default)]
-pub struct ComponentContext {
-    /// What results are reported under (the table's `name`, or its kind).
-    pub name: String,
-    /// Directory of the scenario file that configured the component.
-    pub dir: PathBuf,
-}
+pub use forkbench_scenario::{
+    ComponentContext, ComponentSpec, DEFAULT_LOCALIZER, POCKET_DETECTOR, Role,
+};
 
 type Ctor<T> = Arc<dyn Fn(&Settings, &ComponentContext) -> Result<T, SettingsError> + Send + Sync>;
 /// Builds a planner from its settings table.
@@ -67,13 +58,6 @@ pub struct LocalizerContext<'a> {
 /// Builds the pallet-pose estimator from the scenario's estimate settings.
 pub type EstimatorCtor =
     Arc<dyn Fn(&PalletEstimateConfig) -> Box<dyn PalletEstimator> + Send + Sync>;
-
-/// The localiser a scenario without `[sensors.localizer]` uses (σ around the truth).
-pub const DEFAULT_LOCALIZER: &str = "gaussian";
-
-/// The pocket detector: a scanner's default detector, and the one the Gaussian sensing's
-/// `scan` shows.
-pub const POCKET_DETECTOR: &str = "pockets";
 
 /// Planners and trackers by name, and the sensor models.
 #[derive(Clone)]

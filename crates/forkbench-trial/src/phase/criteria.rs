@@ -9,7 +9,7 @@ use crate::step_criteria::{LoadHeld, PalletStayed, StepCriterion};
 /// A criterion as a phase's result: its failure, by its name, and why, when it is broken.
 pub fn held(criterion: &dyn StepCriterion) -> Result<(), Failed> {
     match criterion.broken() {
-        Some(why) => Err((Failure::of_criterion(criterion.name()), why)),
+        Some(why) => Err(Failed::new(Failure::of_criterion(criterion.name()), why)),
         None => Ok(()),
     }
 }

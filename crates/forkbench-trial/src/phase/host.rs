@@ -1,4 +1,4 @@
-//! What a phase sees: the scenario's site when its settings are checked ([`Context`]), and the running trial when it drives ([`PhaseHost`]), both as traits so phases need nothing of the trial engine's own types.
+//! What a phase sees: the scenario's site when its settings are checked ([`Context`], the format's), and the running trial when it drives ([`PhaseHost`]), both as traits so phases need nothing of the trial engine's own types.
 
 use std::future::Future;
 use std::pin::Pin;
@@ -15,26 +15,7 @@ use crate::recorder::Recorder;
 use crate::stage_error::StageError;
 use crate::tolerances::Limits;
 
-/// What a phase's settings are checked against when the scenario loads: the world's
-/// slots, stations and fixed obstacles, the pallet, and the mission.
-pub trait Context {
-    /// The scenario's pallet.
-    fn pallet(&self) -> &PalletSpec;
-    /// The pose of the world's pallet slot `name` (its face centre, heading in).
-    fn slot_pose(&self, name: &str) -> Option<Pose2>;
-    /// The world's pallet slots' names, for messages.
-    fn slot_names(&self) -> Vec<String>;
-    /// The pose of the world's station `name`.
-    fn station_pose(&self, name: &str) -> Option<Pose2>;
-    /// The world's stations' names, for messages.
-    fn station_names(&self) -> Vec<String>;
-    /// The rack or wall (its label) a pallet standing with its face centre at `at` would
-    /// overlap; shapes may touch.
-    fn pallet_overlaps(&self, at: &Pose2) -> Option<String>;
-    /// The mission's start, by name and pose (a return's default destination); `None`:
-    /// the scenario has no `[mission]`, whose planner and tracker drive legs.
-    fn mission_start(&self) -> Option<(String, Pose2)>;
-}
+pub use forkbench_scenario::Context;
 
 /// A phase's command at the controller's pose each tick: `None` ends the drive.
 pub type Steer<'s> =

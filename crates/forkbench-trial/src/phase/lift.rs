@@ -3,7 +3,7 @@
 use forkbench_core::SettingsError;
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Phase, PhaseHost, PhaseRun, criteria, settings, stand_for};
+use super::{Context, Failed, Phase, PhaseHost, PhaseRun, criteria, settings, stand_for};
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 
@@ -40,7 +40,7 @@ impl Phase for Lift {
         Box::pin(async move {
             t.sim_mut()
                 .lift()
-                .map_err(|e| (Failure::LiftFailed, e.to_string()))?;
+                .map_err(|e| Failed::new(Failure::LiftFailed, e.to_string()))?;
             stand_for(t, self.time_s, rec).await?;
             criteria::load_held(t)
         })

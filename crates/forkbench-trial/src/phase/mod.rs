@@ -18,25 +18,33 @@ use serde::Serialize;
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
 
-/// A phase after the pick as a scenario lists it: its name and its `[phase.NAME]` settings,
-/// and the phase they build (built once, when the scenario loads).
-#[derive(Debug, Clone, Serialize)]
-pub struct PhaseSpec {
-    pub name: String,
-    pub settings: toml::Table,
-    #[serde(skip)]
-    pub(crate) phase: Arc<dyn Phase>,
+/// A phase after the pick as a scenario lists it, built by this crate's phases.
+pub type PhaseSpec = forkbench_scenario::PhaseSpec<Arc<dyn Phase>>;
+
+/// Why a phase (or the pick's staging) failed: the outcome's failure, and its detail (the
+/// value against the limit, or the fault's message).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}: {detail}", failure.name())]
+pub struct Failed {
+    pub failure: Failure,
+    pub detail: String,
 }
 
-impl PartialEq for PhaseSpec {
-    /// Equal settings build equal phases.
-    fn eq(&self, other: &Self) -> bool {
-        self.name == other.name && self.settings == other.settings
+impl Failed {
+    pub fn new(failure: Failure, detail: impl Into<String>) -> Self {
+        Failed {
+            failure,
+            detail: detail.into(),
+        }
     }
 }
 
-/// Why a phase failed: its first failed criterion, with the value against the limit.
-pub type Failed = (Failure, String);
+/// A stage that could not go on fails the phase as an error, its message the detail.
+impl From<crate::stage_error::StageError> for Failed {
+    fn from(e: crate::stage_error::StageError) -> Self {
+        Failed::new(Failure::Error, e.to_string())
+    }
+}
 
 /// A phase's run: it drives the trial tick by tick, yielding where a session's caller
 /// takes a tick.
@@ -154,8 +162,7 @@ pub fn phase_defaults() -> Vec<(String, toml::Value)> {
         .collect()
 }
 
-/// The phase list's name for the pick itself (approach and insertion), always first.
-pub const PICK: &str = "pick";
+pub use forkbench_scenario::PICK;
 
 /// Checks a scenario's phase list and settings: the pick first, then known phases each
 /// after one it may follow and with the pallet on the forks or not as it needs, every

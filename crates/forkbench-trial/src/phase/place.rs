@@ -114,7 +114,7 @@ impl Phase for Place {
     fn run<'t>(&'t self, t: &'t mut dyn PhaseHost, rec: &'t mut dyn Recorder) -> PhaseRun<'t> {
         Box::pin(async move {
             if !t.sim().carrying() {
-                return Err((Failure::Error, "nothing on the forks to place".into()));
+                return Err(Failed::new(Failure::Error, "nothing on the forks to place"));
             }
             self.approach(t, rec).await?;
             t.sim_mut().lower();
@@ -144,11 +144,13 @@ impl Place {
         let root_goal = aim.to_world(&root_on_pallet);
         // The face a pick would aim at to end with the fork root at `root_goal`.
         let face = root_goal.to_world(&Pose2::new(truck.fork_length_m - t.insertion_m(), 0.0, 0.0));
-        let pose = t.sense(rec).map_err(|e| (Failure::Error, e.to_string()))?;
+        let pose = t
+            .sense(rec)
+            .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
         let k0 = t.sim().steer_rad().tan() / truck.wheelbase_m;
         let time = t.sim().time_s();
         let refused = |why: StageError| {
-            (
+            Failed::new(
                 Failure::PlanFailed,
                 format!("to slot {:?}: {why}", self.slot),
             )
@@ -181,14 +183,14 @@ impl Place {
             .drive_under(timeout_s, rec, &mut |t, pose| {
                 let cmd = t
                     .tracker_command(pose)
-                    .map_err(|e| (Failure::Error, e.to_string()))?;
+                    .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
                 Ok((!(cmd.done && t.stands())).then_some(cmd))
             })
             .await?;
         if arrived {
             Ok(())
         } else {
-            Err((
+            Err(Failed::new(
                 Failure::Timeout,
                 format!("not stopped at slot {:?} after {timeout_s} s", self.slot),
             ))

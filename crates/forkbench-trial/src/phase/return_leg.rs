@@ -3,7 +3,7 @@
 use forkbench_core::{Pose2, SettingsError};
 use serde::{Deserialize, Serialize};
 
-use super::{Context, Phase, PhaseHost, PhaseRun, settings};
+use super::{Context, Failed, Phase, PhaseHost, PhaseRun, settings};
 use crate::outcome::Failure;
 use crate::pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
 use crate::recorder::Recorder;
@@ -116,7 +116,7 @@ impl Phase for Leg {
             if leg.success {
                 Ok(())
             } else {
-                Err((
+                Err(Failed::new(
                     Failure::LegFailed,
                     format!("to {name}: {}", leg.failure_detail.unwrap_or_default()),
                 ))

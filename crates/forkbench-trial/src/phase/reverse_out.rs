@@ -84,7 +84,7 @@ pub(super) async fn back_straight(
     if finished {
         Ok(())
     } else {
-        Err((
+        Err(Failed::new(
             Failure::Timeout,
             format!("backed out {backed_m:.2} of {distance_m} m in {timeout_s} s"),
         ))

@@ -97,7 +97,7 @@ pub fn scenario_detector(
             Ok((detector.name.clone(), d))
         }
         PalletSensing::Gaussian => {
-            let cfg = scn.pallet_sensing.pocket_settings(&scn.registry);
+            let cfg = scn.pallet_sensing.pocket_settings(scn.registry.as_ref());
             let name = crate::components::POCKET_DETECTOR.to_owned();
             Ok((name, Box::new(Pockets { cfg })))
         }

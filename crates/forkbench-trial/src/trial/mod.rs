@@ -32,8 +32,7 @@ use std::time::Instant;
 
 use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
 
-use crate::TrialError;
-use crate::components::{ComponentSpec, Role};
+use crate::ScenarioError;
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, NoRecorder, Recorder};
 use crate::scenario::{Case, Scenario};
@@ -75,55 +74,6 @@ pub fn target_insertion_m(truck: &ForkliftSpec, pallet: &PalletSpec) -> f64 {
     pallet.depth_m.min(truck.fork_length_m) - 0.05
 }
 
-impl Scenario {
-    /// The component a run names: the scenario's own when the name is its name, else a
-    /// registered kind with default settings (checked by building it once).
-    pub fn component(&self, role: Role, name: Option<&str>) -> Result<ComponentSpec, TrialError> {
-        let own = match role {
-            Role::Planner => &self.planner,
-            Role::Tracker => &self.tracker,
-            Role::Detector | Role::Localizer => {
-                let table = if role == Role::Detector {
-                    "sensors.pallet.detector"
-                } else {
-                    "sensors.localizer"
-                };
-                return Err(TrialError::Invalid {
-                    file: self.file.clone(),
-                    field: table.into(),
-                    reason: format!(
-                        "a run does not choose the {role}; the scenario's [{table}] does"
-                    ),
-                });
-            }
-        };
-        let Some(name) = name.filter(|n| *n != own.name) else {
-            return Ok(own.clone());
-        };
-        if let Some(spec) = self
-            .named()
-            .iter()
-            .find(|s| s.role == role && s.name == name)
-        {
-            return Ok(spec.clone());
-        }
-        let spec = ComponentSpec::of_kind(role, name);
-        self.registry
-            .check(&spec)
-            .map_err(|e| TrialError::Invalid {
-                file: self.file.clone(),
-                field: role.to_string(),
-                reason: format!(
-                    "{name:?} is neither this scenario's {role} ({:?}), nor one a components \
-                 file defines (`--components FILE`, or components.toml beside the scenario), \
-                 nor a {role} kind usable with default settings: {e}",
-                    own.name
-                ),
-            })?;
-        Ok(spec)
-    }
-}
-
 /// Runs one case of a scenario to its judged outcome.
 pub fn run_trial(scn: &Scenario, case: &Case, opts: &TrialOptions) -> TrialOutcome {
     run_trial_recorded(scn, case, opts, &mut NoRecorder)
@@ -138,7 +88,7 @@ pub fn run_trial_recorded<R: Recorder + ?Sized>(
     rec: &mut R,
 ) -> TrialOutcome {
     let wall = Instant::now();
-    let mut out = match scn.resolve(opts) {
+    let mut out = match opts.resolve(scn) {
         Ok(run) => link::run_to_end(run_stages(scn, case, &run, None, rec)),
         Err(e) => unresolved(scn, case, opts, &e),
     };
@@ -148,7 +98,7 @@ pub fn run_trial_recorded<R: Recorder + ?Sized>(
 }
 
 /// The outcome of a run whose options do not resolve.
-fn unresolved(scn: &Scenario, case: &Case, opts: &TrialOptions, e: &TrialError) -> TrialOutcome {
+fn unresolved(scn: &Scenario, case: &Case, opts: &TrialOptions, e: &ScenarioError) -> TrialOutcome {
     let names = (
         opts.planner.as_deref().unwrap_or(&scn.planner.name),
         opts.tracker.as_deref().unwrap_or(&scn.tracker.name),
@@ -242,14 +192,14 @@ async fn prepare<'a, R: Recorder + ?Sized>(
     }
     if trial.verdict.out.estimates_missed == trial.verdict.out.estimates
         && trial.verdict.out.estimates > 0
-        && let Err((failure, why)) = trial.stage_and_look(rec).await
+        && let Err(f) = trial.stage_and_look(rec).await
     {
-        rec.event(trial.world.sim.time_s(), Level::Error, &why);
-        return end(trial, failure, why);
+        rec.event(trial.world.sim.time_s(), Level::Error, &f.detail);
+        return end(trial, f.failure, f.detail);
     }
     let path = match trial.first_plan(rec) {
         Ok(p) => p,
-        Err((failure, why)) => return end(trial, failure, why),
+        Err(f) => return end(trial, f.failure, f.detail),
     };
     trial.tracker.reset(&path, &scn.truck);
     trial.set_path(path);

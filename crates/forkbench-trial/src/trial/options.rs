@@ -1,14 +1,14 @@
 //! A run's choices on top of a scenario file (`TrialOptions`, its `Overrides`), checked once, and their resolution into what a trial runs with.
 
 use std::collections::BTreeMap;
-use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use crate::TrialError;
+use crate::ScenarioError;
 use crate::components::{ComponentSpec, Role};
 use crate::scenario::sensors::PalletSensing;
 use crate::scenario::{Scenario, invalid, invalid_setting};
+use forkbench_scenario::Catalogue as _;
 
 /// Largest noise scale a run may ask for: far past any sweep's use, and a bound that
 /// keeps scaled σ finite and meaningful.
@@ -109,7 +109,7 @@ impl Overrides {
     }
 
     /// Every value in range (the scenario aside): what the CLI and Python check alike.
-    pub fn validate(&self) -> Result<(), TrialError> {
+    pub fn validate(&self) -> Result<(), ScenarioError> {
         for knob in NOISE_KNOBS {
             if let Some(v) = self.scale(knob)
                 && !(v.is_finite() && (0.0..=MAX_NOISE_SCALE).contains(&v))
@@ -172,7 +172,7 @@ pub const WALL_BUDGET_RANGE_S: (f64, f64) = (0.01, 86_400.0);
 impl TrialOptions {
     /// Every value in range, and no knob that contradicts another: the one check the CLI,
     /// batches and Python share (resolving against a scenario runs it too).
-    pub fn validate(&self) -> Result<(), TrialError> {
+    pub fn validate(&self) -> Result<(), ScenarioError> {
         self.overrides.validate()?;
         let (lo, hi) = WALL_BUDGET_RANGE_S;
         if let Some(b) = self.wall_budget_s
@@ -197,7 +197,7 @@ impl TrialOptions {
     }
 }
 
-fn bad_option(field: &str, reason: &str) -> TrialError {
+fn bad_option(field: &str, reason: &str) -> ScenarioError {
     invalid("options", field, reason)
 }
 
@@ -230,265 +230,218 @@ pub struct Resolved {
     pub shift: super::uncertain_apply::Shift,
 }
 
-impl Scenario {
-    /// Resolves a run's options against this scenario: the one place defaults meet
-    /// overrides. A scale that cannot act on what is configured is refused, naming the
-    /// component and the knob.
-    pub fn resolve(&self, opts: &TrialOptions) -> Result<Resolved, TrialError> {
-        opts.validate()?;
-        let o = &opts.overrides;
-        let noise = self.noise.enabled && !opts.no_noise;
-        let sensing = self.sensing_for(o.pallet_sensing.as_deref())?;
-        let localizer = self.localizer_for(o)?;
-        if !noise && let Some(knob) = NOISE_KNOBS.iter().find(|k| o.scale(k).is_some()) {
-            return Err(invalid(
-                &self.file,
-                "noise.enabled",
-                &format!("noise is off in this scenario, so {knob}_scale has nothing to act on"),
-            ));
+impl TrialOptions {
+    /// Resolves these options against `scn`: the one place defaults meet overrides. A
+    /// scale that cannot act on what is configured is refused, naming the component and
+    /// the knob.
+    pub fn resolve(&self, scn: &Scenario) -> Result<Resolved, ScenarioError> {
+        resolve(scn, self)
+    }
+
+    /// Resolves and also builds the localiser once in `scn`'s world: what a run checks
+    /// before its first trial, so a bad override is one error, not an error outcome per
+    /// trial.
+    pub fn check_against(&self, scn: &Scenario) -> Result<Resolved, ScenarioError> {
+        check_options(scn, self)
+    }
+}
+
+/// Resolves a run's options against this scenario: the one place defaults meet
+/// overrides. A scale that cannot act on what is configured is refused, naming the
+/// component and the knob.
+fn resolve(scn: &Scenario, opts: &TrialOptions) -> Result<Resolved, ScenarioError> {
+    opts.validate()?;
+    let o = &opts.overrides;
+    let noise = scn.noise.enabled && !opts.no_noise;
+    let sensing = scn.sensing_for(o.pallet_sensing.as_deref())?;
+    let localizer = scn.localizer_for(o.localizer.as_deref(), o.missing_reflectors.as_deref())?;
+    if !noise && let Some(knob) = NOISE_KNOBS.iter().find(|k| o.scale(k).is_some()) {
+        return Err(invalid(
+            &scn.file,
+            "noise.enabled",
+            &format!("noise is off in this scenario, so {knob}_scale has nothing to act on"),
+        ));
+    }
+    let mut pallet_estimate = scn.noise.pallet_estimate.clone();
+    let mut pallet_sensing = match o.pallet_noise_scale {
+        Some(s) => {
+            pallet_estimate.scale = s;
+            scaled_sensing(scn, sensing, s)?
         }
-        let mut pallet_estimate = self.noise.pallet_estimate.clone();
-        let mut pallet_sensing = match o.pallet_noise_scale {
-            Some(s) => {
-                pallet_estimate.scale = s;
-                self.scaled_sensing(sensing, s)?
-            }
-            None => sensing,
-        };
-        let mut nav350 = self.noise.nav350.clone();
-        super::truck_knobs::sensor_timing_for(
-            o.truck_preset.as_deref(),
-            &mut nav350,
-            &mut pallet_sensing,
-        );
-        let localization_noise_scale = match o.localization_noise_scale {
-            Some(s) => {
-                self.check_localizer_scale(&localizer)?;
-                s
-            }
-            None => 1.0,
-        };
-        let mut run = Resolved {
-            seed: opts.seed.unwrap_or(self.seed),
-            planner: self.component(Role::Planner, opts.planner.as_deref())?,
-            tracker: self.component(Role::Tracker, opts.tracker.as_deref())?,
-            noise,
-            replan: opts.replan.unwrap_or(self.replan.enabled),
-            pallet_estimate,
-            pallet_sensing,
-            localizer,
-            nav350,
-            localization_noise_scale,
-            odometry: self.scaled_odometry(o.odometry_noise_scale)?,
-            wall_budget_s: opts.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
-            truck: self.truck_for(o)?,
-            uncertain: BTreeMap::new(),
-            shift: Default::default(),
-        };
-        self.with_uncertain(&mut run, &opts.uncertain)?;
-        Ok(run)
-    }
-
-    /// `run` with the scenario's uncertain parameters drawn (or `pinned`) and applied.
-    fn with_uncertain(
-        &self,
-        run: &mut Resolved,
-        pinned: &BTreeMap<String, f64>,
-    ) -> Result<(), TrialError> {
-        let d = super::uncertain_apply::draw(self, run.seed, pinned)?;
-        if !d.truck.is_empty() {
-            run.truck = self.checked_truck(&run.truck, None, &d.truck)?;
+        None => sensing,
+    };
+    let mut nav350 = scn.noise.nav350.clone();
+    super::truck_knobs::sensor_timing_for(
+        o.truck_preset.as_deref(),
+        &mut nav350,
+        &mut pallet_sensing,
+    );
+    let localization_noise_scale = match o.localization_noise_scale {
+        Some(s) => {
+            check_localizer_scale(scn, &localizer)?;
+            s
         }
-        if let Some(v) = d.detector_latency_s {
-            run.pallet_sensing.set_latency_s(v);
-        }
-        if let Some(v) = d.nav350_latency_s {
-            run.nav350.latency_s = v;
-        }
-        run.shift = d.shift;
-        run.uncertain = d.values;
-        Ok(())
-    }
+        None => 1.0,
+    };
+    let mut run = Resolved {
+        seed: opts.seed.unwrap_or(scn.seed),
+        planner: scn.component(Role::Planner, opts.planner.as_deref())?,
+        tracker: scn.component(Role::Tracker, opts.tracker.as_deref())?,
+        noise,
+        replan: opts.replan.unwrap_or(scn.replan.enabled),
+        pallet_estimate,
+        pallet_sensing,
+        localizer,
+        nav350,
+        localization_noise_scale,
+        odometry: scaled_odometry(scn, o.odometry_noise_scale)?,
+        wall_budget_s: opts.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
+        truck: truck_for(scn, o)?,
+        uncertain: BTreeMap::new(),
+        shift: Default::default(),
+    };
+    with_uncertain(scn, &mut run, &opts.uncertain)?;
+    Ok(run)
+}
 
-    /// This scenario's truck with the run's preset and settings, its control period
-    /// checked against the physics step.
-    fn truck_for(&self, o: &Overrides) -> Result<forkbench_core::ForkliftSpec, TrialError> {
-        if o.truck_preset.is_none() && o.truck.is_empty() {
-            return Ok(self.truck.clone());
-        }
-        self.checked_truck(&self.truck, o.truck_preset.as_deref(), &o.truck)
+/// `run` with the scenario's uncertain parameters drawn (or `pinned`) and applied.
+fn with_uncertain(
+    scn: &Scenario,
+    run: &mut Resolved,
+    pinned: &BTreeMap<String, f64>,
+) -> Result<(), ScenarioError> {
+    let d = super::uncertain_apply::draw(scn, run.seed, pinned)?;
+    if !d.truck.is_empty() {
+        run.truck = checked_truck(scn, &run.truck, None, &d.truck)?;
     }
-
-    /// `base` with `preset` and `settings` applied, its control period checked against
-    /// the physics step.
-    fn checked_truck(
-        &self,
-        base: &forkbench_core::ForkliftSpec,
-        preset: Option<&str>,
-        settings: &BTreeMap<String, f64>,
-    ) -> Result<forkbench_core::ForkliftSpec, TrialError> {
-        let truck = super::apply_truck(base, preset, settings)?;
-        truck
-            .control
-            .steps_per_tick(self.sim.dt_s)
-            .map_err(|e| invalid_setting(&self.file, "truck", &e))?;
-        Ok(truck)
+    if let Some(v) = d.detector_latency_s {
+        run.pallet_sensing.set_latency_s(v);
     }
-
-    /// Resolves and also builds the localiser once in this scenario's world: what a run
-    /// checks before its first trial, so a bad override is one error, not an error outcome
-    /// per trial.
-    pub fn check_options(&self, opts: &TrialOptions) -> Result<Resolved, TrialError> {
-        let run = self.resolve(opts)?;
-        let registry = std::sync::Arc::clone(&self.registry);
-        self.check_localizer(&registry, &run.localizer)
-            .map_err(|e| crate::scenario::invalid_setting(&self.file, "sensors.localizer", &e))?;
-        Ok(run)
+    if let Some(v) = d.nav350_latency_s {
+        run.nav350.latency_s = v;
     }
+    run.shift = d.shift;
+    run.uncertain = d.values;
+    Ok(())
+}
 
-    /// The same scenario localising with `kind` (`gaussian`, `nav350`) at its default
-    /// settings: how a run compares localisation models on the same seeds.
-    pub fn with_localizer(self, kind: &str) -> Result<Self, TrialError> {
-        let spec = self.localizer_for(&Overrides {
-            localizer: Some(kind.to_owned()),
-            ..Default::default()
-        })?;
-        self.localizing_with(spec)
+/// This scenario's truck with the run's preset and settings, its control period
+/// checked against the physics step.
+fn truck_for(scn: &Scenario, o: &Overrides) -> Result<forkbench_core::ForkliftSpec, ScenarioError> {
+    if o.truck_preset.is_none() && o.truck.is_empty() {
+        return Ok(scn.truck.clone());
     }
+    checked_truck(scn, &scn.truck, o.truck_preset.as_deref(), &o.truck)
+}
 
-    /// The same scenario with `names` missing from the NAV350's world (a layout review's
-    /// "what if these go"); its map still holds them.
-    pub fn with_missing_reflectors(self, names: &[String]) -> Result<Self, TrialError> {
-        let spec = self.localizer_for(&Overrides {
-            missing_reflectors: Some(names.to_vec()),
-            ..Default::default()
-        })?;
-        self.localizing_with(spec)
-    }
+/// `base` with `preset` and `settings` applied, its control period checked against
+/// the physics step.
+fn checked_truck(
+    scn: &Scenario,
+    base: &forkbench_core::ForkliftSpec,
+    preset: Option<&str>,
+    settings: &BTreeMap<String, f64>,
+) -> Result<forkbench_core::ForkliftSpec, ScenarioError> {
+    let truck = super::apply_truck(base, preset, settings)?;
+    truck
+        .control
+        .steps_per_tick(scn.sim.dt_s)
+        .map_err(|e| invalid_setting(&scn.file, "truck", &e))?;
+    Ok(truck)
+}
 
-    /// The same scenario with the localiser `spec`, built once in its world to check it.
-    fn localizing_with(mut self, spec: ComponentSpec) -> Result<Self, TrialError> {
-        let registry = Arc::clone(&self.registry);
-        self.check_localizer(&registry, &spec)
-            .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;
-        self.localizer = spec;
-        Ok(self)
-    }
+/// Resolves and also builds the localiser once in this scenario's world: what a run
+/// checks before its first trial, so a bad override is one error, not an error outcome
+/// per trial.
+fn check_options(scn: &Scenario, opts: &TrialOptions) -> Result<Resolved, ScenarioError> {
+    let run = resolve(scn, opts)?;
+    scn.registry
+        .check_localizer(&run.localizer, scn)
+        .map_err(|e| crate::scenario::invalid_setting(&scn.file, "sensors.localizer", &e))?;
+    Ok(run)
+}
 
-    /// The pallet sensing a run names by kind (at its defaults), or the scenario's own.
-    pub(crate) fn sensing_for(&self, kind: Option<&str>) -> Result<PalletSensing, TrialError> {
-        match kind {
-            Some(k) => crate::scenario::sensors::of_kind(k, &self.truck, &self.file),
-            None => Ok(self.pallet_sensing.clone()),
-        }
-    }
-
-    /// The localiser a run's overrides name (the scenario's own, or a kind), with any
-    /// missing reflectors.
-    pub(crate) fn localizer_for(&self, o: &Overrides) -> Result<ComponentSpec, TrialError> {
-        let mut spec = match &o.localizer {
-            Some(kind) => ComponentSpec::of_kind(Role::Localizer, kind),
-            None => self.localizer.clone(),
-        };
-        if let Some(names) = &o.missing_reflectors {
-            if !self.registry.localizer_measures_reflectors(&spec.kind) {
+fn scaled_sensing(
+    scn: &Scenario,
+    sensing: PalletSensing,
+    s: f64,
+) -> Result<PalletSensing, ScenarioError> {
+    match sensing {
+        PalletSensing::Gaussian => Ok(PalletSensing::Gaussian),
+        PalletSensing::Scanner {
+            mut sensors,
+            detector,
+            latency_s,
+            min_score,
+        } => {
+            if sensors.iter().all(|n| !n.scanner.has_noise()) {
                 return Err(invalid(
-                    &self.file,
-                    "sensors.localizer.missing_reflectors",
+                    &scn.file,
+                    "sensors.pallet",
                     &format!(
-                        "only the nav350 localiser measures reflectors; this scenario's is {:?}",
-                        spec.kind
+                        "pallet_noise_scale cannot act: the scanners ({}) have no range \
+                         noise or bias to scale",
+                        names_of(&sensors)
                     ),
                 ));
             }
-            let list = names
-                .iter()
-                .map(|n| toml::Value::from(n.as_str()))
-                .collect();
-            spec.settings
-                .insert("missing_reflectors".into(), toml::Value::Array(list));
-        }
-        Ok(spec)
-    }
-
-    fn scaled_sensing(&self, sensing: PalletSensing, s: f64) -> Result<PalletSensing, TrialError> {
-        match sensing {
-            PalletSensing::Gaussian => Ok(PalletSensing::Gaussian),
-            PalletSensing::Scanner {
-                mut sensors,
+            for n in &mut sensors {
+                n.scanner = n.scanner.scaled_errors(s);
+            }
+            Ok(PalletSensing::Scanner {
+                sensors,
                 detector,
                 latency_s,
                 min_score,
-            } => {
-                if sensors.iter().all(|n| !n.scanner.has_noise()) {
-                    return Err(invalid(
-                        &self.file,
-                        "sensors.pallet",
-                        &format!(
-                            "pallet_noise_scale cannot act: the scanners ({}) have no range \
-                             noise or bias to scale",
-                            names_of(&sensors)
-                        ),
-                    ));
-                }
-                for n in &mut sensors {
-                    n.scanner = n.scanner.scaled_errors(s);
-                }
-                Ok(PalletSensing::Scanner {
-                    sensors,
-                    detector,
-                    latency_s,
-                    min_score,
-                })
-            }
+            })
         }
     }
+}
 
-    /// Refuses a localisation scale the localiser cannot take.
-    fn check_localizer_scale(&self, spec: &ComponentSpec) -> Result<(), TrialError> {
-        if self.registry.localizer_takes_noise_scale(&spec.kind) {
-            Ok(())
-        } else {
-            Err(invalid(
-                &self.file,
-                "sensors.localizer",
-                &format!(
-                    "localization_noise_scale cannot act: the {:?} localiser has no noise \
-                     model the bench can scale",
-                    spec.kind
-                ),
-            ))
-        }
+/// Refuses a localisation scale the localiser cannot take.
+fn check_localizer_scale(scn: &Scenario, spec: &ComponentSpec) -> Result<(), ScenarioError> {
+    if scn.registry.localizer_takes_noise_scale(&spec.kind) {
+        Ok(())
+    } else {
+        Err(invalid(
+            &scn.file,
+            "sensors.localizer",
+            &format!(
+                "localization_noise_scale cannot act: the {:?} localiser has no noise \
+                 model the bench can scale",
+                spec.kind
+            ),
+        ))
     }
+}
 
-    fn scaled_odometry(
-        &self,
-        scale: Option<f64>,
-    ) -> Result<forkbench_sensors::OdometryConfig, TrialError> {
-        let base = &self.noise.odometry;
-        let Some(s) = scale else {
-            return Ok(base.clone());
-        };
-        if base.speed_scale_sigma == 0.0 && base.steer_offset_sigma_rad == 0.0 {
-            return Err(invalid(
-                &self.file,
-                "noise.odometry",
-                "odometry_noise_scale cannot act: both odometry σ are 0",
-            ));
-        }
-        let scaled = forkbench_sensors::OdometryConfig {
-            speed_scale_sigma: base.speed_scale_sigma * s,
-            steer_offset_sigma_rad: base.steer_offset_sigma_rad * s,
-        };
-        scaled.validate().map_err(|e| {
-            invalid(
-                &self.file,
-                "noise.odometry",
-                &format!("odometry_noise_scale {s} makes {e}"),
-            )
-        })?;
-        Ok(scaled)
+fn scaled_odometry(
+    scn: &Scenario,
+    scale: Option<f64>,
+) -> Result<forkbench_sensors::OdometryConfig, ScenarioError> {
+    let base = &scn.noise.odometry;
+    let Some(s) = scale else {
+        return Ok(base.clone());
+    };
+    if base.speed_scale_sigma == 0.0 && base.steer_offset_sigma_rad == 0.0 {
+        return Err(invalid(
+            &scn.file,
+            "noise.odometry",
+            "odometry_noise_scale cannot act: both odometry σ are 0",
+        ));
     }
+    let scaled = forkbench_sensors::OdometryConfig {
+        speed_scale_sigma: base.speed_scale_sigma * s,
+        steer_offset_sigma_rad: base.steer_offset_sigma_rad * s,
+    };
+    scaled.validate().map_err(|e| {
+        invalid(
+            &scn.file,
+            "noise.odometry",
+            &format!("odometry_noise_scale {s} makes {e}"),
+        )
+    })?;
+    Ok(scaled)
 }
 
 fn names_of(sensors: &[crate::scenario::sensors::NamedScanner]) -> String {

@@ -8,7 +8,7 @@ use forkbench_sim::Sim;
 use forkbench_track::Command;
 
 use crate::outcome::Failure;
-use crate::phase::{DriveRun, LegRun, PhaseHost, Steer};
+use crate::phase::{DriveRun, Failed, LegRun, PhaseHost, Steer};
 use crate::recorder::Recorder;
 use crate::scenario::mission::Waypoint;
 use crate::stage_error::StageError;
@@ -127,9 +127,9 @@ impl<'a> PhaseHost for Trial<'a> {
             let m = scn
                 .mission
                 .as_ref()
-                .ok_or((Failure::Error, "no [mission]".to_owned()))?;
+                .ok_or_else(|| Failed::new(Failure::Error, "no [mission]"))?;
             let map = NavMap::shared_from_world(&self.world.obstacles, m.global.resolution_m)
-                .map_err(|e| (Failure::Error, e.to_string()))?;
+                .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
             let here = Waypoint {
                 name: "here".to_owned(),
                 pose: self.world.sim.fork_root_pose(),

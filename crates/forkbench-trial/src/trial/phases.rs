@@ -96,8 +96,8 @@ impl<'a> Trial<'a> {
         };
         match result {
             Ok(()) => rec.event(t, Level::Info, &format!("phase {}: done", spec.name)),
-            Err((failure, why)) => {
-                let why = crate::text::compact_numbers(&why);
+            Err(Failed { failure, detail }) => {
+                let why = crate::text::compact_numbers(&detail);
                 rec.event(
                     t,
                     Level::Error,

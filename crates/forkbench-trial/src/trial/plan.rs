@@ -6,6 +6,7 @@ use forkbench_plan::{Plan, PlanRequest};
 use super::goal_for;
 use super::state::Trial;
 use crate::outcome::Failure;
+use crate::phase::Failed;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::{ReplanMethod, truck_footprint};
 use crate::stage_error::StageError;
@@ -106,22 +107,19 @@ impl Trial<'_> {
     }
 
     /// The first plan, from the first fix to the first estimate; its path to drive.
-    pub(super) fn first_plan<R: Recorder + ?Sized>(
-        &mut self,
-        rec: &mut R,
-    ) -> Result<Path, (Failure, String)> {
+    pub(super) fn first_plan<R: Recorder + ?Sized>(&mut self, rec: &mut R) -> Result<Path, Failed> {
         let est = self.sense.pallet_est;
         let t = self.world.sim.time_s();
         let plan = self.plan_from(self.loc.first_fix, 0.0, &est).map_err(|e| {
             rec.event(t, Level::Error, &format!("planning failed: {e}"));
-            (Failure::PlanFailed, e.to_string())
+            Failed::new(Failure::PlanFailed, e.to_string())
         })?;
         rec.plan(t, 0, &plan.path, plan.control_polygon_m.as_deref());
         self.verdict.out.path_length_m = plan.path.length_m();
         if let Some(why) = self.clash(&plan.path) {
             let why = why.to_string();
             rec.event(t, Level::Error, &why);
-            return Err((Failure::PlanFailed, why));
+            return Err(Failed::new(Failure::PlanFailed, why));
         }
         rec.event(
             t,

@@ -9,7 +9,7 @@ use forkbench_core::Path;
 use super::link::{Control, Episode, Link, LinkRecorder, Observation, Stage, Truth, poll_once};
 use super::session_view::SceneView;
 use super::{Resolved, TrialOptions, run_stages};
-use crate::TrialError;
+use crate::ScenarioError;
 use crate::outcome::TrialOutcome;
 use crate::scenario::{Case, Scenario};
 
@@ -76,7 +76,11 @@ impl Session {
     /// Starts case `case` of `scn` under `opts`, for the pick alone. Err: the options or
     /// the case name are not usable. A trial that ends before driving (no plan, no pallet
     /// found) starts already ended.
-    pub fn start(scn: Arc<Scenario>, case: &str, opts: &TrialOptions) -> Result<Self, TrialError> {
+    pub fn start(
+        scn: Arc<Scenario>,
+        case: &str,
+        opts: &TrialOptions,
+    ) -> Result<Self, ScenarioError> {
         Self::start_episode(scn, case, opts, Episode::Pick, false)
     }
 
@@ -85,7 +89,7 @@ impl Session {
         scn: Arc<Scenario>,
         case: &str,
         opts: &TrialOptions,
-    ) -> Result<Self, TrialError> {
+    ) -> Result<Self, ScenarioError> {
         Self::start_episode(scn, case, opts, Episode::Pick, true)
     }
 
@@ -97,8 +101,8 @@ impl Session {
         opts: &TrialOptions,
         episode: Episode,
         viewed: bool,
-    ) -> Result<Self, TrialError> {
-        let run = scn.resolve(opts)?;
+    ) -> Result<Self, ScenarioError> {
+        let run = opts.resolve(&scn)?;
         let case = scn.case(case)?.clone();
         let (start, pallet) = (case.start, case.pallet);
         let link = Link::new(episode, viewed);

@@ -9,6 +9,7 @@ use forkbench_track::SegmentFollower;
 use super::mission::DriveStats;
 use super::state::Trial;
 use crate::outcome::Failure;
+use crate::phase::Failed;
 use crate::recorder::{Level, Recorder};
 use crate::scenario::mission::{GlobalFile, MissionSpec, Waypoint, mission_tracker};
 use crate::scenario::{BetweenLooks, WhenNotSeen};
@@ -27,14 +28,13 @@ impl Trial<'_> {
     pub(super) async fn stage_and_look<R: Recorder + ?Sized>(
         &mut self,
         rec: &mut R,
-    ) -> Result<(), (Failure, String)> {
+    ) -> Result<(), Failed> {
         let pick = self.scn.pick.clone();
         match pick.when_not_seen {
             WhenNotSeen::Fail => {
-                return Err((
+                return Err(Failed::new(
                     Failure::PalletNotFound,
-                    "the pallet sensing found no pallet from the start pose ([pick] when_not_seen = \"fail\")"
-                        .into(),
+                    "the pallet sensing found no pallet from the start pose ([pick] when_not_seen = \"fail\")",
                 ));
             }
             WhenNotSeen::Prior => {
@@ -66,17 +66,17 @@ impl Trial<'_> {
         self.enter(super::link::Stage::Staging);
         self.staging_leg(staging, rec)
             .await
-            .map_err(|why| (Failure::StagingUnreachable, why))?;
+            .map_err(|why| Failed::new(Failure::StagingUnreachable, why))?;
         let truth = self.world.sim.pallet_pose();
         for look in 1..=pick.looks {
             if look > 1 {
                 self.between_looks(pick.between_looks, &pick, rec)
                     .await
-                    .map_err(|e| (Failure::Error, e.to_string()))?;
+                    .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
             }
             let missed = self.verdict.out.estimates_missed;
             self.first_fix_and_estimate(&truth, rec)
-                .map_err(|e| (Failure::Error, e.to_string()))?;
+                .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
             let found = self.verdict.out.estimates_missed == missed;
             rec.event(
                 self.world.sim.time_s(),
@@ -91,7 +91,7 @@ impl Trial<'_> {
                 return Ok(());
             }
         }
-        Err((
+        Err(Failed::new(
             Failure::PalletNotFound,
             format!(
                 "no pallet from the start pose, nor in {} looks from the staging pose {:.1} m before the expected face",

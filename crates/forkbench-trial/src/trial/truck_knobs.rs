@@ -5,12 +5,12 @@ use std::collections::BTreeMap;
 use forkbench_core::ForkliftSpec;
 use forkbench_core::actuators::{Actuators, PRESETS};
 
-use crate::TrialError;
+use crate::ScenarioError;
 use crate::scenario::invalid;
 
 pub use forkbench_core::run_settings::{TRUCK_KNOBS, truck_path};
 
-fn bad(field: &str, reason: &str) -> TrialError {
+fn bad(field: &str, reason: &str) -> ScenarioError {
     invalid("options", field, reason)
 }
 
@@ -20,7 +20,7 @@ pub fn apply_truck(
     truck: &ForkliftSpec,
     preset: Option<&str>,
     settings: &BTreeMap<String, f64>,
-) -> Result<ForkliftSpec, TrialError> {
+) -> Result<ForkliftSpec, ScenarioError> {
     let mut out = truck.clone();
     if let Some(name) = preset {
         let a = Actuators::preset(name).ok_or_else(|| {
@@ -53,7 +53,7 @@ pub fn apply_truck(
 /// every number under the settings a run may change; anything else is refused naming it.
 pub fn truck_file_settings(
     text: &str,
-) -> Result<(Option<String>, BTreeMap<String, f64>), TrialError> {
+) -> Result<(Option<String>, BTreeMap<String, f64>), ScenarioError> {
     let table: toml::Table = toml::from_str(text).map_err(|e| bad("truck", e.message()))?;
     let mut preset = None;
     let mut settings = BTreeMap::new();
@@ -112,7 +112,7 @@ pub(crate) fn sensor_timing_for(
     }
 }
 
-fn number(path: &str, v: &toml::Value) -> Result<f64, TrialError> {
+fn number(path: &str, v: &toml::Value) -> Result<f64, ScenarioError> {
     match v {
         toml::Value::Float(f) => Ok(*f),
         toml::Value::Integer(i) => Ok(*i as f64),

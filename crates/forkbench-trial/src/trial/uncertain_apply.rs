@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use forkbench_core::Pose2;
 
-use crate::TrialError;
+use crate::ScenarioError;
 use crate::scenario::Scenario;
 use crate::scenario::uncertain::{Axis, Target, Values};
 
@@ -38,7 +38,7 @@ pub(super) struct Drawn {
 
 /// Draws the scenario's uncertain parameters for a trial seeded `seed` (or takes the
 /// `pinned` values), each checked against what it declares.
-pub(super) fn draw(scn: &Scenario, seed: u64, pinned: &Values) -> Result<Drawn, TrialError> {
+pub(super) fn draw(scn: &Scenario, seed: u64, pinned: &Values) -> Result<Drawn, ScenarioError> {
     scn.uncertain.check_pinned(pinned)?;
     let mut d = Drawn {
         values: scn.uncertain.values(seed, pinned),

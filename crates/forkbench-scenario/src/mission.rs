@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::world::World;
 use super::{PoseDeg, invalid};
-use crate::TrialError;
+use crate::ScenarioError;
 
 /// Longest back-out, lead-in or approach a mission may ask for (m).
 pub const MAX_MANOEUVRE_M: f64 = 50.0;
@@ -143,8 +143,8 @@ pub struct MissionSpec {
 
 impl MissionFile {
     /// Resolves station names and checks every value, naming the field.
-    pub fn resolve(&self, world: &World, file: &str) -> Result<MissionSpec, TrialError> {
-        let place = |p: &Place, field: &str| -> Result<Waypoint, TrialError> {
+    pub fn resolve(&self, world: &World, file: &str) -> Result<MissionSpec, ScenarioError> {
+        let place = |p: &Place, field: &str| -> Result<Waypoint, ScenarioError> {
             match p {
                 Place::Pose(d) => {
                     d.check(file, field)?;
@@ -206,7 +206,7 @@ impl MissionFile {
     /// Lengths and tolerances in range. Upper bounds keep a typo from becoming work: a
     /// back-out or approach longer than a warehouse aisle is a leg of its own, and its
     /// path's samples and footprint checks grow with its length.
-    fn check_bounded(&self, file: &str) -> Result<(), TrialError> {
+    fn check_bounded(&self, file: &str) -> Result<(), ScenarioError> {
         let g = &self.global;
         let bounded = [
             ("mission.backout_m", self.backout_m, MAX_MANOEUVRE_M),
@@ -235,7 +235,7 @@ impl MissionFile {
         Ok(())
     }
 
-    fn check(&self, file: &str) -> Result<(), TrialError> {
+    fn check(&self, file: &str) -> Result<(), ScenarioError> {
         let g = &self.global;
         self.check_bounded(file)?;
         if g.planner.kinodynamic() && g.collision != CollisionModel::Footprint {

@@ -5,7 +5,22 @@ use std::path::PathBuf;
 use forkbench_core::settings::{Settings, SettingsError};
 use serde::Serialize;
 
-use super::ComponentContext;
+/// The localiser a scenario without `[sensors.localizer]` uses (σ around the truth).
+pub const DEFAULT_LOCALIZER: &str = "gaussian";
+
+/// The pocket detector: a scanner's default detector, and the one the Gaussian sensing's
+/// `scan` shows.
+pub const POCKET_DETECTOR: &str = "pockets";
+
+/// What a constructor knows besides the settings: the component's name and where the
+/// defining file lives.
+#[derive(Debug, Clone, Default)]
+pub struct ComponentContext {
+    /// What results are reported under (the table's `name`, or its kind).
+    pub name: String,
+    /// Directory of the scenario file that configured the component.
+    pub dir: PathBuf,
+}
 
 /// Which extension point a component fills.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

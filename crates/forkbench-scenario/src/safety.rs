@@ -5,14 +5,14 @@ use forkbench_safety::{FieldSizing, Footprint};
 use super::checks::at_line;
 use super::file::ScenarioFile;
 use super::{Scenario, World, invalid, invalid_setting};
-use crate::TrialError;
+use crate::ScenarioError;
 use forkbench_core::geometry::Obstacle;
 use forkbench_core::{ForkliftSpec, Pose2};
 use forkbench_safety::MoverSpec;
 
 /// The `[safety]` settings in range, their speed ranges covering the truck's top speed;
 /// the error names the file, the line of the key and the field.
-pub(super) fn check(f: &ScenarioFile, (file, text): (&str, &str)) -> Result<(), TrialError> {
+pub(super) fn check(f: &ScenarioFile, (file, text): (&str, &str)) -> Result<(), ScenarioError> {
     let Some(s) = &f.safety else {
         return Ok(());
     };
@@ -58,7 +58,7 @@ pub(super) fn check_movers(
     f: &ScenarioFile,
     world: &World,
     (file, text): (&str, &str),
-) -> Result<(), TrialError> {
+) -> Result<(), ScenarioError> {
     let tables: Vec<usize> = text
         .lines()
         .enumerate()
@@ -122,7 +122,7 @@ fn route_blocked(m: &MoverSpec, obstacles: &[Obstacle], labels: &[String]) -> Op
 /// every physics step, so the total bounds a trial's work, not the count of movers.
 pub const MAX_MOVER_ROUTE_POINTS: usize = 4096;
 
-impl Scenario {
+impl<R: crate::Catalogue> Scenario<R> {
     /// The truck's outline drawn fields are checked against: fork tips, chassis' rear,
     /// width, and the scanner's tolerance as the margin.
     pub fn safety_footprint(&self) -> Footprint {
@@ -134,12 +134,12 @@ impl Scenario {
     /// load, braking on its floor (`[sim] tyre_friction`); Z_R follows the world's
     /// reflectors unless `[safety] reflectors_near` says otherwise. Without `[safety]`,
     /// its defaults.
-    pub fn safety_fields(&self) -> Result<FieldSizing, TrialError> {
+    pub fn safety_fields(&self) -> Result<FieldSizing, ScenarioError> {
         self.safety_fields_for(&self.truck)
     }
 
     /// The same for `truck` (a run's, whose actuators may differ from the scenario's).
-    pub fn safety_fields_for(&self, truck: &ForkliftSpec) -> Result<FieldSizing, TrialError> {
+    pub fn safety_fields_for(&self, truck: &ForkliftSpec) -> Result<FieldSizing, ScenarioError> {
         let cfg = self.safety.clone().unwrap_or_default();
         forkbench_safety::size_fields(
             &cfg,
@@ -148,7 +148,7 @@ impl Scenario {
             &self.pallet,
             !self.world.reflector.is_empty(),
         )
-        .map_err(|e| TrialError::Invalid {
+        .map_err(|e| ScenarioError::Invalid {
             file: self.file.clone(),
             field: "safety".to_owned(),
             reason: e.to_string(),

@@ -4,7 +4,7 @@ use forkbench_core::{PalletSpec, Pose2};
 use serde::{Deserialize, Serialize};
 
 use super::invalid;
-use crate::TrialError;
+use crate::ScenarioError;
 use crate::pose_deg::PoseDeg;
 
 /// The kinds, and the size each takes unless the file gives `length_m` and `width_m`.
@@ -76,7 +76,7 @@ impl ClutterFile {
 
     /// Kind known, pose within the world, sizes positive and at most 100 m, given only
     /// where the kind takes one.
-    pub fn check(&self, file: &str, field: &str) -> Result<(), TrialError> {
+    pub fn check(&self, file: &str, field: &str) -> Result<(), ScenarioError> {
         if !CLUTTER_KINDS.contains(&self.kind.as_str()) {
             return Err(invalid(
                 file,

@@ -5,8 +5,9 @@ use std::path::Path as FsPath;
 use serde::Deserialize;
 
 use super::{Scenario, invalid, invalid_setting, read};
-use crate::TrialError;
-use crate::components::{ComponentSpec, Registry, Role};
+use crate::Catalogue;
+use crate::ScenarioError;
+use crate::component_spec::{ComponentSpec, Role};
 
 /// The file found beside a scenario and used with it without being asked for.
 pub const BESIDE: &str = "components.toml";
@@ -30,8 +31,8 @@ struct NamedFile {
 /// run in the file's directory. Errors name the file, line and field.
 pub fn load_components(
     path: &FsPath,
-    registry: &Registry,
-) -> Result<Vec<ComponentSpec>, TrialError> {
+    registry: &impl Catalogue,
+) -> Result<Vec<ComponentSpec>, ScenarioError> {
     let file = path.display().to_string();
     let text = read(path)?;
     let f: NamedFile = super::parse(&text, &file)?;
@@ -81,7 +82,7 @@ pub fn load_components(
     Ok(out)
 }
 
-impl Scenario {
+impl<R: Catalogue> Scenario<R> {
     /// The scenario with `named` usable by name (`--planner NAME`, `--tracker NAME`); a
     /// name is the scenario's own component's only when it is that one.
     pub fn with_named(mut self, named: Vec<ComponentSpec>) -> Self {
@@ -94,8 +95,8 @@ impl Scenario {
     }
 
     /// [`Scenario::with_named`] with the components of the file at `path`.
-    pub fn with_components_file(self, path: &FsPath) -> Result<Self, TrialError> {
-        let named = load_components(path, &self.registry)?;
+    pub fn with_components_file(self, path: &FsPath) -> Result<Self, ScenarioError> {
+        let named = load_components(path, &*self.registry)?;
         Ok(self.with_named(named))
     }
 

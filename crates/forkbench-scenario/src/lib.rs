@@ -1,16 +1,25 @@
-//! Scenario and world files (TOML, unknown fields rejected), validated into SI-unit cases before any simulation.
+//! Scenario and world files (TOML, unknown fields rejected), validated into SI-unit cases before any simulation; the components they name are checked through a [`Catalogue`].
 
+mod catalogue;
 mod checks;
 pub mod clutter;
+mod component_spec;
+mod error;
 mod file;
+pub mod footprints;
 mod hints;
 mod input;
 mod limits;
 pub mod mission;
 mod named;
 mod pallet;
+mod phases;
+pub mod pose_deg;
+mod runs;
 mod safety;
 pub mod sensors;
+pub mod text;
+pub mod tolerances;
 pub mod uncertain;
 pub mod uncertain_file;
 mod world;
@@ -22,19 +31,21 @@ use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
 use forkbench_sim::SimConfig;
 use serde::Serialize;
 
-use crate::TrialError;
-use crate::components::{ComponentSpec, DEFAULT_LOCALIZER, Registry, Role};
-
-pub use crate::footprints::{pallet_footprint, shrunk, truck_footprint};
-pub use crate::pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
-pub use crate::tolerances::{Limits, Tolerances};
+pub use catalogue::{Catalogue, Context, PICK, PhaseSpec};
 pub use checks::{ForkFit, fork_fit};
+pub use component_spec::{
+    ComponentContext, ComponentSpec, DEFAULT_LOCALIZER, POCKET_DETECTOR, Role,
+};
+pub use error::ScenarioError;
 pub use file::{
     APPROACH_GAP_M, BetweenLooks, NoiseFile, PalletKind, PalletPlacement, PickFile, ReplanFile,
     ReplanMethod, WhenNotSeen,
 };
+pub use footprints::{pallet_footprint, shrunk, truck_footprint};
 pub use limits::Replan;
 pub use named::{BESIDE as COMPONENTS_BESIDE, load_components};
+pub use pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
+pub use tolerances::{Limits, Tolerances};
 pub use world::{PalletSlot, RectFile, World};
 
 use checks::{check_values, resolve_cases};
@@ -43,8 +54,8 @@ use file::ScenarioFile;
 /// Most cases one scenario file may list.
 pub const MAX_CASES: usize = 10_000;
 
-pub fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
-    TrialError::Invalid {
+pub fn invalid(file: &str, field: &str, reason: &str) -> ScenarioError {
+    ScenarioError::Invalid {
         file: file.to_owned(),
         field: field.to_owned(),
         reason: reason.to_owned(),
@@ -52,11 +63,11 @@ pub fn invalid(file: &str, field: &str, reason: &str) -> TrialError {
 }
 
 /// A component's settings error under the scenario table it came from (`prefix`).
-pub(crate) fn invalid_setting(
+pub fn invalid_setting(
     file: &str,
     prefix: &str,
     e: &forkbench_core::SettingsError,
-) -> TrialError {
+) -> ScenarioError {
     let field = match &e.field {
         Some(f) => format!("{prefix}.{f}"),
         None => prefix.to_owned(),
@@ -68,11 +79,13 @@ pub(crate) fn invalid_setting(
 pub const MAX_TIMEOUT_S: f64 = 600.0;
 
 pub use input::MAX_INPUT_BYTES;
-pub(crate) use input::{parse, read};
+pub use input::{parse, read};
 
-/// A loaded, validated scenario file (serialisable: a batch's manifest records it whole).
+/// A loaded, validated scenario file (serialisable: a batch's manifest records it whole),
+/// its components checked against the catalogue `R`.
 #[derive(Debug, Clone, Serialize)]
-pub struct Scenario {
+#[serde(bound = "")]
+pub struct Scenario<R: Catalogue> {
     pub file: String,
     pub name: String,
     pub description: String,
@@ -80,7 +93,7 @@ pub struct Scenario {
     pub tracker: ComponentSpec,
     /// Builds the components this scenario names (and any a run asks for by name).
     #[serde(skip)]
-    pub registry: Arc<Registry>,
+    pub registry: Arc<R>,
     /// Components defined by name in a components file, usable with `--planner` and
     /// `--tracker` (a manifest fingerprints the ones a batch uses).
     #[serde(skip)]
@@ -120,7 +133,7 @@ pub struct Scenario {
     pub mission: Option<mission::MissionSpec>,
     /// The phases after the pick, in order (none: the trial is the pick).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub phases: Vec<crate::phase::PhaseSpec>,
+    pub phases: Vec<PhaseSpec<R::Phase>>,
     /// How the truck's safety fields are sized (`[safety]`; none: the defaults, and the
     /// settings hash of scenarios without it is kept).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -147,13 +160,14 @@ pub struct Case {
     pub pallet: Pose2,
 }
 
-impl Scenario {
-    pub fn load(path: &FsPath) -> Result<Self, TrialError> {
-        Self::load_with(path, Registry::shared())
+impl<R: Catalogue> Scenario<R> {
+    /// Loads `path`, checking its components against the built-in catalogue.
+    pub fn load(path: &FsPath) -> Result<Self, ScenarioError> {
+        Self::load_with(path, R::builtin())
     }
 
     /// Loads with a registry that may hold the caller's own components.
-    pub fn load_with(path: &FsPath, registry: Arc<Registry>) -> Result<Self, TrialError> {
+    pub fn load_with(path: &FsPath, registry: Arc<R>) -> Result<Self, ScenarioError> {
         let file = path.display().to_string();
         let text = read(path)?;
         let dir = forkbench_plan::external::dir_of(path);
@@ -172,9 +186,9 @@ impl Scenario {
     pub fn parse(
         text: &str,
         file: &str,
-        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
-    ) -> Result<Self, TrialError> {
-        Self::parse_with(text, file, load_world, Registry::shared())
+        load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
+    ) -> Result<Self, ScenarioError> {
+        Self::parse_with(text, file, load_world, R::builtin())
     }
 
     /// As [`Scenario::parse`], with a registry that may hold the caller's own components
@@ -182,9 +196,9 @@ impl Scenario {
     pub fn parse_with(
         text: &str,
         file: &str,
-        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
-        registry: Arc<Registry>,
-    ) -> Result<Self, TrialError> {
+        load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
+        registry: Arc<R>,
+    ) -> Result<Self, ScenarioError> {
         let s = Self::parse_layout(text, file, load_world)?;
         s.with_components(text, registry, PathBuf::from("."))
     }
@@ -194,9 +208,9 @@ impl Scenario {
     fn with_components(
         mut self,
         text: &str,
-        registry: Arc<Registry>,
+        registry: Arc<R>,
         dir: PathBuf,
-    ) -> Result<Self, TrialError> {
+    ) -> Result<Self, ScenarioError> {
         let f: ScenarioFile = parse(text, &self.file)?;
         let pure_pursuit = Some("pure_pursuit");
         let planner = Some(&f.planner);
@@ -220,7 +234,7 @@ impl Scenario {
         if let Some(v) = localizer {
             self.localizer =
                 ComponentSpec::from_value(Role::Localizer, v.get_ref(), None, dir.clone())
-                    .and_then(|spec| self.check_localizer(&registry, &spec).map(|()| spec))
+                    .and_then(|spec| registry.check_localizer(&spec, &self).map(|()| spec))
                     .map_err(|e| localizer_error(&self.file, text, v.span(), &e))?;
         }
         if let sensors::PalletSensing::Scanner { detector, .. } = &mut self.pallet_sensing {
@@ -229,11 +243,11 @@ impl Scenario {
                 .check(detector)
                 .map_err(|e| invalid_setting(&self.file, "sensors.pallet.detector", &e))?;
         }
-        self.phases = checks::resolve_phases(
+        self.phases = phases::resolve(
             &f,
             (&self.world, &self.pallet, self.mission.as_ref()),
             (text, &self.file),
-            registry.phase_kinds(),
+            &*registry,
         )?;
         self.registry = registry;
         Ok(self)
@@ -243,8 +257,8 @@ impl Scenario {
     fn parse_layout(
         text: &str,
         file: &str,
-        load_world: impl FnOnce(&FsPath) -> Result<World, TrialError>,
-    ) -> Result<Self, TrialError> {
+        load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
+    ) -> Result<Self, ScenarioError> {
         let f: ScenarioFile = parse(text, file)?;
         let world = match &f.world {
             Some(p) => load_world(p).map_err(|e| {
@@ -264,14 +278,14 @@ impl Scenario {
         checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
         pallet::check_thickness(&f, (&pallet, &pallet_label), file)?;
         let cases = resolve_cases(&f, &world, &pallet, file).map_err(|e| match e {
-            TrialError::Invalid {
+            ScenarioError::Invalid {
                 file,
                 field,
                 reason,
             } if reason == "missing" => {
                 let key = field.rsplit('.').next().unwrap_or(&field);
                 let hint = hints::misplaced_key(text, &format!("missing field `{key}`"), None);
-                TrialError::Invalid {
+                ScenarioError::Invalid {
                     file,
                     field,
                     reason: hint.map_or(reason, |h| format!("missing; {h}")),
@@ -293,7 +307,7 @@ impl Scenario {
             description: f.description,
             planner: ComponentSpec::of_kind(Role::Planner, "bspline"),
             tracker: ComponentSpec::of_kind(Role::Tracker, "pure_pursuit"),
-            registry: Registry::shared(),
+            registry: R::builtin(),
             named: Vec::new(),
             seed: f.seed,
             pallet,
@@ -324,27 +338,9 @@ impl Scenario {
     /// The same scenario estimating the pallet with `kind` (`gaussian`, `tim561`,
     /// `kinect2`, `tim561+kinect2`) at its default settings and the pocket detector: how
     /// a run compares sensing models on the same seeds.
-    pub fn with_pallet_sensing(mut self, kind: &str) -> Result<Self, TrialError> {
+    pub fn with_pallet_sensing(mut self, kind: &str) -> Result<Self, ScenarioError> {
         self.pallet_sensing = self.sensing_for(Some(kind))?;
         Ok(self)
-    }
-
-    /// Builds the localiser `spec` names once in this scenario's world, on its truck.
-    pub(crate) fn check_localizer(
-        &self,
-        registry: &Registry,
-        spec: &ComponentSpec,
-    ) -> Result<(), forkbench_core::SettingsError> {
-        let surfaces = self.world.fixed_surfaces();
-        let cx = crate::components::LocalizerContext {
-            nav350: &self.noise.nav350,
-            noise: true,
-            noise_scale: 1.0,
-            reflectors: &self.world.reflector,
-            surfaces: &surfaces,
-            truck: &self.truck,
-        };
-        registry.localizer(spec, &cx).map(drop)
     }
 
     /// How this scenario's forks fit its pallet (checked at load; printed by `check`).
@@ -352,11 +348,11 @@ impl Scenario {
         fork_fit(&self.truck, &self.pallet, self.tolerances.insertion_depth_m)
     }
 
-    pub fn case(&self, name: &str) -> Result<&Case, TrialError> {
+    pub fn case(&self, name: &str) -> Result<&Case, ScenarioError> {
         self.cases
             .iter()
             .find(|c| c.name == name)
-            .ok_or_else(|| TrialError::UnknownCase {
+            .ok_or_else(|| ScenarioError::UnknownCase {
                 file: self.file.clone(),
                 case: name.to_owned(),
                 known: self.case_names(),
@@ -364,12 +360,12 @@ impl Scenario {
     }
 
     /// The case a run asked for: the one named, or the only one (naming none of several
-    /// is [`TrialError::CaseNeeded`]).
-    pub fn pick_case(&self, name: Option<&str>) -> Result<&Case, TrialError> {
+    /// is [`ScenarioError::CaseNeeded`]).
+    pub fn pick_case(&self, name: Option<&str>) -> Result<&Case, ScenarioError> {
         match (name, self.cases.as_slice()) {
             (Some(n), _) => self.case(n),
             (None, [only]) => Ok(only),
-            (None, all) => Err(TrialError::CaseNeeded {
+            (None, all) => Err(ScenarioError::CaseNeeded {
                 file: self.file.clone(),
                 count: all.len(),
                 known: self.case_names(),
@@ -397,13 +393,13 @@ fn localizer_error(
     text: &str,
     span: std::ops::Range<usize>,
     e: &forkbench_core::SettingsError,
-) -> TrialError {
+) -> ScenarioError {
     match component_error(file, text, Role::Localizer, span, e) {
-        TrialError::Invalid {
+        ScenarioError::Invalid {
             file,
             field,
             reason,
-        } => TrialError::Invalid {
+        } => ScenarioError::Invalid {
             file,
             field: format!("sensors.{field}"),
             reason,
@@ -419,7 +415,7 @@ fn component_error(
     role: Role,
     span: std::ops::Range<usize>,
     e: &forkbench_core::SettingsError,
-) -> TrialError {
+) -> ScenarioError {
     // A table's span may cover only its header: search on to the next table header.
     let rest = text.get(span.start..).unwrap_or("");
     let end = rest
@@ -447,7 +443,7 @@ fn component_error(
         Some(f) => format!("{role}.{f}"),
         None => role.to_string(),
     };
-    TrialError::Invalid {
+    ScenarioError::Invalid {
         file: format!("{file}:{line}"),
         field,
         reason: e.reason.clone(),

@@ -8,8 +8,8 @@ use forkbench_sensors::scan::{SCANNER_PRESETS, ScannerConfig};
 use serde::{Deserialize, Serialize};
 
 use super::{invalid, invalid_setting};
-use crate::TrialError;
-use crate::components::{ComponentSpec, Role};
+use crate::ScenarioError;
+use crate::component_spec::{ComponentSpec, Role};
 
 /// `[sensors.pallet] kind` of the range-scaled Gaussian estimate around the truth; every
 /// other kind names scanner models (`SCANNER_PRESETS`, joined by `+`).
@@ -96,7 +96,7 @@ impl PalletSensing {
 
     /// Sets the scans' latency (the Gaussian has none; an uncertain parameter on it is
     /// refused at load).
-    pub(crate) fn set_latency_s(&mut self, v: f64) {
+    pub fn set_latency_s(&mut self, v: f64) {
         if let PalletSensing::Scanner { latency_s, .. } = self {
             *latency_s = v;
         }
@@ -139,7 +139,7 @@ impl PalletSensing {
 
     /// The pocket detector's settings, when this sensing's detector takes them (the
     /// registry says which kinds do; else their defaults).
-    pub fn pocket_settings(&self, registry: &crate::Registry) -> DetectorConfig {
+    pub fn pocket_settings(&self, registry: &impl crate::Catalogue) -> DetectorConfig {
         match self {
             PalletSensing::Scanner { detector, .. }
                 if registry.detector_takes_pocket_settings(&detector.kind) =>
@@ -158,7 +158,7 @@ pub(super) fn resolve(
     f: Option<&SensorsFile>,
     truck: &ForkliftSpec,
     file: &str,
-) -> Result<PalletSensing, TrialError> {
+) -> Result<PalletSensing, ScenarioError> {
     let Some(p) = f.and_then(|s| s.pallet.as_ref()) else {
         return Ok(PalletSensing::Gaussian);
     };
@@ -233,16 +233,16 @@ pub(super) fn resolve(
 }
 
 /// `[sensors.pallet.detector]`: its kind (the pocket detector by default) and settings.
-fn detector_of(p: &PalletSensorFile, file: &str) -> Result<ComponentSpec, TrialError> {
+fn detector_of(p: &PalletSensorFile, file: &str) -> Result<ComponentSpec, ScenarioError> {
     let table = toml::Value::Table(p.detector.clone().unwrap_or_default());
-    let default = Some(crate::components::POCKET_DETECTOR);
+    let default = Some(crate::component_spec::POCKET_DETECTOR);
     ComponentSpec::from_value(Role::Detector, &table, default, ".".into())
         .map_err(|e| invalid_setting(file, "sensors.pallet.detector", &e))
 }
 
 /// `[sensors.pallet] min_score`, in 0–1 (default `detect`'s threshold, so a trial's
 /// detector is the one `detect` measures); refused for the Gaussian estimate.
-fn min_score_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
+fn min_score_of(p: &PalletSensorFile, file: &str) -> Result<f64, ScenarioError> {
     scanning_setting(
         p,
         file,
@@ -257,7 +257,7 @@ fn min_score_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
 }
 
 /// `[sensors.pallet] latency_s`, in range; refused for the Gaussian estimate.
-fn latency_of(p: &PalletSensorFile, file: &str) -> Result<f64, TrialError> {
+fn latency_of(p: &PalletSensorFile, file: &str) -> Result<f64, ScenarioError> {
     scanning_setting(
         p,
         file,
@@ -277,7 +277,7 @@ fn scanning_setting(
     (key, value, default): (&str, Option<f64>, f64),
     (max, unit): (f64, &str),
     gaussian_why: &str,
-) -> Result<f64, TrialError> {
+) -> Result<f64, ScenarioError> {
     let field = format!("sensors.pallet.{key}");
     if p.kind == GAUSSIAN_SENSING && value.is_some() {
         return Err(invalid(file, &field, gaussian_why));
@@ -298,7 +298,7 @@ pub(crate) fn of_kind(
     kind: &str,
     truck: &ForkliftSpec,
     file: &str,
-) -> Result<PalletSensing, TrialError> {
+) -> Result<PalletSensing, ScenarioError> {
     let f = SensorsFile {
         localizer: None,
         pallet: Some(PalletSensorFile {
@@ -332,7 +332,7 @@ fn check_scanner(
     truck: &ForkliftSpec,
     file: &str,
     table: &str,
-) -> Result<(), TrialError> {
+) -> Result<(), ScenarioError> {
     scanner
         .validate()
         .map_err(|e| invalid_setting(file, table, &e))?;

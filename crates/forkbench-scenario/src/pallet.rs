@@ -5,14 +5,14 @@ use forkbench_core::pallet::{PalletBuild, PalletFace};
 
 use super::checks::at_line;
 use super::file::{PalletKind, ScenarioFile};
-use super::{TrialError, invalid};
+use super::{ScenarioError, invalid};
 
 /// The pallet `f` names, as the truck meets it, and how to name it in messages
 /// (`pallet_kind epal-1`, `pallet_model NAME`).
 pub(super) fn resolve(
     f: &ScenarioFile,
     (file, text): (&str, &str),
-) -> Result<(PalletSpec, String), TrialError> {
+) -> Result<(PalletSpec, String), ScenarioError> {
     let face = f.pallet_entry.unwrap_or(PalletFace::Front);
     let (model, label) = match (&f.pallet_model, f.pallet_kind) {
         (Some(_), Some(_)) => {
@@ -61,7 +61,7 @@ fn stringer_kind(
     face: PalletFace,
     label: String,
     (file, text): (&str, &str),
-) -> Result<(PalletSpec, String), TrialError> {
+) -> Result<(PalletSpec, String), ScenarioError> {
     if matches!(face, PalletFace::Left | PalletFace::Right) {
         return Err(invalid(
             &at_line(file, text, "pallet_entry"),
@@ -82,7 +82,7 @@ pub(super) fn check_thickness(
     f: &ScenarioFile,
     (pallet, label): (&PalletSpec, &str),
     file: &str,
-) -> Result<(), TrialError> {
+) -> Result<(), ScenarioError> {
     let (Some(t), Some(h)) = (f.truck.fork_thickness_m, pallet.pocket_height_m) else {
         return Ok(());
     };

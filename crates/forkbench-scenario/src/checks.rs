@@ -7,7 +7,7 @@ use crate::footprints::{pallet_footprint, shrunk, truck_footprint};
 
 use super::file::{CaseFile, PalletPlacement, ScenarioFile};
 use super::{Case, MAX_CASES, MAX_TIMEOUT_S, World, invalid, invalid_setting};
-use crate::TrialError;
+use crate::ScenarioError;
 
 fn check_layout(
     case: &Case,
@@ -16,7 +16,7 @@ fn check_layout(
     world: &World,
     file: &str,
     field: &str,
-) -> Result<(), TrialError> {
+) -> Result<(), ScenarioError> {
     let (obstacles, labels) = world.footprint_obstacles();
     let (pallet_fp, truck_fp) = (
         shrunk(pallet_footprint(pallet)),
@@ -54,7 +54,7 @@ fn check_layout(
 
 /// Run settings of a scenario file, checked at load: the trial timeout, [sim], [replan]
 /// and the tolerances.
-fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
+fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), ScenarioError> {
     if !(f.timeout_s.is_finite() && f.timeout_s > 0.0 && f.timeout_s <= MAX_TIMEOUT_S) {
         return Err(invalid(
             file,
@@ -110,7 +110,7 @@ fn check_settings(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
 
 /// Upper bounds of `[replan]` and `[tolerances]`: a threshold or a tolerance beyond them
 /// judges nothing.
-fn check_upper_bounds(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
+fn check_upper_bounds(f: &ScenarioFile, file: &str) -> Result<(), ScenarioError> {
     let t = &f.tolerances;
     let ranges = f.replan.reestimate_at_m.as_deref().unwrap_or_default();
     let r = &f.replan;
@@ -160,46 +160,6 @@ fn check_upper_bounds(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
     Ok(())
 }
 
-/// The phases after the pick from `phases` and `[phase.NAME]`; errors name the line.
-pub(super) fn resolve_phases(
-    f: &ScenarioFile,
-    (world, pallet, mission): (&World, &PalletSpec, Option<&super::mission::MissionSpec>),
-    (text, file): (&str, &str),
-    kinds: &[crate::phase::PhaseKind],
-) -> Result<Vec<crate::phase::PhaseSpec>, TrialError> {
-    let names = f.phases.as_ref();
-    let list = names.map_or_else(
-        || vec![crate::phase::PICK.to_owned()],
-        |n| n.get_ref().clone(),
-    );
-    let cx = Site {
-        world,
-        pallet,
-        mission,
-    };
-    crate::phase::resolve(&list, &f.phase, &cx, kinds).map_err(|(field, reason)| {
-        // A phase's settings are at their table's header; the list's errors, and those of
-        // a phase without a table, at the list.
-        let list_at = || {
-            names.map_or_else(
-                || file.to_owned(),
-                |n| {
-                    let line = text[..n.span().start.min(text.len())].matches('\n').count();
-                    format!("{file}:{}", line + 1)
-                },
-            )
-        };
-        let at = match field.split_once('.') {
-            Some(("phase", name)) => {
-                let at = at_line(file, text, &format!("[phase.{name}]"));
-                if at == file { list_at() } else { at }
-            }
-            _ => list_at(),
-        };
-        invalid(&at, &field, &reason)
-    })
-}
-
 /// `file:line` of the first line that writes `key` (a key before its `=`, or a table
 /// header), else `file` alone.
 pub(super) fn at_line(file: &str, text: &str, key: &str) -> String {
@@ -218,7 +178,7 @@ pub(super) fn check_payload(
     truck: &ForkliftSpec,
     pallet: &PalletSpec,
     (file, text): (&str, &str),
-) -> Result<(), TrialError> {
+) -> Result<(), ScenarioError> {
     let file = &at_line(file, text, "payload_kg");
     // The pallet kinds are fixed and valid: only the payload can fail here.
     if let Err(e) = pallet.validate() {
@@ -244,7 +204,7 @@ pub(super) fn check_payload(
 }
 
 /// Value ranges of the truck, sensors, run settings, estimate bias and pallet jitter.
-pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), TrialError> {
+pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), ScenarioError> {
     f.truck
         .validate()
         .map_err(|e| invalid_setting(file, "truck", &e))?;
@@ -285,7 +245,12 @@ pub(super) fn check_values(f: &ScenarioFile, file: &str) -> Result<(), TrialErro
 }
 
 /// Where a placement puts the pallet: its pose, or the world's slot of that name.
-fn place(p: &PalletPlacement, world: &World, file: &str, field: &str) -> Result<Pose2, TrialError> {
+fn place(
+    p: &PalletPlacement,
+    world: &World,
+    file: &str,
+    field: &str,
+) -> Result<Pose2, ScenarioError> {
     match p {
         PalletPlacement::Pose(pd) => {
             pd.check(file, field)?;
@@ -308,7 +273,7 @@ pub(super) fn resolve_cases(
     world: &World,
     pallet: &PalletSpec,
     file: &str,
-) -> Result<Vec<Case>, TrialError> {
+) -> Result<Vec<Case>, ScenarioError> {
     if f.case.len() > MAX_CASES {
         return Err(invalid(
             file,
@@ -408,7 +373,7 @@ pub(super) fn check_geometry(
     f: &ScenarioFile,
     (pallet, kind): (&forkbench_core::PalletSpec, &str),
     file: &str,
-) -> Result<(), TrialError> {
+) -> Result<(), ScenarioError> {
     let t = &f.truck;
     let fit = fork_fit(t, pallet, f.tolerances.insertion_depth_m);
     let o = pallet.pocket_offsets_m()[0].abs();
@@ -451,47 +416,4 @@ pub(super) fn check_geometry(
         ));
     }
     Ok(())
-}
-
-/// The scenario's world, pallet and mission, as a phase's settings are checked against them.
-struct Site<'a> {
-    world: &'a World,
-    pallet: &'a PalletSpec,
-    mission: Option<&'a super::mission::MissionSpec>,
-}
-
-impl crate::phase::Context for Site<'_> {
-    fn pallet(&self) -> &PalletSpec {
-        self.pallet
-    }
-
-    fn slot_pose(&self, name: &str) -> Option<Pose2> {
-        self.world.slot_pose(name)
-    }
-
-    fn slot_names(&self) -> Vec<String> {
-        self.world
-            .pallet_slot
-            .iter()
-            .map(|s| s.name.clone())
-            .collect()
-    }
-
-    fn station_pose(&self, name: &str) -> Option<Pose2> {
-        self.world.station_pose(name)
-    }
-
-    fn station_names(&self) -> Vec<String> {
-        self.world.station.iter().map(|s| s.name.clone()).collect()
-    }
-
-    fn pallet_overlaps(&self, at: &Pose2) -> Option<String> {
-        let (obstacles, mut labels) = self.world.footprint_obstacles();
-        let hit = obstacles.hit(&shrunk(pallet_footprint(self.pallet)), at)?;
-        Some(labels.swap_remove(hit))
-    }
-
-    fn mission_start(&self) -> Option<(String, Pose2)> {
-        self.mission.map(|m| (m.start.name.clone(), m.start.pose))
-    }
 }

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::invalid;
 use super::uncertain::{Axis, Dist, MAX_UNCERTAIN, Target, Uncertain, UncertainSet, Z_LIMIT};
-use crate::TrialError;
+use crate::ScenarioError;
 use forkbench_core::run_settings::{TRUCK_KNOBS, set, truck_path};
 use forkbench_rare::normal;
 
@@ -132,7 +132,7 @@ pub(super) fn check_sensing(
     set: &UncertainSet,
     gaussian: bool,
     file: &str,
-) -> Result<(), TrialError> {
+) -> Result<(), ScenarioError> {
     match set.0.iter().find(|u| u.target == Target::DetectorLatency) {
         Some(u) if gaussian => Err(invalid(
             file,
@@ -162,7 +162,7 @@ pub(super) fn resolve(
     entries: &[toml::Spanned<UncertainFile>],
     movers: &[forkbench_safety::MoverSpec],
     (file, text): (&str, &str),
-) -> Result<UncertainSet, TrialError> {
+) -> Result<UncertainSet, ScenarioError> {
     if entries.len() > MAX_UNCERTAIN {
         return Err(invalid(
             file,

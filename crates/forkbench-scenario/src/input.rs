@@ -3,7 +3,7 @@
 use std::path::Path as FsPath;
 
 use super::hints;
-use crate::TrialError;
+use crate::ScenarioError;
 
 /// Largest scenario or world file read: far above any real one, and a bound on what a
 /// wrong path (a device, a huge file) can make the loader read.
@@ -13,11 +13,11 @@ pub const MAX_INPUT_BYTES: u64 = 4 << 20;
 /// pathological file can be most of it.
 const MAX_MESSAGE_CHARS: usize = 2000;
 
-pub(crate) fn read(path: &FsPath) -> Result<String, TrialError> {
+pub fn read(path: &FsPath) -> Result<String, ScenarioError> {
     // The one capped reader: regular files only, so a FIFO or a device is refused at once
     // instead of blocking or growing without end.
     forkbench_core::files::read_text(path, MAX_INPUT_BYTES).map_err(|e| match e {
-        forkbench_core::files::FileError::Io { cause, .. } => TrialError::Read {
+        forkbench_core::files::FileError::Io { cause, .. } => ScenarioError::Read {
             file: path.display().to_string(),
             cause,
         },
@@ -28,15 +28,12 @@ pub(crate) fn read(path: &FsPath) -> Result<String, TrialError> {
                 .strip_prefix(&format!("{file}: "))
                 .unwrap_or(&message)
                 .to_owned();
-            TrialError::Parse { file, message }
+            ScenarioError::Parse { file, message }
         }
     })
 }
 
-pub(crate) fn parse<T: serde::de::DeserializeOwned>(
-    text: &str,
-    file: &str,
-) -> Result<T, TrialError> {
+pub fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, ScenarioError> {
     toml::from_str(text).map_err(|e| {
         let mut message = crate::text::compact_numbers(e.to_string().trim_end());
         let hint = hints::misplaced_key(
@@ -51,7 +48,7 @@ pub(crate) fn parse<T: serde::de::DeserializeOwned>(
         if let Some(hint) = hint {
             message = format!("{message}\n{hint}");
         }
-        TrialError::Parse {
+        ScenarioError::Parse {
             file: file.to_owned(),
             message,
         }

@@ -6,7 +6,7 @@ use rand::RngExt as _;
 use serde::Serialize;
 
 use super::invalid;
-use crate::TrialError;
+use crate::ScenarioError;
 use forkbench_rare::normal;
 
 /// How far a draw reaches in standard-normal terms: beyond ±6 the nominal probability is
@@ -164,7 +164,7 @@ impl UncertainSet {
     }
 
     /// Refuses pinned values of undeclared parameters, or outside their declared range.
-    pub fn check_pinned(&self, pinned: &Values) -> Result<(), TrialError> {
+    pub fn check_pinned(&self, pinned: &Values) -> Result<(), ScenarioError> {
         for (name, v) in pinned {
             let Some(u) = self.0.iter().find(|u| &u.name == name) else {
                 let known: Vec<&str> = self.0.iter().map(|u| u.name.as_str()).collect();

@@ -8,12 +8,12 @@ use forkbench_sim::Obstacle;
 use serde::{Deserialize, Serialize};
 
 use super::{invalid, parse, read};
-use crate::TrialError;
+use crate::ScenarioError;
 use crate::pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
 
 impl PoseDeg {
     /// Each value finite and within the world's extent; errors name `file` and `field`.
-    pub(super) fn check(&self, file: &str, field: &str) -> Result<(), TrialError> {
+    pub(super) fn check(&self, file: &str, field: &str) -> Result<(), ScenarioError> {
         for (name, v) in [
             ("x_m", self.x_m),
             ("y_m", self.y_m),
@@ -110,7 +110,7 @@ pub struct World {
 
 impl World {
     /// A world file (TOML), or a ROS map_server map (`.yaml`/`.yml` with its image).
-    pub fn load(path: &FsPath) -> Result<Self, TrialError> {
+    pub fn load(path: &FsPath) -> Result<Self, ScenarioError> {
         let file = path.display().to_string();
         if path.extension().is_some_and(|e| e == "yaml" || e == "yml") {
             return Self::from_map(path);
@@ -120,9 +120,9 @@ impl World {
 
     /// A map_server map's grid, its cells within the world's extent (±10 km): the bound
     /// every planner's memory and work is sized by, for scenarios and `plan --map` alike.
-    pub fn read_grid(path: &FsPath) -> Result<forkbench_nav::OccupancyGrid, TrialError> {
+    pub fn read_grid(path: &FsPath) -> Result<forkbench_nav::OccupancyGrid, ScenarioError> {
         let file = path.display().to_string();
-        let grid = forkbench_nav::read_map(path).map_err(|e| TrialError::Parse {
+        let grid = forkbench_nav::read_map(path).map_err(|e| ScenarioError::Parse {
             file: file.clone(),
             message: e.to_string(),
         })?;
@@ -144,7 +144,7 @@ impl World {
     /// A map from SLAM or Nav2 as a world: its occupied and unknown cells, merged into
     /// rectangles, are the racks (the physics and the planners see the same cells). A map
     /// has no named places: scenarios give poses.
-    pub fn from_map(path: &FsPath) -> Result<Self, TrialError> {
+    pub fn from_map(path: &FsPath) -> Result<Self, ScenarioError> {
         let file = path.display().to_string();
         let grid = Self::read_grid(path)?;
         let rack = forkbench_nav::blocked_rects(&grid)
@@ -173,7 +173,7 @@ impl World {
         Ok(w)
     }
 
-    pub fn parse(text: &str, file: &str) -> Result<Self, TrialError> {
+    pub fn parse(text: &str, file: &str) -> Result<Self, ScenarioError> {
         let w: World = parse(text, file)?;
         w.check(file)?;
         Ok(w)
@@ -181,7 +181,7 @@ impl World {
 
     /// Every coordinate finite and within ±10 km, lengths positive, and no two pallet
     /// slots or stations sharing a name (scenarios and missions pick them by name).
-    fn check(&self, file: &str) -> Result<(), TrialError> {
+    fn check(&self, file: &str) -> Result<(), ScenarioError> {
         let w = self;
         for (kind, list) in [("rack", &w.rack), ("wall", &w.wall)] {
             for (i, r) in list.iter().enumerate() {
@@ -243,7 +243,7 @@ impl World {
 
     /// Reflectors: finite and within the world's extent, each name once, none inside a
     /// rack or wall (mount them on a face, a few centimetres proud of it).
-    fn check_reflectors(&self, file: &str) -> Result<(), TrialError> {
+    fn check_reflectors(&self, file: &str) -> Result<(), ScenarioError> {
         let obstacles = self.obstacles();
         // Each NAV350 fix tests reflectors against the racks and walls: a bound on that
         // work, not on either count alone.
@@ -309,7 +309,7 @@ impl World {
     }
 
     /// The same world without the reflectors named (each must exist).
-    pub fn without_reflectors(&self, names: &[String]) -> Result<World, TrialError> {
+    pub fn without_reflectors(&self, names: &[String]) -> Result<World, ScenarioError> {
         if let Some(n) = names
             .iter()
             .find(|n| !self.reflector.iter().any(|r| &r.name == *n))
