@@ -17,32 +17,57 @@ use serde::Serialize;
 
 use crate::outcome::Failure;
 use crate::recorder::Recorder;
+use crate::stage_error::StageError;
 
 /// A phase after the pick as a scenario lists it, built by this crate's phases.
 pub type PhaseSpec = forkbench_scenario::PhaseSpec<Arc<dyn Phase>>;
 
-/// Why a phase (or the pick's staging) failed: the outcome's failure, and its detail (the
-/// value against the limit, or the fault's message).
+/// Why a phase (or the pick's staging) failed: the outcome's failure, and its cause.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{}: {detail}", failure.name())]
+#[error("{}: {cause}", failure.name())]
 pub struct Failed {
     pub failure: Failure,
-    pub detail: String,
+    pub cause: Cause,
+}
+
+/// What made a phase fail: a check in its own words (a criterion's value against its
+/// limit), or a stage of the trial that could not go on (a component's fault, a
+/// non-finite state, a refused plan), kept typed so a phase can tell them apart.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Cause {
+    #[error("{0}")]
+    Detail(String),
+    #[error(transparent)]
+    Stage(#[from] StageError),
 }
 
 impl Failed {
+    /// A failure in the phase's own words.
     pub fn new(failure: Failure, detail: impl Into<String>) -> Self {
         Failed {
             failure,
-            detail: detail.into(),
+            cause: Cause::Detail(detail.into()),
         }
+    }
+
+    /// A stage that could not go on, failing as `failure`.
+    pub fn stage(failure: Failure, e: StageError) -> Self {
+        Failed {
+            failure,
+            cause: Cause::Stage(e),
+        }
+    }
+
+    /// The outcome's failure detail: the cause's message.
+    pub fn detail(&self) -> String {
+        self.cause.to_string()
     }
 }
 
-/// A stage that could not go on fails the phase as an error, its message the detail.
-impl From<crate::stage_error::StageError> for Failed {
-    fn from(e: crate::stage_error::StageError) -> Self {
-        Failed::new(Failure::Error, e.to_string())
+/// A stage that could not go on fails the phase as an error.
+impl From<StageError> for Failed {
+    fn from(e: StageError) -> Self {
+        Failed::stage(Failure::Error, e)
     }
 }
 
@@ -261,4 +286,29 @@ pub fn settings<T: serde::de::DeserializeOwned>(table: &toml::Table) -> Result<T
         field: None,
         reason: e.to_string().trim_end().to_owned(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stage_s_fault_stays_typed_and_reads_as_before() {
+        let tracker = StageError::Tracker {
+            tracker: "mine".into(),
+            reason: "no answer in 0.2 s".into(),
+        };
+        let f = Failed::from(tracker.clone());
+        assert_eq!(f.failure, Failure::Error);
+        assert!(matches!(f.cause, Cause::Stage(StageError::Tracker { .. })));
+        assert_eq!(f.detail(), tracker.to_string());
+        let nan = Failed::from(StageError::NonFinite { t_s: 1.5 });
+        assert!(matches!(
+            nan.cause,
+            Cause::Stage(StageError::NonFinite { .. })
+        ));
+        assert_eq!(nan.detail(), "non-finite state at t = 1.500 s");
+        let own = Failed::new(Failure::Timeout, "not stopped after 20 s");
+        assert_eq!(own.to_string(), "timeout: not stopped after 20 s");
+    }
 }

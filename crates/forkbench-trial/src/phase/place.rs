@@ -144,9 +144,7 @@ impl Place {
         let root_goal = aim.to_world(&root_on_pallet);
         // The face a pick would aim at to end with the fork root at `root_goal`.
         let face = root_goal.to_world(&Pose2::new(truck.fork_length_m - t.insertion_m(), 0.0, 0.0));
-        let pose = t
-            .sense(rec)
-            .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
+        let pose = t.sense(rec)?;
         let k0 = t.sim().steer_rad().tan() / truck.wheelbase_m;
         let time = t.sim().time_s();
         let refused = |why: StageError| {
@@ -181,9 +179,7 @@ impl Place {
         let timeout_s = self.cfg.timeout_s;
         let arrived = t
             .drive_under(timeout_s, rec, &mut |t, pose| {
-                let cmd = t
-                    .tracker_command(pose)
-                    .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
+                let cmd = t.tracker_command(pose)?;
                 Ok((!(cmd.done && t.stands())).then_some(cmd))
             })
             .await?;

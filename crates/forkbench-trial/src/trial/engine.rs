@@ -367,9 +367,3 @@ impl Future for Yield {
         }
     }
 }
-
-impl From<StageError> for (crate::outcome::Failure, String) {
-    fn from(e: StageError) -> Self {
-        (crate::outcome::Failure::Error, e.to_string())
-    }
-}

@@ -194,12 +194,13 @@ async fn prepare<'a, R: Recorder + ?Sized>(
         && trial.verdict.out.estimates > 0
         && let Err(f) = trial.stage_and_look(rec).await
     {
-        rec.event(trial.world.sim.time_s(), Level::Error, &f.detail);
-        return end(trial, f.failure, f.detail);
+        let why = f.detail();
+        rec.event(trial.world.sim.time_s(), Level::Error, &why);
+        return end(trial, f.failure, why);
     }
     let path = match trial.first_plan(rec) {
         Ok(p) => p,
-        Err(f) => return end(trial, f.failure, f.detail),
+        Err(f) => return end(trial, f.failure.clone(), f.detail()),
     };
     trial.tracker.reset(&path, &scn.truck);
     trial.set_path(path);

@@ -96,8 +96,8 @@ impl<'a> Trial<'a> {
         };
         match result {
             Ok(()) => rec.event(t, Level::Info, &format!("phase {}: done", spec.name)),
-            Err(Failed { failure, detail }) => {
-                let why = crate::text::compact_numbers(&detail);
+            Err(Failed { failure, cause }) => {
+                let why = crate::text::compact_numbers(&cause.to_string());
                 rec.event(
                     t,
                     Level::Error,

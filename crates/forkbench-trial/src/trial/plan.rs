@@ -112,7 +112,7 @@ impl Trial<'_> {
         let t = self.world.sim.time_s();
         let plan = self.plan_from(self.loc.first_fix, 0.0, &est).map_err(|e| {
             rec.event(t, Level::Error, &format!("planning failed: {e}"));
-            Failed::new(Failure::PlanFailed, e.to_string())
+            Failed::stage(Failure::PlanFailed, e)
         })?;
         rec.plan(t, 0, &plan.path, plan.control_polygon_m.as_deref());
         self.verdict.out.path_length_m = plan.path.length_m();

@@ -70,13 +70,10 @@ impl Trial<'_> {
         let truth = self.world.sim.pallet_pose();
         for look in 1..=pick.looks {
             if look > 1 {
-                self.between_looks(pick.between_looks, &pick, rec)
-                    .await
-                    .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
+                self.between_looks(pick.between_looks, &pick, rec).await?;
             }
             let missed = self.verdict.out.estimates_missed;
-            self.first_fix_and_estimate(&truth, rec)
-                .map_err(|e| Failed::new(Failure::Error, e.to_string()))?;
+            self.first_fix_and_estimate(&truth, rec)?;
             let found = self.verdict.out.estimates_missed == missed;
             rec.event(
                 self.world.sim.time_s(),
