@@ -158,35 +158,27 @@ fn a_shipped_cycle_loads_against_a_catalogue_of_names() {
     assert!(asked.contains(&"phases pick lift reverse_out carry place return".to_owned()));
 }
 
-#[test]
-fn a_kind_the_catalogue_refuses_is_named_at_its_line() {
-    let text = cycle_text().replace("planner = \"bspline\"", "planner = \"nope\"");
-    let e = parse(&text, Arc::new(Names::default()))
+/// The cycle's error with `from` written as `to`.
+fn refusal(from: &str, to: &str) -> String {
+    let text = cycle_text().replace(from, to);
+    assert_ne!(text, cycle_text(), "{from} is in the cycle");
+    parse(&text, Arc::new(Names::default()))
         .expect_err("refused")
-        .to_string();
+        .to_string()
+}
+
+#[test]
+fn what_the_catalogue_refuses_is_named_at_its_line() {
     assert_eq!(
-        e,
+        refusal("planner = \"bspline\"", "planner = \"nope\""),
         "cycle.toml:10: field `planner.kind`: no planner \"nope\""
     );
-}
-
-#[test]
-fn a_setting_the_catalogue_refuses_is_named_at_its_key() {
-    let text = cycle_text().replace("lookahead_m = 0.7", "lookahead_m = 7.0");
-    let e = parse(&text, Arc::new(Names::default()))
-        .expect_err("refused")
-        .to_string();
-    assert_eq!(e, "cycle.toml:36: field `tracker.lookahead_m`: at most 5");
-}
-
-#[test]
-fn a_phase_the_catalogue_refuses_is_named_at_its_table() {
-    let text = cycle_text().replace("slot = \"sorting-drop\"", "slot = \"nowhere\"");
-    let e = parse(&text, Arc::new(Names::default()))
-        .expect_err("refused")
-        .to_string();
     assert_eq!(
-        e,
+        refusal("lookahead_m = 0.7", "lookahead_m = 7.0"),
+        "cycle.toml:36: field `tracker.lookahead_m`: at most 5"
+    );
+    assert_eq!(
+        refusal("slot = \"sorting-drop\"", "slot = \"nowhere\""),
         "cycle.toml:26: field `phase.place`: no slot or station \"nowhere\""
     );
 }
