@@ -13,7 +13,8 @@ pub const MAX_INPUT_BYTES: u64 = 4 << 20;
 /// pathological file can be most of it.
 const MAX_MESSAGE_CHARS: usize = 2000;
 
-pub fn read(path: &FsPath) -> Result<String, ScenarioError> {
+/// The text of the file at `path`, within [`MAX_INPUT_BYTES`].
+pub(crate) fn read(path: &FsPath) -> Result<String, ScenarioError> {
     // The one capped reader: regular files only, so a FIFO or a device is refused at once
     // instead of blocking or growing without end.
     forkbench_core::files::read_text(path, MAX_INPUT_BYTES).map_err(|e| match e {
@@ -33,7 +34,12 @@ pub fn read(path: &FsPath) -> Result<String, ScenarioError> {
     })
 }
 
-pub fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, ScenarioError> {
+/// `text` of `file` as `T`; the error names the file and line, and a key that landed in
+/// the wrong table.
+pub(crate) fn parse<T: serde::de::DeserializeOwned>(
+    text: &str,
+    file: &str,
+) -> Result<T, ScenarioError> {
     toml::from_str(text).map_err(|e| {
         let mut message = crate::text::compact_numbers(e.to_string().trim_end());
         let hint = hints::misplaced_key(

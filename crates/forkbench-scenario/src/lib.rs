@@ -54,6 +54,7 @@ use file::ScenarioFile;
 /// Most cases one scenario file may list.
 pub const MAX_CASES: usize = 10_000;
 
+/// The error of `field` in `file` (`file:line` where known), and why.
 pub fn invalid(file: &str, field: &str, reason: &str) -> ScenarioError {
     ScenarioError::Invalid {
         file: file.to_owned(),
@@ -79,7 +80,7 @@ pub fn invalid_setting(
 pub const MAX_TIMEOUT_S: f64 = 600.0;
 
 pub use input::MAX_INPUT_BYTES;
-pub use input::{parse, read};
+use input::{parse, read};
 
 /// A loaded, validated scenario file (serialisable: a batch's manifest records it whole),
 /// its components checked against the catalogue `R`.
