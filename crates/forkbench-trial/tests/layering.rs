@@ -113,7 +113,8 @@ fn each_module_names_only_those_below_it() {
 }
 
 /// The files (or subfolders) of `dir` that each one imports through `super::` or
-/// `crate::<folder>::`.
+/// `crate::<folder>::` (a crate's own `src/`, `folder` empty: through `super::` or
+/// `crate::`; its `lib.rs` is the folder's `mod.rs`).
 fn sibling_edges(dir: &Path, folder: &str) -> BTreeMap<String, BTreeSet<String>> {
     let unit = |p: &Path| -> String {
         let rel = p.strip_prefix(dir).expect("under the folder");
@@ -122,15 +123,19 @@ fn sibling_edges(dir: &Path, folder: &str) -> BTreeMap<String, BTreeSet<String>>
     };
     let files = rust_files(dir);
     let units: BTreeSet<String> = files.iter().map(|f| unit(f)).collect();
+    let through = match folder {
+        "" => "crate::".to_owned(),
+        f => format!("crate::{f}::"),
+    };
     let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for file in &files {
         let me = unit(file);
-        if me == "mod" {
+        if me == "mod" || me == "lib" {
             continue;
         }
         let text = code(file);
         let mut named = after(&text, "super::");
-        named.extend(after(&text, &format!("crate::{folder}::")));
+        named.extend(after(&text, &through));
         for n in named {
             if n != me && n != "mod" && units.contains(&n) {
                 edges.entry(me.clone()).or_default().insert(n);
@@ -172,10 +177,23 @@ fn a_cycle(edges: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
 
 #[test]
 fn the_files_of_a_folder_import_one_another_without_a_cycle() {
-    for folder in ["phase", "scenario", "components", "step_criteria", "trial"] {
-        let edges = sibling_edges(&src().join(folder), folder);
+    for folder in [
+        "phase",
+        "components",
+        "step_criteria",
+        "trial",
+        "trial/safety",
+    ] {
+        let edges = sibling_edges(&src().join(folder), &folder.replace('/', "::"));
         assert_eq!(a_cycle(&edges), None, "in {folder}/");
     }
+    // The scenario format's crate: its modules are the root's files.
+    let format = src().join("../../forkbench-scenario/src");
+    assert_eq!(
+        a_cycle(&sibling_edges(&format, "")),
+        None,
+        "in forkbench-scenario"
+    );
 }
 
 #[test]
@@ -190,6 +208,11 @@ fn the_checks_see_a_cycle_and_an_edge_against_the_layers() {
         ["outcome", "scenario"]
     );
     assert_eq!(after("crate::World::load", "crate::"), ["World"]);
+    let format = sibling_edges(&src().join("../../forkbench-scenario/src"), "");
+    assert!(
+        format.get("phases").is_some_and(|e| e.contains("checks")),
+        "the format crate's imports are seen: {format:?}"
+    );
     assert_eq!(
         root_reexports().get("World").map(String::as_str),
         Some("scenario")
