@@ -1,7 +1,5 @@
 //! What a run may choose of a scenario besides its file: a component by name, another localiser or pallet sensing, reflectors taken away; each checked as the file's own would be.
 
-use std::sync::Arc;
-
 use crate::sensors::PalletSensing;
 use crate::{Catalogue, ComponentSpec, Role, Scenario, ScenarioError, invalid, invalid_setting};
 
@@ -73,8 +71,7 @@ impl<R: Catalogue> Scenario<R> {
 
     /// The same scenario with the localiser `spec`, built once in its world to check it.
     fn localizing_with(mut self, spec: ComponentSpec) -> Result<Self, ScenarioError> {
-        let registry = Arc::clone(&self.registry);
-        registry
+        self.registry
             .check_localizer(&spec, &self)
             .map_err(|e| invalid_setting(&self.file, "sensors.localizer", &e))?;
         self.localizer = spec;

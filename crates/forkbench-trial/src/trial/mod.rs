@@ -200,7 +200,10 @@ async fn prepare<'a, R: Recorder + ?Sized>(
     }
     let path = match trial.first_plan(rec) {
         Ok(p) => p,
-        Err(f) => return end(trial, f.failure.clone(), f.detail()),
+        Err(f) => {
+            let why = f.detail();
+            return end(trial, f.failure, why);
+        }
     };
     trial.tracker.reset(&path, &scn.truck);
     trial.set_path(path);

@@ -235,73 +235,71 @@ impl TrialOptions {
     /// scale that cannot act on what is configured is refused, naming the component and
     /// the knob.
     pub fn resolve(&self, scn: &Scenario) -> Result<Resolved, ScenarioError> {
-        resolve(scn, self)
+        self.validate()?;
+        let o = &self.overrides;
+        let noise = scn.noise.enabled && !self.no_noise;
+        let sensing = scn.sensing_for(o.pallet_sensing.as_deref())?;
+        let localizer =
+            scn.localizer_for(o.localizer.as_deref(), o.missing_reflectors.as_deref())?;
+        if !noise && let Some(knob) = NOISE_KNOBS.iter().find(|k| o.scale(k).is_some()) {
+            return Err(invalid(
+                &scn.file,
+                "noise.enabled",
+                &format!("noise is off in this scenario, so {knob}_scale has nothing to act on"),
+            ));
+        }
+        let mut pallet_estimate = scn.noise.pallet_estimate.clone();
+        let mut pallet_sensing = match o.pallet_noise_scale {
+            Some(s) => {
+                pallet_estimate.scale = s;
+                scaled_sensing(scn, sensing, s)?
+            }
+            None => sensing,
+        };
+        let mut nav350 = scn.noise.nav350.clone();
+        super::truck_knobs::sensor_timing_for(
+            o.truck_preset.as_deref(),
+            &mut nav350,
+            &mut pallet_sensing,
+        );
+        let localization_noise_scale = match o.localization_noise_scale {
+            Some(s) => {
+                check_localizer_scale(scn, &localizer)?;
+                s
+            }
+            None => 1.0,
+        };
+        let mut run = Resolved {
+            seed: self.seed.unwrap_or(scn.seed),
+            planner: scn.component(Role::Planner, self.planner.as_deref())?,
+            tracker: scn.component(Role::Tracker, self.tracker.as_deref())?,
+            noise,
+            replan: self.replan.unwrap_or(scn.replan.enabled),
+            pallet_estimate,
+            pallet_sensing,
+            localizer,
+            nav350,
+            localization_noise_scale,
+            odometry: scaled_odometry(scn, o.odometry_noise_scale)?,
+            wall_budget_s: self.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
+            truck: truck_for(scn, o)?,
+            uncertain: BTreeMap::new(),
+            shift: Default::default(),
+        };
+        with_uncertain(scn, &mut run, &self.uncertain)?;
+        Ok(run)
     }
 
     /// Resolves and also builds the localiser once in `scn`'s world: what a run checks
     /// before its first trial, so a bad override is one error, not an error outcome per
     /// trial.
     pub fn check_against(&self, scn: &Scenario) -> Result<Resolved, ScenarioError> {
-        check_options(scn, self)
+        let run = self.resolve(scn)?;
+        scn.registry
+            .check_localizer(&run.localizer, scn)
+            .map_err(|e| invalid_setting(&scn.file, "sensors.localizer", &e))?;
+        Ok(run)
     }
-}
-
-/// Resolves a run's options against this scenario: the one place defaults meet
-/// overrides. A scale that cannot act on what is configured is refused, naming the
-/// component and the knob.
-fn resolve(scn: &Scenario, opts: &TrialOptions) -> Result<Resolved, ScenarioError> {
-    opts.validate()?;
-    let o = &opts.overrides;
-    let noise = scn.noise.enabled && !opts.no_noise;
-    let sensing = scn.sensing_for(o.pallet_sensing.as_deref())?;
-    let localizer = scn.localizer_for(o.localizer.as_deref(), o.missing_reflectors.as_deref())?;
-    if !noise && let Some(knob) = NOISE_KNOBS.iter().find(|k| o.scale(k).is_some()) {
-        return Err(invalid(
-            &scn.file,
-            "noise.enabled",
-            &format!("noise is off in this scenario, so {knob}_scale has nothing to act on"),
-        ));
-    }
-    let mut pallet_estimate = scn.noise.pallet_estimate.clone();
-    let mut pallet_sensing = match o.pallet_noise_scale {
-        Some(s) => {
-            pallet_estimate.scale = s;
-            scaled_sensing(scn, sensing, s)?
-        }
-        None => sensing,
-    };
-    let mut nav350 = scn.noise.nav350.clone();
-    super::truck_knobs::sensor_timing_for(
-        o.truck_preset.as_deref(),
-        &mut nav350,
-        &mut pallet_sensing,
-    );
-    let localization_noise_scale = match o.localization_noise_scale {
-        Some(s) => {
-            check_localizer_scale(scn, &localizer)?;
-            s
-        }
-        None => 1.0,
-    };
-    let mut run = Resolved {
-        seed: opts.seed.unwrap_or(scn.seed),
-        planner: scn.component(Role::Planner, opts.planner.as_deref())?,
-        tracker: scn.component(Role::Tracker, opts.tracker.as_deref())?,
-        noise,
-        replan: opts.replan.unwrap_or(scn.replan.enabled),
-        pallet_estimate,
-        pallet_sensing,
-        localizer,
-        nav350,
-        localization_noise_scale,
-        odometry: scaled_odometry(scn, o.odometry_noise_scale)?,
-        wall_budget_s: opts.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
-        truck: truck_for(scn, o)?,
-        uncertain: BTreeMap::new(),
-        shift: Default::default(),
-    };
-    with_uncertain(scn, &mut run, &opts.uncertain)?;
-    Ok(run)
 }
 
 /// `run` with the scenario's uncertain parameters drawn (or `pinned`) and applied.
@@ -348,17 +346,6 @@ fn checked_truck(
         .steps_per_tick(scn.sim.dt_s)
         .map_err(|e| invalid_setting(&scn.file, "truck", &e))?;
     Ok(truck)
-}
-
-/// Resolves and also builds the localiser once in this scenario's world: what a run
-/// checks before its first trial, so a bad override is one error, not an error outcome
-/// per trial.
-fn check_options(scn: &Scenario, opts: &TrialOptions) -> Result<Resolved, ScenarioError> {
-    let run = resolve(scn, opts)?;
-    scn.registry
-        .check_localizer(&run.localizer, scn)
-        .map_err(|e| crate::scenario::invalid_setting(&scn.file, "sensors.localizer", &e))?;
-    Ok(run)
 }
 
 fn scaled_sensing(
