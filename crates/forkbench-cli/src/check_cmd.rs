@@ -19,8 +19,12 @@ pub fn run(a: &CheckArgs) -> anyhow::Result<()> {
     crate::warn_slips(&scn);
     let fit = scn.fork_fit();
     if a.json {
-        let v =
-            serde_json::json!({"scenario": scn, "pallet_kind": scn.pallet_kind, "fork_fit": fit});
+        let v = serde_json::json!({
+            "scenario": scn,
+            "pallet_kind": scn.pallet_kind,
+            "fork_fit": fit,
+            "truck": whole_truck(&scn.truck),
+        });
         let text = serde_json::to_string_pretty(&v).context("serialising the scenario")?;
         return crate::emit(&(text + "\n"));
     }
@@ -83,11 +87,12 @@ fn summary(scn: &Scenario) -> String {
             yes(fit.spacing_ok())
         ),
         format!(
-            "depth        insertion {:.3} m required; forks {:.3} m, pallet {:.3} m deep: {}",
+            "depth        insertion {:.3} m required, {:.3} m aimed for; forks {:.3} m, pallet {:.3} m deep: {}",
             fit.insertion_depth_m,
+            fit.insertion_target_m,
             fit.fork_length_m,
             fit.pallet_depth_m,
-            yes(fit.depth_ok())
+            yes(fit.depth_ok() && fit.target_ok())
         ),
         format!(
             "limits       lateral {} m, heading {:.2}°, contact {} N, pallet moved {} m",
@@ -96,6 +101,7 @@ fn summary(scn: &Scenario) -> String {
             scn.tolerances.contact_force_n,
             scn.tolerances.pallet_displacement_m
         ),
+        truck_line(&scn.truck),
         steering_line(&scn.truck),
         drive_line(&scn.truck),
         format!("seed         {}; timeout {} s", scn.seed, scn.timeout_s),
@@ -212,4 +218,46 @@ fn pallet_line(scn: &forkbench_trial::Scenario) -> String {
         p.pocket_width_m,
         p.pocket_offsets_m()[0]
     )
+}
+
+/// The truck's geometry and mass in one line: what its type sheet gives.
+fn truck_line(t: &forkbench_core::ForkliftSpec) -> String {
+    format!(
+        "truck        wheelbase {:.3} m, lock {:.1}° (turn radius {:.3} m), {:.0} kg, rated {:.0} kg, body {:.3} × {:.3} m, forks {:.3} m × {:.3} m at {:.3} m spacing, root {:.3} m ahead of the front axle, ≤ {} m/s",
+        t.wheelbase_m,
+        t.max_steer_rad.to_degrees(),
+        t.min_turn_radius_m(),
+        t.mass_kg,
+        t.rated_capacity_kg,
+        t.body_length_m,
+        t.body_width_m,
+        t.fork_length_m,
+        t.fork_width_m,
+        t.fork_spacing_m,
+        t.fork_root_ahead_of_front_axle_m,
+        t.max_speed_mps
+    )
+}
+
+/// The whole truck as JSON: every field, the actuators and control timing included even
+/// where they equal the defaults (which the scenario's own serialisation leaves out).
+fn whole_truck(t: &forkbench_core::ForkliftSpec) -> serde_json::Value {
+    let mut v = serde_json::to_value(t).unwrap_or_default();
+    if let Some(m) = v.as_object_mut() {
+        m.insert("rated_capacity_kg".into(), t.rated_capacity_kg.into());
+        m.insert(
+            "steering".into(),
+            serde_json::to_value(&t.steering).unwrap_or_default(),
+        );
+        m.insert(
+            "drive".into(),
+            serde_json::to_value(&t.drive).unwrap_or_default(),
+        );
+        m.insert(
+            "control".into(),
+            serde_json::to_value(&t.control).unwrap_or_default(),
+        );
+        m.insert("max_curvature_per_m".into(), t.max_curvature_per_m().into());
+    }
+    v
 }

@@ -8,9 +8,10 @@ use forkbench_trial::trial::Overrides;
 pub struct RunOptionArgs {
     #[command(flatten)]
     pub options: Overrides,
-    /// The truck's actuators and control timing: a preset (`ideal`, `realistic`) or a
-    /// truck file (`[steering]`, `[drive]`, `[control]`, `max_steer_rate_radps`, and an
-    /// optional `preset`), applied over each scenario's `[truck]`.
+    /// The truck: a preset of actuators and timing (`ideal`, `realistic`), or a truck
+    /// file (a whole truck as `trucks/*.toml`, or some of its keys: geometry, mass,
+    /// `[steering]`, `[drive]`, `[control]`, an optional `preset`), applied over each
+    /// scenario's `[truck]` as if that table said so.
     #[arg(long, value_name = "PRESET|FILE")]
     pub truck: Option<String>,
 }

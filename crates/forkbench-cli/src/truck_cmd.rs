@@ -23,12 +23,9 @@ pub(crate) fn truck_settings(
         );
     }
     let text = crate::read_input(&path)?;
-    let named = |e: forkbench_trial::ScenarioError| anyhow::anyhow!("{}: {e}", path.display());
-    let (preset, settings) = forkbench_trial::trial::truck_file_settings(&text).map_err(named)?;
-    // Names and ranges checked here, so an error names the file it is in.
-    let a30 = forkbench_core::ForkliftSpec::default();
-    forkbench_trial::trial::apply_truck(&a30, preset.as_deref(), &settings).map_err(named)?;
-    Ok((preset, settings))
+    // Names, lines and ranges checked here, so an error names the file it is in.
+    let f = forkbench_trial::trial::read_truck_text(&text, &path.display().to_string())?;
+    Ok((f.preset, f.settings))
 }
 
 /// `forkbench identify LOG`: the truck's actuators fitted from a log.

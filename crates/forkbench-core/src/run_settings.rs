@@ -1,4 +1,4 @@
-//! The truck settings a run may change (actuators and control timing), by their sweep names and dotted paths, and how one is set.
+//! The truck settings a run may change (actuators, control timing and geometry), by their sweep names and dotted paths, and how one is set.
 
 use crate::ForkliftSpec;
 
@@ -21,12 +21,37 @@ pub const TRUCK_KNOBS: [(&str, &str); 14] = [
     ("control_transport_delay_s", "control.transport_delay_s"),
 ];
 
-/// The dotted path of a sweep knob's name, or of a dotted path itself.
+/// The truck's geometry and mass, by the names a truck file, a sweep and a `[truck]`
+/// table share: a run that changes one runs its trials against the scenario as if its
+/// `[truck]` table said so (every check and every derived figure follows).
+pub const TRUCK_GEOMETRY: [&str; 12] = [
+    "wheelbase_m",
+    "max_steer_rad",
+    "body_length_m",
+    "body_width_m",
+    "mass_kg",
+    "fork_length_m",
+    "fork_width_m",
+    "fork_spacing_m",
+    "fork_root_ahead_of_front_axle_m",
+    "max_speed_mps",
+    "rated_capacity_kg",
+    "fork_thickness_m",
+];
+
+/// The dotted path of a sweep knob's name, or of a dotted path itself (the geometry's
+/// names are their own paths).
 pub fn truck_path(name: &str) -> Option<&'static str> {
     TRUCK_KNOBS
         .iter()
         .find(|(k, p)| *k == name || *p == name)
         .map(|(_, p)| *p)
+        .or_else(|| TRUCK_GEOMETRY.iter().find(|g| **g == name).copied())
+}
+
+/// Whether `path` names the truck's geometry or mass (not its actuators or timing).
+pub fn is_geometry(path: &str) -> bool {
+    TRUCK_GEOMETRY.contains(&path)
 }
 
 /// Sets the truck's setting at `path` (one of [`TRUCK_KNOBS`]); false for another path.
@@ -49,6 +74,26 @@ pub fn set(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
         "drive.creep_speed_mps" => dr.creep_speed_mps = v,
         "control.period_s" => ct.period_s = Some(v),
         "control.transport_delay_s" => ct.transport_delay_s = v,
+        _ => return set_geometry(t, path, v),
+    }
+    true
+}
+
+/// Sets a geometry field ([`TRUCK_GEOMETRY`]); false for another path.
+fn set_geometry(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
+    match path {
+        "wheelbase_m" => t.wheelbase_m = v,
+        "max_steer_rad" => t.max_steer_rad = v,
+        "body_length_m" => t.body_length_m = v,
+        "body_width_m" => t.body_width_m = v,
+        "mass_kg" => t.mass_kg = v,
+        "fork_length_m" => t.fork_length_m = v,
+        "fork_width_m" => t.fork_width_m = v,
+        "fork_spacing_m" => t.fork_spacing_m = v,
+        "fork_root_ahead_of_front_axle_m" => t.fork_root_ahead_of_front_axle_m = v,
+        "max_speed_mps" => t.max_speed_mps = v,
+        "rated_capacity_kg" => t.rated_capacity_kg = v,
+        "fork_thickness_m" => t.fork_thickness_m = Some(v),
         _ => return false,
     }
     true

@@ -133,12 +133,19 @@ impl ForkliftSpec {
             .map(|y| root.to_world(&crate::Pose2::new(along_m, y, 0.0)))
     }
 
-    /// Depth of the shallower fork tip past the face of a pallet whose face centre is at
-    /// `pallet`, at most the fork length, for forks rooted at `root`. A fork root that is
-    /// itself past the face plane (a truck that drove past or away behind the pallet)
-    /// inserted nothing: 0.
-    pub fn insertion_depth_m(&self, pallet: &crate::Pose2, root: &crate::Pose2) -> f64 {
-        if pallet.to_local(root).x_m > 0.0 {
+    /// Depth of the shallower fork tip past the face of a pallet `pallet_depth_m` deep
+    /// whose face centre is at `pallet`, at most the fork length, for forks rooted at
+    /// `root`. The fork root may reach the face (and, pressed against it, lie a contact's
+    /// penetration past it): a truck whose forks are no longer than the pallet is deep
+    /// inserts them whole that way. Only a root past the pallet's back (a truck that drove
+    /// past or away behind it) inserted nothing: 0.
+    pub fn insertion_depth_m(
+        &self,
+        pallet: &crate::Pose2,
+        pallet_depth_m: f64,
+        root: &crate::Pose2,
+    ) -> f64 {
+        if pallet.to_local(root).x_m > pallet_depth_m {
             return 0.0;
         }
         self.fork_points(root, self.fork_length_m)
@@ -146,6 +153,18 @@ impl ForkliftSpec {
             .map(|tip| pallet.to_local(tip).x_m)
             .fold(f64::INFINITY, f64::min)
             .min(self.fork_length_m)
+    }
+
+    /// The same geometry and mass as `other`, whatever either's actuators and timing.
+    pub fn same_geometry(&self, other: &Self) -> bool {
+        let strip = |t: &Self| Self {
+            steering: SteeringActuator::default(),
+            drive: DriveActuator::default(),
+            control: ControlTiming::default(),
+            max_steer_rate_radps: 0.0,
+            ..t.clone()
+        };
+        strip(self) == strip(other)
     }
 
     /// Equivalent steering angle that yields the given path curvature: arctan(L κ).
@@ -270,7 +289,7 @@ mod tests {
     fn insertion_depth_is_bounded_by_the_forks_and_counted_from_the_front() {
         let truck = ForkliftSpec::default();
         let pallet = crate::Pose2::new(0.0, 0.0, 0.0);
-        let at = |x: f64| truck.insertion_depth_m(&pallet, &crate::Pose2::new(x, 0.0, 0.0));
+        let at = |x: f64| truck.insertion_depth_m(&pallet, 1.2, &crate::Pose2::new(x, 0.0, 0.0));
         assert!(
             (at(-truck.fork_length_m - 0.5) + 0.5).abs() < 1e-12,
             "short of the face"
@@ -280,8 +299,24 @@ mod tests {
             "0.8 m in"
         );
         assert!(at(-0.01) <= truck.fork_length_m);
-        assert_eq!(at(0.5), 0.0, "root past the face");
         assert_eq!(at(105.0), 0.0, "drove away behind the pallet");
+        assert_eq!(at(1.3), 0.0, "root past the pallet's back");
+    }
+
+    /// Issue 77: forks no longer than the pallet is deep go in whole with the root at the
+    /// face, and a root pressed a contact's penetration past the face still counts them
+    /// in (the 1.22 m forks read "0.000 m deep" there).
+    #[test]
+    fn a_root_at_or_just_past_the_face_counts_the_whole_forks() {
+        let truck = ForkliftSpec {
+            fork_length_m: 1.22,
+            ..ForkliftSpec::default()
+        };
+        let pallet = crate::Pose2::new(0.0, 0.0, 0.0);
+        let at = |x: f64| truck.insertion_depth_m(&pallet, 1.2, &crate::Pose2::new(x, 0.0, 0.0));
+        assert_eq!(at(0.0), 1.22);
+        assert_eq!(at(0.003), 1.22, "pressed against the face");
+        assert!((at(-0.07) - 1.15).abs() < 1e-12, "the default target");
     }
 
     #[test]

@@ -332,6 +332,8 @@ pub struct ForkFit {
     pub fork_length_m: f64,
     /// The insertion the judge requires (`tolerances.insertion_depth_m`).
     pub insertion_depth_m: f64,
+    /// The insertion the pick aims for (`[pick] insertion_m`, or its default).
+    pub insertion_target_m: f64,
     pub pallet_depth_m: f64,
 }
 
@@ -343,13 +345,21 @@ impl ForkFit {
     pub fn depth_ok(&self) -> bool {
         self.insertion_depth_m <= self.fork_length_m.min(self.pallet_depth_m)
     }
+
+    /// The target reaches the required depth and stays within the forks and the pallet.
+    pub fn target_ok(&self) -> bool {
+        self.insertion_target_m >= self.insertion_depth_m
+            && self.insertion_target_m <= self.fork_length_m.min(self.pallet_depth_m)
+    }
 }
 
-/// The fit of `truck`'s forks in `pallet` for a required insertion depth.
+/// The fit of `truck`'s forks in `pallet` for a required insertion depth and the
+/// insertion the pick aims for.
 pub fn fork_fit(
     truck: &forkbench_core::ForkliftSpec,
     pallet: &forkbench_core::PalletSpec,
     insertion_depth_m: f64,
+    insertion_target_m: f64,
 ) -> ForkFit {
     let (half_fork, half_pocket) = (truck.fork_width_m / 2.0, pallet.pocket_width_m / 2.0);
     let o = pallet.pocket_offsets_m()[0].abs();
@@ -362,6 +372,7 @@ pub fn fork_fit(
         ],
         fork_length_m: truck.fork_length_m,
         insertion_depth_m,
+        insertion_target_m,
         pallet_depth_m: pallet.depth_m,
     }
 }
@@ -375,7 +386,8 @@ pub(super) fn check_geometry(
     file: &str,
 ) -> Result<(), ScenarioError> {
     let t = &f.truck;
-    let fit = fork_fit(t, pallet, f.tolerances.insertion_depth_m);
+    let target = f.pick.insertion_for(t, pallet);
+    let fit = fork_fit(t, pallet, f.tolerances.insertion_depth_m, target);
     let o = pallet.pocket_offsets_m()[0].abs();
     let [lo, hi] = fit.spacing_range_m;
     if !fit.spacing_ok() {
@@ -415,5 +427,42 @@ pub(super) fn check_geometry(
             ),
         ));
     }
-    Ok(())
+    check_target(&fit, f.pick.insertion_m.is_some(), kind, file)
+}
+
+/// The pick's insertion target within the forks and the pallet, and deep enough for the
+/// judge: a target short of the required depth would fail every pick.
+fn check_target(fit: &ForkFit, set: bool, kind: &str, file: &str) -> Result<(), ScenarioError> {
+    if fit.target_ok() {
+        return Ok(());
+    }
+    let target = fit.insertion_target_m;
+    let whose = if set {
+        "pick.insertion_m".to_owned()
+    } else {
+        format!(
+            "the default insertion ({} m forks less {} m, or {kind} {} m deep less {} m)",
+            fit.fork_length_m,
+            crate::file::MAST_MARGIN_M,
+            fit.pallet_depth_m,
+            crate::file::INSERTION_MARGIN_M
+        )
+    };
+    let reason = if target < fit.insertion_depth_m {
+        format!(
+            "{whose} = {target:.3} m is short of the required tolerances.insertion_depth_m = {} m: no pick could succeed; lower that, or set [pick] insertion_m between them",
+            fit.insertion_depth_m
+        )
+    } else {
+        format!(
+            "{whose} = {target:.3} m is deeper than the forks ({} m) or the pallet ({} m) allow",
+            fit.fork_length_m, fit.pallet_depth_m
+        )
+    };
+    let field = if set {
+        "pick.insertion_m"
+    } else {
+        "tolerances.insertion_depth_m"
+    };
+    Err(invalid(file, field, &reason))
 }

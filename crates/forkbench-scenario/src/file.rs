@@ -148,6 +148,33 @@ pub struct PickFile {
     pub pre_entry_gap_m: f64,
     /// Docked: the tracker reports the goal reached and the truck moves slower than this.
     pub docked_speed_mps: f64,
+    /// How deep past the face the fork tips are driven (the pick's goal); by default
+    /// [`default_insertion_m`]: 5 cm short of the pallet's back, or the mast's face 10 cm
+    /// short of its front, the shallower. It must reach `tolerances.insertion_depth_m`, or
+    /// no pick could succeed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub insertion_m: Option<f64>,
+}
+
+/// The margin the default insertion keeps the fork tips short of the pallet's back: a
+/// choice, the paper's truck's (its forks are longer than the pallet is deep).
+pub const INSERTION_MARGIN_M: f64 = 0.05;
+
+/// The margin the default insertion keeps the fork root (the mast's face) short of the
+/// pallet's face, for forks not much longer than the pallet is deep: a choice that
+/// covers where a docked truck stops about its goal with the default sensing, whose
+/// pallet estimate moves the goal along the pallet's axis (docs/truck.md gives the
+/// spread measured).
+pub const MAST_MARGIN_M: f64 = 0.10;
+
+/// The pick's default insertion: the tips [`INSERTION_MARGIN_M`] short of the pallet's
+/// back, and the mast's face at least [`MAST_MARGIN_M`] short of its front, the
+/// shallower of the two.
+pub fn default_insertion_m(
+    truck: &forkbench_core::ForkliftSpec,
+    pallet: &forkbench_core::PalletSpec,
+) -> f64 {
+    (pallet.depth_m - INSERTION_MARGIN_M).min(truck.fork_length_m - MAST_MARGIN_M)
 }
 
 /// What a pick does when the first look finds no pallet.
@@ -185,6 +212,7 @@ impl Default for PickFile {
             retry_step_m: 0.5,
             pre_entry_gap_m: APPROACH_GAP_M,
             docked_speed_mps: 0.01,
+            insertion_m: None,
         }
     }
 }
@@ -204,7 +232,19 @@ impl PickFile {
             ("retry_step_m", self.retry_step_m, 0.0, 5.0),
             ("pre_entry_gap_m", self.pre_entry_gap_m, 0.0, 5.0),
             ("docked_speed_mps", self.docked_speed_mps, 0.001, 0.5),
+            ("insertion_m", self.insertion_m.unwrap_or(1.0), 0.05, 5.0),
         ])
+    }
+
+    /// The insertion a pick with `truck` and `pallet` aims for: [`Self::insertion_m`] or
+    /// the default.
+    pub fn insertion_for(
+        &self,
+        truck: &forkbench_core::ForkliftSpec,
+        pallet: &forkbench_core::PalletSpec,
+    ) -> f64 {
+        self.insertion_m
+            .unwrap_or_else(|| default_insertion_m(truck, pallet))
     }
 }
 
@@ -244,7 +284,12 @@ pub(super) struct ScenarioFile {
     /// colliding plan be driven, to study the collision itself.
     #[serde(default = "default_true")]
     pub(super) validate_paths: bool,
-    #[serde(default)]
+    /// A `[truck]` table, `truck = "FILE"` (a truck file, relative to this scenario), or
+    /// a table with `file = "FILE"` whose other keys override the file's.
+    #[serde(default, rename = "truck")]
+    pub(super) truck_entry: Option<toml::Spanned<toml::Value>>,
+    /// The truck the entry resolves to (filled after parsing).
+    #[serde(skip)]
     pub(super) truck: ForkliftSpec,
     /// A `[tracker]` table: `kind` (default pure pursuit) and its settings.
     pub(super) tracker: Option<toml::Spanned<toml::Value>>,

@@ -20,6 +20,7 @@ mod safety;
 pub mod sensors;
 pub mod text;
 pub mod tolerances;
+pub mod truck_file;
 pub mod uncertain;
 pub mod uncertain_file;
 mod world;
@@ -38,14 +39,15 @@ pub use component_spec::{
 };
 pub use error::ScenarioError;
 pub use file::{
-    APPROACH_GAP_M, BetweenLooks, NoiseFile, PalletKind, PalletPlacement, PickFile, ReplanFile,
-    ReplanMethod, WhenNotSeen,
+    APPROACH_GAP_M, BetweenLooks, INSERTION_MARGIN_M, MAST_MARGIN_M, NoiseFile, PalletKind,
+    PalletPlacement, PickFile, ReplanFile, ReplanMethod, WhenNotSeen, default_insertion_m,
 };
 pub use footprints::{pallet_footprint, shrunk, truck_footprint};
 pub use limits::Replan;
 pub use named::{BESIDE as COMPONENTS_BESIDE, load_components};
 pub use pose_deg::{MAX_WORLD_EXTENT_M, PoseDeg};
 pub use tolerances::{Limits, Tolerances};
+pub use truck_file::{TruckSettings, apply_truck, read_truck_file, read_truck_text};
 pub use world::{PalletSlot, RectFile, World};
 
 use checks::{check_values, resolve_cases};
@@ -149,6 +151,10 @@ pub struct Scenario<R: Catalogue> {
     /// `file:line: …`; front ends print them.
     #[serde(skip)]
     pub warnings: Vec<String>,
+    /// The text it was read from and its folder: what [`Scenario::with_truck`] checks a
+    /// run's truck against.
+    #[serde(skip)]
+    source: Option<Arc<String>>,
 }
 
 /// One start/pallet geometry of a scenario.
@@ -172,7 +178,9 @@ impl<R: Catalogue> Scenario<R> {
         let file = path.display().to_string();
         let text = read(path)?;
         let dir = forkbench_plan::external::dir_of(path);
-        let layout = Self::parse_layout(&text, &file, |world| World::load(&dir.join(world)))?;
+        let load_world = |world: &FsPath| World::load(&dir.join(world));
+        let load_truck = |p: &str| truck_file::read_truck_file(&dir.join(p));
+        let layout = Self::parse_layout(&text, &file, load_world, &load_truck, None)?;
         let scn = layout.with_components(&text, registry, dir.clone())?;
         // The documented rule: a components file beside the scenario comes with it.
         let beside = dir.join(named::BESIDE);
@@ -200,8 +208,21 @@ impl<R: Catalogue> Scenario<R> {
         load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
         registry: Arc<R>,
     ) -> Result<Self, ScenarioError> {
-        let s = Self::parse_layout(text, file, load_world)?;
+        let load_truck = |p: &str| truck_file::read_truck_file(FsPath::new(p));
+        let s = Self::parse_layout(text, file, load_world, &load_truck, None)?;
         s.with_components(text, registry, PathBuf::from("."))
+    }
+
+    /// As [`Scenario::parse`], its truck files read by `load_truck` (by the path the
+    /// scenario names): how embedded scenarios name embedded trucks.
+    pub fn parse_embedded(
+        text: &str,
+        file: &str,
+        load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
+        load_truck: &dyn Fn(&str) -> Result<TruckSettings, ScenarioError>,
+    ) -> Result<Self, ScenarioError> {
+        let s = Self::parse_layout(text, file, load_world, load_truck, None)?;
+        s.with_components(text, R::builtin(), PathBuf::from("."))
     }
 
     /// Reads the `[planner]` and `[tracker]` tables against `registry`; errors name the
@@ -254,13 +275,20 @@ impl<R: Catalogue> Scenario<R> {
         Ok(self)
     }
 
-    /// Everything but the components: world, truck, sensors, settings and cases.
+    /// Everything but the components: world, truck, sensors, settings and cases; a
+    /// truck file is read by `load_truck`, and `truck` (a run's) stands for the file's own.
     fn parse_layout(
         text: &str,
         file: &str,
         load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
+        load_truck: &dyn Fn(&str) -> Result<TruckSettings, ScenarioError>,
+        truck: Option<&ForkliftSpec>,
     ) -> Result<Self, ScenarioError> {
-        let f: ScenarioFile = parse(text, file)?;
+        let mut f: ScenarioFile = parse(text, file)?;
+        f.truck = match truck {
+            Some(t) => t.clone(),
+            None => truck_file::resolve_entry(f.truck_entry.as_ref(), load_truck, (file, text))?,
+        };
         let world = match &f.world {
             Some(p) => load_world(p).map_err(|e| {
                 invalid(
@@ -333,6 +361,33 @@ impl<R: Catalogue> Scenario<R> {
             movers: f.mover,
             uncertain,
             warnings: hints::unit_warnings(text, file),
+            source: Some(Arc::new(text.to_owned())),
+        })
+    }
+
+    /// The same scenario with `truck` for its own, checked as if its `[truck]` table said
+    /// so: every load-time check that reads the truck (forks in the pockets, the depth and
+    /// the insertion, the payload, the sensors' mounts, the safety fields, each case's
+    /// layout) runs again, and what a run derives from the truck follows it. How a run's
+    /// geometry (`--truck FILE`, a sweep) reaches its trials.
+    pub fn with_truck(&self, truck: &ForkliftSpec) -> Result<Self, ScenarioError>
+    where
+        Self: Clone,
+    {
+        let Some(src) = &self.source else {
+            return Err(invalid(
+                &self.file,
+                "truck",
+                "this scenario was built, not read: its truck cannot be checked anew",
+            ));
+        };
+        // The run's truck stands for the file's own, so no truck file is read again.
+        let no_file = |_: &str| Ok(TruckSettings::default());
+        let world = |_: &FsPath| Ok(self.world.clone());
+        let checked = Self::parse_layout(src, &self.file, world, &no_file, Some(truck))?;
+        Ok(Self {
+            truck: checked.truck,
+            ..self.clone()
         })
     }
 
@@ -346,7 +401,18 @@ impl<R: Catalogue> Scenario<R> {
 
     /// How this scenario's forks fit its pallet (checked at load; printed by `check`).
     pub fn fork_fit(&self) -> ForkFit {
-        fork_fit(&self.truck, &self.pallet, self.tolerances.insertion_depth_m)
+        fork_fit(
+            &self.truck,
+            &self.pallet,
+            self.tolerances.insertion_depth_m,
+            self.insertion_m(),
+        )
+    }
+
+    /// How deep the pick drives the fork tips past the face (`[pick] insertion_m`, or the
+    /// default from the forks and the pallet).
+    pub fn insertion_m(&self) -> f64 {
+        self.pick.insertion_for(&self.truck, &self.pallet)
     }
 
     pub fn case(&self, name: &str) -> Result<&Case, ScenarioError> {

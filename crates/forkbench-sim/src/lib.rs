@@ -82,7 +82,8 @@ pub struct Sim {
     /// Chassis centre (the centre of mass) ahead of the front axle, in the body frame.
     com_ahead_m: f64,
     pallet_inertia: f64,
-    last_fork_force_n: f64,
+    last_pallet_force_n: f64,
+    last_mast_force_n: f64,
     last_obstacle_contact: bool,
     /// The pallet on the forks, once lifted.
     carried: Option<load::Carried>,
@@ -229,7 +230,8 @@ impl Sim {
             truck_inertia,
             com_ahead_m: chassis_centre,
             pallet_inertia,
-            last_fork_force_n: 0.0,
+            last_pallet_force_n: 0.0,
+            last_mast_force_n: 0.0,
             last_obstacle_contact: false,
             carried: None,
             load_shifted: false,
@@ -323,9 +325,16 @@ impl Sim {
         self.world.bodies[self.truck].angvel() as f64
     }
 
-    /// Largest fork–pallet contact force in the last step.
-    pub fn fork_contact_force_n(&self) -> f64 {
-        self.last_fork_force_n
+    /// Largest contact force between the truck (forks, chassis and mast) and the pallet
+    /// in the last step.
+    pub fn pallet_contact_force_n(&self) -> f64 {
+        self.last_pallet_force_n
+    }
+
+    /// Largest contact force between the chassis (with the mast, whose face is the fork
+    /// root) and the pallet in the last step: the truck pressing the pallet's face.
+    pub fn mast_contact_force_n(&self) -> f64 {
+        self.last_mast_force_n
     }
 
     /// Whether the truck touched a rack or wall in the last step.
@@ -442,17 +451,26 @@ impl Sim {
 
     fn read_contacts(&mut self, dt: f64) {
         let np = &self.world.narrow_phase;
-        let mut fork_force = 0.0_f64;
-        for &f in &self.forks {
+        let mut pallet_force = 0.0_f64;
+        let mut mast_force = 0.0_f64;
+        // Every body of the truck that can push the pallet: the forks, and the chassis with
+        // its mast (whose face is the fork root), which a short-forked truck presses against
+        // the pallet's face.
+        for f in [self.forks[0], self.forks[1], self.chassis] {
             for &s in &self.stringers {
                 if let Some(pair) = np.contact_pair(f, s)
                     && pair.has_any_active_contact()
                 {
-                    fork_force = fork_force.max(pair.total_impulse_magnitude() as f64 / dt);
+                    let n = pair.total_impulse_magnitude() as f64 / dt;
+                    pallet_force = pallet_force.max(n);
+                    if f == self.chassis {
+                        mast_force = mast_force.max(n);
+                    }
                 }
             }
         }
-        self.last_fork_force_n = fork_force;
+        self.last_pallet_force_n = pallet_force;
+        self.last_mast_force_n = mast_force;
         // A carried pallet is part of the truck: its stringers can hit a rack too.
         let load: &[ColliderHandle] = match self.carried {
             Some(_) => &self.stringers,

@@ -95,7 +95,9 @@ impl Sim {
             });
         }
         let (axle, pallet) = (self.front_axle_pose(), self.pallet_pose());
-        let depth_m = self.spec.insertion_depth_m(&pallet, &self.fork_root_pose());
+        let depth_m =
+            self.spec
+                .insertion_depth_m(&pallet, self.pallet_spec.depth_m, &self.fork_root_pose());
         let required_m = self.pallet_spec.depth_m / 2.0;
         if depth_m < required_m {
             return Err(LiftError::NotUnder {

@@ -230,7 +230,7 @@ fn steady_push_force_n(payload_kg: f64) -> f64 {
     while sim.time_s() < 8.0 {
         sim.step(0.5, 0.0);
         if sim.time_s() > 6.0 {
-            sum += sim.fork_contact_force_n();
+            sum += sim.pallet_contact_force_n();
             n += 1;
         }
     }

@@ -90,7 +90,7 @@ fn a_fork_striking_a_stringer_pushes_the_pallet() {
     let mut peak = 0.0_f64;
     while sim.time_s() < 8.0 {
         sim.step(0.5, 0.0);
-        peak = peak.max(sim.fork_contact_force_n());
+        peak = peak.max(sim.pallet_contact_force_n());
     }
     let moved = sim.pallet_pose().distance_to(&pallet_pose);
     assert!(peak > 100.0, "contact force {peak} N");
@@ -115,7 +115,7 @@ fn straight_entry_into_the_pockets_touches_nothing() {
     // Drive until the fork root is 5 cm short of the pallet face.
     while sim.fork_root_pose().x_m < 2.95 && sim.time_s() < 20.0 {
         sim.step(0.3, 0.0);
-        peak = peak.max(sim.fork_contact_force_n());
+        peak = peak.max(sim.pallet_contact_force_n());
     }
     assert!(peak < 1.0, "contact force {peak} N");
     assert!(sim.pallet_pose().distance_to(&pallet_pose) < 1e-4);

@@ -185,8 +185,12 @@ pub struct TrialOutcome {
     #[serde(with = "nan_as_null")]
     pub insertion_depth_m: f64,
     pub max_steer_rad: f64,
-    /// Largest fork–pallet contact force before full depth.
+    /// Largest truck–pallet contact force before full depth (forks, chassis and mast).
     pub max_contact_force_n: f64,
+    /// Largest force the chassis and mast pressed the pallet's face with, at any depth
+    /// (0, left out of records: they never touched it).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub mast_contact_force_n: f64,
     pub pallet_displacement_m: f64,
     pub pallet_rotation_rad: f64,
     pub replans: u32,
@@ -437,6 +441,7 @@ impl TrialOutcome {
             insertion_depth_m: f64::NAN,
             max_steer_rad: 0.0,
             max_contact_force_n: 0.0,
+            mast_contact_force_n: 0.0,
             pallet_displacement_m: 0.0,
             pallet_rotation_rad: 0.0,
             replans: 0,
@@ -497,4 +502,8 @@ impl TrialOutcome {
 
 fn default_tracker() -> String {
     "pure_pursuit".to_owned()
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }

@@ -18,6 +18,8 @@ pub struct PickMeasures {
     pub collision: bool,
     pub timed_out: bool,
     pub max_contact_force_n: f64,
+    /// The chassis and mast pressing the pallet's face, at any depth.
+    pub mast_contact_force_n: f64,
     pub pallet_displacement_m: f64,
     pub pallet_rotation_rad: f64,
     /// At entry (`None`: the tips have not reached the face).

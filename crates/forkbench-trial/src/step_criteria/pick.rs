@@ -250,8 +250,16 @@ fn pallet_displaced(j: &Judged<'_>) -> Option<String> {
     (m.pallet_displacement_m > tol.pallet_displacement_m
         || m.pallet_rotation_rad.abs() > tol.pallet_rotation_rad)
         .then(|| {
+            let by = if m.mast_contact_force_n > 0.0 {
+                format!(
+                    ", pushed by the truck's mast face ({:.0} N)",
+                    m.mast_contact_force_n
+                )
+            } else {
+                String::new()
+            };
             format!(
-                "pallet moved {:.3} m and turned {:.2}° (limits {} m, {}°)",
+                "pallet moved {:.3} m and turned {:.2}° (limits {} m, {}°){by}",
                 m.pallet_displacement_m,
                 m.pallet_rotation_rad.to_degrees(),
                 tol.pallet_displacement_m,
@@ -361,6 +369,7 @@ mod tests {
             collision: false,
             timed_out: false,
             max_contact_force_n: 0.0,
+            mast_contact_force_n: 0.0,
             pallet_displacement_m: 0.0,
             pallet_rotation_rad: 0.0,
             lateral_error_m: Some(0.0),

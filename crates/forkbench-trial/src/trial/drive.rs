@@ -145,13 +145,20 @@ impl<'a> Trial<'a> {
     pub(super) fn check_entry<R: Recorder + ?Sized>(&mut self, rec: &mut R) {
         let root = self.world.sim.fork_root_pose();
         let pallet_now = self.world.sim.pallet_pose();
-        let depth = self.scn.truck.insertion_depth_m(&pallet_now, &root);
+        let depth = self
+            .scn
+            .truck
+            .insertion_depth_m(&pallet_now, self.scn.pallet.depth_m, &root);
+        let out = &mut self.verdict.out;
+        out.mast_contact_force_n = out
+            .mast_contact_force_n
+            .max(self.world.sim.mast_contact_force_n());
         if depth < self.insertion_m - 0.01 {
             self.verdict.out.max_contact_force_n = self
                 .verdict
                 .out
                 .max_contact_force_n
-                .max(self.world.sim.fork_contact_force_n());
+                .max(self.world.sim.pallet_contact_force_n());
         }
         self.observe_step_criteria(root, pallet_now, rec);
         let local = in_pallet_frame(&pallet_now, &root);

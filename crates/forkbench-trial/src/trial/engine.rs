@@ -181,7 +181,7 @@ impl<'a> Trial<'a> {
         slot.truth = Some(Truth {
             fork_root: root,
             goal: goal_for(&pallet, truck, self.insertion_m),
-            insertion_depth_m: truck.insertion_depth_m(&pallet, &root),
+            insertion_depth_m: truck.insertion_depth_m(&pallet, self.scn.pallet.depth_m, &root),
             pallet,
         });
         if slot.path_version != Some(self.path_version) {
@@ -308,7 +308,7 @@ fn record_step<R: Recorder + ?Sized>(
         lookahead: cmd.lookahead_point,
         cross_track_m: cmd.cross_track_m,
         path_curvature_per_m: cmd.path_curvature_per_m,
-        contact_force_n: sim.fork_contact_force_n(),
+        contact_force_n: sim.pallet_contact_force_n(),
     });
 }
 

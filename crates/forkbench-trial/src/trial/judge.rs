@@ -79,6 +79,7 @@ impl<'a> Trial<'a> {
             collision: self.world.collision,
             timed_out,
             max_contact_force_n: out.max_contact_force_n,
+            mast_contact_force_n: out.mast_contact_force_n,
             pallet_displacement_m: now.pallet_displacement_m,
             pallet_rotation_rad: now.pallet_rotation_rad,
             lateral_error_m: out.lateral_error_m,
@@ -133,7 +134,7 @@ impl<'a> Trial<'a> {
             .fold(0.0, f64::max);
         Standing {
             local: in_pallet_frame(&pallet_now, &root),
-            insertion_depth_m: truck.insertion_depth_m(&pallet_now, &root),
+            insertion_depth_m: truck.insertion_depth_m(&pallet_now, self.scn.pallet.depth_m, &root),
             pallet_displacement_m: pallet_now.distance_to(&self.world.pallet0),
             pallet_rotation_rad: wrap_angle(
                 pallet_now.heading_rad - self.world.pallet0.heading_rad,

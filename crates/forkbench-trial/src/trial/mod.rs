@@ -30,7 +30,7 @@ mod world;
 
 use std::time::Instant;
 
-use forkbench_core::{ForkliftSpec, PalletSpec, Pose2};
+use forkbench_core::{ForkliftSpec, Pose2};
 
 use crate::ScenarioError;
 use crate::outcome::{Failure, TrialOutcome};
@@ -60,18 +60,16 @@ pub use options::{MAX_NOISE_SCALE, NOISE_KNOBS, Overrides, Resolved, TrialOption
 pub use session::{Session, SessionEnd};
 pub use session_view::SceneView;
 pub use streams::accuracy_stream;
-pub use truck_knobs::{TRUCK_KNOBS, apply_truck, truck_file_settings, truck_path};
+pub use truck_knobs::{
+    TRUCK_GEOMETRY, TRUCK_KNOBS, TruckSettings, apply_truck, is_geometry, read_truck_text,
+    truck_path,
+};
 pub use uncertain_apply::Shift;
 
 /// Fork-root pose that puts the fork tips `insertion_m` past the pallet face
 /// (negative: before it).
 pub fn goal_for(face: &Pose2, truck: &ForkliftSpec, insertion_m: f64) -> Pose2 {
     face.to_world(&Pose2::new(insertion_m - truck.fork_length_m, 0.0, 0.0))
-}
-
-/// Depth the fork tips reach aimed at: 5 cm short of the pallet back (or the fork length).
-pub fn target_insertion_m(truck: &ForkliftSpec, pallet: &PalletSpec) -> f64 {
-    pallet.depth_m.min(truck.fork_length_m) - 0.05
 }
 
 /// Runs one case of a scenario to its judged outcome.
@@ -88,13 +86,29 @@ pub fn run_trial_recorded<R: Recorder + ?Sized>(
     rec: &mut R,
 ) -> TrialOutcome {
     let wall = Instant::now();
-    let mut out = match opts.resolve(scn) {
-        Ok(run) => link::run_to_end(run_stages(scn, case, &run, None, rec)),
+    let mut out = match opts
+        .resolve(scn)
+        .and_then(|run| Ok((scenario_for(scn, &run)?, run)))
+    {
+        Ok((scn, run)) => link::run_to_end(run_stages(&scn, case, &run, None, rec)),
         Err(e) => unresolved(scn, case, opts, &e),
     };
     out.wall_time_ms = wall.elapsed().as_secs_f64() * 1e3;
     rec.outcome(out.sim_time_s, &out);
     out
+}
+
+/// `scn` as a run's truck makes it: itself when the run keeps its geometry, else the
+/// scenario checked anew with the run's truck ([`Scenario::with_truck`]), so a truck
+/// given by a run gives the outcome the same `[truck]` table in the file would.
+pub fn scenario_for<'s>(
+    scn: &'s Scenario,
+    run: &Resolved,
+) -> Result<std::borrow::Cow<'s, Scenario>, ScenarioError> {
+    if run.truck.same_geometry(&scn.truck) {
+        return Ok(std::borrow::Cow::Borrowed(scn));
+    }
+    scn.with_truck(&run.truck).map(std::borrow::Cow::Owned)
 }
 
 /// The outcome of a run whose options do not resolve.

@@ -295,6 +295,8 @@ impl TrialOptions {
     /// trial.
     pub fn check_against(&self, scn: &Scenario) -> Result<Resolved, ScenarioError> {
         let run = self.resolve(scn)?;
+        // A run's own geometry is checked against the scenario once, here.
+        super::scenario_for(scn, &run)?;
         scn.registry
             .check_localizer(&run.localizer, scn)
             .map_err(|e| invalid_setting(&scn.file, "sensors.localizer", &e))?;

@@ -103,6 +103,10 @@ impl Session {
         viewed: bool,
     ) -> Result<Self, ScenarioError> {
         let run = opts.resolve(&scn)?;
+        let scn = match super::scenario_for(&scn, &run)? {
+            std::borrow::Cow::Borrowed(_) => scn,
+            std::borrow::Cow::Owned(s) => Arc::new(s),
+        };
         let case = scn.case(case)?.clone();
         let (start, pallet) = (case.start, case.pallet);
         let link = Link::new(episode, viewed);

@@ -6,12 +6,12 @@ use forkbench_plan::Planner;
 use forkbench_sensors::Localizer;
 use forkbench_track::{PosePredictor, Tracker};
 
+use super::Resolved;
 use super::loc_stats::LocStats;
 use super::localize::record_reflectors;
 use super::state::{Localization, Perception, ScannerState, Trial, Verdict, WorldState};
 use super::streams::{self, stream};
 use super::world::build_world;
-use super::{Resolved, target_insertion_m};
 use crate::components::LocalizerContext;
 use crate::outcome::{Failure, TrialOutcome};
 use crate::recorder::{Level, Recorder, SceneInfo};
@@ -211,7 +211,7 @@ impl<'a> Trial<'a> {
             tracker,
             path: forkbench_core::Path::default(),
             path_version: 0,
-            insertion_m: target_insertion_m(&scn.truck, &scn.pallet),
+            insertion_m: scn.insertion_m(),
             link: None,
             stage: super::link::Stage::Leg,
             wall_start: std::time::Instant::now(),

@@ -1,87 +1,7 @@
-//! A run's changes to the truck's actuators and timing: a named preset, single settings by their dotted names (a `--truck` file, a sweep), and their application to a scenario's truck.
+//! A run's changes to the truck: a named preset, single settings by their dotted names (a `--truck` file, a sweep; the format's `truck_file`), and the sensors' timing under the `ideal` preset.
 
-use std::collections::BTreeMap;
-
-use forkbench_core::ForkliftSpec;
-use forkbench_core::actuators::{Actuators, PRESETS};
-
-use crate::ScenarioError;
-use crate::scenario::invalid;
-
-pub use forkbench_core::run_settings::{TRUCK_KNOBS, truck_path};
-
-fn bad(field: &str, reason: &str) -> ScenarioError {
-    invalid("options", field, reason)
-}
-
-/// `truck` with `preset`'s actuators (if any), then each of `settings` (dotted paths of
-/// [`TRUCK_KNOBS`]), checked as a truck file is.
-pub fn apply_truck(
-    truck: &ForkliftSpec,
-    preset: Option<&str>,
-    settings: &BTreeMap<String, f64>,
-) -> Result<ForkliftSpec, ScenarioError> {
-    let mut out = truck.clone();
-    if let Some(name) = preset {
-        let a = Actuators::preset(name).ok_or_else(|| {
-            let known: Vec<&str> = PRESETS.iter().map(|(n, _)| *n).collect();
-            bad(
-                "truck_preset",
-                &format!("unknown preset {name:?} (known: {})", known.join(", ")),
-            )
-        })?;
-        out = out.with_actuators(a);
-    }
-    for (path, v) in settings {
-        if !forkbench_core::run_settings::set(&mut out, path, *v) {
-            let known: Vec<&str> = TRUCK_KNOBS.iter().map(|(_, p)| *p).collect();
-            return Err(bad(
-                path,
-                &format!(
-                    "not a setting a run may change (the geometry is the scenario's); known: {}",
-                    known.join(", ")
-                ),
-            ));
-        }
-    }
-    out.validate()
-        .map_err(|e| bad(&format!("truck.{}", e.field.unwrap_or_default()), &e.reason))?;
-    Ok(out)
-}
-
-/// A truck file (`--truck FILE`) as a run's changes: its `preset`, if it names one, and
-/// every number under the settings a run may change; anything else is refused naming it.
-pub fn truck_file_settings(
-    text: &str,
-) -> Result<(Option<String>, BTreeMap<String, f64>), ScenarioError> {
-    let table: toml::Table = toml::from_str(text).map_err(|e| bad("truck", e.message()))?;
-    let mut preset = None;
-    let mut settings = BTreeMap::new();
-    for (key, value) in &table {
-        match (key.as_str(), value) {
-            ("preset", toml::Value::String(name)) => preset = Some(name.clone()),
-            (_, toml::Value::Table(inner)) => {
-                for (k, v) in inner {
-                    let path = format!("{key}.{k}");
-                    settings.insert(path.clone(), number(&path, v)?);
-                }
-            }
-            (_, v) => {
-                settings.insert(key.clone(), number(key, v)?);
-            }
-        }
-    }
-    for path in settings.keys() {
-        if truck_path(path) != Some(path.as_str()) {
-            return Err(bad(
-                path,
-                "a truck file for a run changes only the actuators and control timing \
-                 (the geometry is the scenario's [truck])",
-            ));
-        }
-    }
-    Ok((preset, settings))
-}
+pub use forkbench_core::run_settings::{TRUCK_GEOMETRY, TRUCK_KNOBS, is_geometry, truck_path};
+pub use forkbench_scenario::truck_file::{TruckSettings, apply_truck, read_truck_text};
 
 /// The sensors' timing under `preset`: the `ideal` truck is the bench's first one as it
 /// was sensed too, a NAV350 delivering each fix at once, scans taken in an instant,
@@ -112,17 +32,12 @@ pub(crate) fn sensor_timing_for(
     }
 }
 
-fn number(path: &str, v: &toml::Value) -> Result<f64, ScenarioError> {
-    match v {
-        toml::Value::Float(f) => Ok(*f),
-        toml::Value::Integer(i) => Ok(*i as f64),
-        _ => Err(bad(path, "must be a number")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use forkbench_core::ForkliftSpec;
+    use forkbench_core::actuators::Actuators;
+    use std::collections::BTreeMap;
 
     #[test]
     fn a_setting_lands_where_its_path_says_and_bad_ones_are_named() {
@@ -138,10 +53,16 @@ mod tests {
         assert!(e.contains("steering.dead_time_s"), "{e}");
         let mut g = BTreeMap::new();
         g.insert("wheelbase_m".to_owned(), 2.0);
+        let t = apply_truck(&truck, None, &g).expect("geometry is a truck setting");
+        assert_eq!(t.wheelbase_m, 2.0);
+        g.insert("wheel_base".to_owned(), 2.0);
         let e = apply_truck(&truck, None, &g)
-            .expect_err("geometry")
+            .expect_err("unknown")
             .to_string();
-        assert!(e.contains("wheelbase_m") && e.contains("geometry"), "{e}");
+        assert!(
+            e.contains("wheel_base") && e.contains("not a truck setting"),
+            "{e}"
+        );
     }
 
     /// A setting over the first truck keeps the rest of it (its unlimited rates too).
@@ -164,10 +85,13 @@ mod tests {
         assert_eq!(t.steering, Actuators::REALISTIC.steering);
         assert_eq!(t.control.period_s, Some(0.05));
         assert!(apply_truck(&truck, Some("sporty"), &s).is_err());
-        let (p, s) = truck_file_settings("preset = \"ideal\"\n[steering]\ndead_time_s = 0.1\n")
-            .expect("valid file");
-        assert_eq!(p.as_deref(), Some("ideal"));
-        assert_eq!(s.get("steering.dead_time_s"), Some(&0.1));
-        assert!(truck_file_settings("wheelbase_m = 2.0").is_err());
+        let f = read_truck_text(
+            "preset = \"ideal\"\n[steering]\ndead_time_s = 0.1\n",
+            "t.toml",
+        )
+        .expect("valid file");
+        assert_eq!(f.preset.as_deref(), Some("ideal"));
+        assert_eq!(f.settings.get("steering.dead_time_s"), Some(&0.1));
+        assert!(read_truck_text("wheel_base_m = 2.0", "t.toml").is_err());
     }
 }
