@@ -62,6 +62,22 @@ pub struct IdentifyArgs {
 
 pub fn identify(a: &IdentifyArgs) -> anyhow::Result<()> {
     use anyhow::Context as _;
+    let outputs = [("--truck-out", &a.truck_out), ("--plot", &a.plot)];
+    for (flag, out) in outputs {
+        if let Some(out) = out
+            && forkbench_core::files::same_file(&a.log, out)
+        {
+            anyhow::bail!(
+                "{flag} {}: is the log being identified; writing there would destroy it",
+                out.display()
+            );
+        }
+    }
+    if let (Some(t), Some(p)) = (&a.truck_out, &a.plot)
+        && (t == p || forkbench_core::files::same_file(t, p))
+    {
+        anyhow::bail!("--truck-out and --plot name one file, {}", t.display());
+    }
     let is_mcap = a
         .log
         .extension()
@@ -95,7 +111,8 @@ pub fn identify(a: &IdentifyArgs) -> anyhow::Result<()> {
 /// steps and write the actuator log `identify` reads.
 #[derive(Debug, clap::Args)]
 pub struct StepTestArgs {
-    /// The truck's actuators (a preset or a truck file) over the A30 defaults.
+    /// The truck driven: a preset of actuators, or a truck file (a whole truck from
+    /// `trucks/`, or some of its keys over the A30's).
     #[arg(long, value_name = "PRESET|FILE")]
     truck: Option<String>,
     /// Where the CSV log goes.
@@ -115,6 +132,14 @@ pub fn step_test(a: &StepTestArgs) -> anyhow::Result<()> {
     use anyhow::Context as _;
     if !(a.run_s.is_finite() && (2.0..=600.0).contains(&a.run_s)) {
         anyhow::bail!("--run-s {}: must lie within 2–600 s", a.run_s);
+    }
+    if let Some(t) = &a.truck
+        && forkbench_core::files::same_file(std::path::Path::new(t), &a.out)
+    {
+        anyhow::bail!(
+            "--out {}: is the --truck file itself; writing the log there would destroy it",
+            a.out.display()
+        );
     }
     let (preset, settings) = truck_settings(a.truck.as_deref())?;
     let truck = forkbench_trial::trial::apply_truck(

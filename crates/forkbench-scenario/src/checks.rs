@@ -348,8 +348,9 @@ impl ForkFit {
 
     /// The target reaches the required depth and stays within the forks and the pallet.
     pub fn target_ok(&self) -> bool {
-        self.insertion_target_m >= self.insertion_depth_m
-            && self.insertion_target_m <= self.fork_length_m.min(self.pallet_depth_m)
+        const EPS_M: f64 = 1e-9;
+        self.insertion_target_m + EPS_M >= self.insertion_depth_m
+            && self.insertion_target_m <= self.fork_length_m.min(self.pallet_depth_m) + EPS_M
     }
 }
 
@@ -384,7 +385,7 @@ pub(super) fn check_geometry(
     f: &ScenarioFile,
     (pallet, kind): (&forkbench_core::PalletSpec, &str),
     file: &str,
-) -> Result<(), ScenarioError> {
+) -> Result<Option<String>, ScenarioError> {
     let t = &f.truck;
     let target = f.pick.insertion_for(t, pallet);
     let fit = fork_fit(t, pallet, f.tolerances.insertion_depth_m, target);
@@ -430,15 +431,20 @@ pub(super) fn check_geometry(
     check_target(&fit, f.pick.insertion_m.is_some(), kind, file)
 }
 
-/// The pick's insertion target within the forks and the pallet, and deep enough for the
-/// judge: a target short of the required depth would fail every pick.
-fn check_target(fit: &ForkFit, set: bool, kind: &str, file: &str) -> Result<(), ScenarioError> {
-    if fit.target_ok() {
-        return Ok(());
-    }
+/// The pick's insertion target within the forks and the pallet (refused when set deeper),
+/// and a warning when it is short of the depth the judge requires: such a pick succeeds
+/// only when it overshoots its own goal.
+fn check_target(
+    fit: &ForkFit,
+    set: bool,
+    kind: &str,
+    file: &str,
+) -> Result<Option<String>, ScenarioError> {
+    // A target that equals a bound up to rounding (0.6 m − 0.05 m against 0.55 m) meets it.
+    const EPS_M: f64 = 1e-9;
     let target = fit.insertion_target_m;
     let whose = if set {
-        "pick.insertion_m".to_owned()
+        "[pick] insertion_m".to_owned()
     } else {
         format!(
             "the default insertion ({} m forks less {} m, or {kind} {} m deep less {} m)",
@@ -448,21 +454,20 @@ fn check_target(fit: &ForkFit, set: bool, kind: &str, file: &str) -> Result<(), 
             crate::file::INSERTION_MARGIN_M
         )
     };
-    let reason = if target < fit.insertion_depth_m {
+    if set && target > fit.fork_length_m.min(fit.pallet_depth_m) + EPS_M {
+        return Err(invalid(
+            file,
+            "pick.insertion_m",
+            &format!(
+                "{target} m is deeper than the forks ({} m) or the pallet ({} m) allow",
+                fit.fork_length_m, fit.pallet_depth_m
+            ),
+        ));
+    }
+    Ok((target + EPS_M < fit.insertion_depth_m).then(|| {
         format!(
-            "{whose} = {target:.3} m is short of the required tolerances.insertion_depth_m = {} m: no pick could succeed; lower that, or set [pick] insertion_m between them",
+            "{file}: {whose} = {target:.3} m is short of the required tolerances.insertion_depth_m = {} m: a pick succeeds only by overshooting its goal; lower that, or set [pick] insertion_m to reach it",
             fit.insertion_depth_m
         )
-    } else {
-        format!(
-            "{whose} = {target:.3} m is deeper than the forks ({} m) or the pallet ({} m) allow",
-            fit.fork_length_m, fit.pallet_depth_m
-        )
-    };
-    let field = if set {
-        "pick.insertion_m"
-    } else {
-        "tolerances.insertion_depth_m"
-    };
-    Err(invalid(file, field, &reason))
+    }))
 }

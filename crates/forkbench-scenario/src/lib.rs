@@ -304,7 +304,7 @@ impl<R: Catalogue> Scenario<R> {
         checks::check_payload(&f.truck, &pallet, (file, text))?;
         safety::check(&f, (file, text))?;
         safety::check_movers(&f, &world, (file, text))?;
-        checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
+        let short_target = checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
         pallet::check_thickness(&f, (&pallet, &pallet_label), file)?;
         let cases = resolve_cases(&f, &world, &pallet, file).map_err(|e| match e {
             ScenarioError::Invalid {
@@ -360,7 +360,10 @@ impl<R: Catalogue> Scenario<R> {
             safety: f.safety,
             movers: f.mover,
             uncertain,
-            warnings: hints::unit_warnings(text, file),
+            warnings: hints::unit_warnings(text, file)
+                .into_iter()
+                .chain(short_target)
+                .collect(),
             source: Some(Arc::new(text.to_owned())),
         })
     }

@@ -24,4 +24,5 @@ mod settings_ranges;
 mod staging;
 mod state_owners;
 mod trial;
+mod trucks;
 mod uncertain;
