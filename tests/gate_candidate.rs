@@ -130,6 +130,24 @@ fn a_candidate_mapped_onto_the_shipped_tracker_is_gated_pair_by_pair() {
         err.contains("no planner or tracker named \"mypp\""),
         "{err}"
     );
+    // Issue 78: two candidates mapped onto one shipped name would merge into one row.
+    let two = batch(
+        "two",
+        "pure_pursuit_compensated",
+        &["--tracker", "regulated_pure_pursuit"],
+    );
+    let (code, _, err) = regress(
+        &same_base,
+        &two,
+        &[
+            "--as",
+            "pure_pursuit_compensated=pure_pursuit",
+            "--as",
+            "regulated_pure_pursuit=pure_pursuit",
+        ],
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("mapped onto \"pure_pursuit\" too"), "{err}");
 }
 
 /// A tracker setting changed in the scenario runs the same trials: still paired, and the

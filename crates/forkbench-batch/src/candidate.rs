@@ -41,6 +41,7 @@ pub fn map_components(
         .flat_map(|r| [r.outcome.planner.as_str(), r.outcome.tracker.as_str()])
         .collect();
     let mut seen = BTreeSet::new();
+    let mut onto: std::collections::BTreeMap<&str, &str> = Default::default();
     for m in mappings {
         let refuse = |why: String| {
             Err(BatchError::Setting(format!(
@@ -58,6 +59,12 @@ pub fn map_components(
         }
         if !seen.insert(m.from.as_str()) {
             return refuse(format!("{:?} is mapped twice", m.from));
+        }
+        if let Some(first) = onto.insert(m.to.as_str(), m.from.as_str()) {
+            return refuse(format!(
+                "{first:?} is mapped onto {:?} too: two candidates' trials would merge into one row",
+                m.to
+            ));
         }
         if names.contains(m.to.as_str()) && m.to != m.from {
             return refuse(format!(

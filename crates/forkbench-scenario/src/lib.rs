@@ -213,18 +213,6 @@ impl<R: Catalogue> Scenario<R> {
         s.with_components(text, registry, PathBuf::from("."))
     }
 
-    /// As [`Scenario::parse`], its truck files read by `load_truck` (by the path the
-    /// scenario names): how embedded scenarios name embedded trucks.
-    pub fn parse_embedded(
-        text: &str,
-        file: &str,
-        load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
-        load_truck: &dyn Fn(&str) -> Result<TruckSettings, ScenarioError>,
-    ) -> Result<Self, ScenarioError> {
-        let s = Self::parse_layout(text, file, load_world, load_truck, None)?;
-        s.with_components(text, R::builtin(), PathBuf::from("."))
-    }
-
     /// Reads the `[planner]` and `[tracker]` tables against `registry`; errors name the
     /// file, line and field.
     fn with_components(
@@ -306,22 +294,7 @@ impl<R: Catalogue> Scenario<R> {
         safety::check_movers(&f, &world, (file, text))?;
         let short_target = checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
         pallet::check_thickness(&f, (&pallet, &pallet_label), file)?;
-        let cases = resolve_cases(&f, &world, &pallet, file).map_err(|e| match e {
-            ScenarioError::Invalid {
-                file,
-                field,
-                reason,
-            } if reason == "missing" => {
-                let key = field.rsplit('.').next().unwrap_or(&field);
-                let hint = hints::misplaced_key(text, &format!("missing field `{key}`"), None);
-                ScenarioError::Invalid {
-                    file,
-                    field,
-                    reason: hint.map_or(reason, |h| format!("missing; {h}")),
-                }
-            }
-            e => e,
-        })?;
+        let cases = cases_of(&f, (&world, &pallet), (file, text))?;
         let mission = match &f.mission {
             Some(m) => Some(m.resolve(&world, file)?),
             None => None,
@@ -365,32 +338,6 @@ impl<R: Catalogue> Scenario<R> {
                 .chain(short_target)
                 .collect(),
             source: Some(Arc::new(text.to_owned())),
-        })
-    }
-
-    /// The same scenario with `truck` for its own, checked as if its `[truck]` table said
-    /// so: every load-time check that reads the truck (forks in the pockets, the depth and
-    /// the insertion, the payload, the sensors' mounts, the safety fields, each case's
-    /// layout) runs again, and what a run derives from the truck follows it. How a run's
-    /// geometry (`--truck FILE`, a sweep) reaches its trials.
-    pub fn with_truck(&self, truck: &ForkliftSpec) -> Result<Self, ScenarioError>
-    where
-        Self: Clone,
-    {
-        let Some(src) = &self.source else {
-            return Err(invalid(
-                &self.file,
-                "truck",
-                "this scenario was built, not read: its truck cannot be checked anew",
-            ));
-        };
-        // The run's truck stands for the file's own, so no truck file is read again.
-        let no_file = |_: &str| Ok(TruckSettings::default());
-        let world = |_: &FsPath| Ok(self.world.clone());
-        let checked = Self::parse_layout(src, &self.file, world, &no_file, Some(truck))?;
-        Ok(Self {
-            truck: checked.truck,
-            ..self.clone()
         })
     }
 
@@ -451,6 +398,30 @@ impl<R: Catalogue> Scenario<R> {
             .collect::<Vec<_>>()
             .join(", ")
     }
+}
+
+/// The file's cases resolved; a missing key's error says where it may have landed.
+fn cases_of(
+    f: &ScenarioFile,
+    (world, pallet): (&World, &PalletSpec),
+    (file, text): (&str, &str),
+) -> Result<Vec<Case>, ScenarioError> {
+    resolve_cases(f, world, pallet, file).map_err(|e| match e {
+        ScenarioError::Invalid {
+            file,
+            field,
+            reason,
+        } if reason == "missing" => {
+            let key = field.rsplit('.').next().unwrap_or(&field);
+            let hint = hints::misplaced_key(text, &format!("missing field `{key}`"), None);
+            ScenarioError::Invalid {
+                file,
+                field,
+                reason: hint.map_or(reason, |h| format!("missing; {h}")),
+            }
+        }
+        e => e,
+    })
 }
 
 fn is_gaussian_localizer(spec: &ComponentSpec) -> bool {

@@ -62,6 +62,21 @@ pub fn load_components(
             let spec = ComponentSpec::from_value(role, v.get_ref(), None, dir.clone())
                 .and_then(|s| registry.check(&s).map(|()| s))
                 .map_err(|e| invalid_setting(&at, &field, &e))?;
+            // A file adds names; a built-in kind's name would make `--planner bspline`
+            // run whatever the file says while every record says bspline.
+            if registry
+                .check(&ComponentSpec::of_kind(role, &spec.name))
+                .is_ok()
+            {
+                return Err(invalid(
+                    &at,
+                    &format!("{field}.name"),
+                    &format!(
+                        "{:?} is the name of a built-in {role}; this file defines it as kind {:?}: a components file adds names and never redefines a built-in, so name it otherwise",
+                        spec.name, spec.kind
+                    ),
+                ));
+            }
             if out.iter().any(|o| o.role == role && o.name == spec.name) {
                 return Err(invalid(
                     &at,

@@ -1,13 +1,13 @@
 //! Truck files: one file for a truck (geometry, mass, actuators, timing, its name and source), read into settings by dotted path and applied over a truck.
 
 use std::collections::BTreeMap;
-use std::path::Path as FsPath;
+use std::path::{Path as FsPath, PathBuf};
 
 use forkbench_core::ForkliftSpec;
 use forkbench_core::actuators::{Actuators, PRESETS};
 use forkbench_core::run_settings::{TRUCK_GEOMETRY, TRUCK_KNOBS, truck_path};
 
-use crate::{ScenarioError, invalid};
+use crate::{ScenarioError, World, invalid};
 
 /// A truck file as read: what it names and every number it sets.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -234,6 +234,46 @@ fn flatten(
         }
     }
     Ok(())
+}
+
+impl<R: crate::Catalogue> crate::Scenario<R> {
+    /// As [`Scenario::parse`], its truck files read by `load_truck` (by the path the
+    /// scenario names): how embedded scenarios name embedded trucks.
+    pub fn parse_embedded(
+        text: &str,
+        file: &str,
+        load_world: impl FnOnce(&FsPath) -> Result<World, ScenarioError>,
+        load_truck: &dyn Fn(&str) -> Result<TruckSettings, ScenarioError>,
+    ) -> Result<Self, ScenarioError> {
+        let s = Self::parse_layout(text, file, load_world, load_truck, None)?;
+        s.with_components(text, R::builtin(), PathBuf::from("."))
+    }
+
+    /// The same scenario with `truck` for its own, checked as if its `[truck]` table said
+    /// so: every load-time check that reads the truck (forks in the pockets, the depth and
+    /// the insertion, the payload, the sensors' mounts, the safety fields, each case's
+    /// layout) runs again, and what a run derives from the truck follows it. How a run's
+    /// geometry (`--truck FILE`, a sweep) reaches its trials.
+    pub fn with_truck(&self, truck: &ForkliftSpec) -> Result<Self, ScenarioError>
+    where
+        Self: Clone,
+    {
+        let Some(src) = &self.source else {
+            return Err(invalid(
+                &self.file,
+                "truck",
+                "this scenario was built, not read: its truck cannot be checked anew",
+            ));
+        };
+        // The run's truck stands for the file's own, so no truck file is read again.
+        let no_file = |_: &str| Ok(TruckSettings::default());
+        let world = |_: &FsPath| Ok(self.world.clone());
+        let checked = Self::parse_layout(src, &self.file, world, &no_file, Some(truck))?;
+        Ok(Self {
+            truck: checked.truck,
+            ..self.clone()
+        })
+    }
 }
 
 #[cfg(test)]

@@ -84,3 +84,42 @@ fn a_run_names_the_scenarios_own_component_or_a_registered_kind() {
         .to_string();
     assert!(e.contains("unknown planner \"nope\""), "{e}");
 }
+
+/// Issue 78: a components file adds names and never redefines a built-in one; the refusal
+/// names the built-in and what the file made of it.
+#[test]
+fn a_components_file_cannot_redefine_a_built_in_name() {
+    let dir = std::env::temp_dir().join(format!("fb-redefine-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let registry = forkbench_trial::Registry::builtin();
+    for (text, name) in [
+        (
+            "[[tracker]]\nname = \"regulated_pure_pursuit\"\nkind = \"external\"\ncommand = [\"sh\", \"-c\", \"true\"]\n",
+            "regulated_pure_pursuit",
+        ),
+        (
+            "[[planner]]\nname = \"bspline\"\nkind = \"spiral\"\n",
+            "bspline",
+        ),
+    ] {
+        let path = dir.join("components.toml");
+        std::fs::write(&path, text).expect("written");
+        let e = forkbench_trial::scenario::load_components(&path, &registry)
+            .expect_err(name)
+            .to_string();
+        assert!(
+            e.contains(name) && e.contains("built-in") && e.contains("components.toml:"),
+            "{e}"
+        );
+    }
+    // A new name still loads.
+    let path = dir.join("components.toml");
+    std::fs::write(
+        &path,
+        "[[planner]]\nname = \"my_spiral\"\nkind = \"spiral\"\n",
+    )
+    .expect("written");
+    let named = forkbench_trial::scenario::load_components(&path, &registry).expect("a new name");
+    assert_eq!(named[0].name, "my_spiral");
+    std::fs::remove_dir_all(&dir).ok();
+}
