@@ -217,6 +217,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     Ok(())
 }
 
+/// Whether `a` and `b` name one existing file (through links and relative paths alike):
+/// an output that is one of its command's inputs would destroy it.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -284,14 +293,5 @@ mod tests {
         let left: Vec<_> = std::fs::read_dir(&dir).expect("ls").collect();
         assert_eq!(left.len(), 1, "no temporary file left behind");
         let _ = std::fs::remove_dir_all(&dir);
-    }
-}
-
-/// Whether `a` and `b` name one existing file (through links and relative paths alike):
-/// an output that is one of its command's inputs would destroy it.
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
     }
 }
