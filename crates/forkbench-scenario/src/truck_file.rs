@@ -237,7 +237,7 @@ fn flatten(
 }
 
 impl<R: crate::Catalogue> crate::Scenario<R> {
-    /// As [`Scenario::parse`], its truck files read by `load_truck` (by the path the
+    /// As [`crate::Scenario::parse`], its truck files read by `load_truck` (by the path the
     /// scenario names): how embedded scenarios name embedded trucks.
     pub fn parse_embedded(
         text: &str,
