@@ -5,7 +5,7 @@ use std::path::{Path as FsPath, PathBuf};
 
 use forkbench_core::ForkliftSpec;
 use forkbench_core::actuators::{Actuators, PRESETS};
-use forkbench_core::run_settings::{TRUCK_GEOMETRY, TRUCK_KNOBS, truck_path};
+use forkbench_core::run_settings::{TRUCK_GEOMETRY, TRUCK_KNOBS};
 
 use crate::{ScenarioError, World, invalid};
 
@@ -72,36 +72,26 @@ pub fn read_truck_text(text: &str, file: &str) -> Result<TruckSettings, Scenario
         message: crate::text::compact_numbers(e.message()),
     })?;
     let mut out = TruckSettings::default();
-    for (key, value) in &table {
-        let text_of = |v: &toml::Value| v.as_str().map(str::to_owned);
-        match (key.as_str(), value) {
-            ("preset" | "name" | "source", v) => {
-                let s = text_of(v)
-                    .ok_or_else(|| invalid(&at(file, text, key), key, "must be a string"))?;
-                match key.as_str() {
-                    "preset" => out.preset = Some(s),
-                    "name" => out.name = Some(s),
-                    _ => out.source = Some(s),
-                }
-            }
-            (_, v) => {
-                let mut one = toml::Table::new();
-                one.insert(key.clone(), v.clone());
-                flatten(&one, &mut out.settings, &|path| {
-                    invalid(&at(file, text, path), path, "must be a number")
-                })?;
-            }
+    let mut numbers = table.clone();
+    for key in ["preset", "name", "source"] {
+        let Some(v) = numbers.remove(key) else {
+            continue;
+        };
+        let s = v
+            .as_str()
+            .map(str::to_owned)
+            .ok_or_else(|| invalid(&at(file, text, key), key, "must be a string"))?;
+        match key {
+            "preset" => out.preset = Some(s),
+            "name" => out.name = Some(s),
+            _ => out.source = Some(s),
         }
     }
-    for path in out.settings.keys() {
-        if truck_path(path) != Some(path.as_str()) {
-            return Err(invalid(
-                &at(file, text, path),
-                path,
-                &format!("not a truck setting (known: {})", known_keys()),
-            ));
-        }
-    }
+    flatten(&numbers, &mut out.settings, &|path| {
+        invalid(&at(file, text, path), path, "must be a number")
+    })?;
+    // Applying them refuses a key that is no truck setting and a value out of its range;
+    // the error is placed at the key's line.
     apply_truck(
         &ForkliftSpec::default(),
         out.preset.as_deref(),
