@@ -155,3 +155,64 @@ fn a_trial_of_a_defined_tracker_replays_with_its_components_file() {
         text(&o)
     );
 }
+
+/// A built-in kind defined by name with settings of its own is fingerprinted by them: a
+/// resume after its settings were edited is refused, naming the setting (once only
+/// external commands were, and every stale trial was reused).
+#[test]
+fn an_edited_setting_of_a_named_component_refuses_a_resume() {
+    let dir = tmp("settings");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let file = dir.join("components.toml");
+    let define = |lookahead: f64| {
+        std::fs::write(
+            &file,
+            format!(
+                "[[tracker]]\nname = \"pp\"\nkind = \"pure_pursuit\"\nlookahead_m = {lookahead}\n"
+            ),
+        )
+        .expect("components");
+    };
+    define(1.0);
+    let out = tmp("settings-out");
+    let field = repo_root().join("scenarios/field-test.toml");
+    let batch = |extra: &[&str]| {
+        let mut args = vec![
+            "batch",
+            s(&field),
+            "--components",
+            s(&file),
+            "--tracker",
+            "pp",
+            "--trials",
+            "2",
+            "--record",
+            "none",
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        forkbench(&args)
+    };
+    let first = batch(&["--force-new"]);
+    assert!(
+        matches!(first.status.code(), Some(0 | 3)),
+        "{}",
+        text(&first)
+    );
+    let again = batch(&[]);
+    assert!(
+        matches!(again.status.code(), Some(0 | 3)),
+        "{}",
+        text(&again)
+    );
+    define(1.6);
+    let stale = batch(&[]);
+    assert_eq!(stale.status.code(), Some(1), "{}", text(&stale));
+    assert!(
+        text(&stale).contains("components[0].settings.lookahead_m: 1 → 1.6")
+            && text(&stale).contains("different batch"),
+        "{}",
+        text(&stale)
+    );
+}

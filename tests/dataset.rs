@@ -218,3 +218,101 @@ fn a_worlds_clutter_is_seen_and_checked() {
         assert!(text(&o).contains(says), "{bad}: {}", text(&o));
     }
 }
+
+/// A folder is the set's: a folder with files but no set of forkbench's is refused, its
+/// files kept; a rerun into a set's folder replaces the set, and one that would leave the
+/// earlier set's arrays beside new labels is refused; nothing is left half-written.
+#[test]
+fn a_folder_holds_one_whole_set() {
+    let mine = tmp_in("dataset-folder", "mine");
+    std::fs::create_dir_all(&mine).expect("dir");
+    std::fs::write(mine.join("labels.json"), "my labels").expect("mine");
+    let o = forkbench(&["dataset", "--out", s(&mine), "--scans", "10"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o).contains("no dataset forkbench wrote"),
+        "{}",
+        text(&o)
+    );
+    assert_eq!(
+        std::fs::read_to_string(mine.join("labels.json")).expect("kept"),
+        "my labels"
+    );
+    let set = tmp_in("dataset-folder", "set");
+    let _ = std::fs::remove_dir_all(&set);
+    let run = |extra: &[&str]| {
+        let mut args = vec!["dataset", "--out", s(&set), "--scans", "20"];
+        args.extend_from_slice(extra);
+        forkbench(&args)
+    };
+    assert!(run(&["--npy", "--seed", "1"]).status.success());
+    let npy = std::fs::read(set.join("scans.npy")).expect("npy");
+    let o = run(&["--seed", "2"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o).contains("scans.npy and labels.npy of an earlier set"),
+        "{}",
+        text(&o)
+    );
+    assert_eq!(std::fs::read(set.join("scans.npy")).expect("kept"), npy);
+    let o = run(&["--npy", "--seed", "2"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_ne!(std::fs::read(set.join("scans.npy")).expect("replaced"), npy);
+    let labels: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(set.join("labels.json")).expect("labels"))
+            .expect("the streamed labels are JSON");
+    assert_eq!(labels["scans"].as_array().expect("scans").len(), 20);
+    assert_eq!(labels["dataset"]["seed"], 2);
+    let mut names: Vec<String> = std::fs::read_dir(&set)
+        .expect("dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["labels.json", "labels.npy", "scans.mcap", "scans.npy"]
+    );
+}
+
+/// A label says "present" only for a pallet the scanner can see: with a short, narrow
+/// scanner the faces are drawn within its reach and view (and the note says so); a spec
+/// whose ranges lie wholly outside it is refused naming the field.
+#[test]
+fn present_means_in_the_scanners_view() {
+    let dir = tmp_in("dataset-view", "set");
+    let _ = std::fs::remove_dir_all(&dir);
+    let spec = tmp_in("dataset-view", "kinect.toml");
+    std::fs::write(&spec, "scanner = \"kinect2\"\nscans = 200\n").expect("spec");
+    let o = forkbench(&["dataset", s(&spec), "--out", s(&dir)]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("faces drawn only where"), "{}", text(&o));
+    let labels: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("labels.json")).expect("labels"))
+            .expect("json");
+    let mut present = 0;
+    for l in labels["scans"].as_array().expect("scans") {
+        if l["present"] == true {
+            present += 1;
+            let (x, y) = (
+                l["face"]["x_m"].as_f64().expect("x"),
+                l["face"]["y_m"].as_f64().expect("y"),
+            );
+            assert!(x.hypot(y) <= 4.5, "{l}");
+            assert!(y.atan2(x).to_degrees().abs() <= 35.0, "{l}");
+        }
+    }
+    assert!(present > 50, "{present}");
+    std::fs::write(&spec, "scanner = \"kinect2\"\nrange_m = [6.0, 8.0]\n").expect("spec");
+    let o = forkbench(&[
+        "dataset",
+        s(&spec),
+        "--out",
+        s(&tmp_in("dataset-view", "none")),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o).contains("range_m") && text(&o).contains("reach"),
+        "{}",
+        text(&o)
+    );
+}

@@ -89,3 +89,103 @@ fn outputs_refuse_inputs_links_and_fifos_and_dash_prints() {
     assert_eq!(std::fs::read(&base).expect("baseline"), kept);
     let _ = std::fs::remove_dir_all(tmp(""));
 }
+
+/// A trial's recordings (`--rrd`, `--mcap`, `--ros2`, `--actuator-log`): a run refused for
+/// any of them touches none, `--force` or not; no recording replaces an input of the run
+/// (scenario, truck file, components) or writes through a link; `-` is refused (it would
+/// mix a recording into the report); a recording appears at its path whole, with no
+/// temporary file left beside it.
+#[test]
+fn recordings_are_checked_before_anything_is_touched() {
+    let dir = crate::common::tmp_in("forkbench-recordings", "run");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scn = dir.join("s.toml");
+    std::fs::copy(root.join("scenarios/field-test.toml"), &scn).expect("scenario");
+    let truck = dir.join("t.toml");
+    std::fs::copy(root.join("trucks/hangcha-a30.toml"), &truck).expect("truck");
+    let trial = |extra: &[&str]| {
+        let mut args = vec!["trial", s(&scn), "--no-noise", "--force"];
+        args.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_forkbench"))
+            .args(&args)
+            .current_dir(&dir)
+            .output()
+            .expect("runs")
+    };
+    let old = dir.join("old.mcap");
+    std::fs::write(&old, "keep").expect("old");
+    let kept = |p: &Path, what: &[u8]| {
+        assert_eq!(
+            std::fs::read(p).expect("still there"),
+            what,
+            "{}",
+            p.display()
+        )
+    };
+    // One bad target refuses the run before any other is opened.
+    let scenario_text = std::fs::read(&scn).expect("scenario");
+    let truck_text = std::fs::read(&truck).expect("truck");
+    for (flags, says) in [
+        (
+            vec!["--mcap", s(&old), "--actuator-log", "nodir/x.csv"],
+            "does not exist",
+        ),
+        (
+            vec!["--mcap", s(&old), "--ros2", s(&scn)],
+            "which this run reads",
+        ),
+        (vec!["--rrd", s(&scn)], "which this run reads"),
+        (vec!["--actuator-log", s(&scn)], "which this run reads"),
+        (
+            vec!["--truck", s(&truck), "--mcap", s(&truck)],
+            "which this run reads",
+        ),
+        (
+            vec!["--mcap", s(&old), "--actuator-log", "-"],
+            "standard output",
+        ),
+    ] {
+        let out = trial(&flags);
+        assert_eq!(out.status.code(), Some(1), "{flags:?}: {}", err(&out));
+        assert!(err(&out).contains(says), "{flags:?}: {}", err(&out));
+        kept(&old, b"keep");
+        kept(&scn, &scenario_text);
+        kept(&truck, &truck_text);
+    }
+    assert!(!dir.join("-").exists(), "`-` made a file");
+    // A link is refused, forced or not, and neither it nor its target changes.
+    let link = dir.join("link.mcap");
+    std::os::unix::fs::symlink(&old, &link).expect("symlink");
+    for flag in ["--mcap", "--ros2", "--rrd", "--actuator-log"] {
+        let out = trial(&[flag, s(&link)]);
+        assert_eq!(out.status.code(), Some(1), "{flag}: {}", err(&out));
+        assert!(err(&out).contains("symbolic link"), "{flag}: {}", err(&out));
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .expect("link")
+                .file_type()
+                .is_symlink()
+        );
+        kept(&old, b"keep");
+    }
+    // Forced, a good run replaces the file whole and leaves nothing else behind.
+    let out = trial(&["--mcap", s(&old), "--actuator-log", "a.csv"]);
+    assert!(matches!(out.status.code(), Some(0 | 3)), "{}", err(&out));
+    assert!(
+        std::fs::read(&old)
+            .expect("mcap")
+            .starts_with(b"\x89MCAP0\r\n")
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .expect("dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["a.csv", "link.mcap", "old.mcap", "s.toml", "t.toml"]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

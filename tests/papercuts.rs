@@ -146,3 +146,43 @@ fn every_scenario_s_entry_errors_are_drawn_against_its_own_limits() {
         assert!(page.contains(needle), "{needle} missing");
     }
 }
+
+/// The shipped scenarios and worlds are real files (`cp -r scenarios` copies them, not
+/// dangling links), each the same bytes as the twin the binary embeds, so what a user
+/// edits is what `forkbench trial field-test` runs.
+#[test]
+fn shipped_scenarios_are_files_equal_to_their_embedded_twins() {
+    let root = crate::common::repo_root();
+    let twins = [
+        ("scenarios", "crates/forkbench-trial/data/scenarios"),
+        ("worlds", "crates/forkbench-trial/data/worlds"),
+        (
+            "scenarios/reference",
+            "crates/forkbench-plan/data/reference",
+        ),
+    ];
+    let mut checked = 0;
+    for (shipped, embedded) in twins {
+        for e in std::fs::read_dir(root.join(shipped)).expect("folder") {
+            let path = e.expect("entry").path();
+            let meta = std::fs::symlink_metadata(&path).expect("meta");
+            assert!(
+                !meta.file_type().is_symlink(),
+                "{} is a link",
+                path.display()
+            );
+            let twin = root.join(embedded).join(path.file_name().expect("name"));
+            if meta.is_file() && twin.is_file() {
+                assert_eq!(
+                    std::fs::read(&path).expect("shipped"),
+                    std::fs::read(&twin).expect("embedded"),
+                    "{} differs from {} (the binary embeds the second): copy one over the other",
+                    path.display(),
+                    twin.display()
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 13, "{checked} twins");
+}

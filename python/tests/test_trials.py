@@ -159,7 +159,7 @@ def test_python_validates_options_as_the_cli_does(cli):
     assert without_clock(got) == without_clock(want)
 
 
-def test_a_runs_truck_is_its_actuators_and_timing():
+def test_a_runs_truck_is_its_actuators_timing_and_geometry():
     scn = forkbench.load("field-test")
 
     def run(**truck: object) -> dict:
@@ -170,8 +170,11 @@ def test_a_runs_truck_is_its_actuators_and_timing():
     assert run(truck_preset="realistic") == default
     assert run(truck_preset="ideal")["lateral_error_m"] != default["lateral_error_m"]
     assert run(truck={"steering.dead_time_s": 0.3})["lateral_error_m"] != default["lateral_error_m"]
+    # The geometry is a run's to set too (a truck file holds the whole truck); it acts, and
+    # a value out of range is refused naming the key.
+    assert run(truck={"wheelbase_m": 2.0})["lateral_error_m"] != default["lateral_error_m"]
     with pytest.raises(forkbench.ScenarioError, match="wheelbase_m"):
-        run(truck={"wheelbase_m": 2.0})
+        run(truck={"wheelbase_m": -1.0})
 
 
 def test_a_tracker_from_a_components_file_runs_on_any_scenario(tmp_path):

@@ -52,6 +52,9 @@ struct LabelFile {
     _dataset: Option<serde::de::IgnoredAny>,
     #[serde(default, rename = "frame")]
     _frame: Option<serde::de::IgnoredAny>,
+    /// The files of the set (so a later run into its folder knows them).
+    #[serde(default, rename = "files")]
+    _files: Option<serde::de::IgnoredAny>,
 }
 
 /// The labels of a JSON file `{"scans": [{"index": 0, "present": true, "face": {"x_m": …,

@@ -1,4 +1,4 @@
-//! Fingerprints of the external components a batch runs: their settings and the content of each file their command names, so a resume after an edited script is refused, naming the file.
+//! Fingerprints of the components a batch runs with settings of their own: the settings, and the content of each file an external one's command names, so a resume after an edited script or setting is refused, naming it.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -48,15 +48,19 @@ pub fn prints_of(scn: &Scenario, planners: &[String], trackers: &[String]) -> Ve
     specs.iter().filter_map(print_of).collect()
 }
 
-/// The print of `spec` when it runs a command.
+/// The print of `spec` when it runs a command or has settings of its own (a built-in kind
+/// defined by name with its keys: editing them changes every trial it runs); a built-in
+/// at its defaults has none.
 fn print_of(spec: &ComponentSpec) -> Option<ComponentPrint> {
-    let command: Vec<String> = spec
-        .settings
-        .get("command")?
-        .as_array()?
-        .iter()
-        .filter_map(|v| v.as_str().map(str::to_owned))
-        .collect();
+    let command: Vec<String> = match spec.settings.get("command") {
+        Some(c) => c
+            .as_array()?
+            .iter()
+            .filter_map(|v| v.as_str().map(str::to_owned))
+            .collect(),
+        None if spec.settings.is_empty() => return None,
+        None => Vec::new(),
+    };
     let dir = spec.dir.canonicalize().ok();
     let files = command
         .iter()

@@ -299,6 +299,13 @@ impl RareSetup {
             "case": self.case,
             "planner": self.planner,
             "tracker": self.tracker,
+            // A component defined by name is fingerprinted by its settings and files, so
+            // an edit to it refuses the resume.
+            "components": crate::prints::prints_of(
+                &self.scenario,
+                self.planner.as_slice(),
+                self.tracker.as_slice(),
+            ),
             "overrides": self.overrides,
             "seed": self.seed,
             "event": self.event,

@@ -91,6 +91,7 @@ impl RecordFlags {
             rerun: self.rerun,
             connect: self.connect,
             force: self.force,
+            inputs: Vec::new(),
         }
     }
 }
@@ -132,6 +133,9 @@ struct TrialCli {
 impl TrialCli {
     fn run(self, mission: bool) -> anyhow::Result<Done> {
         let overrides = self.options.overrides()?;
+        let mut record = self.record.args();
+        record.inputs.extend(self.options.truck_file());
+        record.inputs.extend(self.components.clone());
         let opts = trial_cmd::options(
             self.seed,
             (self.planner, self.tracker),
@@ -144,7 +148,7 @@ impl TrialCli {
             self.case.as_deref(),
             &opts,
             (self.json, mission),
-            &self.record.args(),
+            &record,
         )?;
         Ok(if ok { Done::Ok } else { Done::PickFailed })
     }

@@ -43,7 +43,11 @@ pub fn replay(
     job.scenario = crate::with_components(job.scenario, components)?;
     let opts = job.options();
     let run = opts.resolve(&job.scenario)?;
-    let r = forkbench_log::run_recorded((&job.scenario, job.case()?), (&opts, &run), rec)?;
+    // The trials file and a components file are inputs too: no recording replaces them.
+    let mut rec = rec.clone();
+    rec.inputs.push(file.to_path_buf());
+    rec.inputs.extend(components.map(Path::to_path_buf));
+    let r = forkbench_log::run_recorded((&job.scenario, job.case()?), (&opts, &run), &rec)?;
     if let Some(e) = &r.viewer_error {
         eprintln!(
             "error: {} (the trial ran without the viewer)",

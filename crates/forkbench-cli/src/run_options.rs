@@ -26,4 +26,13 @@ impl RunOptionArgs {
             ..self.options.clone()
         })
     }
+
+    /// The truck file `--truck` names, if it names one (not a preset): an input no output
+    /// of the run may replace.
+    pub fn truck_file(&self) -> Option<std::path::PathBuf> {
+        self.truck
+            .as_deref()
+            .filter(|t| forkbench_core::actuators::Actuators::preset(t).is_none())
+            .map(std::path::PathBuf::from)
+    }
 }

@@ -192,6 +192,58 @@ impl Drop for AtomicWriter {
     }
 }
 
+/// A file written elsewhere (a writer thread owns the handle) that appears at its path
+/// only when committed: a temporary file beside it, renamed into place. Dropped
+/// uncommitted, the temporary file is removed and the path left as it was, so a refused
+/// or failed run replaces nothing.
+#[derive(Debug)]
+pub struct Partial {
+    path: std::path::PathBuf,
+    tmp: Option<std::path::PathBuf>,
+}
+
+impl Partial {
+    /// The temporary file for `path` (checked with [`check_output`]), and its handle.
+    pub fn create(path: &Path) -> Result<(Self, std::fs::File), FileError> {
+        check_output(path)?;
+        let tmp = temporary(path);
+        let file = std::fs::File::create_new(&tmp).map_err(io_err(path))?;
+        Ok((
+            Self {
+                path: path.to_owned(),
+                tmp: Some(tmp),
+            },
+            file,
+        ))
+    }
+
+    /// Renames the written file into place (its handle closed by the writer first).
+    pub fn commit(mut self) -> Result<(), FileError> {
+        let Some(tmp) = self.tmp.take() else {
+            return Ok(());
+        };
+        let result = std::fs::rename(&tmp, &self.path);
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        result.map_err(io_err(&self.path))
+    }
+
+    /// Leaves the temporary file where it is, as a process that died would, and returns
+    /// its path.
+    pub fn keep(mut self) -> std::path::PathBuf {
+        self.tmp.take().unwrap_or_else(|| self.path.clone())
+    }
+}
+
+impl Drop for Partial {
+    fn drop(&mut self) {
+        if let Some(tmp) = self.tmp.take() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+    }
+}
+
 /// Writes `bytes` to `path` so that a reader sees the old file or the new one, never a
 /// part: a temporary file in the same folder, flushed to disk, then renamed over `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {

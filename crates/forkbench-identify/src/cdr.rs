@@ -14,6 +14,9 @@ const MAX_DEPTH: usize = 32;
 /// Most elements one sequence may claim: a corrupt count cannot make a decoder loop on.
 const MAX_SEQUENCE: usize = 1 << 24;
 
+/// Values a message may decode beyond one per byte of its body (empty messages cost none).
+const SPARE_VALUES: usize = 1024;
+
 /// A primitive's kind and size in bytes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Prim {
@@ -186,7 +189,13 @@ impl Schema {
         if bytes[1] != 0x01 {
             return Err("not little-endian CDR".into());
         }
-        let mut r = Reader { body, at: 0 };
+        // Every value costs at least one byte save empty messages: a schema declaring a
+        // billion of them must not build a billion values from no bytes.
+        let mut r = Reader {
+            body,
+            at: 0,
+            values_left: body.len() + SPARE_VALUES,
+        };
         self.message(&self.root, &mut r, 0)
     }
 
@@ -222,6 +231,12 @@ impl Schema {
     }
 
     fn value(&self, kind: &Kind, r: &mut Reader<'_>, depth: usize) -> Result<Value, String> {
+        r.values_left = r.values_left.checked_sub(1).ok_or_else(|| {
+            format!(
+                "its schema asks for more values than its {} bytes hold",
+                r.body.len()
+            )
+        })?;
         match kind {
             Kind::Prim(p) => r.prim(*p),
             Kind::String => r.string(),
@@ -234,6 +249,8 @@ impl Schema {
 struct Reader<'a> {
     body: &'a [u8],
     at: usize,
+    /// Values still to be decoded before the message is refused.
+    values_left: usize,
 }
 
 impl Reader<'_> {
@@ -331,5 +348,29 @@ mod tests {
         huge[28..32].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(schema.decode(&huge).is_err());
         assert!(Schema::parse("pkg/msg/Bad", "pkg/Missing m\n").is_err());
+    }
+
+    /// Values cost bytes: a schema of a billion empty messages (or of a billion zero-size
+    /// values) is refused from a few bytes, at once and without building them.
+    #[test]
+    fn a_schema_cannot_make_values_from_no_bytes() {
+        let bomb = "pkg/Empty[1000000000] e\n\
+            ================================================================================\n\
+            MSG: pkg/Empty\n";
+        let schema = Schema::parse("pkg/msg/Bomb", bomb).expect("schema");
+        let t0 = std::time::Instant::now();
+        let e = schema.decode(&[0, 1, 0, 0]).expect_err("refused");
+        assert!(e.to_string().contains("more values than"), "{e}");
+        assert!(t0.elapsed().as_secs() < 5);
+        // Nested: a thousand of a thousand of a thousand.
+        let nested = "pkg/A[1000] a\n\
+            ================================================================================\n\
+            MSG: pkg/A\npkg/B[1000] b\n\
+            ================================================================================\n\
+            MSG: pkg/B\npkg/Empty[1000] c\n\
+            ================================================================================\n\
+            MSG: pkg/Empty\n";
+        let schema = Schema::parse("pkg/msg/Nested", nested).expect("schema");
+        assert!(schema.decode(&[0, 1, 0, 0, 0, 0, 0, 0]).is_err());
     }
 }

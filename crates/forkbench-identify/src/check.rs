@@ -1,7 +1,7 @@
-//! What a log must show before a fit is worth making: enough samples and time, and commands that move.
+//! What a log must show before a fit is worth making: enough samples and time, commands that move and a response that follows.
 
 use crate::IdentifyError;
-use crate::log::Run;
+use crate::log::{Channel, Run};
 use crate::model::{Kind, channel};
 
 /// Fewest samples over a channel's runs.
@@ -27,21 +27,11 @@ pub fn enough(kind: Kind, runs: &[&Run]) -> Result<(), IdentifyError> {
             duration_s: duration,
         });
     }
-    let cmds: Vec<f64> = runs
-        .iter()
-        .filter_map(|r| channel(r, kind))
-        .flat_map(|c| c.cmd.iter().copied())
-        .collect();
-    let (lo, hi) = cmds
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(*v), b.max(*v))
-        });
     let threshold = match kind {
         Kind::Steering => 0.01,
         Kind::Drive => 0.02,
     };
-    let span = hi - lo;
+    let span = span_of(runs, kind, |c| &c.cmd);
     // NaN-safe: an empty or non-finite span is no excitation either.
     if span.is_nan() || span < threshold {
         return Err(IdentifyError::NoExcitation {
@@ -50,5 +40,27 @@ pub fn enough(kind: Kind, runs: &[&Run]) -> Result<(), IdentifyError> {
             threshold,
         });
     }
+    // A response that never moves (a wheel held at its stop, a sensor stuck) says nothing
+    // of the dynamics: any dead time, lag and limit fit it.
+    let moved = span_of(runs, kind, |c| &c.measured);
+    if moved.is_nan() || moved < threshold {
+        return Err(IdentifyError::NoResponse {
+            channel: name,
+            span: moved.max(0.0),
+            threshold,
+        });
+    }
     Ok(())
+}
+
+/// How far `values` of the channel range over all runs.
+fn span_of(runs: &[&Run], kind: Kind, values: impl Fn(&Channel) -> &Vec<f64>) -> f64 {
+    let (lo, hi) = runs
+        .iter()
+        .filter_map(|r| channel(r, kind))
+        .flat_map(|c| values(c).iter().copied())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    hi - lo
 }

@@ -94,7 +94,7 @@ fn nelder_mead(f: &dyn Fn(&[f64]) -> f64, x0: &[f64], step: f64, iters: usize) -
 /// its own least-squares time constant and limits, then the limits the log does not show
 /// dropped.
 pub fn fit(kind: Kind, runs: &[&Run]) -> Params {
-    let dt = median_step(runs);
+    let dt = grid_step(runs);
     let peak = runs
         .iter()
         .filter_map(|r| channel(r, kind).map(|c| (r, c)))
@@ -115,10 +115,11 @@ pub fn fit(kind: Kind, runs: &[&Run]) -> Params {
             Kind::Drive => 0.01,
         };
         let f = |x: &[f64]| {
-            if x[0].exp() < tau_min || x[0].exp() > 10.0 {
+            if !x.iter().all(|v| v.is_finite()) || x[0].exp() < tau_min || x[0].exp() > 10.0 {
                 return f64::INFINITY;
             }
-            sse(kind, &params(kind, d, x), runs)
+            let e = sse(kind, &params(kind, d, x), runs);
+            if e.is_nan() { f64::INFINITY } else { e }
         };
         nelder_mead(&f, &x0, 0.7, iters)
     };
@@ -159,6 +160,15 @@ fn drop_unseen_limits(kind: Kind, p: &mut Params, err: f64, runs: &[&Run]) {
     }
 }
 
+/// The dead-time grid's spacing: the log's sample step, and no finer than 10 ms (what
+/// the physics resolves), so the grid has at most 61 points.
+pub fn grid_step(runs: &[&Run]) -> f64 {
+    let (step, floor) = (median_step(runs), 1.0 / crate::rate::FIT_RATE_HZ);
+    // A step a rounding short of the floor (epoch stamps in a bag) is the log's own: the
+    // grid stays on its samples.
+    if step >= floor * 0.999 { step } else { floor }
+}
+
 fn median_step(runs: &[&Run]) -> f64 {
     let mut steps: Vec<f64> = runs
         .iter()
@@ -186,15 +196,22 @@ pub fn split(n: usize) -> (Vec<usize>, Vec<usize>) {
 
 /// Fits `kind` on the log's training runs and validates it on the held-out ones.
 pub fn identify_channel(kind: Kind, log: &ActuatorLog) -> Result<ChannelFit, IdentifyError> {
-    let with: Vec<&Run> = log
+    let all: Vec<&Run> = log
         .runs
         .iter()
         .filter(|r| channel(r, kind).is_some())
         .collect();
+    let (prepared, mut notes) = crate::rate::prepare(kind, &all);
+    let with: Vec<&Run> = prepared.iter().collect();
     crate::check::enough(kind, &with)?;
     let (train, held) = split(with.len());
-    let fit_runs: Vec<&Run> = train.iter().map(|&i| with[i]).collect();
+    let (fitted, cut) = crate::rate::within_budget(train.iter().map(|&i| with[i]).collect());
+    notes.extend(cut);
+    let fit_runs: Vec<&Run> = fitted.iter().collect();
     let p = fit(kind, &fit_runs);
+    let dead_time_step_s = grid_step(&fit_runs);
+    let (settings, refused) = in_truck_ranges(settings(kind, &p));
+    notes.extend(refused.iter().map(|(k, why)| format!("{k}: {why}")));
     let check_runs: Vec<&Run> = if held.is_empty() {
         fit_runs.clone()
     } else {
@@ -214,8 +231,13 @@ pub fn identify_channel(kind: Kind, log: &ActuatorLog) -> Result<ChannelFit, Ide
             Kind::Drive => "drive",
         }
         .to_owned(),
-        settings: settings(kind, &p),
-        not_identified: unseen(kind, &p),
+        settings,
+        not_identified: unseen(kind, &p)
+            .into_iter()
+            .chain(refused.into_iter().map(|(k, _)| k))
+            .collect(),
+        dead_time_step_s,
+        notes,
         fit_percent: fit_percent(&y, &yh),
         fit_runs: fit_runs.len(),
         held_out_runs: held.len(),
@@ -284,6 +306,30 @@ fn settings(kind: Kind, p: &Params) -> BTreeMap<String, f64> {
     s
 }
 
+/// The settings a truck file takes, and those it would refuse with the reason: a fitted
+/// value out of a truck's range means the log does not show that setting.
+fn in_truck_ranges(
+    fitted: BTreeMap<String, f64>,
+) -> (BTreeMap<String, f64>, Vec<(String, String)>) {
+    let mut refused = Vec::new();
+    let mut kept = BTreeMap::new();
+    for (k, v) in fitted {
+        let mut truck = forkbench_core::ForkliftSpec::default();
+        let known = forkbench_core::run_settings::set(&mut truck, &k, v);
+        match truck.validate() {
+            Ok(()) if known => {
+                kept.insert(k, v);
+            }
+            Ok(()) => refused.push((k, "not a truck file's setting".to_owned())),
+            Err(e) => refused.push((
+                k,
+                format!("fitted {v:.4}, which a truck file refuses ({e}): not identified"),
+            )),
+        }
+    }
+    (kept, refused)
+}
+
 /// The limits the log never reached, by the truck file's names.
 fn unseen(kind: Kind, p: &Params) -> Vec<String> {
     match kind {
@@ -297,5 +343,32 @@ fn unseen(kind: Kind, p: &Params) -> Vec<String> {
         .filter(|(v, _)| v.is_none())
         .map(|(_, n)| (*n).to_owned())
         .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fitted value a truck file would refuse (a rate of 0, an acceleration of
+    /// 0.003 m/s²) is not written: it is named as not identified, with the reason.
+    #[test]
+    fn fitted_values_a_truck_refuses_are_not_written() {
+        let fitted: BTreeMap<String, f64> = [
+            ("drive.accel_limit_mps2", 0.003),
+            ("drive.dead_time_s", 0.1),
+            ("max_steer_rate_radps", 0.0),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v))
+        .collect();
+        let (kept, refused) = in_truck_ranges(fitted);
+        assert_eq!(kept.keys().collect::<Vec<_>>(), ["drive.dead_time_s"]);
+        let names: Vec<&str> = refused.iter().map(|(k, _)| k.as_str()).collect();
+        assert_eq!(names, ["drive.accel_limit_mps2", "max_steer_rate_radps"]);
+        assert!(
+            refused.iter().all(|(_, why)| why.contains("refuses")),
+            "{refused:?}"
+        );
     }
 }

@@ -7,6 +7,7 @@ pub mod fit;
 pub mod log;
 pub mod mcap_log;
 pub mod model;
+pub mod rate;
 
 use std::collections::BTreeMap;
 
@@ -36,6 +37,14 @@ pub enum IdentifyError {
         span: f64,
         threshold: f64,
     },
+    #[error(
+        "{channel}: no response: the measured value spans only {span:.4} while the command moves (at least {threshold} is needed; a wheel held at its stop or a stuck sensor tells nothing of the dynamics)"
+    )]
+    NoResponse {
+        channel: &'static str,
+        span: f64,
+        threshold: f64,
+    },
     #[error("the log has neither a steering nor a drive channel with runs to fit")]
     Empty,
 }
@@ -56,8 +65,13 @@ pub struct ChannelFit {
     pub channel: String,
     /// Fitted values by the truck file's dotted names.
     pub settings: BTreeMap<String, f64>,
-    /// Limits the log never drove the actuator into, so it cannot tell them.
+    /// Settings the log cannot tell: limits it never drove the actuator into, and fitted
+    /// values a truck file would refuse (the reason is in `notes`).
     pub not_identified: Vec<String>,
+    /// The spacing of the dead-time grid searched (the log's sample step, at least 10 ms).
+    pub dead_time_step_s: f64,
+    /// What was done to the log before the fit, and settings dropped after it.
+    pub notes: Vec<String>,
     /// NRMSE fit % on the held-out runs (on the fitted runs when there is only one).
     pub fit_percent: f64,
     pub fit_runs: usize,
@@ -135,8 +149,18 @@ impl Identified {
             for (k, v) in &c.settings {
                 s.push_str(&format!("  {k} = {v:.4}\n"));
             }
+            s.push_str(&format!(
+                "  dead time searched on a {:.3} s grid\n",
+                c.dead_time_step_s
+            ));
             for k in &c.not_identified {
-                s.push_str(&format!("  {k}: not reached in the log, not identified\n"));
+                // A dropped fit says why in its note; a limit left out was never reached.
+                if !c.notes.iter().any(|n| n.starts_with(&format!("{k}:"))) {
+                    s.push_str(&format!("  {k}: not reached in the log, not identified\n"));
+                }
+            }
+            for n in &c.notes {
+                s.push_str(&format!("  note: {n}\n"));
             }
             let roll: Vec<String> = c
                 .rollout_rmse

@@ -105,6 +105,16 @@ fn header(rec: &csv::StringRecord, file: &str) -> Result<Header, LogError> {
     Ok(h)
 }
 
+/// The largest magnitude a column may hold, and why: a value beyond it is a unit slip or
+/// a corrupt cell, and would overflow the fit's sums.
+fn bound(column: &str) -> (f64, &'static str) {
+    match column {
+        "t_s" => (1e10, "s, past any clock's epoch time"),
+        "steer_cmd_rad" | "steer_rad" => (7.0, "rad, more than a full turn of the wheel"),
+        _ => (100.0, "m/s, beyond any forklift"),
+    }
+}
+
 /// Parses a CSV log's text; `file` names it in errors.
 pub fn parse_csv(text: &str, file: &str) -> Result<ActuatorLog, LogError> {
     let mut reader = csv::ReaderBuilder::new()
@@ -134,11 +144,14 @@ pub fn parse_csv(text: &str, file: &str) -> Result<ActuatorLog, LogError> {
                 reason: format!("{reason} (got {text:?})"),
             };
             let v: f64 = text.parse().map_err(|_| bad("not a number"))?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(bad("not a finite number"))
+            if !v.is_finite() {
+                return Err(bad("not a finite number"));
             }
+            let (most, what) = bound(&names[col]);
+            if v.abs() > most {
+                return Err(bad(&format!("beyond ±{most} {what}")));
+            }
+            Ok(v)
         };
         let id = h.run.map(|c| rec.get(c).unwrap_or("").trim().to_owned());
         if log.runs.is_empty() || id != run_id {

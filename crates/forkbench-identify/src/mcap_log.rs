@@ -16,6 +16,14 @@ pub const TELEMETRY_TOPIC: &str = "/forkbench/telemetry";
 pub const ROS2_COMMAND_TOPIC: &str = "/forkbench/actuators/command";
 pub const ROS2_MEASURED_TOPIC: &str = "/forkbench/actuators/measured";
 
+/// Most bytes a log's chunks may decompress to: a small file of highly compressed chunks
+/// must not take the machine's memory.
+pub const MAX_DECODED_BYTES: u64 = 512 << 20;
+
+/// Most messages read on a log's topics: hours of a 100 Hz controller, and a bound on the
+/// samples held however small each message is.
+pub const MAX_MESSAGES: usize = 2_000_000;
+
 /// A time field that is the message's log time, not one of its fields.
 pub const LOG_TIME: &str = "@log_time";
 
@@ -82,6 +90,7 @@ pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<Actua
     };
     let bytes = forkbench_core::files::read_bytes(path, crate::log::MAX_LOG_BYTES)
         .map_err(|e| bad(e.to_string()))?;
+    check_decoded_size(&bytes).map_err(&bad)?;
     let topics = topics_in(&bytes).map_err(&bad)?;
     let defaults = COLUMNS.map(str::to_owned);
     let (topic, fields) = if topic == TELEMETRY_TOPIC
@@ -111,6 +120,28 @@ pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<Actua
     }
     let csv = rows(&bytes, &used).map_err(bad)?;
     parse_csv(&csv, &format!("{file} (topic {topic})"))
+}
+
+/// The chunks' declared sizes (what decompressing them allocates) within
+/// [`MAX_DECODED_BYTES`], before any is decompressed.
+fn check_decoded_size(bytes: &[u8]) -> Result<(), String> {
+    let mut total = 0u64;
+    for record in
+        mcap::read::LinearReader::new(bytes).map_err(|e| format!("not an MCAP file: {e}"))?
+    {
+        if let mcap::records::Record::Chunk { header, .. } =
+            record.map_err(|e| format!("reading a record: {e}"))?
+        {
+            total = total.saturating_add(header.uncompressed_size);
+        }
+        if total > MAX_DECODED_BYTES {
+            return Err(format!(
+                "its chunks decompress to more than {MAX_DECODED_BYTES} bytes, the most \
+                 identify reads"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The topics that carry messages.
@@ -174,6 +205,12 @@ fn samples(bytes: &[u8], used: &[(usize, Source)]) -> Result<Vec<Sample>, String
         let topic = &m.channel.topic;
         if !used.iter().any(|(_, s)| &s.topic == topic) {
             continue;
+        }
+        if out.len() == MAX_MESSAGES {
+            return Err(format!(
+                "more than {MAX_MESSAGES} messages on its topics, the most identify reads \
+                 (cut the log to the runs to fit)"
+            ));
         }
         let v = match m.channel.message_encoding.as_str() {
             "json" => serde_json::from_slice(&m.data)

@@ -1,3 +1,4 @@
 //! The identification's integration tests, one binary.
 
+mod hostile;
 mod round_trip;

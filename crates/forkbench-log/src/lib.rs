@@ -58,50 +58,62 @@ pub enum LogError {
     Rerun(String),
 }
 
-/// Checks before a run that `path` can be written: parent exists and is writable, and
-/// the file is absent unless `force`.
+/// Checks before a run that `path` can be written, without touching it: not standard
+/// output (which carries the run's report), not a link, folder, FIFO or device, absent
+/// unless `force`, in a folder that exists and takes a new file. Nothing is created at
+/// `path` until its recording is complete.
 pub fn check_writable(path: &Path, force: bool) -> Result<(), LogError> {
     let p = path.display().to_string();
-    if path.is_dir() {
-        return Err(LogError::Io {
-            path: p,
-            message: "is a directory; give a file name".into(),
-        });
+    let refuse = |message: &str| LogError::Io {
+        path: p.clone(),
+        message: message.into(),
+    };
+    if forkbench_core::files::is_stdout(path) {
+        return Err(refuse(
+            "standard output carries the run's report; give a recording a file's path",
+        ));
     }
-    // Opening a FIFO to write waits for a reader, and a device is not a recording.
-    if let Ok(meta) = std::fs::metadata(path)
-        && !meta.is_file()
-    {
-        return Err(LogError::Io {
-            path: p,
-            message:
-                "exists and is not a regular file (a FIFO, socket or device); give a file name"
-                    .into(),
-        });
-    }
-    if path.exists() && !force {
-        return Err(LogError::Exists { path: p });
+    if let Ok(meta) = std::fs::symlink_metadata(path) {
+        let t = meta.file_type();
+        if t.is_symlink() {
+            return Err(refuse(
+                "is a symbolic link; a recording is not written through a link (give the \
+                 file's own path)",
+            ));
+        }
+        if t.is_dir() {
+            return Err(refuse("is a directory; give a file name"));
+        }
+        // Opening a FIFO to write waits for a reader, and a device is not a recording.
+        if !t.is_file() {
+            return Err(refuse(
+                "exists and is not a regular file (a FIFO, socket or device); give a file name",
+            ));
+        }
+        if !force {
+            return Err(LogError::Exists { path: p });
+        }
     }
     let parent = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     if !parent.is_dir() {
-        return Err(LogError::Io {
-            path: p,
-            message: format!("directory {} does not exist", parent.display()),
-        });
+        return Err(refuse(&format!(
+            "directory {} does not exist",
+            parent.display()
+        )));
     }
-    // Probe: create (or truncate) the file itself, so a read-only place fails now.
-    std::fs::OpenOptions::new()
-        .write(true)
-        .create(true)
-        .truncate(true)
-        .open(path)
-        .map(|_| ())
-        .map_err(|e| LogError::Io {
-            path: p,
-            message: e.to_string(),
+    // Probe with a file of our own beside it (removed at once), so a read-only place
+    // fails now and the file at `path` is left as it is.
+    forkbench_core::files::Partial::create(path)
+        .map(drop)
+        .map_err(|e| match e {
+            forkbench_core::files::FileError::Io { cause, .. } => LogError::Io {
+                path: p.clone(),
+                message: cause.to_string(),
+            },
+            other => refuse(&other.to_string()),
         })
 }
 

@@ -26,6 +26,9 @@ pub struct RecordTargets {
     pub connect: Option<String>,
     /// Overwrite existing recording files.
     pub force: bool,
+    /// The files the run reads (scenario, world, truck, components): no recording may
+    /// replace one, `force` or not.
+    pub inputs: Vec<PathBuf>,
 }
 
 /// A trial that could not be recorded: its options, or a sink.
@@ -81,6 +84,15 @@ impl Sinks {
                 });
             }
             check_writable(p, a.force)?;
+            forkbench_core::files::check_not_input(p, &a.inputs).map_err(|e| LogError::Io {
+                path: p.display().to_string(),
+                message: match e {
+                    forkbench_core::files::FileError::IsInput { input, .. } => {
+                        format!("is {input}, which this run reads; give the recording another name")
+                    }
+                    other => other.to_string(),
+                },
+            })?;
         }
         let (rerun, viewer_error) = open_rerun(a)?;
         let ros2 = a
@@ -213,7 +225,9 @@ pub fn run_recorded(
     (opts, run): (&TrialOptions, &Resolved),
     targets: &RecordTargets,
 ) -> Result<Recorded, LogError> {
-    let mut sinks = Sinks::open(targets, metadata(&scn.name, &case.name, run))?;
+    let mut targets = targets.clone();
+    targets.inputs.extend(scn.files().iter().cloned());
+    let mut sinks = Sinks::open(&targets, metadata(&scn.name, &case.name, run))?;
     let (outcome, written) =
         sinks.record(|rec| forkbench_trial::run_trial_recorded(scn, case, opts, rec));
     Ok(Recorded {

@@ -20,6 +20,8 @@ pub(crate) struct WriterThread<C: Send + 'static> {
     tx: Option<SyncSender<C>>,
     thread: Option<JoinHandle<Option<String>>>,
     error: Option<String>,
+    /// The file being written beside the path, renamed onto it when all went well.
+    partial: Option<forkbench_core::files::Partial>,
 }
 
 /// An error and its causes: crates' own messages ("I/O error from writing…") hide the
@@ -36,9 +38,10 @@ pub(crate) fn with_causes(e: &dyn std::error::Error) -> String {
 }
 
 impl<C: Send + 'static> WriterThread<C> {
-    /// Creates `path` (checked beforehand with [`crate::check_writable`]) and starts `run`
-    /// on a thread named `name`: only creating the file, the step that fails on a bad path,
-    /// holds up the caller.
+    /// Creates the file for `path` (checked beforehand with [`crate::check_writable`]) and
+    /// starts `run` on a thread named `name`: only creating the file, the step that fails
+    /// on a bad path, holds up the caller. The file appears at `path` when
+    /// [`Self::finish`] succeeds; until then (and after a failure) `path` is untouched.
     pub fn spawn(
         path: &Path,
         name: &str,
@@ -51,7 +54,7 @@ impl<C: Send + 'static> WriterThread<C> {
             path: p.clone(),
             message: with_causes(e),
         };
-        let file = File::create(path).map_err(|e| io(&e))?;
+        let (partial, file) = forkbench_core::files::Partial::create(path).map_err(|e| io(&e))?;
         let (tx, rx) = sync_channel::<C>(bound);
         let thread = std::thread::Builder::new()
             .name(name.into())
@@ -63,6 +66,7 @@ impl<C: Send + 'static> WriterThread<C> {
             tx: Some(tx),
             thread: Some(thread),
             error: None,
+            partial: Some(partial),
         })
     }
 
@@ -97,8 +101,21 @@ impl<C: Send + 'static> WriterThread<C> {
             }
         }
         match self.error.take() {
-            Some(message) => Err(self.io_error(message)),
-            None => Ok(()),
+            Some(message) => {
+                self.partial = None;
+                Err(self.io_error(message))
+            }
+            None => match self
+                .partial
+                .take()
+                .map(forkbench_core::files::Partial::commit)
+            {
+                Some(Err(forkbench_core::files::FileError::Io { cause, .. })) => {
+                    Err(self.io_error(format!("moving the written file into place: {cause}")))
+                }
+                Some(Err(e)) => Err(self.io_error(e.to_string())),
+                _ => Ok(()),
+            },
         }
     }
 
@@ -116,11 +133,15 @@ impl<C: Send + 'static> WriterThread<C> {
     }
 
     /// Joins the thread without reporting anything (a simulated crash).
-    pub fn abandon(&mut self) {
+    /// The bytes stay in the temporary file, as a crash leaves them; its path is returned.
+    pub fn abandon(&mut self) -> Option<std::path::PathBuf> {
         self.close();
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
+        self.partial
+            .take()
+            .map(forkbench_core::files::Partial::keep)
     }
 }
 

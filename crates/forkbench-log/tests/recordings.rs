@@ -235,8 +235,12 @@ fn a_crash_mid_trial_leaves_a_readable_mcap_up_to_the_last_chunk() {
             steps: 0,
         },
     );
-    rec.abandon(); // no summary, no footer: as if the process died
-    let bytes = std::fs::read(&path).expect("written");
+    // No summary, no footer: as if the process died. The target is untouched; what was
+    // written is in the temporary file beside it.
+    let partial = rec.abandon().expect("a partial file");
+    assert!(!path.exists(), "a crashed recording appeared at its path");
+    assert_eq!(partial.parent(), path.parent());
+    let bytes = std::fs::read(&partial).expect("written");
     let opts = enumset::EnumSet::only(mcap::read::Options::IgnoreEndMagic);
     let mut telemetry = 0;
     for m in mcap::MessageStream::new_with_options(&bytes, opts).expect("header readable") {
@@ -478,30 +482,64 @@ fn rrd_files_are_written_whole() {
     );
 }
 
-/// A full disk reaches the caller as an error naming the file and the reason, for both
-/// sinks (`/dev/full` opens, then every write fails with ENOSPC): both write on threads of
-/// their own, so the error comes when the recording is finished.
+/// A write that fails (a full disk, a file-size limit) reaches the caller as an error
+/// naming the file and the reason, for both sinks, and leaves nothing at the path: both
+/// write on threads of their own, so the error comes when the recording is finished. The
+/// failure is made real in a child of this test with a 64 KiB file-size limit (a device
+/// such as `/dev/full` is refused as a recording's target).
 #[test]
 #[cfg(target_os = "linux")]
-fn a_full_disk_is_reported_by_both_sinks() {
+fn a_failed_write_is_reported_by_both_sinks() {
+    let exe = std::env::current_exe().expect("the test binary");
+    let out = std::process::Command::new("bash")
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 64; exec \"$0\" --exact write_failure_child --nocapture")
+        .arg(&exe)
+        .env(
+            "FORKBENCH_WRITE_FAILURE_CHILD",
+            tmp("write-failure").as_os_str(),
+        )
+        .output()
+        .expect("bash runs");
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("1 passed"), "the child ran no test: {text}");
+}
+
+/// The child of [`a_failed_write_is_reported_by_both_sinks`]: runs only there.
+#[test]
+fn write_failure_child() {
+    let Some(dir) = std::env::var_os("FORKBENCH_WRITE_FAILURE_CHILD") else {
+        return;
+    };
+    let dir = std::path::PathBuf::from(dir);
+    std::fs::create_dir_all(&dir).expect("dir");
     let scn = field_test();
-    let full = Path::new("/dev/full");
-    let mut mcap = McapRecorder::create(full, BTreeMap::new()).expect("opens");
-    let mut rrd = RerunRecorder::new(&RerunTarget::File(full.to_path_buf())).expect("opens");
+    let (m, r) = (dir.join("big.mcap"), dir.join("big.rrd"));
+    let mut mcap = McapRecorder::create(&m, BTreeMap::new()).expect("opens");
+    let mut rrd = RerunRecorder::new(&RerunTarget::File(r.clone())).expect("opens");
     run_trial_recorded(
         &scn,
         &scn.cases[0],
         &opts(),
         &mut forkbench_trial::Tee(vec![&mut mcap, &mut rrd]),
     );
-    for e in [
-        mcap.finish().expect_err("the MCAP does not fit"),
-        rrd.finish().expect_err("the .rrd does not fit"),
+    for (e, path) in [
+        (mcap.finish().expect_err("the MCAP does not fit"), &m),
+        (rrd.finish().expect_err("the .rrd does not fit"), &r),
     ] {
         let e = e.to_string();
-        assert!(e.contains("/dev/full"), "{e}");
-        assert!(e.to_lowercase().contains("no space"), "{e}");
+        assert!(e.contains(&path.display().to_string()), "{e}");
+        assert!(e.to_lowercase().contains("too large"), "{e}");
+        assert!(
+            !path.exists(),
+            "a failed recording appeared at {}",
+            path.display()
+        );
     }
+    let left: Vec<_> = std::fs::read_dir(&dir).expect("dir").collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
 }
 
 /// Every signal kind, as a component the sinks know nothing about would send it.

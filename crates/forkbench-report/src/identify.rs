@@ -49,10 +49,16 @@ where
         .x_label_area_size(35)
         .y_label_area_size(55)
         .caption(
-            format!(
-                "{}: a held-out run, fit {:.1} % over the held-out runs",
-                c.channel, c.fit_percent
-            ),
+            match c.held_out_runs {
+                0 => format!(
+                    "{}: the fitted run (none held out), fit {:.1} % on it",
+                    c.channel, c.fit_percent
+                ),
+                n => format!(
+                    "{}: a held-out run, fit {:.1} % over the {n} held-out run(s)",
+                    c.channel, c.fit_percent
+                ),
+            },
             ("sans-serif", 18),
         )
         .build_cartesian_2d(0.0..t_max, (lo - pad)..(hi + pad))

@@ -10,6 +10,7 @@ pub mod footprints;
 mod hints;
 mod input;
 mod limits;
+mod load;
 pub mod mission;
 mod named;
 mod pallet;
@@ -155,6 +156,10 @@ pub struct Scenario<R: Catalogue> {
     /// run's truck against.
     #[serde(skip)]
     source: Option<Arc<String>>,
+    /// The files it was read from (its own, the world's, the truck's, components files):
+    /// what no output of a run may replace.
+    #[serde(skip)]
+    read_from: Vec<PathBuf>,
 }
 
 /// One start/pallet geometry of a scenario.
@@ -168,28 +173,6 @@ pub struct Case {
 }
 
 impl<R: Catalogue> Scenario<R> {
-    /// Loads `path`, checking its components against the built-in catalogue.
-    pub fn load(path: &FsPath) -> Result<Self, ScenarioError> {
-        Self::load_with(path, R::builtin())
-    }
-
-    /// Loads with a registry that may hold the caller's own components.
-    pub fn load_with(path: &FsPath, registry: Arc<R>) -> Result<Self, ScenarioError> {
-        let file = path.display().to_string();
-        let text = read(path)?;
-        let dir = forkbench_plan::external::dir_of(path);
-        let load_world = |world: &FsPath| World::load(&dir.join(world));
-        let load_truck = |p: &str| truck_file::read_truck_file(&dir.join(p));
-        let layout = Self::parse_layout(&text, &file, load_world, &load_truck, None)?;
-        let scn = layout.with_components(&text, registry, dir.clone())?;
-        // The documented rule: a components file beside the scenario comes with it.
-        let beside = dir.join(named::BESIDE);
-        match beside.is_file() {
-            true => scn.with_components_file(&beside),
-            false => Ok(scn),
-        }
-    }
-
     /// Parses scenario text; `load_world` resolves the `world` path. Components are built
     /// from the built-in registry, external commands run in the working directory.
     pub fn parse(
@@ -338,6 +321,7 @@ impl<R: Catalogue> Scenario<R> {
                 .chain(short_target)
                 .collect(),
             source: Some(Arc::new(text.to_owned())),
+            read_from: Vec::new(),
         })
     }
 

@@ -112,7 +112,9 @@ impl<R: Catalogue> Scenario<R> {
     /// [`Scenario::with_named`] with the components of the file at `path`.
     pub fn with_components_file(self, path: &FsPath) -> Result<Self, ScenarioError> {
         let named = load_components(path, &*self.registry)?;
-        Ok(self.with_named(named))
+        let mut scn = self.with_named(named);
+        scn.read_from.push(path.to_path_buf());
+        Ok(scn)
     }
 
     /// The components defined for use by name (a components file's).

@@ -159,12 +159,13 @@ impl McapRecorder {
         }
     }
 
-    /// Stops writing without finishing the file, as a crash would (tests).
-    pub fn abandon(mut self) {
+    /// Stops writing without finishing the file, as a crash would (tests): the bytes
+    /// written stay in the temporary file beside the path, whose path is returned.
+    pub fn abandon(mut self) -> Option<std::path::PathBuf> {
         // What a crash would lose: messages not yet handed over.
         self.pending.clear();
         self.command(Cmd::Abandon);
-        self.writer.abandon();
+        self.writer.abandon()
     }
 }
 

@@ -52,6 +52,8 @@ pub struct Ros2Recorder {
     /// The last pallet estimate written, so a new one is written when it changes.
     pallet_estimate: Option<Pose2>,
     error: Option<String>,
+    /// The file being written beside the path, renamed onto it when all went well.
+    partial: Option<forkbench_core::files::Partial>,
 }
 
 impl std::fmt::Debug for Ros2Recorder {
@@ -61,15 +63,15 @@ impl std::fmt::Debug for Ros2Recorder {
 }
 
 impl Ros2Recorder {
-    /// Creates `path` (checked beforehand with [`crate::check_writable`]) with the
-    /// trial's metadata record.
+    /// Creates the bag for `path` (checked beforehand with [`crate::check_writable`]) with
+    /// the trial's metadata record; it appears at `path` when [`Self::finish`] succeeds.
     pub fn create(path: &FsPath, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
         let p = path.display().to_string();
         let io = |e: &dyn std::error::Error| LogError::Io {
             path: p.clone(),
             message: with_causes(e),
         };
-        let file = File::create(path).map_err(|e| io(&e))?;
+        let (partial, file) = forkbench_core::files::Partial::create(path).map_err(|e| io(&e))?;
         let mut writer = mcap::WriteOptions::new()
             .profile("ros2")
             .chunk_size(Some(256 * 1024))
@@ -91,6 +93,7 @@ impl Ros2Recorder {
             sequence: 0,
             pallet_estimate: None,
             error: None,
+            partial: Some(partial),
         };
         for (topic, ty) in TOPICS {
             me.channel(topic, ty);
@@ -100,10 +103,20 @@ impl Ros2Recorder {
 
     /// Finishes the file (summary and footer); Err: the first error, naming the file.
     pub fn finish(&mut self) -> Result<(), LogError> {
-        if let Some(mut w) = self.writer.take()
-            && let Err(e) = w.finish()
+        if let Some(mut w) = self.writer.take() {
+            if let Err(e) = w.finish() {
+                self.error.get_or_insert(with_causes(&e));
+            }
+            // The buffer's last bytes: flushed here, where an error is seen (a drop hides it).
+            if let Err(e) = std::io::Write::flush(&mut w.into_inner()) {
+                self.error.get_or_insert(e.to_string());
+            }
+        }
+        let partial = self.partial.take();
+        if self.error.is_none()
+            && let Some(Err(e)) = partial.map(forkbench_core::files::Partial::commit)
         {
-            self.error.get_or_insert(with_causes(&e));
+            self.error = Some(with_causes(&e));
         }
         match self.error.take() {
             Some(message) => Err(LogError::Io {

@@ -1,50 +1,54 @@
-//! A ROS 2 bag of laser scans alone (MCAP, ros2 profile, CDR `sensor_msgs/msg/LaserScan`), built in memory and written atomically: what `forkbench dataset` hands a detector team.
+//! A ROS 2 bag of laser scans alone (MCAP, ros2 profile, CDR `sensor_msgs/msg/LaserScan`), streamed to a temporary file beside its path and renamed into place when finished: what `forkbench dataset` hands a detector team.
 
 use std::collections::BTreeMap;
-use std::io::Cursor;
+use std::fs::File;
+use std::io::BufWriter;
 use std::path::Path as FsPath;
 
+use forkbench_core::files::Partial;
 use forkbench_core::signal::Scan;
 
 use super::msgs;
 use crate::LogError;
 use crate::writer::with_causes;
 
-/// Scans a bag may hold in memory before it is written: 1 GiB of ranges.
-pub const MAX_BAG_BYTES: u64 = 1 << 30;
+/// A bag being written scan by scan: memory holds one chunk, not the set.
+pub struct ScanBag {
+    path: String,
+    writer: mcap::Writer<BufWriter<File>>,
+    channel: u16,
+    frame: String,
+    written: u32,
+    partial: Partial,
+}
 
-/// A bag of `scans` (each at its stamp, s, in `frame`) on `topic`, with `metadata` as the
-/// file's `forkbench` metadata record; refused when its ranges would pass
-/// [`MAX_BAG_BYTES`].
-pub fn write_scan_bag(
-    path: &FsPath,
-    topic: &str,
-    frame: &str,
-    scans: &[(f64, Scan)],
-    metadata: BTreeMap<String, String>,
-) -> Result<(), LogError> {
-    let p = path.display().to_string();
-    let io = |message: String| LogError::Io {
-        path: p.clone(),
-        message,
-    };
-    let bytes: u64 = scans
-        .iter()
-        .map(|(_, s)| 4 * s.ranges_m.len() as u64 + 64)
-        .sum();
-    if bytes > MAX_BAG_BYTES {
-        return Err(io(format!(
-            "{bytes} bytes of scans: a bag is built in memory, at most {MAX_BAG_BYTES}"
-        )));
+impl std::fmt::Debug for ScanBag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ScanBag({}, {} scans)", self.path, self.written)
     }
-    let mut buf = Cursor::new(Vec::with_capacity(bytes as usize + 4096));
-    {
+}
+
+impl ScanBag {
+    /// Starts the bag for `path` (appearing there at [`Self::finish`]) with scans on
+    /// `topic` in `frame`, and `metadata` as the file's `forkbench` metadata record.
+    pub fn create(
+        path: &FsPath,
+        topic: &str,
+        frame: &str,
+        metadata: BTreeMap<String, String>,
+    ) -> Result<Self, LogError> {
+        let p = path.display().to_string();
+        let io = |message: String| LogError::Io {
+            path: p.clone(),
+            message,
+        };
+        let (partial, file) = Partial::create(path).map_err(|e| io(e.to_string()))?;
         let mut w = mcap::WriteOptions::new()
             .profile("ros2")
             .chunk_size(Some(1 << 20))
             .compression(Some(mcap::Compression::Lz4))
             .compression_threads(0)
-            .create(&mut buf)
+            .create(BufWriter::new(file))
             .map_err(|e| io(with_causes(&e)))?;
         let ty = &msgs::LASER_SCAN_MSG;
         let schema = w
@@ -58,18 +62,43 @@ pub fn write_scan_bag(
             metadata,
         })
         .map_err(|e| io(with_causes(&e)))?;
-        for (k, (t_s, scan)) in scans.iter().enumerate() {
-            let ns = msgs::unix_ns(*t_s);
-            let header = mcap::records::MessageHeader {
-                channel_id: channel,
-                sequence: u32::try_from(k).unwrap_or(u32::MAX),
-                log_time: ns,
-                publish_time: ns,
-            };
-            w.write_to_known_channel(&header, &msgs::laser_scan(*t_s, frame, scan))
-                .map_err(|e| io(with_causes(&e)))?;
-        }
-        w.finish().map_err(|e| io(with_causes(&e)))?;
+        Ok(Self {
+            path: p,
+            writer: w,
+            channel,
+            frame: frame.to_owned(),
+            written: 0,
+            partial,
+        })
     }
-    forkbench_core::files::write_atomic(path, buf.get_ref()).map_err(|e| io(e.to_string()))
+
+    /// Appends `scan`, stamped `t_s`.
+    pub fn write(&mut self, t_s: f64, scan: &Scan) -> Result<(), LogError> {
+        let ns = msgs::unix_ns(t_s);
+        let header = mcap::records::MessageHeader {
+            channel_id: self.channel,
+            sequence: self.written,
+            log_time: ns,
+            publish_time: ns,
+        };
+        self.written = self.written.saturating_add(1);
+        self.writer
+            .write_to_known_channel(&header, &msgs::laser_scan(t_s, &self.frame, scan))
+            .map_err(|e| LogError::Io {
+                path: self.path.clone(),
+                message: with_causes(&e),
+            })
+    }
+
+    /// Finishes the file and moves it into place; on an error nothing appears at the path.
+    pub fn finish(mut self) -> Result<(), LogError> {
+        let io = |message: String| LogError::Io {
+            path: self.path.clone(),
+            message,
+        };
+        self.writer.finish().map_err(|e| io(with_causes(&e)))?;
+        // The buffer's last bytes: flushed here, where an error is seen (a drop hides it).
+        std::io::Write::flush(&mut self.writer.into_inner()).map_err(|e| io(e.to_string()))?;
+        self.partial.commit().map_err(|e| io(e.to_string()))
+    }
 }

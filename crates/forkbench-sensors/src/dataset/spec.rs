@@ -153,4 +153,51 @@ impl DatasetSpec {
         }
         Ok(())
     }
+
+    /// The spec with the pallet's face drawn only where the scanner sees it: the range
+    /// clipped to [`VIEW_RANGE_MARGIN_M`] inside the scanner's reach, the bearing to
+    /// [`VIEW_BEARING_MARGIN_DEG`] inside its field of view, so a label that says
+    /// "present" is a pallet in view. `Err` names the field the view leaves nothing of;
+    /// the `bool` says whether anything was clipped.
+    pub fn within_view(
+        &self,
+        range_max_m: f64,
+        fov_rad: f64,
+    ) -> Result<(Self, bool), SettingsError> {
+        let mut s = self.clone();
+        let far = range_max_m - VIEW_RANGE_MARGIN_M;
+        let side = (fov_rad / 2.0).to_degrees() - VIEW_BEARING_MARGIN_DEG;
+        s.range_m[1] = s.range_m[1].min(far);
+        s.bearing_deg = [s.bearing_deg[0].max(-side), s.bearing_deg[1].min(side)];
+        if s.range_m[0] > s.range_m[1] {
+            return Err(SettingsError::field(
+                "range_m",
+                format!(
+                    "[{}, {}] m lies beyond the scanner's reach ({range_max_m} m, less \
+                     {VIEW_RANGE_MARGIN_M} m): no face drawn there is seen",
+                    self.range_m[0], self.range_m[1]
+                ),
+            ));
+        }
+        if s.bearing_deg[0] > s.bearing_deg[1] {
+            return Err(SettingsError::field(
+                "bearing_deg",
+                format!(
+                    "[{}, {}]° lies outside the scanner's view (±{side:.1}°): no face drawn \
+                     there is seen",
+                    self.bearing_deg[0], self.bearing_deg[1]
+                ),
+            ));
+        }
+        let clipped = s != *self;
+        Ok((s, clipped))
+    }
 }
+
+/// How far inside the scanner's reach a drawn face stays: the face's own returns must
+/// come back, not only its centre's (a choice).
+pub const VIEW_RANGE_MARGIN_M: f64 = 0.2;
+
+/// How far inside the field of view a drawn face's bearing stays: a face at the edge is
+/// half cut off (a choice: about the half-width of a pallet's face at 5 m).
+pub const VIEW_BEARING_MARGIN_DEG: f64 = 7.0;
