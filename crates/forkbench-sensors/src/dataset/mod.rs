@@ -4,7 +4,10 @@ mod scene;
 mod spec;
 
 pub use scene::Scene;
-pub use spec::{CLUTTER_KINDS, ClutterSpec, DatasetSpec, MAX_SCANS};
+pub use spec::{
+    CLUTTER_KINDS, ClutterSpec, DatasetSpec, MAX_SCANS, VIEW_BEARING_MARGIN_DEG,
+    VIEW_RANGE_MARGIN_M,
+};
 
 use forkbench_core::hash::fnv1a;
 use forkbench_core::signal::Scan;
