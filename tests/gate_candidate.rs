@@ -130,6 +130,18 @@ fn a_candidate_mapped_onto_the_shipped_tracker_is_gated_pair_by_pair() {
         err.contains("no planner or tracker named \"mypp\""),
         "{err}"
     );
+    // Issue 78: a target the baseline does not have (a typo) is refused naming it, not
+    // read as every row missing (exit 3).
+    let (code, _, err) = regress(
+        &same_base,
+        &equal,
+        &["--as", "pure_pursuit_compensated=pure_pursit"],
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("no planner or tracker named \"pure_pursit\" in the baseline"),
+        "{err}"
+    );
     // Issue 78: two candidates mapped onto one shipped name would merge into one row.
     let two = batch(
         "two",

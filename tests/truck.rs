@@ -143,3 +143,37 @@ fn bad_truck_files_and_logs_are_refused_naming_where() {
     let t = text(&out);
     assert!(t.contains("nan.csv:3: column steer_cmd_rad"), "{t}");
 }
+
+/// `-` is the one output on standard output: `step-test --out -` prints the CSV alone
+/// (its status on standard error), `identify --truck-out -` the truck file alone, and
+/// `--truck-out -` with `--json` is refused before anything is printed.
+#[test]
+fn an_output_on_standard_output_is_alone_there() {
+    let out = forkbench(&["step-test", "--out", "-", "--runs", "2", "--run-s", "4"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let csv = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(csv.starts_with("run,t_s,"), "{}", &csv[..60.min(csv.len())]);
+    let width = csv.lines().next().expect("header").split(',').count();
+    assert!(
+        csv.lines().all(|l| l.split(',').count() == width),
+        "a stray line"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("written to -"));
+    let log = tmp("stdout-log.csv");
+    std::fs::write(&log, &out.stdout).expect("log");
+    let fit = forkbench(&["identify", s(&log), "--truck-out", "-"]);
+    assert!(fit.status.success(), "{}", text(&fit));
+    let toml_text = String::from_utf8_lossy(&fit.stdout).to_string();
+    assert!(toml_text.starts_with("# Identified"), "{toml_text}");
+    assert!(
+        !toml_text.contains("fit "),
+        "the report is mixed in: {toml_text}"
+    );
+    let both = forkbench(&["identify", s(&log), "--truck-out", "-", "--json"]);
+    assert_eq!(both.status.code(), Some(1), "{}", text(&both));
+    assert!(
+        both.stdout.is_empty() && text(&both).contains("both print"),
+        "{}",
+        text(&both)
+    );
+}

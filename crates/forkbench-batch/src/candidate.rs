@@ -30,11 +30,13 @@ impl std::str::FromStr for Mapping {
 }
 
 /// The records with each mapped planner and tracker renamed. Refused: a name the results
-/// do not have, a name mapped twice, or a target the results already run (two components
-/// would merge into one row).
+/// do not have, a target the baseline (its planners and trackers, `shipped`) does not
+/// have (a typo would read as every row missing), a name mapped twice, or a target the
+/// results already run (two components would merge into one row).
 pub fn map_components(
     records: &[TrialRecord],
     mappings: &[Mapping],
+    shipped: &BTreeSet<&str>,
 ) -> Result<Vec<TrialRecord>, BatchError> {
     let names: BTreeSet<&str> = records
         .iter()
@@ -54,6 +56,14 @@ pub fn map_components(
             return refuse(format!(
                 "no planner or tracker named {:?} in the results (they have: {})",
                 m.from,
+                known.join(", ")
+            ));
+        }
+        if !shipped.contains(m.to.as_str()) {
+            let known: Vec<&str> = shipped.iter().copied().collect();
+            return refuse(format!(
+                "no planner or tracker named {:?} in the baseline (it has: {})",
+                m.to,
                 known.join(", ")
             ));
         }

@@ -119,7 +119,12 @@ fn gate(
     let (s, records) = if mappings.is_empty() {
         (s, records)
     } else {
-        let mapped = batch::map_components(&records, mappings)?;
+        let shipped = base
+            .rows
+            .iter()
+            .flat_map(|r| [r.planner.as_str(), r.tracker.as_str()])
+            .collect();
+        let mapped = batch::map_components(&records, mappings, &shipped)?;
         let summary = batch::Summary {
             provenance: s.provenance.clone(),
             ..batch::summarize(&mapped)

@@ -78,6 +78,13 @@ pub fn identify(a: &IdentifyArgs) -> anyhow::Result<()> {
     {
         anyhow::bail!("--truck-out and --plot name one file, {}", t.display());
     }
+    let truck_to_stdout = a
+        .truck_out
+        .as_deref()
+        .is_some_and(forkbench_core::files::is_stdout);
+    if truck_to_stdout && a.json {
+        anyhow::bail!("--json and --truck-out - both print to standard output; give one a file");
+    }
     let is_mcap = a
         .log
         .extension()
@@ -100,6 +107,11 @@ pub fn identify(a: &IdentifyArgs) -> anyhow::Result<()> {
     }
     if let Some(plot) = &a.plot {
         forkbench_report::identify::draw(plot, &fit)?;
+    }
+    // With `--truck-out -` standard output is the truck file: the report goes to stderr.
+    if truck_to_stdout {
+        eprint!("{}", fit.text());
+        return Ok(());
     }
     if a.json {
         return crate::emit_json_line(&fit);
@@ -158,10 +170,16 @@ pub fn step_test(a: &StepTestArgs) -> anyhow::Result<()> {
     let log = forkbench_identify::excite::step_test(&truck, &sim, &test)?;
     forkbench_core::files::write_atomic(&a.out, forkbench_identify::to_csv(&log).as_bytes())
         .with_context(|| format!("writing {}", a.out.display()))?;
-    crate::emit(&format!(
+    let status = format!(
         "{} runs of {} s written to {}\n",
         a.runs,
         a.run_s,
         a.out.display()
-    ))
+    );
+    // With `--out -` standard output is the CSV: the status line goes to standard error.
+    if forkbench_core::files::is_stdout(&a.out) {
+        eprint!("{status}");
+        return Ok(());
+    }
+    crate::emit(&status)
 }
