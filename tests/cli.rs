@@ -608,10 +608,7 @@ fn batch_records_failures_and_replay_reproduces_a_trial() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let files: Vec<String> = std::fs::read_dir(dir.join("recordings"))
-        .expect("recordings written")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
+    let files = crate::common::names_in(&dir.join("recordings"));
     assert_eq!(
         files.iter().filter(|f| f.ends_with(".rrd")).count(),
         2,

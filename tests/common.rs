@@ -51,3 +51,13 @@ pub fn record_field_mcap(mcap: &Path) {
     ]);
     assert!(matches!(o.status.code(), Some(0 | 3)), "{}", text(&o));
 }
+
+/// The names in folder `dir`, sorted.
+pub fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}

@@ -263,13 +263,8 @@ fn a_folder_holds_one_whole_set() {
             .expect("the streamed labels are JSON");
     assert_eq!(labels["scans"].as_array().expect("scans").len(), 20);
     assert_eq!(labels["dataset"]["seed"], 2);
-    let mut names: Vec<String> = std::fs::read_dir(&set)
-        .expect("dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
     assert_eq!(
-        names,
+        crate::common::names_in(&set),
         ["labels.json", "labels.npy", "scans.mcap", "scans.npy"]
     );
 }

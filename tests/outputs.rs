@@ -178,13 +178,8 @@ fn recordings_are_checked_before_anything_is_touched() {
             .expect("mcap")
             .starts_with(b"\x89MCAP0\r\n")
     );
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .expect("dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
     assert_eq!(
-        names,
+        crate::common::names_in(&dir),
         ["a.csv", "link.mcap", "old.mcap", "s.toml", "t.toml"]
     );
     let _ = std::fs::remove_dir_all(&dir);

@@ -51,21 +51,17 @@ pub fn map_components(
                 m.from, m.to
             )))
         };
-        if !names.contains(m.from.as_str()) {
-            let known: Vec<&str> = names.iter().copied().collect();
-            return refuse(format!(
-                "no planner or tracker named {:?} in the results (they have: {})",
-                m.from,
-                known.join(", ")
-            ));
-        }
-        if !shipped.contains(m.to.as_str()) {
-            let known: Vec<&str> = shipped.iter().copied().collect();
-            return refuse(format!(
-                "no planner or tracker named {:?} in the baseline (it has: {})",
-                m.to,
-                known.join(", ")
-            ));
+        for (name, set, whose) in [
+            (&m.from, &names, "the results (they have"),
+            (&m.to, shipped, "the baseline (it has"),
+        ] {
+            if !set.contains(name.as_str()) {
+                let known: Vec<&str> = set.iter().copied().collect();
+                return refuse(format!(
+                    "no planner or tracker named {name:?} in {whose}: {})",
+                    known.join(", ")
+                ));
+            }
         }
         if !seen.insert(m.from.as_str()) {
             return refuse(format!("{:?} is mapped twice", m.from));

@@ -25,6 +25,32 @@ pub enum FileError {
     IsInput { path: String, input: String },
 }
 
+impl FileError {
+    /// The file the error is about.
+    pub fn path(&self) -> &str {
+        match self {
+            Self::Io { path, .. }
+            | Self::NotRegular { path, .. }
+            | Self::TooLarge { path, .. }
+            | Self::NotText { path }
+            | Self::NotAnOutput { path, .. }
+            | Self::IsInput { path, .. } => path,
+        }
+    }
+
+    /// The message without the file's name, for a caller that names the file itself.
+    pub fn reason(&self) -> String {
+        match self {
+            Self::Io { cause, .. } => cause.to_string(),
+            other => {
+                let text = other.to_string();
+                let prefix = format!("{}: ", other.path());
+                text.strip_prefix(&prefix).unwrap_or(&text).to_owned()
+            }
+        }
+    }
+}
+
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> FileError + '_ {
     move |cause| FileError::Io {
         path: path.display().to_string(),

@@ -58,6 +58,15 @@ pub enum LogError {
     Rerun(String),
 }
 
+impl From<forkbench_core::files::FileError> for LogError {
+    fn from(e: forkbench_core::files::FileError) -> Self {
+        Self::Io {
+            path: e.path().to_owned(),
+            message: e.reason(),
+        }
+    }
+}
+
 /// Checks before a run that `path` can be written, without touching it: not standard
 /// output (which carries the run's report), not a link, folder, FIFO or device, absent
 /// unless `force`, in a folder that exists and takes a new file. Nothing is created at
@@ -108,13 +117,7 @@ pub fn check_writable(path: &Path, force: bool) -> Result<(), LogError> {
     // fails now and the file at `path` is left as it is.
     forkbench_core::files::Partial::create(path)
         .map(drop)
-        .map_err(|e| match e {
-            forkbench_core::files::FileError::Io { cause, .. } => LogError::Io {
-                path: p.clone(),
-                message: cause.to_string(),
-            },
-            other => refuse(&other.to_string()),
-        })
+        .map_err(LogError::from)
 }
 
 /// Outlines of the truck at a fork-root pose: chassis and the two forks.

@@ -54,7 +54,7 @@ impl<C: Send + 'static> WriterThread<C> {
             path: p.clone(),
             message: with_causes(e),
         };
-        let (partial, file) = forkbench_core::files::Partial::create(path).map_err(|e| io(&e))?;
+        let (partial, file) = forkbench_core::files::Partial::create(path)?;
         let (tx, rx) = sync_channel::<C>(bound);
         let thread = std::thread::Builder::new()
             .name(name.into())
@@ -110,10 +110,10 @@ impl<C: Send + 'static> WriterThread<C> {
                 .take()
                 .map(forkbench_core::files::Partial::commit)
             {
-                Some(Err(forkbench_core::files::FileError::Io { cause, .. })) => {
-                    Err(self.io_error(format!("moving the written file into place: {cause}")))
-                }
-                Some(Err(e)) => Err(self.io_error(e.to_string())),
+                Some(Err(e)) => Err(self.io_error(format!(
+                    "moving the written file into place: {}",
+                    e.reason()
+                ))),
                 _ => Ok(()),
             },
         }

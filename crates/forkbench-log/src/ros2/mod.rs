@@ -71,7 +71,7 @@ impl Ros2Recorder {
             path: p.clone(),
             message: with_causes(e),
         };
-        let (partial, file) = forkbench_core::files::Partial::create(path).map_err(|e| io(&e))?;
+        let (partial, file) = forkbench_core::files::Partial::create(path)?;
         let mut writer = mcap::WriteOptions::new()
             .profile("ros2")
             .chunk_size(Some(256 * 1024))
@@ -116,7 +116,7 @@ impl Ros2Recorder {
         if self.error.is_none()
             && let Some(Err(e)) = partial.map(forkbench_core::files::Partial::commit)
         {
-            self.error = Some(with_causes(&e));
+            self.error = Some(e.reason());
         }
         match self.error.take() {
             Some(message) => Err(LogError::Io {

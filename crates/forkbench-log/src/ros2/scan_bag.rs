@@ -42,7 +42,7 @@ impl ScanBag {
             path: p.clone(),
             message,
         };
-        let (partial, file) = Partial::create(path).map_err(|e| io(e.to_string()))?;
+        let (partial, file) = Partial::create(path)?;
         let mut w = mcap::WriteOptions::new()
             .profile("ros2")
             .chunk_size(Some(1 << 20))
@@ -99,6 +99,6 @@ impl ScanBag {
         self.writer.finish().map_err(|e| io(with_causes(&e)))?;
         // The buffer's last bytes: flushed here, where an error is seen (a drop hides it).
         std::io::Write::flush(&mut self.writer.into_inner()).map_err(|e| io(e.to_string()))?;
-        self.partial.commit().map_err(|e| io(e.to_string()))
+        Ok(self.partial.commit()?)
     }
 }
