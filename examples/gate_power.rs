@@ -58,6 +58,7 @@ fn run(s: Scenario, trials: u64, seed: u64) -> (Summary, Vec<TrialRecord>) {
         compare_replanning: false,
         force_new: false,
         success_run: Default::default(),
+        profile: false,
     };
     let summary = batch::run_batch(&spec, &dir, 2, &|_| {}).expect("batch runs");
     let mut records = batch::read_records(&dir.join("trials.jsonl")).expect("records");

@@ -156,6 +156,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         compare_replanning: false,
         force_new: true,
         success_run: Default::default(),
+        profile: false,
     };
     let summary = run_batch(&spec, &root.join("recordings/rust-planner"), 2, &|_| {})?;
     print!("{}", summary.markdown());

@@ -142,6 +142,7 @@ pub fn run_batch<'py>(
         compare_replanning,
         force_new,
         success_run: Default::default(),
+        profile: false,
     };
     let bytes = records_bytes(&spec);
     if bytes > MAX_RECORDS_BYTES {

@@ -105,6 +105,9 @@ pub struct BatchSpec {
     pub force_new: bool,
     /// The confidence and reliability the summary states success runs at.
     pub success_run: success_run::SuccessTarget,
+    /// Gather each trial's profile (where its time went) into its record and the
+    /// summary; outcomes are the same either way.
+    pub profile: bool,
 }
 
 /// Why a batch could not run or be read.
@@ -349,7 +352,14 @@ impl BatchSpec {
             uncertain: Default::default(),
         };
         let names = (j.planner.as_str(), j.tracker.as_str());
-        let outcome = guarded(s, &case.name, names, seed, || run_trial(s, case, &opts));
+        let run = || run_trial(s, case, &opts);
+        let outcome = guarded(s, &case.name, names, seed, || {
+            if self.profile {
+                forkbench_trial::profiled(run)
+            } else {
+                run()
+            }
+        });
         TrialRecord {
             trial: j.trial,
             overrides: self.overrides.clone(),

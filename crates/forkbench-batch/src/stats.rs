@@ -62,15 +62,33 @@ pub fn normal_quantile(p: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// ln k! for k = 0..=n, so binomial probabilities need no gamma function.
-fn ln_factorials(n: u64) -> Vec<f64> {
-    let mut t = Vec::with_capacity(n as usize + 1);
-    let mut acc = 0.0;
-    t.push(0.0);
-    for k in 1..=n {
+/// ln k! for k = 0..=n at least, so binomial probabilities need no gamma function: one
+/// table for the process, extended as larger counts are asked for (each entry the same
+/// running sum whatever the table's length, so the answers do not depend on what was
+/// asked before).
+fn ln_factorials(n: u64) -> std::sync::Arc<Vec<f64>> {
+    static TABLE: std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>> = std::sync::Mutex::new(None);
+    let mut kept = TABLE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let have = kept.as_ref().map_or(0, |t| t.len() as u64);
+    if have > n
+        && let Some(t) = kept.as_ref()
+    {
+        return t.clone();
+    }
+    let mut t: Vec<f64> = kept.as_ref().map_or_else(Vec::new, |t| t.as_ref().clone());
+    if t.is_empty() {
+        t.push(0.0);
+    }
+    t.reserve(n as usize + 1 - t.len());
+    let mut acc = *t.last().unwrap_or(&0.0);
+    for k in t.len() as u64..=n {
         acc += (k as f64).ln();
         t.push(acc);
     }
+    let t = std::sync::Arc::new(t);
+    *kept = Some(t.clone());
     t
 }
 

@@ -59,6 +59,9 @@ pub struct SummaryRow {
     /// summaries written before it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub success_run: Option<crate::success_run::SuccessRun>,
+    /// Where the row's profiled trials spent their time, summed (`batch --profile`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<forkbench_core::profile::Profile>,
 }
 
 /// Success of one mission leg (or cycle phase) across a row's trials.
@@ -112,6 +115,9 @@ pub struct Summary {
     /// Replanning against planning once, paired, for every row run in both modes.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub replanning: Vec<super::ModePairs>,
+    /// Where every profiled trial's time went, summed over the rows (`batch --profile`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<forkbench_core::profile::Profile>,
     /// How, where and with what the batch ran (absent in summaries derived from records alone).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub provenance: Option<super::Provenance>,
@@ -131,6 +137,7 @@ struct Acc {
     est: Vec<f64>,
     loc: Vec<f64>,
     safety: super::safety_summary::SafetyAcc,
+    profile: Option<forkbench_core::profile::Profile>,
 }
 
 impl Acc {
@@ -169,6 +176,9 @@ impl Acc {
         );
         if let Some(s) = &o.safety {
             self.safety.add(s);
+        }
+        if let Some(p) = &o.profile {
+            self.profile = forkbench_core::profile::Profile::sum(self.profile.iter().chain([p]));
         }
     }
 }
@@ -230,10 +240,14 @@ pub fn summarize_with(
                 phases: leg_summaries(a.phases),
                 safety: a.safety.finish(),
                 success_run: Some(crate::success_run::success_run(a.k, a.n, target)),
+                profile: a.profile,
             }
         })
         .collect();
     Summary {
+        profile: forkbench_core::profile::Profile::sum(
+            rows.iter().filter_map(|r| r.profile.as_ref()),
+        ),
         trials: rows.iter().map(|r| r.trials).sum(),
         successes: rows.iter().map(|r| r.successes).sum(),
         rows,

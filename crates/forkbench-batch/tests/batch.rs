@@ -29,6 +29,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, seed: u64) -> BatchSpec {
         compare_replanning: false,
         force_new: false,
         success_run: Default::default(),
+        profile: false,
     }
 }
 

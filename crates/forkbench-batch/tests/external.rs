@@ -112,6 +112,7 @@ fn spec(s: Scenario, trials: u64) -> BatchSpec {
         compare_replanning: false,
         force_new: false,
         success_run: Default::default(),
+        profile: false,
     }
 }
 

@@ -19,6 +19,7 @@ fn spec(scenario: &str, trials: u64, both: bool, force_new: bool) -> BatchSpec {
         compare_replanning: both,
         force_new,
         success_run: Default::default(),
+        profile: false,
     }
 }
 

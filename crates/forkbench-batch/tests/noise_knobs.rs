@@ -25,6 +25,7 @@ fn spec(scenarios: Vec<Scenario>, trials: u64, overrides: Overrides) -> BatchSpe
         compare_replanning: false,
         force_new: true,
         success_run: Default::default(),
+        profile: false,
     }
 }
 

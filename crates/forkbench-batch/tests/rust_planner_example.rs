@@ -40,6 +40,7 @@ fn the_example_planner_runs_in_a_trial_and_a_batch() {
         compare_replanning: false,
         force_new: true,
         success_run: Default::default(),
+        profile: false,
     };
     let summary = run_batch(&spec, &dir, 2, &|_| {}).expect("batch");
     let rows: Vec<_> = summary

@@ -125,6 +125,11 @@ pub struct BatchArgs {
     /// Also write OUT/report.html (see `forkbench report`).
     #[arg(long)]
     pub report: bool,
+    /// Time each trial's stages (physics, scans, detection, localisation, planning,
+    /// tracking, criteria, safety, recording) into its record, summary.json and the
+    /// report, and print where the batch's time went.
+    #[arg(long)]
+    pub profile: bool,
     /// The drop (0–1, e.g. 0.05) the regression gate must see with 80 % power: refuse to
     /// run when a row has fewer trials than a paired gate needs for it.
     #[arg(long)]
@@ -222,6 +227,7 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
             a.success_confidence,
             a.success_reliability,
         )?,
+        profile: a.profile,
     };
     Ok((spec, a))
 }

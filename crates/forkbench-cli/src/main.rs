@@ -126,6 +126,11 @@ struct TrialCli {
     options: run_options::RunOptionArgs,
     #[arg(long)]
     json: bool,
+    /// Time each stage of the trial (physics, scans per sensor, detection and its
+    /// evidence check, localisation, planning, tracking, criteria, safety, recording):
+    /// printed after the outcome, and in --json as `profile`.
+    #[arg(long)]
+    profile: bool,
     #[command(flatten)]
     record: RecordFlags,
 }
@@ -147,7 +152,7 @@ impl TrialCli {
             (&self.scenario, self.components.as_deref()),
             self.case.as_deref(),
             &opts,
-            (self.json, mission),
+            (self.json, mission, self.profile),
             &record,
         )?;
         Ok(if ok { Done::Ok } else { Done::PickFailed })

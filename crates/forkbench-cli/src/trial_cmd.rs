@@ -12,7 +12,7 @@ pub fn run(
     (file, components): (&Path, Option<&Path>),
     case: Option<&str>,
     opts: &TrialOptions,
-    (json, mission): (bool, bool),
+    (json, mission, profile): (bool, bool, bool),
     rec: &forkbench_log::RecordTargets,
 ) -> anyhow::Result<bool> {
     let scn = crate::with_components(forkbench_trial::defaults::load_scenario(file)?, components)?;
@@ -29,11 +29,22 @@ pub fn run(
     let run = opts.check_against(&scn)?;
     // File targets are checked before the run; a viewer that cannot be reached is
     // reported and the trial runs anyway.
+    let recorded = || forkbench_log::run_recorded((&scn, case), (opts, &run), rec);
+    // A profile covers the recording too: its files are opened and written in it.
+    let (recorded, gathered) = if profile {
+        let (r, p) = forkbench_core::profile::gather(recorded);
+        (r, Some(p))
+    } else {
+        (recorded(), None)
+    };
     let forkbench_log::Recorded {
-        outcome: out,
+        outcome: mut out,
         written,
         viewer_error,
-    } = forkbench_log::run_recorded((&scn, case), (opts, &run), rec)?;
+    } = recorded?;
+    if let Some(p) = gathered {
+        forkbench_trial::attach_profile(&mut out, p);
+    }
     if let Some(e) = &viewer_error {
         eprintln!(
             "error: {} (the trial ran without the viewer)",
@@ -145,6 +156,9 @@ fn text_report(out: &TrialOutcome) -> String {
         format!("sim time             {:.2} s", out.sim_time_s),
         format!("wall time            {:.1} ms", out.wall_time_ms),
     ]);
+    if let Some(p) = &out.profile {
+        lines.extend(p.lines("profile "));
+    }
     lines.join("\n") + "\n"
 }
 

@@ -8,6 +8,7 @@ pub mod hash;
 pub mod pallet;
 pub mod path;
 pub mod pose;
+pub mod profile;
 pub mod quantile;
 pub mod run_settings;
 pub mod settings;

@@ -89,6 +89,43 @@ fn bounds_gap_xy(a: &Bounds, b: &Bounds) -> [f64; 2] {
     ]
 }
 
+/// A footprint as an oriented rectangle, for a cheap test that an obstacle's bounds lie
+/// wholly beside it before the exact one.
+struct Oriented {
+    centre: [f64; 2],
+    axes: [[f64; 2]; 2],
+    half: [f64; 2],
+}
+
+/// How far apart a separation must be for [`Oriented::clear_of`] to trust it: far more
+/// than the exact test's single-precision rounding, so the exact test decides every
+/// near-touch.
+const CLEAR_SLACK_M: f64 = 1e-3;
+
+impl Oriented {
+    fn of(fp: &Footprint, centre: &Pose2) -> Self {
+        let (s, c) = centre.heading_rad.sin_cos();
+        Self {
+            centre: [centre.x_m, centre.y_m],
+            axes: [[c, s], [-s, c]],
+            half: [fp.length_m / 2.0, fp.width_m / 2.0],
+        }
+    }
+
+    /// Whether `b` lies beyond one of the rectangle's own sides by more than the slack
+    /// (the axis-aligned sides are the bounds test's).
+    fn clear_of(&self, b: &Bounds) -> bool {
+        let (cx, cy) = ((b[0] + b[2]) / 2.0, (b[1] + b[3]) / 2.0);
+        let (hx, hy) = ((b[2] - b[0]) / 2.0, (b[3] - b[1]) / 2.0);
+        let d = [cx - self.centre[0], cy - self.centre[1]];
+        self.axes.iter().zip(self.half).any(|(a, h)| {
+            let gap = (d[0] * a[0] + d[1] * a[1]).abs();
+            let reach = h + hx * a[0].abs() + hy * a[1].abs();
+            gap > reach + CLEAR_SLACK_M
+        })
+    }
+}
+
 impl std::fmt::Debug for Obstacles {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "Obstacles({})", self.shapes.len())
@@ -172,9 +209,14 @@ impl Obstacles {
     /// The first obstacle the footprint at `reference` overlaps (touching counts), if any.
     pub fn hit(&self, fp: &Footprint, reference: &Pose2) -> Option<usize> {
         let body = fp.cuboid();
-        let at = pose(&fp.centre(reference));
+        let centre = fp.centre(reference);
+        let at = pose(&centre);
         let near = bounds_of(&fp.corners(reference));
+        let obb = Oriented::of(fp, &centre);
         self.candidates(&near, 0.0).into_iter().find(|&i| {
+            if obb.clear_of(&self.bounds[i]) {
+                return false;
+            }
             let (p, s) = &self.shapes[i];
             // Convex–cuboid pairs are always supported; an unsupported pair would be a bug here.
             intersection_test(&at, &body, p, s.as_ref()).is_ok_and(|r| r.intersecting)
@@ -200,8 +242,26 @@ impl Obstacles {
         best
     }
 
+    /// Whether the footprint at `reference` overlaps any obstacle (touching counts): the
+    /// answer [`Obstacles::hit`] gives, without finding which obstacle is first.
     pub fn collides(&self, fp: &Footprint, reference: &Pose2) -> bool {
-        self.hit(fp, reference).is_some()
+        let body = fp.cuboid();
+        let centre = fp.centre(reference);
+        let at = pose(&centre);
+        let near = bounds_of(&fp.corners(reference));
+        let obb = Oriented::of(fp, &centre);
+        let mut found = false;
+        self.buckets.each_near(&near, 0.0, |i| {
+            if found || bounds_gap_xy(&near, &self.bounds[i]) != [0.0, 0.0] {
+                return;
+            }
+            if obb.clear_of(&self.bounds[i]) {
+                return;
+            }
+            let (p, s) = &self.shapes[i];
+            found = intersection_test(&at, &body, p, s.as_ref()).is_ok_and(|r| r.intersecting);
+        });
+        found
     }
 
     /// Checks the footprint along a path (its poses are the reference point's) every
@@ -245,6 +305,35 @@ mod tests {
         };
         assert!(obs.collides(&ahead, &Pose2::new(-2.0, 0.0, 0.0)));
         assert!(!obs.collides(&ahead, &Pose2::new(-2.0, 0.0, std::f64::consts::PI)));
+    }
+
+    #[test]
+    fn collides_agrees_with_the_first_hit() {
+        let mut obs = Obstacles::new();
+        let mut state = 12345u64;
+        let mut draw = |lo: f64, hi: f64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        for _ in 0..60 {
+            let c = Pose2::new(draw(0.0, 40.0), draw(0.0, 40.0), draw(-3.2, 3.2));
+            obs.add_rect(&c, draw(0.2, 4.0), draw(0.2, 2.0));
+        }
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..4000 {
+            let fp = Footprint {
+                length_m: draw(0.5, 12.0),
+                width_m: draw(0.5, 2.0),
+                centre_ahead_m: draw(-3.0, 3.0),
+            };
+            let at = Pose2::new(draw(-2.0, 42.0), draw(-2.0, 42.0), draw(-3.2, 3.2));
+            let hit = obs.hit(&fp, &at).is_some();
+            assert_eq!(obs.collides(&fp, &at), hit, "{fp:?} at {at:?}");
+            if hit { hits += 1 } else { misses += 1 }
+        }
+        assert!(hits > 400 && misses > 400, "{hits} hits, {misses} misses");
     }
 
     #[test]

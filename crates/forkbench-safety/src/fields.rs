@@ -259,12 +259,19 @@ impl Outline {
 /// for the nearest multiple, so a straight run or a held turn builds it once.
 pub const FIELD_STEER_STEP_RAD: f64 = 0.005;
 
-/// The fields last built, kept while the field set, the direction and the (rounded)
-/// steering angle stay the same.
+/// The fields built so far in a run, by field set, direction and (rounded) steering
+/// angle: the same key builds the same fields, so a truck that steers back and forth
+/// builds each once.
 #[derive(Debug, Clone, Default)]
 pub struct FieldCache {
-    kept: Option<((u64, bool, i64), Fields)>,
+    kept: std::collections::HashMap<FieldKey, Fields>,
 }
+
+type FieldKey = (u64, bool, i64);
+
+/// The most field sets a cache keeps (it starts over past it): bounds its memory however
+/// long a run steers.
+const FIELD_CACHE_ENTRIES: usize = 4096;
 
 impl FieldCache {
     /// [`FieldSets::fields`] at the steering angle rounded to [`FIELD_STEER_STEP_RAD`].
@@ -281,11 +288,12 @@ impl FieldCache {
             speed_cmd_mps >= 0.0,
             step as i64,
         );
-        if self.kept.as_ref().is_none_or(|(k, _)| *k != key) {
-            let f = sets.fields(set, speed_cmd_mps, step * FIELD_STEER_STEP_RAD);
-            self.kept = Some((key, f));
+        if self.kept.len() >= FIELD_CACHE_ENTRIES && !self.kept.contains_key(&key) {
+            self.kept.clear();
         }
-        &self.kept.as_ref().expect("just built").1
+        self.kept
+            .entry(key)
+            .or_insert_with(|| sets.fields(set, speed_cmd_mps, step * FIELD_STEER_STEP_RAD))
     }
 }
 

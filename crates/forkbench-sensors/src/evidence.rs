@@ -2,6 +2,7 @@
 
 use forkbench_core::Pose2;
 use forkbench_core::pallet::PalletSpec;
+use forkbench_core::profile::{self, Stage};
 use forkbench_core::signal::Scan;
 use serde::Serialize;
 
@@ -88,9 +89,10 @@ pub fn verified(
         let Some(s) = req.scans.get(c.sensor) else {
             continue;
         };
-        let score = c
-            .score
-            .unwrap_or_else(|| face_evidence(s.scan, req.pallet, &c.detection.face).score);
+        let score = c.score.unwrap_or_else(|| {
+            let _timed = profile::enter(Stage::Evidence);
+            face_evidence(s.scan, req.pallet, &c.detection.face).score
+        });
         v.scored.push((c.detection.face, score));
         if chosen.is_none() && score >= min_score {
             chosen = Some((c, score));

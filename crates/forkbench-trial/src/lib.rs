@@ -18,4 +18,7 @@ pub use mission_summary::MissionSummary;
 pub use outcome::{Failure, SafetyOutcome, TrialOutcome};
 pub use recorder::{Level, NoRecorder, Recorder, SceneInfo, StepRecord, Tee};
 pub use scenario::{Case, Limits, PoseDeg, Replan, Scenario, Tolerances, World};
-pub use trial::{LegError, Resolved, StageError, TrialOptions, run_trial, run_trial_recorded};
+pub use trial::{
+    LegError, Resolved, StageError, TrialOptions, attach_profile, profiled, run_trial,
+    run_trial_recorded,
+};

@@ -232,6 +232,9 @@ pub struct TrialOutcome {
     pub path_length_m: f64,
     pub sim_time_s: f64,
     pub wall_time_ms: f64,
+    /// Where the trial's time went, stage by stage, when the run asked (`--profile`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<forkbench_core::profile::Profile>,
     /// What the pick's step criteria measured, by name with its unit
     /// (`fork_tip_clearance_mm`).
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
@@ -431,6 +434,7 @@ impl TrialOutcome {
             path_length_m: 0.0,
             sim_time_s: 0.0,
             wall_time_ms: 0.0,
+            profile: None,
             legs: Vec::new(),
             phases: Vec::new(),
             cycle: None,
@@ -458,6 +462,7 @@ impl TrialOutcome {
     pub fn without_wall_times(&self) -> TrialOutcome {
         let mut o = self.clone();
         o.wall_time_ms = 0.0;
+        o.profile = None;
         for l in &mut o.legs {
             l.planning_time_s = 0.0;
         }

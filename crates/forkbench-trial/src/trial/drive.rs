@@ -1,6 +1,7 @@
 //! The pick's drive as a `Steering` of the one drive loop: the re-estimates due on the way (maybe a replan), the tracker's command, the entry checks and the criteria observed each step, until docked or timed out.
 
 use forkbench_core::Pose2;
+use forkbench_core::profile::{self, Stage};
 use forkbench_core::units::wrap_angle;
 use forkbench_track::{Command, TrackerInput};
 
@@ -107,7 +108,9 @@ fn reestimate_schedule(t: &Trial<'_>) -> Vec<f64> {
 impl<'a> Trial<'a> {
     /// The scenario's tracker's command at the measured `pose`. Err: it failed.
     pub(super) fn tracker_command(&mut self, pose: Pose2) -> Result<Command, StageError> {
+        let timed = profile::enter(Stage::Track);
         let cmd = self.tracker.command(&self.tracker_input(pose));
+        drop(timed);
         match self.tracker.fault() {
             Some(reason) => Err(StageError::Tracker {
                 tracker: self.tracker.name().to_owned(),

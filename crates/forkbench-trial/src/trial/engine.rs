@@ -5,6 +5,7 @@ use std::pin::Pin;
 use std::task::{Context, Poll};
 
 use forkbench_core::Pose2;
+use forkbench_core::profile::{self, Stage};
 use forkbench_track::Command;
 
 use super::link::{Control, Link, Observation, Truth};
@@ -80,9 +81,14 @@ impl<'a> Trial<'a> {
             {
                 *since += 1;
                 let (mut cmd, control) = (*cmd, *control);
+                let gate = profile::enter(Stage::Safety);
                 cmd.speed_mps = safety::gate(&mut self.safety, &self.world.sim, cmd.speed_mps, rec);
+                drop(gate);
                 self.physics_step(&cmd, None, pose, rec);
-                match steering.stepped(self, control, &cmd, rec) {
+                let criteria = profile::enter(Stage::Criteria);
+                let stepped = steering.stepped(self, control, &cmd, rec);
+                drop(criteria);
+                match stepped {
                     Ok(false) => continue,
                     Ok(true) => break Ok(true),
                     Err(e) => break Err(e),
@@ -103,10 +109,15 @@ impl<'a> Trial<'a> {
                 Err(e) => break Err(e),
             };
             let mut cmd = asked;
+            let gate = profile::enter(Stage::Safety);
             cmd.speed_mps = safety::gate(&mut self.safety, &self.world.sim, asked.speed_mps, rec);
+            drop(gate);
             self.physics_step(&cmd, fix, pose, rec);
             held = Some((asked, control, 1));
-            match steering.stepped(self, control, &cmd, rec) {
+            let criteria = profile::enter(Stage::Criteria);
+            let stepped = steering.stepped(self, control, &cmd, rec);
+            drop(criteria);
+            match stepped {
                 Ok(false) => {}
                 Ok(true) => break Ok(true),
                 Err(e) => break Err(e),
@@ -222,8 +233,11 @@ impl Trial<'_> {
             cmd,
             rec,
         );
+        let safety = profile::enter(Stage::Safety);
         self.safety_step(rec);
+        drop(safety);
         let pallet_est = self.sense.pallet_est;
+        let _record = profile::enter(Stage::Record);
         record_step(&self.world, pallet_est, cmd, (fix, pose), rec);
     }
 }
@@ -240,7 +254,9 @@ fn step_world<R: Recorder + ?Sized>(
     rec: &mut R,
 ) {
     let before = world.sim.fork_root_pose();
+    let physics = profile::enter(Stage::Physics);
     world.sim.step(cmd.speed_mps, cmd.steer_rad);
+    drop(physics);
     let moved_m = before.distance_to(&world.sim.fork_root_pose());
     world.mark();
     world.travelled_m += moved_m;

@@ -67,7 +67,12 @@ where
         _control: Control,
         pose: Pose2,
     ) -> Result<Option<Command>, LegError> {
+        let timed = forkbench_core::profile::enter_as(
+            forkbench_core::profile::Stage::Track,
+            "mission legs",
+        );
         let cmd = (self.next)(&t.tracker_input(pose));
+        drop(timed);
         Ok((!(cmd.done && t.stands())).then_some(cmd))
     }
 

@@ -33,6 +33,7 @@ impl Trial<'_> {
         if self.wall_start.elapsed().as_secs_f64() > budget_s {
             return Err(StageError::WallBudget { budget_s });
         }
+        let _timed = forkbench_core::profile::enter(forkbench_core::profile::Stage::Localise);
         let occluders = self.movers_in_sight();
         let reflectors = &self.scn.world.reflector;
         localize(&mut self.loc, &self.world, occluders, reflectors, rec)

@@ -366,6 +366,8 @@ fn plan_leg(
     seed: u64,
 ) -> (Result<GlobalPlan, LegError>, u32, f64) {
     let t0 = Instant::now();
+    let _timed =
+        forkbench_core::profile::enter_as(forkbench_core::profile::Stage::Plan, "mission route");
     let g = &m.global;
     if let Err(why) = leg_work(map, m, (from, to)) {
         return (Err(why), 0, 0.0);

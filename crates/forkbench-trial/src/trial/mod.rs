@@ -98,6 +98,23 @@ pub fn run_trial_recorded<R: Recorder + ?Sized>(
     out
 }
 
+/// Runs `trial` (a [`run_trial`] or [`run_trial_recorded`]) gathering where its time
+/// went into the outcome's `profile`, the planner's and tracker's stages named after
+/// them.
+pub fn profiled(trial: impl FnOnce() -> TrialOutcome) -> TrialOutcome {
+    let (mut out, p) = forkbench_core::profile::gather(trial);
+    attach_profile(&mut out, p);
+    out
+}
+
+/// Puts `p`, gathered over `out`'s trial, into `out`, the planner's and tracker's
+/// stages named after them.
+pub fn attach_profile(out: &mut TrialOutcome, mut p: forkbench_core::profile::Profile) {
+    p.label(forkbench_core::profile::Stage::Plan, &out.planner);
+    p.label(forkbench_core::profile::Stage::Track, &out.tracker);
+    out.profile = Some(p);
+}
+
 /// `scn` as a run's truck makes it: itself when the run keeps its geometry, else the
 /// scenario checked anew with the run's truck ([`Scenario::with_truck`]), so a truck
 /// given by a run gives the outcome the same `[truck]` table in the file would.

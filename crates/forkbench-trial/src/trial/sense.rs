@@ -1,5 +1,6 @@
 //! Pallet estimates as the scenario's sensing makes them: the Gaussian model around the truth, or scans of the world from the truck and a detector on them, placed in the map with the truck's believed pose.
 
+use forkbench_core::profile::{self, Stage};
 use forkbench_core::signal::Scan;
 use forkbench_core::units::wrap_angle;
 use forkbench_core::{Pose2, Signal, Style};
@@ -182,7 +183,9 @@ impl Trial<'_> {
                 continue;
             }
             self.sense.scanners[k].next_frame_s = t + 1.0 / s.scanner.rate_hz;
+            let timed = profile::enter_as(Stage::Scan, &s.name);
             let sc = self.scan_from(k, s, placed);
+            drop(timed);
             let style = SCAN_STYLES[k % SCAN_STYLES.len()];
             rec.signal(t, &format!("sensors/{}", s.name), &Signal::Scan(&sc), style);
             scans.push((s.name.as_str(), sc));
@@ -200,7 +203,10 @@ impl Trial<'_> {
             prior: Some(prior),
         };
         let min_score = self.run.pallet_sensing.min_score();
-        let Some((found, _)) = verified(detector.as_mut(), &req, min_score)?.chosen else {
+        let timed = profile::enter_as(Stage::Detect, detector.name());
+        let verdict = verified(detector.as_mut(), &req, min_score);
+        drop(timed);
+        let Some((found, _)) = verdict?.chosen else {
             return Ok(None);
         };
         let face = found.detection.face;
