@@ -13,6 +13,7 @@ mod hostile_round4;
 mod navigation;
 mod outputs;
 mod papercuts;
+mod profile;
 mod rare;
 mod ros2;
 mod run_options;

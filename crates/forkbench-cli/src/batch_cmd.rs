@@ -235,6 +235,7 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
 /// Runs the batch; `Ok(false)` when a row fell below `--floor` (the run worked, the
 /// result is a failure: exit 3).
 pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
+    let began = std::time::Instant::now();
     let (spec, a) = prepare(a)?;
     // Before anything is sized by the trial count (the progress bar lists the jobs).
     spec.check(a.jobs)?;
@@ -244,9 +245,10 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     if let Some(sweep) = &a.sweep {
         return run_sweep(&spec, &a, sweep).map(|()| true);
     }
-    let t0 = std::time::Instant::now();
+    let mut clock = Clock::new(began);
+    clock.lap("setup");
     let summary = run_one(&spec, &a.out, a.jobs)?;
-    let elapsed = t0.elapsed().as_secs_f64();
+    clock.lap("trials");
     // Every output is attempted, whatever failed before it (a full disk while recording
     // must not cost the table, JUnit, CSV or report); the failures are reported together.
     // The recordings first: the report links the failed trials' recordings it finds.
@@ -255,14 +257,23 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
         failed.push(format!("recordings: {e:#}"));
         0
     });
+    clock.lap("recordings");
     let extras = write_extras(&summary, &a, &mut failed);
+    clock.lap("report, CSV and JUnit");
     let shown = if a.json {
         crate::emit(&format!("{}\n", serde_json::to_string(&summary)?))
     } else {
+        let profile = summary.profile.as_ref().map_or(String::new(), |p| {
+            format!(
+                "\nwhere the trials' time went ({} profiled trials, summed over the jobs):\n{}\n",
+                p.trials,
+                p.lines("  ").join("\n")
+            )
+        });
         crate::emit(&format!(
-            "{}\nelapsed {:.1} s with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md{extras}){}\n",
+            "{}{profile}\n{} with {} jobs; results in {}/ (trials.jsonl, summary.json, summary.md{extras}){}\n",
             summary.markdown(),
-            elapsed,
+            clock.text(),
             a.jobs,
             a.out.display(),
             if recorded > 0 {
@@ -292,6 +303,47 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
         );
     }
     Ok(below.is_empty())
+}
+
+/// The batch's wall clock from its start, by part (what the closing line prints).
+struct Clock {
+    began: std::time::Instant,
+    last: std::time::Instant,
+    laps: Vec<(&'static str, f64)>,
+}
+
+impl Clock {
+    fn new(began: std::time::Instant) -> Self {
+        Self {
+            began,
+            last: began,
+            laps: Vec::new(),
+        }
+    }
+
+    /// The time since the last lap (or the start) was spent on `part`.
+    fn lap(&mut self, part: &'static str) {
+        let now = std::time::Instant::now();
+        self.laps.push((part, (now - self.last).as_secs_f64()));
+        self.last = now;
+    }
+
+    /// "elapsed T s (setup S s, trials N s, …)": the whole, and the parts that took a
+    /// twentieth of a second or more.
+    fn text(&self) -> String {
+        let total = self.began.elapsed().as_secs_f64();
+        let parts: Vec<String> = self
+            .laps
+            .iter()
+            .filter(|(_, s)| *s >= 0.05)
+            .map(|(part, s)| format!("{part} {s:.1} s"))
+            .collect();
+        if parts.is_empty() {
+            format!("elapsed {total:.1} s")
+        } else {
+            format!("elapsed {total:.1} s ({})", parts.join(", "))
+        }
+    }
 }
 
 /// The outputs asked for beside the results (CSV, JUnit, HTML report), each attempted,

@@ -1,5 +1,6 @@
 //! `forkbench report`: one self-contained HTML page per batch directory (tables, SVG plots, recordings, provenance).
 
+mod profile;
 mod safety;
 mod sections;
 mod success_run;
@@ -90,6 +91,7 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> Result<String> {
         h.push_str(&safety);
     }
     h.push_str(&success_run::table(&summary));
+    h.push_str(&profile::table(&summary));
     h.push_str("<h2>Failures by first failed criterion</h2>");
     h.push_str(&sections::failure_breakdown(&summary));
     let maps = sections::heatmaps(&manifest, &records);
