@@ -56,7 +56,11 @@ pub fn run(
     let text = if json {
         json_report(&out)?
     } else {
-        crate::mission_report::legs_text(&out) + &text_report(&out)
+        let profile = out
+            .profile
+            .as_ref()
+            .map_or(String::new(), |p| p.lines("profile ").join("\n") + "\n");
+        crate::mission_report::legs_text(&out) + &text_report(&out) + &profile
     };
     crate::emit(&text)?;
     written.context("writing the recording")?;
@@ -156,9 +160,6 @@ fn text_report(out: &TrialOutcome) -> String {
         format!("sim time             {:.2} s", out.sim_time_s),
         format!("wall time            {:.1} ms", out.wall_time_ms),
     ]);
-    if let Some(p) = &out.profile {
-        lines.extend(p.lines("profile "));
-    }
     lines.join("\n") + "\n"
 }
 
