@@ -139,3 +139,50 @@ fn scheduler_variables_that_are_missing_or_disagree_are_errors() {
     ok(&out);
     assert!(Path::new(o).join("shard-1-of-2/manifest.json").is_file());
 }
+
+#[test]
+fn shards_stating_success_runs_differently_are_not_merged_under_one() {
+    let out = tmp("confidence");
+    let field = crate::common::repo_root().join("scenarios/field-test.toml");
+    let shard = |i: &str, confidence: &str| {
+        let o = forkbench(
+            &[
+                "batch",
+                crate::common::s(&field),
+                "--out",
+                out.to_str().expect("utf-8"),
+                "--shard",
+                i,
+                "--success-confidence",
+                confidence,
+            ]
+            .iter()
+            .chain(&ARGS)
+            .copied()
+            .collect::<Vec<_>>(),
+            &[],
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    shard("0/2", "0.95");
+    shard("1/2", "0.9");
+    let merged = out.join("merged");
+    let o = forkbench(
+        &[
+            "merge",
+            out.to_str().expect("utf-8"),
+            "--out",
+            merged.to_str().expect("utf-8"),
+        ],
+        &[],
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("confidence 0.95")
+            && e.contains("confidence 0.9 ")
+            && e.contains("--success-confidence"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

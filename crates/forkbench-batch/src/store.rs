@@ -273,6 +273,24 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
                 diff.into_iter().take(8).collect::<Vec<_>>().join("; ")
             )));
         }
+        if m.success_run != m0.success_run {
+            // The trials are the same whatever the statement; which one the merged
+            // summary makes is not the merge's to pick.
+            let said = |t: &crate::success_run::SuccessTarget| {
+                format!(
+                    "confidence {} and reliability {}",
+                    t.confidence, t.reliability
+                )
+            };
+            return Err(BatchError::Directory(format!(
+                "{} states its success runs at {}, {} at {}: run the shards with one \
+                 --success-confidence and --success-reliability",
+                first.display(),
+                said(&m0.success_run),
+                d.display(),
+                said(&m.success_run)
+            )));
+        }
         if let Some(other) = by_index.insert(m.shard[0], d) {
             return Err(BatchError::Directory(format!(
                 "shard {}/{n} given twice: {} and {}",
