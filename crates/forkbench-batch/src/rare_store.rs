@@ -17,8 +17,16 @@ pub const TRIALS_FILE: &str = "trials.jsonl";
 const MAX_SETTINGS_BYTES: u64 = 64 << 20;
 /// The results a run writes at its end.
 const RESULT_FILES: [&str; 2] = ["estimate.json", "falsify.json"];
+/// The lock a run holds on its directory while it writes there (a batch's too).
+const LOCK_FILE: &str = ".lock";
 /// Every file a run writes in its directory.
-pub const OUT_FILES: [&str; 4] = [SETTINGS_FILE, TRIALS_FILE, RESULT_FILES[0], RESULT_FILES[1]];
+pub const OUT_FILES: [&str; 5] = [
+    SETTINGS_FILE,
+    TRIALS_FILE,
+    RESULT_FILES[0],
+    RESULT_FILES[1],
+    LOCK_FILE,
+];
 
 /// The trials a directory already holds for this run, and where new ones are appended.
 #[derive(Debug)]
@@ -29,6 +37,9 @@ pub struct RareStore {
     file: Option<File>,
     dir: PathBuf,
     settings: Value,
+    /// Held while the run may write: a second run on the same directory is refused
+    /// rather than appending its trials among these.
+    _lock: crate::DirLock,
 }
 
 impl RareStore {
@@ -37,6 +48,7 @@ impl RareStore {
     /// starts over (deleting only the files a run writes).
     pub fn open(dir: &Path, settings: &Value, force_new: bool) -> Result<Self, BatchError> {
         std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let lock = crate::DirLock::take(dir)?;
         let (settings_path, path) = (dir.join(SETTINGS_FILE), dir.join(TRIALS_FILE));
         if std::fs::metadata(&settings_path).is_ok_and(|m| m.len() > MAX_SETTINGS_BYTES) {
             return Err(BatchError::Content(format!(
@@ -72,6 +84,7 @@ impl RareStore {
             file: None,
             dir: dir.to_path_buf(),
             settings: settings.clone(),
+            _lock: lock,
         })
     }
 
@@ -144,4 +157,26 @@ fn other_run(dir: &Path, have: &Value, want: &Value) -> BatchError {
         diff.len(),
         diff.iter().take(6).cloned().collect::<Vec<_>>().join("; ")
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_second_run_on_a_directory_in_use_is_refused() {
+        let dir = std::env::temp_dir().join(format!("forkbench-rare-lock-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let settings = serde_json::json!({ "estimate": "ce" });
+        let first = RareStore::open(&dir, &settings, false).expect("opens");
+        let e = RareStore::open(&dir, &settings, false).expect_err("in use");
+        assert!(
+            e.to_string()
+                .contains("another forkbench process is writing"),
+            "{e}"
+        );
+        drop(first);
+        RareStore::open(&dir, &settings, false).expect("free again");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
