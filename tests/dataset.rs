@@ -55,6 +55,11 @@ fn a_set_is_written_by_seed_and_scored_with_its_labels() {
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let v = json(&o);
+    assert_eq!(
+        v["label_warnings"],
+        serde_json::json!([]),
+        "its own labels fit"
+    );
     let sc = &v["scores"];
     assert!(sc["precision"].as_f64().expect("p") >= 0.95, "{sc}");
     assert!(sc["recall"].as_f64().expect("r") >= 0.75, "{sc}");
@@ -310,4 +315,48 @@ fn present_means_in_the_scanners_view() {
         "{}",
         text(&o)
     );
+}
+
+#[test]
+fn labels_the_scores_cannot_use_are_warned_of() {
+    let dir = tmp_in("dataset-labels", "set");
+    let o = forkbench(&["dataset", "--out", s(&dir), "--scans", "40", "--seed", "3"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let mut labels: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("labels.json")).expect("labels"))
+            .expect("json");
+    let scans = labels["scans"].as_array_mut().expect("scans");
+    let k = scans
+        .iter()
+        .position(|l| l["present"] == true)
+        .expect("a pallet in 40 scans");
+    scans[k].as_object_mut().expect("label").remove("face");
+    scans.push(serde_json::json!({"index": 40, "present": false}));
+    let edited = dir.with_file_name("edited.json");
+    std::fs::write(&edited, labels.to_string()).expect("write");
+    let o = forkbench(&[
+        "detect",
+        s(&dir.join("scans.mcap")),
+        "--labels",
+        s(&edited),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("warning: 1 labels name scans the bag does not have (it has 40; scans 40)"),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!("without its face (scans {k})")),
+        "{err}"
+    );
+    assert_eq!(
+        json(&o)["label_warnings"]
+            .as_array()
+            .expect("warnings")
+            .len(),
+        2
+    );
+    let _ = std::fs::remove_dir_all(dir.parent().expect("folder"));
 }

@@ -18,10 +18,11 @@ pub struct Label {
     pub present: bool,
     #[serde(default)]
     pub face: Option<LabelFace>,
-    /// The pallet's kind, as `forkbench dataset` writes it (read by people and learning
-    /// code, not by the scoring).
+    /// The pallet's kind, as `forkbench dataset` writes it (`pallet_kind epal-1`): a
+    /// label of another kind than the pallet the detector looks for is named
+    /// ([`label_problems`]).
     #[serde(default)]
-    pub kind: Option<serde::de::IgnoredAny>,
+    pub kind: Option<String>,
     /// The scene's clutter kinds, as `forkbench dataset` writes them: the scores are
     /// also given per kind.
     #[serde(default)]
@@ -86,6 +87,60 @@ pub fn parse_labels(text: &str, file: &str) -> Result<BTreeMap<usize, Label>, Ba
         }
     }
     Ok(out)
+}
+
+/// What the scores cannot say about `labels` against a bag of `scans` scans read for
+/// `pallet_kind`: labels of scans the bag lacks (left out), pallets labelled present
+/// without a face (found wherever the detector puts it, with no pose error), labels of
+/// another pallet kind. Each a sentence with its count and the first few indices.
+pub fn label_problems(
+    labels: &BTreeMap<usize, Label>,
+    scans: usize,
+    pallet_kind: &str,
+) -> Vec<String> {
+    let first = |v: &[usize]| {
+        let shown: Vec<String> = v.iter().take(5).map(usize::to_string).collect();
+        let more = if v.len() > 5 { ", …" } else { "" };
+        format!("{}{more}", shown.join(", "))
+    };
+    let mut out = Vec::new();
+    let beyond: Vec<usize> = labels.keys().copied().filter(|i| *i >= scans).collect();
+    if !beyond.is_empty() {
+        out.push(format!(
+            "{} labels name scans the bag does not have (it has {scans}; scans {}): they are \
+             left out of the scores",
+            beyond.len(),
+            first(&beyond)
+        ));
+    }
+    let faceless: Vec<usize> = labels
+        .iter()
+        .filter(|(i, l)| **i < scans && l.present && l.face.is_none())
+        .map(|(i, _)| *i)
+        .collect();
+    if !faceless.is_empty() {
+        out.push(format!(
+            "{} labels say a pallet is present without its face (scans {}): any detection \
+             there counts as found, and its pose error is unknown",
+            faceless.len(),
+            first(&faceless)
+        ));
+    }
+    let other: Vec<usize> = labels
+        .iter()
+        .filter(|(_, l)| l.kind.as_deref().is_some_and(|k| k != pallet_kind))
+        .map(|(i, _)| *i)
+        .collect();
+    if let Some(kind) = other.first().and_then(|i| labels[i].kind.as_deref()) {
+        out.push(format!(
+            "{} labels are of another pallet than the scenario's {pallet_kind} (scan {} is \
+             {kind}; scans {}): the detector looks for the scenario's",
+            other.len(),
+            other[0],
+            first(&other)
+        ));
+    }
+    out
 }
 
 /// How far a detection may be from the labelled face and still be that face; farther,
@@ -185,6 +240,26 @@ pub fn score(found: &[Option<Pose2>], labels: &BTreeMap<usize, Label>, gate: Gat
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn labels_the_scores_cannot_use_are_named() {
+        let text = r#"{"scans": [
+            {"index": 0, "present": true, "face": {"x_m": 3.0, "y_m": 0.0, "heading_deg": 0.0}, "kind": "pallet_kind epal-1"},
+            {"index": 1, "present": true},
+            {"index": 2, "present": true, "face": {"x_m": 3.0, "y_m": 0.0, "heading_deg": 0.0}, "kind": "pallet_kind field-1200"},
+            {"index": 9, "present": false}
+        ]}"#;
+        let labels = parse_labels(text, "labels.json").expect("parses");
+        let p = label_problems(&labels, 3, "pallet_kind epal-1");
+        assert_eq!(p.len(), 3, "{p:?}");
+        assert!(
+            p[0].starts_with("1 labels name scans the bag does not have (it has 3; scans 9)"),
+            "{p:?}"
+        );
+        assert!(p[1].contains("without its face (scans 1)"), "{p:?}");
+        assert!(p[2].contains("scan 2 is pallet_kind field-1200"), "{p:?}");
+        assert!(label_problems(&labels, 10, "pallet_kind epal-1").len() == 2);
+    }
 
     fn label(index: usize, present: bool, face: Option<(f64, f64, f64)>) -> (usize, Label) {
         let face = face.map(|(x_m, y_m, heading_deg)| LabelFace {

@@ -8,7 +8,7 @@ use anyhow::{Context as _, bail};
 use forkbench_batch::detect_curve::{
     ByPlace, ClutterScore, CurvePoint, by_clutter, by_place, curve,
 };
-use forkbench_batch::detect_eval::{Gate, Label, Scores, parse_labels, score};
+use forkbench_batch::detect_eval::{Gate, Label, Scores, label_problems, parse_labels, score};
 use forkbench_core::Pose2;
 use forkbench_core::files::AtomicWriter;
 use forkbench_log::bag::BagSummary;
@@ -114,6 +114,8 @@ impl DetectArgs {
 /// The labelled scans' scores: at the threshold asked for, over every threshold, and by
 /// the labelled face's range and bearing.
 struct Scored {
+    /// What the scores cannot say about the labels (`label_problems`).
+    warnings: Vec<String>,
     at_threshold: Scores,
     curve: Vec<CurvePoint>,
     by_place: ByPlace,
@@ -178,6 +180,7 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     let summary = summary.with_context(|| format!("after {} scans", tally.results.len()))?;
     check_topics(a, &summary)?;
     let scores = labels.as_ref().map(|l| Scored {
+        warnings: label_problems(l, tally.results.len(), &scn.pallet_kind),
         at_threshold: score(&tally.results, l, gate),
         curve: curve(&tally.candidates, l, gate),
         by_place: by_place(&tally.results, l, gate),
@@ -188,6 +191,9 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     }
     if let (Some(file), Some(s)) = (&a.curve, &scores) {
         forkbench_report::detect_curve::draw(file, &s.curve, a.min_score)?;
+    }
+    for w in scores.iter().flat_map(|s| &s.warnings) {
+        eprintln!("warning: {}", forkbench_trial::text::visible(w));
     }
     report(a, &name, &summary, &tally, scores.as_ref())?;
     if !tally.errors.is_empty() {
@@ -336,6 +342,7 @@ fn report(
             "curve": scores.map(|s| &s.curve),
             "by_place": scores.map(|s| &s.by_place),
             "by_clutter": scores.map(|s| &s.by_clutter),
+            "label_warnings": scores.map(|s| &s.warnings),
         });
         return crate::emit(&format!("{v}\n"));
     }
