@@ -235,6 +235,31 @@ fn complete_records(dir: &Path, m: &Manifest) -> Result<Vec<TrialRecord>, BatchE
     Ok(records)
 }
 
+/// Shards of one batch state their success runs alike: the trials are the same whatever
+/// the statement, and which one the merged summary makes is not the merge's to pick.
+fn same_success_run(
+    (first, m0): (&Path, &Manifest),
+    (d, m): (&Path, &Manifest),
+) -> Result<(), BatchError> {
+    if m.success_run == m0.success_run {
+        return Ok(());
+    }
+    let said = |t: &crate::success_run::SuccessTarget| {
+        format!(
+            "confidence {} and reliability {}",
+            t.confidence, t.reliability
+        )
+    };
+    Err(BatchError::Directory(format!(
+        "{} states its success runs at {}, {} at {}: run the shards with one \
+         --success-confidence and --success-reliability",
+        first.display(),
+        said(&m0.success_run),
+        d.display(),
+        said(&m.success_run)
+    )))
+}
+
 /// Merges the shards of one batch into `out` and summarises. Refuses inputs from
 /// different batches, duplicate or missing shards, unfinished shards, no inputs, and
 /// an `out` that is one of the inputs.
@@ -273,24 +298,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Summary, BatchError> {
                 diff.into_iter().take(8).collect::<Vec<_>>().join("; ")
             )));
         }
-        if m.success_run != m0.success_run {
-            // The trials are the same whatever the statement; which one the merged
-            // summary makes is not the merge's to pick.
-            let said = |t: &crate::success_run::SuccessTarget| {
-                format!(
-                    "confidence {} and reliability {}",
-                    t.confidence, t.reliability
-                )
-            };
-            return Err(BatchError::Directory(format!(
-                "{} states its success runs at {}, {} at {}: run the shards with one \
-                 --success-confidence and --success-reliability",
-                first.display(),
-                said(&m0.success_run),
-                d.display(),
-                said(&m.success_run)
-            )));
-        }
+        same_success_run((first, m0), (d, m))?;
         if let Some(other) = by_index.insert(m.shard[0], d) {
             return Err(BatchError::Directory(format!(
                 "shard {}/{n} given twice: {} and {}",
