@@ -97,6 +97,12 @@ pub(super) fn check_reach(
         }
         Target::Pallet(_) | Target::Start(_) => within(-MAX_OFFSET_M, MAX_OFFSET_M, "m"),
         Target::DetectorLatency | Target::Nav350Latency => within(0.0, MAX_LATENCY_S, "s"),
+        Target::Truck("control.period_s") => Err(
+            "the control period must be a whole number of physics steps ([sim] dt_s), which a \
+             draw from a distribution almost never is: give each period its own run \
+             ([truck.control] period_s, or a truck file per period) instead"
+                .to_owned(),
+        ),
         Target::Truck(path) => {
             for v in [lo, hi] {
                 let mut truck = forkbench_core::ForkliftSpec::default();

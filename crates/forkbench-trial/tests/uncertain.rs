@@ -141,6 +141,13 @@ fn malformed_parameters_are_refused_with_file_line_and_field() {
             "uncertain[0].name",
             "0 [[mover]]",
         ),
+        // A drawn control period is never a whole number of physics steps: refused at
+        // load, not by each trial at run time.
+        (
+            "name = \"control_period_s\"\ndist = \"uniform\"\nmin = 0.015\nmax = 0.035",
+            "uncertain[0].dist",
+            "whole number of physics steps",
+        ),
     ];
     for (i, (entry, field, why)) in cases.iter().enumerate() {
         let e = field_test_with(&format!("bad{i}"), &format!("[[uncertain]]\n{entry}\n"))
