@@ -158,6 +158,9 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
     let store = c.store(&setup, what)?;
     let (e, _) = forkbench_batch::rare::estimate(&setup, method, c.budget as usize, Some(store))?;
     c.write("estimate.json", &e)?;
+    if let Some(why) = e.thin() {
+        eprintln!("warning: {why}");
+    }
     if c.json {
         return crate::out::emit_json_line(&e);
     }

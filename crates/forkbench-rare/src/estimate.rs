@@ -96,7 +96,30 @@ pub struct Estimate {
 /// Events the nominal first stage must draw before the event counts as not rare.
 const NOT_RARE_EVENTS: usize = 10;
 
+/// Below this effective sample size an estimate's interval is not to be trusted: a
+/// choice, where a normal interval on a weighted mean is commonly taken to need some
+/// thirty effective draws.
+pub const MIN_ESS: f64 = 30.0;
+
 impl Estimate {
+    /// Why the estimate's interval may not cover, when it rests on fewer than
+    /// [`MIN_ESS`] effective samples of the event (a starved adaptation, or too small a
+    /// budget): the sentence a run warns with.
+    pub fn thin(&self) -> Option<String> {
+        if self.events == 0 || self.ess >= MIN_ESS {
+            return None;
+        }
+        let re = self.relative_error.map_or(String::new(), |r| {
+            format!(", relative error {:.0} %", 100.0 * r)
+        });
+        Some(format!(
+            "the estimate rests on an effective sample size of {:.0} (under {MIN_ESS:.0}{re}): \
+             its interval may not cover the true probability; a larger --budget gives the \
+             adaptation and the final stage more trials",
+            self.ess
+        ))
+    }
+
     /// The share of the event in the cross-entropy's first stage, drawn from the nominal
     /// density, when it drew enough events to call it not rare: there importance sampling
     /// gains little, and where the event has several causes its proposal follows one of

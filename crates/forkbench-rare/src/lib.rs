@@ -13,7 +13,7 @@ pub mod falsify;
 pub mod mixture;
 pub mod normal;
 
-pub use estimate::{Estimate, EstimateSettings, Method, clopper_pearson, estimate};
+pub use estimate::{Estimate, EstimateSettings, MIN_ESS, Method, clopper_pearson, estimate};
 pub use falsify::{Falsified, FalsifySettings, falsify};
 
 /// What a trial at a point gave.

@@ -182,3 +182,34 @@ fn bad_settings_and_a_short_answer_are_named() {
         "{e}"
     );
 }
+
+/// A budget too small for the event leaves few effective samples: the estimate says so;
+/// one large enough does not.
+#[test]
+fn a_starved_estimate_says_its_interval_may_not_cover() {
+    let mc = estimate(
+        &EstimateSettings::new(Method::Mc, 2, 2000, 1),
+        half_space(upper_quantile(2e-3), 1),
+    )
+    .expect("runs");
+    assert!(
+        mc.events > 0 && mc.ess < forkbench_rare::MIN_ESS,
+        "{} events",
+        mc.events
+    );
+    let why = mc.thin().expect("a warning");
+    assert!(
+        why.contains("effective sample size") && why.contains("--budget"),
+        "{why}"
+    );
+    let plenty = estimate(
+        &EstimateSettings::new(Method::Mc, 2, 4000, 1),
+        half_space(upper_quantile(5e-2), 1),
+    )
+    .expect("runs");
+    assert!(
+        plenty.ess >= forkbench_rare::MIN_ESS && plenty.thin().is_none(),
+        "{}",
+        plenty.ess
+    );
+}
