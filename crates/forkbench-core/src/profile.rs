@@ -232,6 +232,12 @@ pub fn enter_as(stage: Stage, label: &str) -> Timed {
     enter_with(stage, Some(label))
 }
 
+/// Runs `f` timed as `stage`: [`enter`] around one expression.
+pub fn timed<T>(stage: Stage, f: impl FnOnce() -> T) -> T {
+    let _timed = enter(stage);
+    f()
+}
+
 fn enter_with(stage: Stage, label: Option<&str>) -> Timed {
     if !ON.with(Cell::get) {
         return Timed(false);

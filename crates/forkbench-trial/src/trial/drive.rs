@@ -108,9 +108,8 @@ fn reestimate_schedule(t: &Trial<'_>) -> Vec<f64> {
 impl<'a> Trial<'a> {
     /// The scenario's tracker's command at the measured `pose`. Err: it failed.
     pub(super) fn tracker_command(&mut self, pose: Pose2) -> Result<Command, StageError> {
-        let timed = profile::enter(Stage::Track);
-        let cmd = self.tracker.command(&self.tracker_input(pose));
-        drop(timed);
+        let input = self.tracker_input(pose);
+        let cmd = profile::timed(Stage::Track, || self.tracker.command(&input));
         match self.tracker.fault() {
             Some(reason) => Err(StageError::Tracker {
                 tracker: self.tracker.name().to_owned(),

@@ -81,14 +81,13 @@ impl<'a> Trial<'a> {
             {
                 *since += 1;
                 let (mut cmd, control) = (*cmd, *control);
-                let gate = profile::enter(Stage::Safety);
-                cmd.speed_mps = safety::gate(&mut self.safety, &self.world.sim, cmd.speed_mps, rec);
-                drop(gate);
+                cmd.speed_mps = profile::timed(Stage::Safety, || {
+                    safety::gate(&mut self.safety, &self.world.sim, cmd.speed_mps, rec)
+                });
                 self.physics_step(&cmd, None, pose, rec);
-                let criteria = profile::enter(Stage::Criteria);
-                let stepped = steering.stepped(self, control, &cmd, rec);
-                drop(criteria);
-                match stepped {
+                match profile::timed(Stage::Criteria, || {
+                    steering.stepped(self, control, &cmd, rec)
+                }) {
                     Ok(false) => continue,
                     Ok(true) => break Ok(true),
                     Err(e) => break Err(e),
@@ -109,15 +108,14 @@ impl<'a> Trial<'a> {
                 Err(e) => break Err(e),
             };
             let mut cmd = asked;
-            let gate = profile::enter(Stage::Safety);
-            cmd.speed_mps = safety::gate(&mut self.safety, &self.world.sim, asked.speed_mps, rec);
-            drop(gate);
+            cmd.speed_mps = profile::timed(Stage::Safety, || {
+                safety::gate(&mut self.safety, &self.world.sim, asked.speed_mps, rec)
+            });
             self.physics_step(&cmd, fix, pose, rec);
             held = Some((asked, control, 1));
-            let criteria = profile::enter(Stage::Criteria);
-            let stepped = steering.stepped(self, control, &cmd, rec);
-            drop(criteria);
-            match stepped {
+            match profile::timed(Stage::Criteria, || {
+                steering.stepped(self, control, &cmd, rec)
+            }) {
                 Ok(false) => {}
                 Ok(true) => break Ok(true),
                 Err(e) => break Err(e),
@@ -233,12 +231,11 @@ impl Trial<'_> {
             cmd,
             rec,
         );
-        let safety = profile::enter(Stage::Safety);
-        self.safety_step(rec);
-        drop(safety);
+        profile::timed(Stage::Safety, || self.safety_step(rec));
         let pallet_est = self.sense.pallet_est;
-        let _record = profile::enter(Stage::Record);
-        record_step(&self.world, pallet_est, cmd, (fix, pose), rec);
+        profile::timed(Stage::Record, || {
+            record_step(&self.world, pallet_est, cmd, (fix, pose), rec);
+        });
     }
 }
 
@@ -254,9 +251,9 @@ fn step_world<R: Recorder + ?Sized>(
     rec: &mut R,
 ) {
     let before = world.sim.fork_root_pose();
-    let physics = profile::enter(Stage::Physics);
-    world.sim.step(cmd.speed_mps, cmd.steer_rad);
-    drop(physics);
+    profile::timed(Stage::Physics, || {
+        world.sim.step(cmd.speed_mps, cmd.steer_rad)
+    });
     let moved_m = before.distance_to(&world.sim.fork_root_pose());
     world.mark();
     world.travelled_m += moved_m;

@@ -47,10 +47,8 @@ impl Trial<'_> {
         req.start_curvature_per_m = curvature;
         req.obstacles = self.world.obstacles.clone();
         req.seed = self.run.seed;
-        let timed = forkbench_core::profile::enter(forkbench_core::profile::Stage::Plan);
-        let plan = self.planner.plan(&req);
-        drop(timed);
-        let mut plan = plan?;
+        let stage = forkbench_core::profile::Stage::Plan;
+        let mut plan = forkbench_core::profile::timed(stage, || self.planner.plan(&req))?;
         plan.path
             .extend_straight(self.scn.pick.pre_entry_gap_m + self.insertion_m, 0.01);
         Ok(plan)
