@@ -186,3 +186,31 @@ fn shipped_scenarios_are_files_equal_to_their_embedded_twins() {
     }
     assert!(checked >= 13, "{checked} twins");
 }
+
+/// `trial` prints every criterion a pick broke, not only the first (the verdict's).
+#[test]
+fn a_trial_prints_every_broken_criterion() {
+    let field = repo_root().join("scenarios/field-test.toml");
+    let field = field.to_str().expect("utf-8");
+    // The README's failed pick: its entry is off in offset and in heading.
+    let seed = ["--seed", "5517791687142952246"];
+    let json = forkbench(&[&["trial", field, "--json"][..], &seed].concat());
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).expect("json");
+    let also: Vec<&str> = v["also_failed"]
+        .as_array()
+        .expect("also_failed")
+        .iter()
+        .map(|a| a.as_str().expect("text"))
+        .collect();
+    assert!(
+        !also.is_empty(),
+        "the seed breaks more than one criterion: {v}"
+    );
+    let printed = text(&forkbench(&[&["trial", field][..], &seed].concat()));
+    for a in also {
+        assert!(
+            printed.contains(&format!("also failed          {a}")),
+            "{a}: {printed}"
+        );
+    }
+}

@@ -95,25 +95,7 @@ fn text_report(out: &TrialOutcome) -> String {
     let opt = |v: Option<f64>, scale: f64, unit: &str| {
         v.map_or("never entered".to_owned(), |v| num(v * scale, 4, unit))
     };
-    let verdict = out.verdict_word();
-    let noise = if out.noise { "" } else { " / no noise" };
-    let mut lines = vec![
-        format!(
-            "scenario             {} / case {} / planner {} / seed {}{noise}",
-            one_line(&out.scenario),
-            one_line(&out.case),
-            one_line(&out.planner),
-            out.seed
-        ),
-        format!("outcome              {verdict}"),
-    ];
-    if let Some(d) = &out.failure_detail {
-        // A planner's message may carry terminal escapes: shown, never obeyed.
-        lines.push(format!("reason               {}", one_line(d)));
-    }
-    if let Some(c) = &out.likely_cause {
-        lines.push(format!("likely cause         {}", one_line(c)));
-    }
+    let mut lines = verdict_lines(out);
     lines.extend([
         format!(
             "lateral error entry  {}",
@@ -161,6 +143,33 @@ fn text_report(out: &TrialOutcome) -> String {
         format!("wall time            {:.1} ms", out.wall_time_ms),
     ]);
     lines.join("\n") + "\n"
+}
+
+/// The trial, its verdict, the reason and likely cause, and every other criterion it
+/// broke (the verdict names the first).
+fn verdict_lines(out: &TrialOutcome) -> Vec<String> {
+    let noise = if out.noise { "" } else { " / no noise" };
+    let mut lines = vec![
+        format!(
+            "scenario             {} / case {} / planner {} / seed {}{noise}",
+            one_line(&out.scenario),
+            one_line(&out.case),
+            one_line(&out.planner),
+            out.seed
+        ),
+        format!("outcome              {}", out.verdict_word()),
+    ];
+    if let Some(d) = &out.failure_detail {
+        // A planner's message may carry terminal escapes: shown, never obeyed.
+        lines.push(format!("reason               {}", one_line(d)));
+    }
+    if let Some(c) = &out.likely_cause {
+        lines.push(format!("likely cause         {}", one_line(c)));
+    }
+    for also in &out.also_failed {
+        lines.push(format!("also failed          {}", one_line(also)));
+    }
+    lines
 }
 
 /// What the people and the safety function did.
