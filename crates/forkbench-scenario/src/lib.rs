@@ -7,6 +7,7 @@ mod component_spec;
 mod error;
 mod file;
 pub mod footprints;
+pub mod fork_play;
 mod hints;
 mod input;
 mod limits;
@@ -276,6 +277,8 @@ impl<R: Catalogue> Scenario<R> {
         safety::check(&f, (file, text))?;
         safety::check_movers(&f, &world, (file, text))?;
         let short_target = checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
+        let wide_tolerance =
+            fork_play::wide_tolerance(f.tolerances.lateral_m, &f.truck, (&pallet, &pallet_label));
         pallet::check_thickness(&f, (&pallet, &pallet_label), file)?;
         let cases = cases_of(&f, (&world, &pallet), (file, text))?;
         let mission = match &f.mission {
@@ -319,6 +322,7 @@ impl<R: Catalogue> Scenario<R> {
             warnings: hints::unit_warnings(text, file)
                 .into_iter()
                 .chain(short_target)
+                .chain(wide_tolerance)
                 .collect(),
             source: Some(Arc::new(text.to_owned())),
             read_from: Vec::new(),

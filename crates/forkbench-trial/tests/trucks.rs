@@ -250,3 +250,51 @@ proptest! {
         }
     }
 }
+
+/// Whether a fork `fork_width_m` wide centred `y_m` across the pallet overlaps a solid
+/// part of its face.
+fn fork_meets_a_part(pallet: &PalletSpec, y_m: f64, fork_width_m: f64) -> bool {
+    pallet
+        .parts()
+        .iter()
+        .any(|p| (p.y_m - y_m).abs() < (p.width_m + fork_width_m) / 2.0)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// The forks' lateral play is where a fork first meets a block or stringer, for every
+    /// pallet kind and drawn forks; a lateral tolerance wider than it is warned of at
+    /// load, one within it is not.
+    #[test]
+    fn the_forks_play_is_where_a_fork_meets_a_part_and_a_wider_tolerance_warns(
+        k in 0..PALLET_KINDS.len(), share in 0.0..1.0f64, off in -0.02..0.02f64
+    ) {
+        let kind = PALLET_KINDS[k].name;
+        let pallet = pallet_of(kind);
+        let fork_width = 0.05 + share * (pallet.pocket_width_m - 0.1);
+        let spacing = 2.0 * pallet.pocket_offsets_m()[0].abs() + off;
+        let truck = ForkliftSpec { fork_width_m: fork_width, fork_spacing_m: spacing, ..ForkliftSpec::default() };
+        let play = forkbench_trial::scenario::fork_play::lateral_play_m(&truck, &pallet);
+        prop_assume!(play > 0.004);
+        for side in [-1.0, 1.0] {
+            let at = |y: f64| [spacing / 2.0 + y, -spacing / 2.0 + y]
+                .iter()
+                .any(|&c| fork_meets_a_part(&pallet, c, fork_width));
+            prop_assert!(!at(side * (play - 0.002)), "{kind}: a fork meets a part within the play {play}");
+            prop_assert!(at(side * (play + 0.002)), "{kind}: no part beyond the play {play}");
+        }
+        let table = toml::to_string(&truck).expect("serialises");
+        let scn = |lateral: f64| {
+            let text = format!(
+                "name = \"play\"\nplanner = \"bspline\"\npallet_kind = \"{kind}\"\n\
+                 start = {{ x_m = 0.0, y_m = 0.0, heading_deg = 0.0 }}\n\
+                 pallet = {{ x_m = 5.0, y_m = 0.0, heading_deg = 0.0 }}\n\
+                 [tolerances]\nlateral_m = {lateral}\ninsertion_depth_m = 0.3\n[truck]\n{table}"
+            );
+            Scenario::parse(&text, "play.toml", |_| Ok(World::default())).expect("parses")
+        };
+        let warns = |s: &Scenario| s.warnings.iter().any(|w| w.contains("wider than the forks' play"));
+        prop_assert!(warns(&scn(play + 0.003)), "{kind}: no warning above the play {play}");
+        prop_assert!(!warns(&scn(play - 0.003)), "{kind}: a warning within the play {play}");
+    }
+}
