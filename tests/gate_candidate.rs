@@ -110,6 +110,31 @@ fn a_candidate_mapped_onto_the_shipped_tracker_is_gated_pair_by_pair() {
     );
     assert_eq!(code, Some(0), "{v} {err}");
     assert_eq!(v["pairing"]["pairs"], 12, "{v}");
+    // Its JUnit cases are named after the candidate, and the passing one carries its
+    // numbers.
+    let junit = tmp("ppc.xml");
+    let (code, _, err) = regress(
+        &same_base,
+        &equal,
+        &[
+            "--as",
+            "pure_pursuit_compensated=pure_pursuit",
+            "--junit",
+            s(&junit),
+        ],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let xml = std::fs::read_to_string(&junit).expect("junit");
+    assert!(
+        xml.contains("bspline / pure_pursuit_compensated (as pure_pursuit) /"),
+        "{xml}"
+    );
+    assert!(
+        xml.contains("<system-out>baseline ")
+            && xml.contains("detectable drop")
+            && !xml.contains("<failure"),
+        "{xml}"
+    );
     // Results that run both would merge two components' trials into one row: refused.
     let both = batch(
         "both",

@@ -11,6 +11,8 @@ pub struct Case {
     pub classname: String,
     /// (short message, full text) of a failure.
     pub failure: Option<(String, String)>,
+    /// The case's numbers, passing or not (its `<system-out>`).
+    pub numbers: String,
 }
 
 /// A `<testsuites>` document with one suite of `cases`, and provenance as properties.
@@ -56,10 +58,11 @@ pub fn junit_xml(suite: &str, cases: &[Case], provenance: Option<&Provenance>) -
             escape(&c.name),
             escape(&c.classname)
         );
+        let out = format!("      <system-out>{}</system-out>\n", escape(&c.numbers));
         match &c.failure {
-            None => x.push_str(&format!("{head}/>\n")),
+            None => x.push_str(&format!("{head}>\n{out}    </testcase>\n")),
             Some((message, text)) => x.push_str(&format!(
-                "{head}>\n      <failure type=\"forkbench.regression\" message=\"{}\">{}</failure>\n    </testcase>\n",
+                "{head}>\n      <failure type=\"forkbench.regression\" message=\"{}\">{}</failure>\n{out}    </testcase>\n",
                 escape(message),
                 escape(text)
             )),
@@ -87,13 +90,25 @@ fn case_name(
 /// `regress` as JUnit: a case per row (baseline rows, then new ones), failing on a
 /// significant drop after the correction, a rate below the floor, a missing row, too few
 /// trials, or a new row with `--fail-on-new`; the numbers (adjusted p included) in the
-/// message.
-pub fn regress_cases(report: &GateReport, fail_on_new: bool) -> Vec<Case> {
+/// message and, on every case, its output. A component gated `--as` a shipped one
+/// (`mappings`) names its cases: `mypp (as pure_pursuit)`.
+pub fn regress_cases(
+    report: &GateReport,
+    fail_on_new: bool,
+    mappings: &[super::Mapping],
+) -> Vec<Case> {
+    let shown = |name: &str| {
+        mappings
+            .iter()
+            .find(|m| m.to == name)
+            .map_or(name.to_owned(), |m| format!("{} (as {name})", m.from))
+    };
     report
         .rows
         .iter()
         .map(|r| {
-            let (name, classname) = case_name(&r.scenario, &r.planner, &r.tracker, r.replan);
+            let (planner, tracker) = (shown(&r.planner), shown(&r.tracker));
+            let (name, classname) = case_name(&r.scenario, &planner, &tracker, r.replan);
             let numbers = r.numbers(report);
             let what = match r.verdict {
                 Verdict::Ok => None,
@@ -108,6 +123,7 @@ pub fn regress_cases(report: &GateReport, fail_on_new: bool) -> Vec<Case> {
                 name,
                 classname,
                 failure: what.map(|w| (format!("{w}: {numbers}"), numbers.clone())),
+                numbers,
             }
         })
         .collect()
@@ -161,5 +177,6 @@ fn rate_case(
         name,
         classname,
         failure,
+        numbers,
     }
 }

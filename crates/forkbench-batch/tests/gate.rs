@@ -173,7 +173,7 @@ fn a_slow_steering_actuator_fails_the_gate_with_junit_numbers() {
     let g = gate_as_build(&base, &worse, &GateOptions::default());
     assert!(!g.passed, "{}", g.markdown());
     assert_eq!(g.rows[0].verdict, Verdict::Drop);
-    let xml = junit::junit_xml("regress", &junit::regress_cases(&g, false), None);
+    let xml = junit::junit_xml("regress", &junit::regress_cases(&g, false, &[]), None);
     let r = &g.rows[0];
     let c = r.paired.expect("paired");
     assert_eq!(c.fixed, 0, "nothing gets better with a slower actuator");

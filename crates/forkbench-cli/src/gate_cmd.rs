@@ -165,7 +165,7 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
         );
     }
     if let Some(file) = &a.junit {
-        let cases = batch::junit::regress_cases(&report, a.fail_on_new);
+        let cases = batch::junit::regress_cases(&report, a.fail_on_new, &a.mappings);
         let xml = batch::junit::junit_xml("forkbench regress", &cases, provenance.as_ref());
         batch::write_atomic(file, xml.as_bytes())?;
     }
