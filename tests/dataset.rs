@@ -60,7 +60,22 @@ fn a_set_is_written_by_seed_and_scored_with_its_labels() {
         serde_json::json!([]),
         "its own labels fit"
     );
+    // Every wrong scan is listed with its label; a detection off its face is both a
+    // false detection and a miss in the scores, so the list accounts for their errors.
     let sc = &v["scores"];
+    let errors: u64 = ["false_positives", "false_negatives"]
+        .iter()
+        .map(|k| sc[k].as_u64().expect("count"))
+        .sum();
+    let wrong = v["wrong_scans"].as_array().expect("wrong scans");
+    let far = wrong.iter().filter(|w| w["why"] == "off the face").count();
+    assert_eq!(v["wrong_total"].as_u64(), Some(wrong.len() as u64));
+    assert_eq!((wrong.len() + far) as u64, errors, "{sc}");
+    for w in wrong {
+        let i = w["index"].as_u64().expect("index") as usize;
+        let face = labels["scans"][i].get("face").cloned().unwrap_or_default();
+        assert_eq!(w["label"], face, "{w}");
+    }
     assert!(sc["precision"].as_f64().expect("p") >= 0.95, "{sc}");
     assert!(sc["recall"].as_f64().expect("r") >= 0.75, "{sc}");
     let at = v["curve"]

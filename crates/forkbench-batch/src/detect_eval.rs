@@ -30,7 +30,7 @@ pub struct Label {
 }
 
 /// A labelled face: centre and heading into the pallet (degrees at the interface).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LabelFace {
     pub x_m: f64,

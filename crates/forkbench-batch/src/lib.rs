@@ -16,6 +16,7 @@ mod checks;
 mod compare;
 pub mod detect_curve;
 pub mod detect_eval;
+pub mod detect_wrong;
 mod export;
 mod gate;
 mod guard;

@@ -116,6 +116,8 @@ impl DetectArgs {
 struct Scored {
     /// What the scores cannot say about the labels (`label_problems`).
     warnings: Vec<String>,
+    /// The scans it got wrong (the first `MAX_LISTED`) and how many in all.
+    wrong: (Vec<forkbench_batch::detect_wrong::Wrong>, usize),
     at_threshold: Scores,
     curve: Vec<CurvePoint>,
     by_place: ByPlace,
@@ -181,6 +183,7 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     check_topics(a, &summary)?;
     let scores = labels.as_ref().map(|l| Scored {
         warnings: label_problems(l, tally.results.len(), &scn.pallet_kind),
+        wrong: forkbench_batch::detect_wrong::wrong_scans(&tally.results, l, gate),
         at_threshold: score(&tally.results, l, gate),
         curve: curve(&tally.candidates, l, gate),
         by_place: by_place(&tally.results, l, gate),
@@ -343,6 +346,8 @@ fn report(
             "by_place": scores.map(|s| &s.by_place),
             "by_clutter": scores.map(|s| &s.by_clutter),
             "label_warnings": scores.map(|s| &s.warnings),
+            "wrong_scans": scores.map(|s| &s.wrong.0),
+            "wrong_total": scores.map(|s| s.wrong.1),
         });
         return crate::emit(&format!("{v}\n"));
     }
@@ -371,6 +376,25 @@ fn report(
         s += &forkbench_report::detect_curve::curve_text(&sc.curve, a.min_score);
         s += &forkbench_report::detect_curve::by_place_text(&sc.by_place);
         s += &forkbench_report::detect_curve::by_clutter_text(&sc.by_clutter);
+        s += &wrong_text(&sc.wrong);
     }
     crate::emit(&s)
+}
+
+/// The wrong scans' count and the first few, by index and why (`--json` lists them with
+/// their labels and detections).
+fn wrong_text((listed, total): &(Vec<forkbench_batch::detect_wrong::Wrong>, usize)) -> String {
+    if *total == 0 {
+        return String::new();
+    }
+    let first: Vec<String> = listed
+        .iter()
+        .take(10)
+        .map(|w| format!("{} {}", w.index, w.why))
+        .collect();
+    format!(
+        "wrong scans: {total} (the first: {}); --json lists up to {} with their labels and detections\n",
+        first.join(", "),
+        forkbench_batch::detect_wrong::MAX_LISTED
+    )
 }
