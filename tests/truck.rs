@@ -115,6 +115,30 @@ fn a_trials_mcap_bag_and_actuator_log_are_identified() {
     assert_eq!(channels.len(), 1, "{v}");
     let d = channels[0]["settings"]["steering.dead_time_s"].as_f64();
     assert!(d.is_some_and(|d| same(d, fits[0].0)), "{v}");
+    // The bag as rosbag2 writes it, a directory with its metadata and the MCAP part: the
+    // same fit as the file (issue 78: identify refused the directory detect reads).
+    let dir = tmp("pick-bag");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("bag dir");
+    std::fs::copy(&bag, dir.join("pick-bag_0.mcap")).expect("part");
+    std::fs::write(
+        dir.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n  version: 5\n",
+    )
+    .expect("metadata");
+    let out = forkbench(&["identify", s(&dir), "--json"]);
+    assert!(out.status.success(), "{}", text(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let d = v["channels"][0]["settings"]["steering.dead_time_s"].as_f64();
+    assert!(d.is_some_and(|d| same(d, fits[1].0)), "{v}");
+    let empty = tmp("empty-bag");
+    std::fs::create_dir_all(&empty).expect("dir");
+    let out = forkbench(&["identify", s(&empty)]);
+    assert!(
+        text(&out).contains("a directory without .mcap files"),
+        "{}",
+        text(&out)
+    );
     // A topic the bag does not have is named.
     let out = forkbench(&["identify", s(&bag), "--topic", "/nope"]);
     assert!(

@@ -85,10 +85,12 @@ pub fn identify(a: &IdentifyArgs) -> anyhow::Result<()> {
     if truck_to_stdout && a.json {
         anyhow::bail!("--json and --truck-out - both print to standard output; give one a file");
     }
-    let is_mcap = a
-        .log
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
+    // A rosbag2 directory (its metadata.yaml and .mcap parts) is read as MCAP, as detect
+    // reads it.
+    let is_mcap = a.log.is_dir()
+        || a.log
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
     let log = if is_mcap {
         let fields: [String; 5] = a
             .fields

@@ -82,7 +82,49 @@ fn number_at(v: &Value, path: &str) -> Option<f64> {
 /// made at each message of the time's topic, the other topics' fields at their latest
 /// values by then. forkbench's own ROS 2 bag is read with [`ros2_fields`] when the
 /// defaults name a telemetry topic it does not have.
+///
+/// `path` may be a rosbag2 directory (what `ros2 bag record` writes): its `*.mcap` files
+/// are read in name order (a split bag's parts), each part's runs after the last's, and
+/// together they are held to the one file's size cap.
 pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<ActuatorLog, LogError> {
+    if !path.is_dir() {
+        return read_one(path, topic, fields);
+    }
+    let bad = |reason: String| LogError::File {
+        file: path.display().to_string(),
+        reason,
+    };
+    let mut parts: Vec<std::path::PathBuf> = std::fs::read_dir(path)
+        .map_err(|e| bad(e.to_string()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
+        .collect();
+    parts.sort();
+    if parts.is_empty() {
+        return Err(bad(
+            "a directory without .mcap files (identify reads rosbag2's MCAP storage)".into(),
+        ));
+    }
+    let total: u64 = parts
+        .iter()
+        .map(|p| std::fs::metadata(p).map_or(0, |m| m.len()))
+        .sum();
+    if total > crate::log::MAX_LOG_BYTES {
+        return Err(bad(format!(
+            "its {} .mcap files hold {total} bytes, more than the {} a log may",
+            parts.len(),
+            crate::log::MAX_LOG_BYTES
+        )));
+    }
+    let mut log = ActuatorLog { runs: Vec::new() };
+    for p in &parts {
+        log.runs.extend(read_one(p, topic, fields)?.runs);
+    }
+    Ok(log)
+}
+
+fn read_one(path: &Path, topic: &str, fields: &[String; 5]) -> Result<ActuatorLog, LogError> {
     let file = path.display().to_string();
     let bad = |reason: String| LogError::File {
         file: file.clone(),
