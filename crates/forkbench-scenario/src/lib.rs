@@ -278,7 +278,8 @@ impl<R: Catalogue> Scenario<R> {
         safety::check_movers(&f, &world, (file, text))?;
         let short_target = checks::check_geometry(&f, (&pallet, &pallet_label), file)?;
         let wide_tolerance =
-            fork_play::wide_tolerance(f.tolerances.lateral_m, &f.truck, (&pallet, &pallet_label));
+            fork_play::wide_tolerance(f.tolerances.lateral_m, &f.truck, (&pallet, &pallet_label))
+                .map(|w| format!("{file}: {w}"));
         pallet::check_thickness(&f, (&pallet, &pallet_label), file)?;
         let cases = cases_of(&f, (&world, &pallet), (file, text))?;
         let mission = match &f.mission {
