@@ -285,8 +285,24 @@ fn a_folder_holds_one_whole_set() {
     assert_eq!(labels["dataset"]["seed"], 2);
     assert_eq!(
         crate::common::names_in(&set),
-        ["labels.json", "labels.npy", "scans.mcap", "scans.npy"]
+        [
+            "labels.json",
+            "labels.npy",
+            "metadata.yaml",
+            "scans.mcap",
+            "scans.npy"
+        ]
     );
+    // The folder is a rosbag2 directory: its metadata names the bag and the scan count.
+    let meta = std::fs::read_to_string(set.join("metadata.yaml")).expect("metadata");
+    for part in [
+        "storage_identifier: mcap",
+        "- scans.mcap",
+        "type: sensor_msgs/msg/LaserScan",
+        "message_count: 20",
+    ] {
+        assert!(meta.contains(part), "{part} missing from\n{meta}");
+    }
 }
 
 /// A label says "present" only for a pallet the scanner can see: with a short, narrow

@@ -109,9 +109,15 @@ pub fn run(a: &DatasetArgs) -> anyhow::Result<()> {
 /// The files of a set: the bag and labels, and with `npy` the arrays.
 fn set_files(npy: bool) -> &'static [&'static str] {
     if npy {
-        &["scans.mcap", "labels.json", "scans.npy", "labels.npy"]
+        &[
+            "scans.mcap",
+            "metadata.yaml",
+            "labels.json",
+            "scans.npy",
+            "labels.npy",
+        ]
     } else {
-        &["scans.mcap", "labels.json"]
+        &["scans.mcap", "metadata.yaml", "labels.json"]
     }
 }
 
@@ -157,7 +163,9 @@ fn write_set(
         ranges.commit()?;
         rows.commit()?;
     }
+    let metadata = bag.rosbag2_metadata("scans.mcap");
     bag.finish()?;
+    forkbench_core::files::write_atomic(&a.out.join("metadata.yaml"), metadata.as_bytes())?;
     labels.commit()?;
     Ok(present)
 }

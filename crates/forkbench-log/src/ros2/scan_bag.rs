@@ -18,7 +18,10 @@ pub struct ScanBag {
     writer: mcap::Writer<BufWriter<File>>,
     channel: u16,
     frame: String,
+    topic: String,
     written: u32,
+    /// The first and last scans' stamps (ns since the Unix epoch).
+    span_ns: Option<(u64, u64)>,
     partial: Partial,
 }
 
@@ -67,7 +70,9 @@ impl ScanBag {
             writer: w,
             channel,
             frame: frame.to_owned(),
+            topic: topic.to_owned(),
             written: 0,
+            span_ns: None,
             partial,
         })
     }
@@ -75,6 +80,10 @@ impl ScanBag {
     /// Appends `scan`, stamped `t_s`.
     pub fn write(&mut self, t_s: f64, scan: &Scan) -> Result<(), LogError> {
         let ns = msgs::unix_ns(t_s);
+        self.span_ns = Some(
+            self.span_ns
+                .map_or((ns, ns), |(a, b)| (a.min(ns), b.max(ns))),
+        );
         let header = mcap::records::MessageHeader {
             channel_id: self.channel,
             sequence: self.written,
@@ -88,6 +97,28 @@ impl ScanBag {
                 path: self.path.clone(),
                 message: with_causes(&e),
             })
+    }
+
+    /// The `metadata.yaml` that makes the bag's folder a rosbag2 directory (what `ros2
+    /// bag play` and rosbags' reader open), the bag being `file` in it: rosbag2's
+    /// version 5 layout (ROS 2 Humble), MCAP storage, the scan topic with its count.
+    pub fn rosbag2_metadata(&self, file: &str) -> String {
+        let (start, end) = self.span_ns.unwrap_or((0, 0));
+        let (n, duration) = (self.written, end - start);
+        format!(
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  \
+             duration:\n    nanoseconds: {duration}\n  starting_time:\n    \
+             nanoseconds_since_epoch: {start}\n  message_count: {n}\n  \
+             topics_with_message_count:\n    - topic_metadata:\n        name: {topic}\n        \
+             type: {ty}\n        serialization_format: cdr\n        \
+             offered_qos_profiles: \"\"\n      message_count: {n}\n  \
+             compression_format: \"\"\n  compression_mode: \"\"\n  relative_file_paths:\n    \
+             - {file}\n  files:\n    - path: {file}\n      starting_time:\n        \
+             nanoseconds_since_epoch: {start}\n      duration:\n        nanoseconds: {duration}\n      \
+             message_count: {n}\n",
+            topic = self.topic,
+            ty = msgs::LASER_SCAN_MSG.name,
+        )
     }
 
     /// Finishes the file and moves it into place; on an error nothing appears at the path.
