@@ -178,7 +178,7 @@ impl Acc {
             self.safety.add(s);
         }
         if let Some(p) = &o.profile {
-            self.profile = forkbench_core::profile::Profile::sum(self.profile.iter().chain([p]));
+            forkbench_core::profile::Profile::add_into(&mut self.profile, p);
         }
     }
 }

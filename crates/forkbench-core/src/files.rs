@@ -110,6 +110,18 @@ pub fn is_stdout(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
+/// The files in `dir` whose name ends in `.{ext}`, in name order (a rosbag2 directory's
+/// parts, which a split bag numbers in order).
+pub fn files_with_extension(dir: &Path, ext: &str) -> std::io::Result<Vec<std::path::PathBuf>> {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(dir)?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
 /// Reads at most `max` bytes of `path`, which must be a regular file (a FIFO would block,
 /// a device never end).
 pub fn read_bytes(path: &Path, max: u64) -> Result<Vec<u8>, FileError> {

@@ -104,33 +104,48 @@ impl Profile {
     pub fn sum<'p>(profiles: impl IntoIterator<Item = &'p Profile>) -> Option<Profile> {
         let mut total: Option<Profile> = None;
         for p in profiles {
-            let t = total.get_or_insert_with(|| Profile {
-                trials: 0,
-                wall_ms: 0.0,
-                cpu_ms: 0.0,
-                stages: Vec::new(),
-            });
-            t.trials += p.trials;
-            t.wall_ms += p.wall_ms;
-            t.cpu_ms += p.cpu_ms;
-            for s in &p.stages {
-                match t
-                    .stages
-                    .iter_mut()
-                    .find(|x| x.stage == s.stage && x.component == s.component)
-                {
-                    Some(x) => {
-                        x.time_ms += s.time_ms;
-                        x.calls += s.calls;
-                    }
-                    None => t.stages.push(s.clone()),
-                }
-            }
-        }
-        if let Some(t) = total.as_mut() {
-            sort_stages(&mut t.stages);
+            Self::add_into(&mut total, p);
         }
         total
+    }
+
+    /// `p` added to `total`, or `total` made of it when it has none yet.
+    pub fn add_into(total: &mut Option<Profile>, p: &Profile) {
+        match total.as_mut() {
+            Some(t) => t.add(p),
+            None => *total = Some(p.clone()),
+        }
+    }
+
+    /// Adds `p` to this profile, stage by stage, largest first again.
+    pub fn add(&mut self, p: &Profile) {
+        self.trials += p.trials;
+        self.wall_ms += p.wall_ms;
+        self.cpu_ms += p.cpu_ms;
+        for s in &p.stages {
+            match self
+                .stages
+                .iter_mut()
+                .find(|x| x.stage == s.stage && x.component == s.component)
+            {
+                Some(x) => {
+                    x.time_ms += s.time_ms;
+                    x.calls += s.calls;
+                }
+                None => self.stages.push(s.clone()),
+            }
+        }
+        sort_stages(&mut self.stages);
+    }
+}
+
+impl StageTime {
+    /// The stage as a profile names it: `tracking (pure_pursuit)`, or the stage alone.
+    pub fn label(&self) -> String {
+        match &self.component {
+            Some(c) => format!("{} ({c})", self.stage),
+            None => self.stage.clone(),
+        }
     }
 }
 
@@ -146,10 +161,7 @@ impl Profile {
             "calls"
         )];
         for s in &self.stages {
-            let name = match &s.component {
-                Some(c) => format!("{} ({c})", s.stage),
-                None => s.stage.clone(),
-            };
+            let name = s.label();
             let calls = if s.stage == OTHER {
                 String::new()
             } else {

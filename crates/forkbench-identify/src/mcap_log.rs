@@ -94,13 +94,8 @@ pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<Actua
         file: path.display().to_string(),
         reason,
     };
-    let mut parts: Vec<std::path::PathBuf> = std::fs::read_dir(path)
-        .map_err(|e| bad(e.to_string()))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
-        .collect();
-    parts.sort();
+    let parts = forkbench_core::files::files_with_extension(path, "mcap")
+        .map_err(|e| bad(e.to_string()))?;
     if parts.is_empty() {
         return Err(bad(
             "a directory without .mcap files (identify reads rosbag2's MCAP storage)".into(),

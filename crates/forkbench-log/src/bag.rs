@@ -92,13 +92,8 @@ pub fn bag_files(path: &FsPath) -> Result<Vec<std::path::PathBuf>, LogError> {
         path: path.display().to_string(),
         message,
     };
-    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(path)
-        .map_err(|e| fail(e.to_string()))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
-        .collect();
-    files.sort();
+    let files = forkbench_core::files::files_with_extension(path, "mcap")
+        .map_err(|e| fail(e.to_string()))?;
     if files.is_empty() {
         return Err(fail(
             "a directory without .mcap files (forkbench reads rosbag2's MCAP storage)".into(),

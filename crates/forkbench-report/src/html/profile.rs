@@ -60,13 +60,7 @@ fn largest(p: &Profile) -> String {
         .iter()
         .filter(|s| s.stage != "other")
         .take(3)
-        .map(|s| {
-            let name = match &s.component {
-                Some(c) => format!("{} ({c})", s.stage),
-                None => s.stage.clone(),
-            };
-            format!("{name} {:.0} %", p.share_pct(s))
-        })
+        .map(|s| format!("{} {:.0} %", s.label(), p.share_pct(s)))
         .collect::<Vec<_>>()
         .join(", ")
 }
