@@ -223,7 +223,8 @@ fn pallet_line(scn: &forkbench_trial::Scenario) -> String {
 /// The truck's geometry and mass in one line: what its type sheet gives.
 fn truck_line(t: &forkbench_core::ForkliftSpec) -> String {
     format!(
-        "truck        wheelbase {:.3} m, lock {:.1}° (turn radius {:.3} m), {:.0} kg, rated {:.0} kg, body {:.3} × {:.3} m, forks {:.3} m × {:.3} m at {:.3} m spacing, root {:.3} m ahead of the front axle, ≤ {} m/s",
+        "truck        {}\n             wheelbase {:.3} m, lock {:.1}° (turn radius {:.3} m), {:.0} kg, rated {:.0} kg, body {:.3} × {:.3} m, forks {:.3} m × {:.3} m at {:.3} m spacing, root {:.3} m ahead of the fixed axle, ≤ {} m/s",
+        t.layout.describe(),
         t.wheelbase_m,
         t.max_steer_rad.to_degrees(),
         t.min_turn_radius_m(),
@@ -245,6 +246,7 @@ fn whole_truck(t: &forkbench_core::ForkliftSpec) -> serde_json::Value {
     let mut v = serde_json::to_value(t).unwrap_or_default();
     if let Some(m) = v.as_object_mut() {
         m.insert("rated_capacity_kg".into(), t.rated_capacity_kg.into());
+        m.insert("layout".into(), t.layout.key().into());
         m.insert(
             "steering".into(),
             serde_json::to_value(&t.steering).unwrap_or_default(),

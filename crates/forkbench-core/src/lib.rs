@@ -5,6 +5,7 @@ pub mod exact;
 pub mod files;
 pub mod geometry;
 pub mod hash;
+pub mod layout;
 pub mod pallet;
 pub mod path;
 pub mod pose;
@@ -16,6 +17,7 @@ pub mod signal;
 pub mod units;
 pub mod vehicle;
 
+pub use layout::TruckLayout;
 pub use pallet::PalletSpec;
 pub use path::{Path, PathMetrics, PathSample};
 pub use pose::{Pose2, PoseParseError};

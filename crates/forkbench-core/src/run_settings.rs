@@ -24,7 +24,8 @@ pub const TRUCK_KNOBS: [(&str, &str); 14] = [
 /// The truck's geometry and mass, by the names a truck file, a sweep and a `[truck]`
 /// table share: a run that changes one runs its trials against the scenario as if its
 /// `[truck]` table said so (every check and every derived figure follows).
-pub const TRUCK_GEOMETRY: [&str; 12] = [
+pub const TRUCK_GEOMETRY: [&str; 13] = [
+    "layout",
     "wheelbase_m",
     "max_steer_rad",
     "body_length_m",
@@ -82,6 +83,10 @@ pub fn set(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
 /// Sets a geometry field ([`TRUCK_GEOMETRY`]); false for another path.
 fn set_geometry(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
     match path {
+        "layout" => match crate::TruckLayout::from_code(v) {
+            Some(l) => t.layout = l,
+            None => return false,
+        },
         "wheelbase_m" => t.wheelbase_m = v,
         "max_steer_rad" => t.max_steer_rad = v,
         "body_length_m" => t.body_length_m = v,

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::actuators::{Actuators, ControlTiming, DriveActuator, SteeringActuator};
+use crate::layout::TruckLayout;
 
 /// Geometry and limits of a rear-steered counterbalance forklift.
 ///
@@ -11,7 +12,11 @@ use crate::actuators::{Actuators, ControlTiming, DriveActuator, SteeringActuator
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ForkliftSpec {
-    /// Distance between front (drive) and rear (steer) axles.
+    /// Which wheel steers and which drives (`layout` in a truck file); left out of
+    /// serialised specs at its default, the counterbalance truck.
+    #[serde(skip_serializing_if = "TruckLayout::is_counterbalance")]
+    pub layout: TruckLayout,
+    /// Distance between the fixed (fork-side) axle and the steered wheel.
     pub wheelbase_m: f64,
     /// Largest equivalent steering angle of the rear wheel.
     pub max_steer_rad: f64,
@@ -63,6 +68,7 @@ impl Default for ForkliftSpec {
     #[allow(clippy::approx_constant)]
     fn default() -> Self {
         Self {
+            layout: TruckLayout::Counterbalance,
             wheelbase_m: 1.629,
             max_steer_rad: 1.0471,
             body_length_m: 2.45,
@@ -92,9 +98,10 @@ fn refused(field: &str, value: f64, reason: &str) -> SpecError {
 }
 
 impl ForkliftSpec {
-    /// Largest path curvature the truck can follow: tan(α_max) / L.
+    /// Largest path curvature the truck can follow: tan(α_max) / L, with α_max the lock
+    /// planners take for its layout (`TruckLayout::planning_lock_rad`).
     pub fn max_curvature_per_m(&self) -> f64 {
-        self.max_steer_rad.tan() / self.wheelbase_m
+        self.layout.planning_lock_rad(self.max_steer_rad).tan() / self.wheelbase_m
     }
 
     /// Smallest turning radius of the front-axle reference point: 1 / κ_max.
@@ -191,13 +198,7 @@ impl ForkliftSpec {
                 return Err(refused(field, value, "must be a positive finite number"));
             }
         }
-        if !(self.max_steer_rad > 0.0 && self.max_steer_rad < std::f64::consts::FRAC_PI_2) {
-            return Err(refused(
-                "max_steer_rad",
-                self.max_steer_rad,
-                "must lie strictly between 0 and π/2",
-            ));
-        }
+        self.validate_lock()?;
         if !self.fork_root_ahead_of_front_axle_m.is_finite() {
             return Err(refused(
                 "fork_root_ahead_of_front_axle_m",
@@ -238,6 +239,33 @@ impl ForkliftSpec {
         self.steering.validate()?;
         self.drive.validate()?;
         self.control.validate()
+    }
+
+    /// The lock's range follows the layout: a counterbalance truck's steered rear axle
+    /// turns less than 90°, a steered drive wheel up to 90°.
+    fn validate_lock(&self) -> Result<(), SpecError> {
+        let (right, lock) = (std::f64::consts::FRAC_PI_2, self.max_steer_rad);
+        let within = if self.layout.allows_right_angle_lock() {
+            // 1.5708, π/2 to four places, is how a truck file writes 90°.
+            lock > 0.0 && lock <= right + 5e-5
+        } else {
+            lock > 0.0 && lock < right
+        };
+        if within {
+            return Ok(());
+        }
+        let reason = if self.layout.allows_right_angle_lock() {
+            format!(
+                "a {}'s steered drive wheel turns at most π/2 (90°)",
+                self.layout.key().replace('_', " ")
+            )
+        } else {
+            "must lie strictly between 0 and π/2: a counterbalance truck's rear axle turns \
+             less than 90° (a steered drive wheel that reaches 90° is layout = \"pallet_stacker\" \
+             or \"reach_truck\")"
+                .to_string()
+        };
+        Err(refused("max_steer_rad", lock, &reason))
     }
 
     /// The actuators and timing, together.

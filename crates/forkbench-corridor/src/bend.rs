@@ -274,7 +274,8 @@ impl Vehicle {
             length_m: spec.body_length_m,
             width_m: spec.body_width_m,
             kinematic_ahead_m: spec.body_length_m / 2.0 - spec.fork_root_ahead_of_front_axle_m,
-            min_radius_m: spec.wheelbase_m / spec.max_steer_rad.tan(),
+            min_radius_m: spec.wheelbase_m
+                / spec.layout.planning_lock_rad(spec.max_steer_rad).tan(),
         }
     }
 

@@ -3,9 +3,9 @@
 use std::collections::BTreeMap;
 use std::path::{Path as FsPath, PathBuf};
 
-use forkbench_core::ForkliftSpec;
 use forkbench_core::actuators::{Actuators, PRESETS};
 use forkbench_core::run_settings::{TRUCK_GEOMETRY, TRUCK_KNOBS};
+use forkbench_core::{ForkliftSpec, TruckLayout};
 
 use crate::{ScenarioError, World, invalid};
 
@@ -209,6 +209,17 @@ fn flatten(
             let n = match v {
                 toml::Value::Float(f) => *f,
                 toml::Value::Integer(i) => *i as f64,
+                // The one key that is a name: it rides among the numbers as its code.
+                toml::Value::String(name) if path == "layout" => TruckLayout::from_key(name)
+                    .ok_or_else(|| {
+                        let mut e = not_a_number(&path);
+                        if let ScenarioError::Invalid { reason, .. } = &mut e {
+                            *reason =
+                                format!("unknown layout {name:?} (known: {})", TruckLayout::keys());
+                        }
+                        e
+                    })?
+                    .code(),
                 _ => return Err(not_a_number(&path)),
             };
             out.insert(path, n);

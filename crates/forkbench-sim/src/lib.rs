@@ -3,6 +3,7 @@
 mod actuator;
 mod bodies;
 mod load;
+mod tyres;
 mod view;
 use bodies::{insert_obstacles, insert_pallet, insert_truck};
 
@@ -355,73 +356,6 @@ impl Sim {
         self.read_contacts(dt);
         self.now = self.kinematics();
         self.check_load(dt);
-    }
-
-    /// Drive/brake force at the front axle from the drive's speed loop, at most what the
-    /// drive tyres' grip on the floor can pass (μ times the front axle load).
-    fn apply_drive(&mut self, speed_cmd: f64, dt: f64) {
-        let a = self.front_axle_pose();
-        let v = self.speed_mps();
-        let accel = self.drive.accel(
-            speed_cmd,
-            v,
-            self.cfg.speed_gain_per_s,
-            self.cfg.max_accel_mps2,
-        );
-        let grip_n = self.cfg.tyre_friction * self.axle_loads_n()[0];
-        let j = (self.truck_mass_kg * accel).clamp(-grip_n, grip_n) * dt;
-        let (s, c) = a.heading_rad.sin_cos();
-        let b = &mut self.world.bodies[self.truck];
-        let p = b.translation();
-        b.apply_impulse_at_point(v2(j * c, j * s), p, true);
-    }
-
-    /// Lateral tyre impulses at the front axle and the steered rear wheel that cancel
-    /// side slip (solved together: they couple through the yaw), each capped at μ N dt.
-    fn apply_tyres(&mut self, dt: f64) {
-        let a = self.front_axle_pose();
-        let (s, c) = a.heading_rad.sin_cos();
-        let l = self.spec.wheelbase_m;
-        let b = &self.world.bodies[self.truck];
-        let com = b.center_of_mass();
-        let com = [com.x as f64, com.y as f64];
-        let lin = b.linvel();
-        let lin = [lin.x as f64, lin.y as f64];
-        let w = b.angvel() as f64;
-        let pf = [a.x_m, a.y_m];
-        let pr = [a.x_m - c * l, a.y_m - s * l];
-        let nf = [-s, c];
-        // Rear wheel points at −α for a left (positive) turn: the ICR lies on the front axle line.
-        let hr = a.heading_rad - self.steer_rad;
-        let nr = [-hr.sin(), hr.cos()];
-        let pts = [(pf, nf), (pr, nr)];
-        let r = pts.map(|(p, _)| [p[0] - com[0], p[1] - com[1]]);
-        let u = [0, 1].map(|k| {
-            let ((_, n), ri) = (pts[k], r[k]);
-            let vp = [lin[0] - w * ri[1], lin[1] + w * ri[0]];
-            vp[0] * n[0] + vp[1] * n[1]
-        });
-        let (m, i) = (self.truck_mass_kg, self.truck_inertia);
-        let k = |a: usize, bb: usize| {
-            let (na, nb) = (pts[a].1, pts[bb].1);
-            (na[0] * nb[0] + na[1] * nb[1]) / m + cross(r[a], na) * cross(r[bb], nb) / i
-        };
-        let kk = [[k(0, 0), k(0, 1)], [k(1, 0), k(1, 1)]];
-        let det = kk[0][0] * kk[1][1] - kk[0][1] * kk[1][0];
-        if det.abs() < 1e-18 {
-            return;
-        }
-        let lam = [
-            -(kk[1][1] * u[0] - kk[0][1] * u[1]) / det,
-            -(kk[0][0] * u[1] - kk[1][0] * u[0]) / det,
-        ];
-        let loads = self.axle_loads_n();
-        let b = &mut self.world.bodies[self.truck];
-        for (idx, ((p, n), lam)) in pts.iter().zip(lam).enumerate() {
-            let cap = self.cfg.tyre_friction * loads[idx] * dt;
-            let lam = lam.clamp(-cap, cap);
-            b.apply_impulse_at_point(v2(lam * n[0], lam * n[1]), v2(p[0], p[1]), true);
-        }
     }
 
     /// Coulomb floor friction on the pallet, as impulses that never reverse its motion.

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use forkbench_core::pallet::{PALLET_KINDS, PalletBuild, PalletFace};
-use forkbench_core::{ForkliftSpec, PalletSpec};
+use forkbench_core::{ForkliftSpec, PalletSpec, TruckLayout};
 use forkbench_trial::trial::{Overrides, read_truck_text};
 use forkbench_trial::{Scenario, TrialOptions, TrialOutcome, World, run_trial};
 use proptest::prelude::*;
@@ -125,6 +125,7 @@ fn pallet_of(kind: &str) -> PalletSpec {
 #[derive(Debug, Clone)]
 struct Drawn {
     kind: &'static str,
+    layout: TruckLayout,
     wheelbase_m: f64,
     lock_rad: f64,
     body_length_m: f64,
@@ -139,25 +140,39 @@ fn drawn() -> impl Strategy<Value = Drawn> {
     let kinds: Vec<&'static str> = PALLET_KINDS.iter().map(|k| k.name).collect();
     (
         proptest::sample::select(kinds),
+        proptest::sample::select(TruckLayout::ALL.to_vec()),
         1.2..2.0f64,
-        0.8..1.2f64,
+        0.0..1.0f64,
         1.6..3.0f64,
         0.9..1.3f64,
         1500.0..6000.0f64,
         1.0..1.8f64,
         0.3..0.8f64,
-        0.25..0.6f64,
+        0.0..1.0f64,
     )
-        .prop_map(|(kind, y, lock, l, b, m, fl, fw, x)| Drawn {
-            kind,
-            wheelbase_m: y,
-            lock_rad: lock,
-            body_length_m: l,
-            body_width_m: b,
-            mass_kg: m,
-            fork_length_m: fl,
-            fork_width_share: fw,
-            root_ahead_m: x,
+        .prop_map(|(kind, layout, y, lock, l, b, m, fl, fw, x)| {
+            // A counterbalance truck: lock 46–69°, the root 0.25–0.6 m ahead of its drive
+            // axle. A steered drive wheel: lock up to 90°, the load wheels up to 0.8 m
+            // under the forks (a stacker's) or the mast reached 0.5 m past them.
+            let (lock_rad, root_ahead_m) = match layout.allows_right_angle_lock() {
+                false => (0.8 + 0.4 * lock, 0.25 + 0.35 * x),
+                true => (
+                    0.8 + (std::f64::consts::FRAC_PI_2 - 0.8) * lock,
+                    -0.8 + 1.3 * x,
+                ),
+            };
+            Drawn {
+                kind,
+                layout,
+                wheelbase_m: y,
+                lock_rad,
+                body_length_m: l,
+                body_width_m: b,
+                mass_kg: m,
+                fork_length_m: fl,
+                fork_width_share: fw,
+                root_ahead_m,
+            }
         })
 }
 
@@ -168,6 +183,7 @@ fn straight_in(d: &Drawn, y_m: f64, heading_deg: f64) -> Scenario {
     let fork_width = (0.06 + d.fork_width_share * 0.1).min(pallet.pocket_width_m - 0.04);
     let spacing = 2.0 * pallet.pocket_offsets_m()[0].abs();
     let truck = ForkliftSpec {
+        layout: d.layout,
         wheelbase_m: d.wheelbase_m,
         max_steer_rad: d.lock_rad,
         body_length_m: d.body_length_m,
