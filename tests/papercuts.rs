@@ -156,6 +156,7 @@ fn shipped_scenarios_are_files_equal_to_their_embedded_twins() {
     let twins = [
         ("scenarios", "crates/forkbench-trial/data/scenarios"),
         ("worlds", "crates/forkbench-trial/data/worlds"),
+        ("trucks", "crates/forkbench-trial/data/trucks"),
         (
             "scenarios/reference",
             "crates/forkbench-plan/data/reference",

@@ -109,7 +109,9 @@ impl ForkliftSpec {
         1.0 / self.max_curvature_per_m()
     }
 
-    /// Closed outlines of the truck at a fork-root pose: the chassis, then the two forks.
+    /// Closed outlines of the truck at a fork-root pose: the chassis, then the two forks,
+    /// then (for a steered drive wheel) the drive wheel, so a drawing shows which end
+    /// drives.
     pub fn outlines(&self, root: &crate::Pose2) -> Vec<[[f64; 2]; 5]> {
         use crate::geometry::rect_outline;
         let mut v = vec![rect_outline(
@@ -119,6 +121,12 @@ impl ForkliftSpec {
         )];
         for f in self.fork_points(root, self.fork_length_m / 2.0) {
             v.push(rect_outline(&f, self.fork_length_m, self.fork_width_m));
+        }
+        if self.layout.drives_at_steered_wheel() {
+            // The wheel's drawn size is a choice: a drive wheel's 0.25 m by 0.1 m.
+            let back = -self.fork_root_ahead_of_front_axle_m - self.wheelbase_m;
+            let wheel = root.to_world(&crate::Pose2::new(back, 0.0, 0.0));
+            v.push(rect_outline(&wheel, 0.25, 0.1));
         }
         v
     }

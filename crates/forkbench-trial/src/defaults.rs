@@ -4,11 +4,20 @@ use std::path::Path;
 
 use crate::ScenarioError;
 use crate::scenario::{Scenario, World};
+use crate::trial::{TruckSettings, read_truck_text};
 
-const SCENARIOS: [(&str, &str); 8] = [
+const SCENARIOS: [(&str, &str); 10] = [
     (
         "scenarios/field-test.toml",
         include_str!("../data/scenarios/field-test.toml"),
+    ),
+    (
+        "scenarios/field-test-efg-316k.toml",
+        include_str!("../data/scenarios/field-test-efg-316k.toml"),
+    ),
+    (
+        "scenarios/field-test-stacker.toml",
+        include_str!("../data/scenarios/field-test-stacker.toml"),
     ),
     (
         "scenarios/rack-pick.toml",
@@ -59,6 +68,36 @@ const WORLDS: [(&str, &str); 4] = [
     ),
 ];
 
+/// The library trucks the embedded scenarios name, by file name (`trucks/` holds them).
+const TRUCKS: [(&str, &str); 2] = [
+    (
+        "jungheinrich-efg-316k.toml",
+        include_str!("../data/trucks/jungheinrich-efg-316k.toml"),
+    ),
+    (
+        "class-pallet-stacker-1.2t.toml",
+        include_str!("../data/trucks/class-pallet-stacker-1.2t.toml"),
+    ),
+];
+
+/// An embedded truck file by the path an embedded scenario names (its file name counts).
+fn embedded_truck(path: &str) -> Result<TruckSettings, ScenarioError> {
+    let name = Path::new(path)
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    let (file, text) =
+        TRUCKS
+            .iter()
+            .find(|(f, _)| *f == name)
+            .ok_or_else(|| ScenarioError::Invalid {
+                file: path.to_owned(),
+                field: "truck".into(),
+                reason: format!("no embedded truck {name:?}"),
+            })?;
+    read_truck_text(text, &format!("trucks/{file}"))
+}
+
 /// An embedded world by file name (`warehouse.toml`), as `worlds/` holds it.
 pub fn embedded_world(name: &str) -> Result<World, ScenarioError> {
     let (file, text) =
@@ -78,7 +117,7 @@ pub fn default_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
     SCENARIOS
         .iter()
         .map(|(file, text)| {
-            Scenario::parse(text, file, |world: &Path| {
+            let load_world = |world: &Path| {
                 let name = world
                     .file_name()
                     .and_then(|n| n.to_str())
@@ -91,7 +130,8 @@ pub fn default_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
                     },
                     e => e,
                 })
-            })
+            };
+            Scenario::parse_embedded(text, file, load_world, &embedded_truck)
         })
         .collect()
 }
