@@ -4,7 +4,7 @@ use std::path::Path;
 
 use crate::ScenarioError;
 use crate::scenario::{Scenario, World};
-use crate::trial::{TruckSettings, read_truck_text};
+use forkbench_scenario::truck_file::{TruckSettings, read_truck_text};
 
 const SCENARIOS: [(&str, &str); 10] = [
     (
