@@ -36,26 +36,16 @@ impl TruckLayout {
         *self == Self::Counterbalance
     }
 
-    /// Whether the traction acts at the steered wheel, along its heading, rather than at
-    /// the fixed axle along the truck's axis.
-    pub fn drives_at_steered_wheel(&self) -> bool {
-        !self.is_counterbalance()
-    }
-
-    /// Whether the truck travels with its forks trailing, so that entering a pallet (toward
-    /// the forks) is, in the truck's own sense, driving in reverse.
-    pub fn enters_in_reverse(&self) -> bool {
-        !self.is_counterbalance()
-    }
-
-    /// Whether a lock of exactly 90° is allowed (a steered drive wheel turns that far).
-    pub fn allows_right_angle_lock(&self) -> bool {
+    /// Whether the truck has one steered drive wheel: its traction acts at that wheel,
+    /// along its heading (not at the fixed axle along the truck's axis), and its lock may
+    /// reach 90°.
+    pub fn steered_drive_wheel(&self) -> bool {
         !self.is_counterbalance()
     }
 
     /// The lock planners take for a truck of this layout with lock `lock_rad`.
     pub fn planning_lock_rad(&self, lock_rad: f64) -> f64 {
-        if self.allows_right_angle_lock() {
+        if self.steered_drive_wheel() {
             lock_rad.min(STEERED_DRIVE_PLANNING_LOCK_RAD)
         } else {
             lock_rad

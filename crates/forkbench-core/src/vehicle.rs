@@ -122,7 +122,7 @@ impl ForkliftSpec {
         for f in self.fork_points(root, self.fork_length_m / 2.0) {
             v.push(rect_outline(&f, self.fork_length_m, self.fork_width_m));
         }
-        if self.layout.drives_at_steered_wheel() {
+        if self.layout.steered_drive_wheel() {
             // The wheel's drawn size is a choice: a drive wheel's 0.25 m by 0.1 m.
             let back = -self.fork_root_ahead_of_front_axle_m - self.wheelbase_m;
             let wheel = root.to_world(&crate::Pose2::new(back, 0.0, 0.0));
@@ -253,7 +253,7 @@ impl ForkliftSpec {
     /// turns less than 90°, a steered drive wheel up to 90°.
     fn validate_lock(&self) -> Result<(), SpecError> {
         let (right, lock) = (std::f64::consts::FRAC_PI_2, self.max_steer_rad);
-        let within = if self.layout.allows_right_angle_lock() {
+        let within = if self.layout.steered_drive_wheel() {
             // 1.5708, π/2 to four places, is how a truck file writes 90°.
             lock > 0.0 && lock <= right + 5e-5
         } else {
@@ -262,7 +262,7 @@ impl ForkliftSpec {
         if within {
             return Ok(());
         }
-        let reason = if self.layout.allows_right_angle_lock() {
+        let reason = if self.layout.steered_drive_wheel() {
             format!(
                 "a {}'s steered drive wheel turns at most π/2 (90°)",
                 self.layout.key().replace('_', " ")

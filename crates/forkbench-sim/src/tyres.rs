@@ -2,11 +2,18 @@
 
 use super::*;
 
+/// Where the steered wheel touches the floor, a wheelbase behind the fixed axle's centre
+/// `axle`.
+fn steered_wheel_point(axle: &Pose2, wheelbase_m: f64) -> [f64; 2] {
+    let (s, c) = axle.heading_rad.sin_cos();
+    [axle.x_m - c * wheelbase_m, axle.y_m - s * wheelbase_m]
+}
+
 impl Sim {
     /// Drive/brake force from the drive's speed loop where the layout puts the traction, at
     /// most what the driven tyres' grip on the floor can pass (μ times their axle's load).
     pub(crate) fn apply_drive(&mut self, speed_cmd: f64, dt: f64) {
-        if self.spec.layout.drives_at_steered_wheel() {
+        if self.spec.layout.steered_drive_wheel() {
             return self.apply_wheel_drive(speed_cmd, dt);
         }
         let a = self.front_axle_pose();
@@ -33,9 +40,7 @@ impl Sim {
     /// It pushes along its heading at its contact point, at most what its grip passes.
     fn apply_wheel_drive(&mut self, speed_cmd: f64, dt: f64) {
         let a = self.front_axle_pose();
-        let l = self.spec.wheelbase_m;
-        let (s, c) = a.heading_rad.sin_cos();
-        let wheel = [a.x_m - c * l, a.y_m - s * l];
+        let wheel = steered_wheel_point(&a, self.spec.wheelbase_m);
         let along = a.heading_rad - self.steer_rad;
         let (hs, hc) = along.sin_cos();
         let b = &self.world.bodies[self.truck];
@@ -68,7 +73,7 @@ impl Sim {
         let lin = [lin.x as f64, lin.y as f64];
         let w = b.angvel() as f64;
         let pf = [a.x_m, a.y_m];
-        let pr = [a.x_m - c * l, a.y_m - s * l];
+        let pr = steered_wheel_point(&a, l);
         let nf = [-s, c];
         // Rear wheel points at −α for a left (positive) turn: the ICR lies on the front axle line.
         let hr = a.heading_rad - self.steer_rad;

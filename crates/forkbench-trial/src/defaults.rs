@@ -80,35 +80,37 @@ const TRUCKS: [(&str, &str); 2] = [
     ),
 ];
 
+/// The text of `name` in an embedded `table` (with the name it is held under), or an error
+/// for `field` naming what was asked for (`asked_as`).
+fn embedded<'t>(
+    table: &'t [(&'t str, &'t str)],
+    name: &str,
+    asked_as: &str,
+    field: &str,
+) -> Result<&'t (&'t str, &'t str), ScenarioError> {
+    table
+        .iter()
+        .find(|(f, _)| *f == name)
+        .ok_or_else(|| ScenarioError::Invalid {
+            file: asked_as.to_owned(),
+            field: field.into(),
+            reason: format!("no embedded {field} {name:?}"),
+        })
+}
+
 /// An embedded truck file by the path an embedded scenario names (its file name counts).
 fn embedded_truck(path: &str) -> Result<TruckSettings, ScenarioError> {
     let name = Path::new(path)
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or_default();
-    let (file, text) =
-        TRUCKS
-            .iter()
-            .find(|(f, _)| *f == name)
-            .ok_or_else(|| ScenarioError::Invalid {
-                file: path.to_owned(),
-                field: "truck".into(),
-                reason: format!("no embedded truck {name:?}"),
-            })?;
+    let (file, text) = embedded(&TRUCKS, name, path, "truck")?;
     read_truck_text(text, &format!("trucks/{file}"))
 }
 
 /// An embedded world by file name (`warehouse.toml`), as `worlds/` holds it.
 pub fn embedded_world(name: &str) -> Result<World, ScenarioError> {
-    let (file, text) =
-        WORLDS
-            .iter()
-            .find(|(f, _)| *f == name)
-            .ok_or_else(|| ScenarioError::Invalid {
-                file: name.to_owned(),
-                field: "world".into(),
-                reason: format!("no embedded world {name:?}"),
-            })?;
+    let (file, text) = embedded(&WORLDS, name, name, "world")?;
     World::parse(text, &format!("worlds/{file}"))
 }
 

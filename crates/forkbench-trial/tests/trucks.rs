@@ -154,7 +154,7 @@ fn drawn() -> impl Strategy<Value = Drawn> {
             // A counterbalance truck: lock 46–69°, the root 0.25–0.6 m ahead of its drive
             // axle. A steered drive wheel: lock up to 90°, the load wheels up to 0.8 m
             // under the forks (a stacker's) or the mast reached 0.5 m past them.
-            let (lock_rad, root_ahead_m) = match layout.allows_right_angle_lock() {
+            let (lock_rad, root_ahead_m) = match layout.steered_drive_wheel() {
                 false => (0.8 + 0.4 * lock, 0.25 + 0.35 * x),
                 true => (
                     0.8 + (std::f64::consts::FRAC_PI_2 - 0.8) * lock,
