@@ -237,6 +237,19 @@ fn truck_line(t: &forkbench_core::ForkliftSpec) -> String {
         t.fork_spacing_m,
         t.fork_root_ahead_of_front_axle_m,
         t.max_speed_mps
+    ) + &mass_centre_line(t)
+}
+
+/// Where the unladen mass sits, and what placed it.
+fn mass_centre_line(t: &forkbench_core::ForkliftSpec) -> String {
+    let behind_m = -t.mass_centre_ahead_of_front_axle_m();
+    let by = match (t.axle_load_fixed_kg, t.axle_load_steered_kg) {
+        (Some(f), Some(s)) => format!("from its axle loads, {f:.0} kg fixed / {s:.0} kg steered"),
+        _ => "at the chassis centre (no axle loads declared)".to_owned(),
+    };
+    format!(
+        "\n             mass centre {behind_m:.3} m behind the fixed axle ({:.0} % on the steered wheel), {by}",
+        100.0 * behind_m / t.wheelbase_m
     )
 }
 
@@ -260,6 +273,10 @@ fn whole_truck(t: &forkbench_core::ForkliftSpec) -> serde_json::Value {
             serde_json::to_value(&t.control).unwrap_or_default(),
         );
         m.insert("max_curvature_per_m".into(), t.max_curvature_per_m().into());
+        m.insert(
+            "mass_centre_ahead_of_front_axle_m".into(),
+            t.mass_centre_ahead_of_front_axle_m().into(),
+        );
     }
     v
 }

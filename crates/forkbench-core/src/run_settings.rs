@@ -24,7 +24,7 @@ pub const TRUCK_KNOBS: [(&str, &str); 14] = [
 /// The truck's geometry and mass, by the names a truck file, a sweep and a `[truck]`
 /// table share: a run that changes one runs its trials against the scenario as if its
 /// `[truck]` table said so (every check and every derived figure follows).
-pub const TRUCK_GEOMETRY: [&str; 13] = [
+pub const TRUCK_GEOMETRY: [&str; 15] = [
     "layout",
     "wheelbase_m",
     "max_steer_rad",
@@ -38,6 +38,8 @@ pub const TRUCK_GEOMETRY: [&str; 13] = [
     "max_speed_mps",
     "rated_capacity_kg",
     "fork_thickness_m",
+    "axle_load_fixed_kg",
+    "axle_load_steered_kg",
 ];
 
 /// The dotted path of a sweep knob's name, or of a dotted path itself (the geometry's
@@ -99,6 +101,8 @@ fn set_geometry(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
         "max_speed_mps" => t.max_speed_mps = v,
         "rated_capacity_kg" => t.rated_capacity_kg = v,
         "fork_thickness_m" => t.fork_thickness_m = Some(v),
+        "axle_load_fixed_kg" => t.axle_load_fixed_kg = Some(v),
+        "axle_load_steered_kg" => t.axle_load_steered_kg = Some(v),
         _ => return false,
     }
     true

@@ -193,7 +193,15 @@ pub(crate) fn resolve_entry(
         flatten(&table, &mut settings, &|path| {
             invalid(&here, &format!("truck.{path}"), "must be a number")
         })?;
-        truck = apply_truck(&truck, None, &settings)?;
+        // A refusal names the scenario and the line of the key it refuses (a check over
+        // several keys names the one it reports), else the `truck` entry's line.
+        truck = apply_truck(&truck, None, &settings).map_err(|e| match e {
+            ScenarioError::Invalid { field, reason, .. } => {
+                let place = line_of(text, &field).map_or(here.clone(), |l| format!("{file}:{l}"));
+                invalid(&place, &field, &reason)
+            }
+            other => other,
+        })?;
     }
     Ok(truck)
 }

@@ -3,7 +3,8 @@
 use super::*;
 
 /// The truck's body (origin at the front axle centre, +x toward the forks), its chassis
-/// (carrying all the mass) and its two massless forks; also the chassis centre's offset.
+/// (carrying the mass, unless axle loads place it) and its two massless forks; also the
+/// centre of mass's offset ahead of the fixed axle.
 pub(crate) fn insert_truck(
     world: &mut PhysicsWorld,
     spec: &ForkliftSpec,
@@ -14,26 +15,36 @@ pub(crate) fn insert_truck(
     let d = spec.fork_root_ahead_of_front_axle_m;
     let (s, c) = start.heading_rad.sin_cos();
     let axle = [start.x_m - c * d, start.y_m - s * d];
-    let truck = world.insert_body(
-        RigidBodyBuilder::dynamic()
-            .translation(v2(axle[0], axle[1]))
-            .rotation(start.heading_rad as Real)
-            .can_sleep(false),
-    );
-    // Chassis (with the mast) ends at the fork root; it carries all the mass, so the
-    // inertia is that of a solid 2.45 × 1.2 m body.
+    let mut body = RigidBodyBuilder::dynamic()
+        .translation(v2(axle[0], axle[1]))
+        .rotation(start.heading_rad as Real)
+        .can_sleep(false);
+    // Chassis (with the mast) ends at the fork root. Without declared axle loads it
+    // carries all the mass, so the inertia is that of a solid body of its outline; with
+    // them the mass sits where they put it, with the same inertia about that point.
     let chassis_front = d;
     let chassis_centre = chassis_front - spec.body_length_m / 2.0;
-    let chassis = world.insert_collider(
-        ColliderBuilder::cuboid(
-            (spec.body_length_m / 2.0) as Real,
-            (spec.body_width_m / 2.0) as Real,
-        )
-        .translation(v2(chassis_centre, 0.0))
-        .mass(spec.mass_kg as Real)
-        .friction(0.5),
-        Some(truck),
-    );
+    let declared = spec.axle_load_fixed_kg.is_some();
+    if declared {
+        let com = spec.mass_centre_ahead_of_front_axle_m();
+        body = body.additional_mass_properties(MassProperties::new(
+            v2(com, 0.0),
+            spec.mass_kg as Real,
+            truck_inertia(spec) as Real,
+        ));
+    }
+    let truck = world.insert_body(body);
+    let chassis = ColliderBuilder::cuboid(
+        (spec.body_length_m / 2.0) as Real,
+        (spec.body_width_m / 2.0) as Real,
+    )
+    .translation(v2(chassis_centre, 0.0))
+    .friction(0.5);
+    let chassis = match declared {
+        true => chassis.density(0.0),
+        false => chassis.mass(spec.mass_kg as Real),
+    };
+    let chassis = world.insert_collider(chassis, Some(truck));
     let fork = |side: f64| {
         ColliderBuilder::cuboid(
             (spec.fork_length_m / 2.0) as Real,
@@ -50,7 +61,18 @@ pub(crate) fn insert_truck(
         world.insert_collider(fork(1.0), Some(truck)),
         world.insert_collider(fork(-1.0), Some(truck)),
     ];
-    (truck, chassis, forks, chassis_centre)
+    (
+        truck,
+        chassis,
+        forks,
+        spec.mass_centre_ahead_of_front_axle_m(),
+    )
+}
+
+/// The unladen truck's moment of inertia about its centre of mass: a solid body of the
+/// chassis outline's.
+pub(crate) fn truck_inertia(spec: &ForkliftSpec) -> f64 {
+    spec.mass_kg * (spec.body_length_m.powi(2) + spec.body_width_m.powi(2)) / 12.0
 }
 
 /// The pallet's body and its solid parts (stringers or blocks), in its face frame.

@@ -198,10 +198,9 @@ impl Sim {
         world.gravity = Vector::ZERO;
         world.integration_parameters.dt = cfg.dt_s as Real;
 
-        let (truck, chassis, forks, chassis_centre) = insert_truck(&mut world, spec, start, cfg);
+        let (truck, chassis, forks, com_ahead_m) = insert_truck(&mut world, spec, start, cfg);
         let truck_mass_kg = spec.mass_kg;
-        let truck_inertia =
-            spec.mass_kg * (spec.body_length_m.powi(2) + spec.body_width_m.powi(2)) / 12.0;
+        let truck_inertia = bodies::truck_inertia(spec);
         let (pallet, stringers) = insert_pallet(&mut world, pallet_spec, pallet_pose, cfg);
         // The pallet stands on the floor with its payload.
         let pallet_inertia = pallet_spec.loaded_mass_kg()
@@ -229,7 +228,7 @@ impl Sim {
             steps: 0,
             truck_mass_kg,
             truck_inertia,
-            com_ahead_m: chassis_centre,
+            com_ahead_m,
             pallet_inertia,
             last_pallet_force_n: 0.0,
             last_mast_force_n: 0.0,

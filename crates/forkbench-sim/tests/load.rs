@@ -282,3 +282,27 @@ fn a_carried_pallet_touches_what_it_is_driven_into() {
         "pallet front at {front_x} m, wall at {wall_face_x} m"
     );
 }
+
+/// Declared axle loads (VDI 2198 line 2.2) put the unladen mass where they say: the static
+/// loads on the two axles are the declared ones, whatever the chassis's outline.
+#[test]
+fn declared_axle_loads_are_the_static_axle_loads() {
+    let truck = ForkliftSpec {
+        mass_kg: 3000.0,
+        axle_load_fixed_kg: Some(1200.0),
+        axle_load_steered_kg: Some(1800.0),
+        ..ForkliftSpec::default()
+    };
+    let sim = Sim::new(
+        &truck,
+        &Pose2::new(0.0, 0.0, 0.0),
+        &PalletSpec::field_1200(),
+        &Pose2::new(4.0, 0.0, 0.0),
+        &[],
+        &SimConfig::default(),
+    )
+    .expect("valid world");
+    let [fixed, steered] = sim.axle_loads_n();
+    assert!((fixed - 1200.0 * G_MPS2).abs() < 1e-6, "{fixed}");
+    assert!((steered - 1800.0 * G_MPS2).abs() < 1e-6, "{steered}");
+}
