@@ -47,6 +47,72 @@ fn a_step_test_is_identified_into_a_truck_file_a_trial_takes() {
     assert!(matches!(out.status.code(), Some(0 | 3)), "{}", text(&out));
 }
 
+/// Issue 77: every library truck's step test is identified within 20 ms of its dead times
+/// and 20 % of its lags, rates and limits. They all carry the realistic preset: the
+/// steering's 0.06 s dead time and 0.01 s on the bus, 0.08 s lag, 10 rad/s² motor; the
+/// drive's 0.05 s and the bus, τ 0.25 s, 1 m/s² up and 1.5 m/s² braking. The steering's
+/// acceleration limit, which the model once lacked, read as 0.07 s more dead time and no lag.
+#[test]
+fn every_library_trucks_step_test_is_identified_within_tolerance() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../trucks");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("trucks/")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 6, "{files:?}");
+    for file in files {
+        let table: toml::Table =
+            toml::from_str(&std::fs::read_to_string(&file).expect("reads")).expect("TOML");
+        assert_eq!(table["preset"].as_str(), Some("realistic"), "{file:?}");
+        assert!(
+            !table.contains_key("steering") && !table.contains_key("drive"),
+            "{file:?}"
+        );
+        let rate = table["max_steer_rate_radps"].as_float().expect("rate");
+        let log = tmp(&format!(
+            "{}.csv",
+            file.file_stem().expect("stem").display()
+        ));
+        let out = forkbench(&[
+            "step-test",
+            "--truck",
+            s(&file),
+            "--out",
+            s(&log),
+            "--runs",
+            "4",
+            "--run-s",
+            "14",
+        ]);
+        assert!(out.status.success(), "{}", text(&out));
+        let out = forkbench(&["identify", s(&log), "--json"]);
+        assert!(out.status.success(), "{}", text(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        let got = |ch: usize, key: &str| {
+            v["channels"][ch]["settings"][key]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{file:?}: {key} not identified: {v}"))
+        };
+        let within = |ch: usize, key: &str, truth: f64, tol: f64| {
+            let g = got(ch, key);
+            assert!(
+                (g - truth).abs() <= tol,
+                "{file:?}: {key} {g} against {truth}: {v}"
+            );
+        };
+        within(0, "steering.dead_time_s", 0.07, 0.02);
+        within(0, "steering.time_constant_s", 0.08, 0.016);
+        within(0, "max_steer_rate_radps", rate, 0.2 * rate);
+        within(0, "steering.accel_limit_radps2", 10.0, 2.0);
+        within(1, "drive.dead_time_s", 0.06, 0.02);
+        within(1, "drive.time_constant_s", 0.25, 0.05);
+        within(1, "drive.accel_limit_mps2", 1.0, 0.2);
+        within(1, "drive.brake_limit_mps2", 1.5, 0.3);
+    }
+}
+
 /// A trial's own MCAP is a log: the realistic truck's steering delay (0.06 s, 0.01 s on
 /// the bus, commands held for a 0.02 s period) and lag come back from one pick.
 /// A default (realistic) pick's MCAP, ROS 2 bag and `--actuator-log` CSV are the same

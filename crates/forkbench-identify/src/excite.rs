@@ -33,9 +33,20 @@ impl Default for StepTest {
 pub const MAX_RUNS: usize = 1000;
 pub const MAX_RUN_S: f64 = 600.0;
 
+/// The step test excites one actuator at a time, as a commissioning test does: steering
+/// steps with the truck standing, then speed steps with the wheel straight (a wheel turned
+/// while driving drags the truck through its tyres, which no speed-loop model holds).
+const STEER_PHASE_S: f64 = 6.0;
+const DRIVE_PHASE_S: f64 = 8.0;
+/// How long each phase first lets the other actuator settle: the truck stop, the wheel
+/// come straight (a quarter of the steering phase in a run shorter than a cycle).
+const SETTLE_S: f64 = 1.5;
+
 /// Drives `truck` through `test` in the physics with `sim`'s settings: each run starts at
-/// rest; the steering command steps to the other side, up to 0.9 of the limit, every
-/// 0.8–2 s, the speed command to a new speed every 1.5–3 s; logged every physics step.
+/// rest, then alternates a steering phase (the speed commanded to 0; the steering command
+/// steps to the other side, up to 0.9 of the limit, every 0.8–2 s) and a drive phase (the
+/// wheel commanded straight; the speed command steps to a new speed every 1.5–3 s); logged
+/// every physics step. Without steering, the speed steps run throughout.
 pub fn step_test(
     truck: &ForkliftSpec,
     sim: &SimConfig,
@@ -89,18 +100,34 @@ fn one_run(
             measured: vec![sim.speed_mps()],
         }),
     };
+    // A run shorter than one cycle holds both phases, in proportion.
+    let cycle_s = (STEER_PHASE_S + DRIVE_PHASE_S).min(run_s);
+    let steer_s = cycle_s * STEER_PHASE_S / (STEER_PHASE_S + DRIVE_PHASE_S);
+    let settle_s = SETTLE_S.min(steer_s / 4.0);
     let steps = (run_s / cfg.dt_s).round() as usize;
     for _ in 0..steps {
         let t = sim.time_s();
-        if steering && t >= next_steer {
-            // Alternating sides, so steps run up to twice the reach: the rate limit shows.
-            let side = if steer_cmd > 0.0 { -1.0 } else { 1.0 };
-            steer_cmd = side * reach * rng.random_range(0.15..=1.0);
-            next_steer = t + rng.random_range(0.8..2.0);
-        }
-        if t >= next_speed {
-            speed_cmd = rng.random_range(-0.5..=truck.max_speed_mps);
-            next_speed = t + rng.random_range(1.5..3.0);
+        let in_cycle = t % cycle_s;
+        let (steer_phase, settled) = match steering {
+            false => (false, true),
+            true if in_cycle < steer_s => (true, in_cycle >= settle_s),
+            true => (false, in_cycle - steer_s >= settle_s),
+        };
+        if steer_phase {
+            speed_cmd = 0.0;
+            if settled && t >= next_steer {
+                // Alternating sides, so steps run up to twice the reach: the rate limit
+                // shows.
+                let side = if steer_cmd > 0.0 { -1.0 } else { 1.0 };
+                steer_cmd = side * reach * rng.random_range(0.15..=1.0);
+                next_steer = t + rng.random_range(0.8..2.0);
+            }
+        } else {
+            steer_cmd = 0.0;
+            if settled && t >= next_speed {
+                speed_cmd = rng.random_range(-0.5..=truck.max_speed_mps);
+                next_speed = t + rng.random_range(1.5..3.0);
+            }
         }
         sim.step(speed_cmd, steer_cmd);
         run.t_s.push(sim.time_s());

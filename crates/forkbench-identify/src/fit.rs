@@ -38,6 +38,10 @@ fn params(kind: Kind, d: f64, x: &[f64]) -> Params {
             Kind::Steering => None,
             Kind::Drive => Some(x[2].exp()),
         },
+        accel_limit: match kind {
+            Kind::Steering => Some(x[2].exp()),
+            Kind::Drive => None,
+        },
     }
 }
 
@@ -105,7 +109,8 @@ pub fn fit(kind: Kind, runs: &[&Run]) -> Params {
         })
         .fold(1e-3, f64::max);
     let x0 = match kind {
-        Kind::Steering => vec![0.1_f64.ln(), (1.5 * peak).ln()],
+        // The motor's acceleration starts as reaching that rate in 50 ms.
+        Kind::Steering => vec![0.1_f64.ln(), (1.5 * peak).ln(), (30.0 * peak).ln()],
         Kind::Drive => vec![0.25_f64.ln(), (1.5 * peak).ln(), (1.5 * peak).ln()],
     };
     let search = |d: f64, iters: usize| {
@@ -139,8 +144,8 @@ pub fn fit(kind: Kind, runs: &[&Run]) -> Params {
 }
 
 /// Drops each limit whose removal changes the error by less than `LIMIT_SEEN`, and any
-/// beyond what a truck file takes (20 rad/s, 50 m/s²): the log cannot tell those apart
-/// from no limit.
+/// beyond what a truck file takes (20 rad/s, 50 m/s², 1000 rad/s²): the log cannot tell
+/// those apart from no limit.
 fn drop_unseen_limits(kind: Kind, p: &mut Params, err: f64, runs: &[&Run]) {
     let cap = match kind {
         Kind::Steering => 20.0,
@@ -148,11 +153,13 @@ fn drop_unseen_limits(kind: Kind, p: &mut Params, err: f64, runs: &[&Run]) {
     };
     p.limit_up = p.limit_up.filter(|v| *v <= cap);
     p.limit_down = p.limit_down.filter(|v| *v <= cap);
-    for which in [0, 1] {
+    p.accel_limit = p.accel_limit.filter(|v| *v <= 1000.0);
+    for which in [0, 1, 2] {
         let mut without = *p;
         match which {
             0 => without.limit_up = None,
-            _ => without.limit_down = None,
+            1 => without.limit_down = None,
+            _ => without.accel_limit = None,
         }
         if without != *p && sse(kind, &without, runs) <= err * (1.0 + LIMIT_SEEN) + 1e-12 {
             *p = without;
@@ -210,7 +217,15 @@ pub fn identify_channel(kind: Kind, log: &ActuatorLog) -> Result<ChannelFit, Ide
     let fit_runs: Vec<&Run> = fitted.iter().collect();
     let p = fit(kind, &fit_runs);
     let dead_time_step_s = grid_step(&fit_runs);
-    let (settings, refused) = in_truck_ranges(settings(kind, &p));
+    let (mut settings, mut refused) = in_truck_ranges(settings(kind, &p));
+    if let Some(why) = lag_unresolved(&p, dead_time_step_s, command_period_s(&fit_runs, kind)) {
+        let key = match kind {
+            Kind::Steering => "steering.time_constant_s",
+            Kind::Drive => "drive.time_constant_s",
+        };
+        settings.remove(key);
+        refused.push((key.to_owned(), why));
+    }
     notes.extend(refused.iter().map(|(k, why)| format!("{k}: {why}")));
     let check_runs: Vec<&Run> = if held.is_empty() {
         fit_runs.clone()
@@ -255,6 +270,49 @@ pub fn identify_channel(kind: Kind, log: &ActuatorLog) -> Result<ChannelFit, Ide
     })
 }
 
+/// Why the fitted lag cannot be told from dead time in this log, if it cannot: it is
+/// shorter than two samples of the dead-time grid, or than the period the commands were
+/// held for, and either blurs a lag into a delay.
+fn lag_unresolved(p: &Params, grid_s: f64, period_s: Option<f64>) -> Option<String> {
+    let (what, resolved_s) = match period_s {
+        Some(t) if t > 2.0 * grid_s => ("the commands' period", t),
+        _ => ("two samples of the log", 2.0 * grid_s),
+    };
+    (p.time_constant_s < resolved_s).then(|| {
+        format!(
+            "fitted {:.4} s, shorter than {what} ({resolved_s:.3} s): this log cannot tell \
+             the lag from dead time (the dead time holds both); not identified",
+            p.time_constant_s
+        )
+    })
+}
+
+/// The controller's period as the log shows it: the median time between changes of the
+/// command, when most changes come within 0.25 s of the last (a controller's stream, not
+/// a step test's held steps).
+fn command_period_s(runs: &[&Run], kind: Kind) -> Option<f64> {
+    let mut gaps: Vec<f64> = Vec::new();
+    for r in runs {
+        let Some(ch) = channel(r, kind) else { continue };
+        let mut last: Option<f64> = None;
+        for k in 1..ch.cmd.len() {
+            if ch.cmd[k] != ch.cmd[k - 1] {
+                if let Some(t0) = last {
+                    gaps.push(r.t_s[k] - t0);
+                }
+                last = Some(r.t_s[k]);
+            }
+        }
+    }
+    let short: Vec<f64> = gaps.iter().copied().filter(|g| *g < 0.25).collect();
+    if gaps.is_empty() || short.len() * 2 < gaps.len() {
+        return None;
+    }
+    let mut short = short;
+    short.sort_by(f64::total_cmp);
+    Some(short[short.len() / 2])
+}
+
 /// RMS error at the end of open-loop rollouts of `h_s`, started every half second from
 /// the measured state.
 fn rollout_rmse(kind: Kind, p: &Params, runs: &[&Run], h_s: f64) -> Option<f64> {
@@ -290,6 +348,9 @@ fn settings(kind: Kind, p: &Params) -> BTreeMap<String, f64> {
             s.insert("steering.time_constant_s".into(), p.time_constant_s);
             if let Some(r) = p.limit_up {
                 s.insert("max_steer_rate_radps".into(), r);
+            }
+            if let Some(a) = p.accel_limit {
+                s.insert("steering.accel_limit_radps2".into(), a);
             }
         }
         Kind::Drive => {
@@ -333,8 +394,14 @@ fn in_truck_ranges(
 /// The limits the log never reached, by the truck file's names.
 fn unseen(kind: Kind, p: &Params) -> Vec<String> {
     match kind {
-        Kind::Steering if p.limit_up.is_none() => vec!["max_steer_rate_radps".into()],
-        Kind::Steering => vec![],
+        Kind::Steering => [
+            (p.limit_up, "max_steer_rate_radps"),
+            (p.accel_limit, "steering.accel_limit_radps2"),
+        ]
+        .iter()
+        .filter(|(v, _)| v.is_none())
+        .map(|(_, n)| (*n).to_owned())
+        .collect(),
         Kind::Drive => [
             (p.limit_up, "drive.accel_limit_mps2"),
             (p.limit_down, "drive.brake_limit_mps2"),
@@ -349,6 +416,38 @@ fn unseen(kind: Kind, p: &Params) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A lag shorter than the commands' period or two samples is not written: the log
+    /// cannot tell it from dead time.
+    #[test]
+    fn a_lag_the_log_cannot_resolve_is_not_identified() {
+        let p = |tau: f64| Params {
+            dead_time_s: 0.1,
+            time_constant_s: tau,
+            limit_up: None,
+            limit_down: None,
+            accel_limit: None,
+        };
+        assert!(lag_unresolved(&p(0.001), 0.01, None).is_some_and(|w| w.contains("two samples")));
+        assert!(lag_unresolved(&p(0.03), 0.01, None).is_none());
+        let why = lag_unresolved(&p(0.03), 0.01, Some(0.05)).expect("below the period");
+        assert!(why.contains("the commands' period (0.050 s)"), "{why}");
+        // A 50 ms controller's stream, and a step test's held steps.
+        let t: Vec<f64> = (0..400).map(|k| k as f64 * 0.01).collect();
+        let run = |cmd: Vec<f64>| Run {
+            t_s: t.clone(),
+            steer: Some(crate::log::Channel {
+                measured: cmd.clone(),
+                cmd,
+            }),
+            speed: None,
+        };
+        let stream = run((0..400).map(|k| (k / 5) as f64 * 0.01).collect());
+        let period = command_period_s(&[&stream], Kind::Steering).expect("a stream");
+        assert!((period - 0.05).abs() < 1e-9, "{period}");
+        let steps = run((0..400).map(|k| (k / 100) as f64 * 0.1).collect());
+        assert_eq!(command_period_s(&[&steps], Kind::Steering), None);
+    }
 
     /// A fitted value a truck file would refuse (a rate of 0, an acceleration of
     /// 0.003 m/s²) is not written: it is named as not identified, with the reason.

@@ -1,4 +1,4 @@
-//! The actuator models a fit simulates, as the physics applies them: a dead time, then the steering's rate-limited first-order lag, or the drive's speed loop limited in acceleration and braking.
+//! The actuator models a fit simulates, as the physics applies them: a dead time, then the steering's first-order lag limited in rate and acceleration, or the drive's speed loop limited in acceleration and braking.
 
 use crate::log::{Channel, Run};
 
@@ -18,6 +18,9 @@ pub struct Params {
     pub limit_up: Option<f64>,
     /// Drive: the braking limit (the steering has one rate limit, in `limit_up`).
     pub limit_down: Option<f64>,
+    /// Steering: the acceleration limit of its motor (the drive has none: its
+    /// acceleration limit is `limit_up`).
+    pub accel_limit: Option<f64>,
 }
 
 /// The channel of `kind` in `run`.
@@ -44,7 +47,7 @@ pub fn simulate(
     let Some(&x0) = ch.measured.get(from) else {
         return out;
     };
-    let mut x = x0;
+    let (mut x, mut rate) = (x0, 0.0);
     out.push(x);
     // The newest sample whose time is at or before t − d (zero-order hold on the commands).
     let mut j: Option<usize> = None;
@@ -55,22 +58,33 @@ pub fn simulate(
         }
         let u = j.map_or(ch.measured[0], |j| ch.cmd[j]);
         let dt = t_s[k] - t_s[k - 1];
-        x = step(kind, p, x, u, dt);
+        (x, rate) = step(kind, p, (x, rate), u, dt);
         out.push(x);
     }
     out
 }
 
-/// One step of the model from state `x` under the (delayed) command `u`.
-fn step(kind: Kind, p: &Params, x: f64, u: f64, dt: f64) -> f64 {
+/// One step of the model from state `x` moving at `rate` under the (delayed) command
+/// `u`; the new state and rate.
+fn step(kind: Kind, p: &Params, (x, rate): (f64, f64), u: f64, dt: f64) -> (f64, f64) {
     match kind {
         Kind::Steering => {
-            let mut delta =
-                forkbench_core::actuators::lag_fraction(dt, p.time_constant_s) * (u - x);
+            let err = u - x;
+            let mut delta = forkbench_core::actuators::lag_fraction(dt, p.time_constant_s) * err;
             if let Some(r) = p.limit_up {
                 delta = delta.clamp(-r * dt, r * dt);
             }
-            x + delta
+            if let Some(acc) = p.accel_limit {
+                // As the physics' motor: it slows in time to stop at the target and
+                // changes its rate only so fast.
+                let half_step = 0.5 * acc * dt;
+                let stop = (2.0 * acc * err.abs() + half_step * half_step).sqrt() - half_step;
+                let w = (delta / dt)
+                    .clamp(-stop, stop)
+                    .clamp(rate - acc * dt, rate + acc * dt);
+                delta = w * dt;
+            }
+            (x + delta, delta / dt)
         }
         Kind::Drive => {
             // The physics' speed loop: an explicit step of v' = (u − v) / τ, limited.
@@ -83,7 +97,7 @@ fn step(kind: Kind, p: &Params, x: f64, u: f64, dt: f64) -> f64 {
             if let Some(l) = lim {
                 a = a.clamp(-l, l);
             }
-            x + a * dt
+            (x + a * dt, a)
         }
     }
 }
@@ -119,6 +133,7 @@ mod tests {
             time_constant_s: 0.2,
             limit_up: None,
             limit_down: None,
+            accel_limit: None,
         };
         let y = simulate(Kind::Steering, &p, &t, &ch, 0, 100);
         // Before t = d the command is the measured state before the log (0).
