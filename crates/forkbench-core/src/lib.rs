@@ -1,6 +1,7 @@
 //! Shared vocabulary of forkbench: poses, units, the forklift and pallet specs, sampled paths.
 
 pub mod actuators;
+pub mod axle_loads;
 pub mod exact;
 pub mod files;
 pub mod geometry;

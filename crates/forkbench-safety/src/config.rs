@@ -99,8 +99,12 @@ pub struct SafetyConfig {
     /// this close to the target (the pallet face the truck aims at; where the place's
     /// path leaves the tips): the pallet or the slot between rack uprights is the
     /// target, not an obstacle. Muted while driving forwards until that part of the
-    /// cycle ends; backing out is watched.
-    pub mute_near_target_m: f64,
+    /// cycle ends; backing out is watched. Absent (the default), each field is muted
+    /// only once the target would itself enter it: the warning field at its reach, the
+    /// protective field at its length S_L (the stopping distance at the speed in force
+    /// with the supplements), so a person crossing before that point is seen.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mute_near_target_m: Option<f64>,
     /// Field sets drawn by hand (`[[safety.field_set]]`), each replacing the sized fields
     /// of one speed range and direction.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -122,7 +126,7 @@ impl Default for SafetyConfig {
             warning_margin_m: 1.0,
             warning_speed_mps: 0.3,
             resume_dwell_s: 1.0,
-            mute_near_target_m: 2.0,
+            mute_near_target_m: None,
             field_set: Vec::new(),
         }
     }
@@ -155,8 +159,10 @@ impl SafetyConfig {
             ("warning_margin_m", self.warning_margin_m, 0.0, 5.0),
             ("warning_speed_mps", self.warning_speed_mps, 0.05, 2.0),
             ("resume_dwell_s", self.resume_dwell_s, 0.0, 30.0),
-            ("mute_near_target_m", self.mute_near_target_m, 0.0, 10.0),
         ])?;
+        if let Some(d) = self.mute_near_target_m {
+            in_ranges(&[("mute_near_target_m", d, 0.0, 10.0)])?;
+        }
         self.check_ranges(truck_max_speed_mps)
     }
 

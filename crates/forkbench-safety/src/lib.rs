@@ -27,7 +27,8 @@ pub use fields::{
 pub use function::{Reading, SafetyFunction, SafetyStats};
 pub use geometry::{Rect, rect_gap_lower_bound_m, rect_gap_m};
 pub use people::{
-    LEG_M, MAX_ROUTE_POINTS, Mover, MoverKind, MoverSpec, PERSON_BODY_M, WALKING_MPS, YIELD_GAP_M,
+    Behaviour, LEG_M, MAX_ROUTE_POINTS, Mover, MoverKind, MoverSpec, PERSON_BODY_M, WAIT_GAP_M,
+    WALKING_MPS, YIELD_GAP_M,
 };
 pub use sizing::{
     FLOOR_CLEARANCE_LIMIT_M, FLOOR_SUPPLEMENT_M, FieldInputs, FieldTerms, Load,

@@ -17,6 +17,40 @@ pub const WALKING_MPS: (f64, f64) = (1.0, 1.6);
 /// makers' formula rests on): they wait while their next position would come closer to
 /// its outline than this.
 pub const YIELD_GAP_M: f64 = 0.5;
+/// A person who stops and waits for a truck to pass keeps this far from a moving one: a
+/// choice, about two strides, the distance at which people in aisles step aside.
+pub const WAIT_GAP_M: f64 = 2.0;
+
+/// How a mover reacts to a moving truck (`behaviour`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Behaviour {
+    /// Stands still while its next position would come within [`YIELD_GAP_M`] of a moving
+    /// truck, then walks on.
+    #[default]
+    Yield,
+    /// Walks its route whatever the trucks do: someone who does not look, whom only the
+    /// truck's fields keep from contact (the case ISO 3691-4's people detection is for).
+    KeepWalking,
+    /// Stops once a moving truck comes within [`WAIT_GAP_M`] of where it would step, and
+    /// waits until none is: someone who lets the truck pass.
+    StopAndWait,
+}
+
+impl Behaviour {
+    fn is_yield(&self) -> bool {
+        *self == Behaviour::Yield
+    }
+
+    /// How close to a moving truck it lets its next position come; none: it never waits.
+    pub fn care_m(&self) -> Option<f64> {
+        match self {
+            Behaviour::Yield => Some(YIELD_GAP_M),
+            Behaviour::KeepWalking => None,
+            Behaviour::StopAndWait => Some(WAIT_GAP_M),
+        }
+    }
+}
 /// Most waypoints a route may have, and the longest wait a setting may ask for.
 pub const MAX_ROUTE_POINTS: usize = 64;
 const MAX_TIME_S: f64 = 3600.0;
@@ -51,6 +85,9 @@ pub struct MoverSpec {
     pub pause_at: Option<usize>,
     #[serde(default)]
     pub pause_s: f64,
+    /// How it reacts to a moving truck; left out of serialised specs at its default.
+    #[serde(default, skip_serializing_if = "Behaviour::is_yield")]
+    pub behaviour: Behaviour,
 }
 
 impl MoverSpec {
@@ -262,6 +299,7 @@ mod tests {
             start_s: [1.0, 1.0],
             pause_at: Some(1),
             pause_s: 2.0,
+            behaviour: Behaviour::Yield,
         }
     }
 

@@ -85,6 +85,60 @@ fn a_crossing_person_costs_a_stop_and_the_pick_goes_on() {
     assert_eq!(out.sim_time_s, again.sim_time_s);
 }
 
+/// Issue 77: someone standing 0.6 m before the pallet's face, to one side of its axis.
+/// With the fields muted at a fixed 2 m from the face (the old default) the truck drives
+/// into them; muted only once the pallet itself would enter each field (the default), it
+/// stops before them and holds.
+#[test]
+fn the_fields_stay_live_until_the_pallet_itself_would_enter_them() {
+    let person = "[[mover]]\nkind = \"person\"\nroute = [[7.4, 0.55], [7.4, 3.55]]\n\
+                  speed_mps = 1.3\nstart_s = [3000.0, 3000.0]\n";
+    let derived = pick(&format!("{person}[safety]\n")).expect("loads");
+    let out = run_trial(&derived, &derived.cases[0], &no_noise());
+    let s = out.safety.clone().expect("a safety outcome");
+    assert_eq!(s.person_contacts, 0, "{out:?}");
+    assert!(s.stops >= 1 && s.stop_time_s > 10.0, "{s:?}");
+    let fixed = pick(&format!("{person}[safety]\nmute_near_target_m = 2.0\n")).expect("loads");
+    let out = run_trial(&fixed, &fixed.cases[0], &no_noise());
+    assert_eq!(
+        out.failure.as_ref().map(|f| f.name()),
+        Some("person_contact"),
+        "{out:?}"
+    );
+}
+
+/// A person's behaviour is theirs to set: crossing the truck's way, one who keeps walking
+/// comes closest, one who yields stands 0.5 m off, one who stops and waits keeps well
+/// clear; over the same seeds.
+#[test]
+fn people_keep_walking_yield_or_stop_and_wait_as_set() {
+    let closest = |behaviour: &str| {
+        let crossing = format!(
+            "[[mover]]\nkind = \"person\"\nroute = [[4.5, -4.0], [4.5, 4.0]]\nspeed_mps = 1.0\n\
+             start_s = [0.0, 4.0]\nbehaviour = \"{behaviour}\"\n"
+        );
+        let scn = pick(&crossing).expect("loads");
+        (1..=8)
+            .map(|seed| {
+                let opts = TrialOptions {
+                    seed: Some(seed),
+                    ..no_noise()
+                };
+                let out = run_trial(&scn, &scn.cases[0], &opts);
+                out.safety.expect("movers").closest_m[0].unwrap_or(f64::INFINITY)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (walks, yields, waits) = (
+        closest("keep_walking"),
+        closest("yield"),
+        closest("stop_and_wait"),
+    );
+    assert!(walks < yields && yields < waits, "{walks} {yields} {waits}");
+    assert!(walks <= 0.0, "nobody looks: touched ({walks} m)");
+    assert!(waits > 1.0, "{waits}");
+}
+
 #[test]
 fn bad_movers_and_fields_are_refused_at_load_with_the_line_and_field() {
     let through =

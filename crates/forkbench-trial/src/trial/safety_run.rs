@@ -46,9 +46,13 @@ pub(super) struct Monitor {
     pub(super) reach_m: f64,
     pub(super) period_s: f64,
     pub(super) next_scan_s: f64,
-    pub(super) mute_near_target_m: f64,
+    /// The scenario's muting distance; none: each field is muted once the target would
+    /// enter it.
+    pub(super) mute_near_target_m: Option<f64>,
     /// The part of the cycle whose entry muted the fields.
     pub(super) muted: Option<Stage>,
+    /// The part of the cycle whose entry muted the warning field alone.
+    pub(super) warning_muted: Option<Stage>,
     /// The last scan found the protective field broken (an event marks each new break).
     pub(super) broken: bool,
     /// When the current protective stop began.
@@ -166,6 +170,7 @@ impl Monitor {
             next_scan_s: 0.0,
             mute_near_target_m: c.mute_near_target_m,
             muted: None,
+            warning_muted: None,
             broken: false,
             stop_began_s: None,
         })

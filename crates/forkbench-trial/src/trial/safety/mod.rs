@@ -1,7 +1,7 @@
 //! Each step of a trial's people and safety function: movers walk their routes, the safety scanners watch the field set the speed selects, the truck is stopped or slowed, and contacts with people are judged.
 
 use forkbench_core::{Pose2, Signal, Style};
-use forkbench_safety::{MoverKind, Reading, Rect, STANDING_MPS, YIELD_GAP_M, detect};
+use forkbench_safety::{Fields, MoverKind, Reading, Rect, STANDING_MPS, detect};
 use forkbench_sensors::scan::WorldView as _;
 
 use super::link::Stage;
@@ -93,11 +93,12 @@ impl Trial<'_> {
         };
         let moving = speed.abs() >= STANDING_MPS;
         for (i, m) in s.movers.iter_mut().enumerate() {
-            let (l, w) = m.spec.body_m();
-            // People yield to a moving truck, and walk round a standing one (passing
-            // through it here: only the moving truck coming into touch is a contact).
+            let ((l, w), care) = (m.spec.body_m(), m.spec.behaviour.care_m());
+            // People wait for a moving truck as their behaviour says (or not at all), and
+            // walk round a standing one (passing through it here: only the moving truck
+            // coming into touch is a contact).
             m.advance(t, dt, |next| {
-                moving && gap(&(*next, l, w), YIELD_GAP_M) < YIELD_GAP_M
+                care.is_some_and(|g| moving && gap(&(*next, l, w), g) < g)
             });
             if m.gone() {
                 s.touching[i] = false;
@@ -142,17 +143,9 @@ impl Trial<'_> {
         }
     }
 
-    /// Whether the fields are muted now: in the pick's or the place's entry, once the
-    /// fork tips came near the target (the pallet face the truck aims at; where the
-    /// place's path leaves the tips), until that part of the cycle ends (the caller
-    /// watches reversing out regardless).
-    fn muted(&self, m: &mut Monitor) -> bool {
-        if m.muted.is_some_and(|st| st != self.stage) {
-            m.muted = None;
-        }
-        if m.muted.is_some() {
-            return true;
-        }
+    /// How far the fork tips are from the target of this part of the cycle (the pallet
+    /// face the pick aims at; where the place's path leaves the tips); none elsewhere.
+    fn target_distance_m(&self) -> Option<f64> {
         let fork = Pose2::new(self.scn.truck.fork_length_m, 0.0, 0.0);
         let target = match self.stage {
             Stage::Pick => Some(self.sense.pallet_est),
@@ -166,7 +159,26 @@ impl Trial<'_> {
             Stage::Leg | Stage::Staging => None,
         };
         let tips = self.world.sim.fork_root_pose().to_world(&fork);
-        if target.is_some_and(|t| t.distance_to(&tips) <= m.mute_near_target_m) {
+        target.map(|t| t.distance_to(&tips))
+    }
+
+    /// Whether the fields are muted now: in the pick's or the place's entry, once the
+    /// fork tips came within the scenario's muting distance of the target, or (without
+    /// one) once the target would have entered the protective field, until that part of
+    /// the cycle ends (the caller watches reversing out regardless).
+    fn muted(&self, m: &mut Monitor, near_m: Option<f64>) -> bool {
+        if m.muted.is_some_and(|st| st != self.stage) {
+            m.muted = None;
+        }
+        if m.warning_muted.is_some_and(|st| st != self.stage) {
+            m.warning_muted = None;
+        }
+        if m.muted.is_some() {
+            return true;
+        }
+        if let Some(d) = m.mute_near_target_m
+            && near_m.is_some_and(|n| n <= d)
+        {
             m.muted = Some(self.stage);
         }
         m.muted.is_some()
@@ -176,13 +188,15 @@ impl Trial<'_> {
     fn read_fields<R: Recorder + ?Sized>(&self, m: &mut Monitor, s: &SafetyRun, rec: &mut R) {
         let t = self.world.sim.time_s();
         // Muting covers the entry (driving forwards); backing out is watched again.
-        let muted = self.muted(m) && s.requested_mps >= 0.0;
+        let forward = s.requested_mps >= 0.0;
+        let near_m = self.target_distance_m();
+        let muted = self.muted(m, near_m) && forward;
         let set = if muted {
             None
         } else {
             m.fields.active(s.requested_mps)
         };
-        let Some(set) = set.copied() else {
+        let clear = |m: &mut Monitor| {
             m.broken = false;
             m.function.read(Reading {
                 t_s: t,
@@ -190,12 +204,20 @@ impl Trial<'_> {
                 warning: false,
                 mover_in_protective: false,
             });
-            return;
+        };
+        let Some(set) = set.copied() else {
+            return clear(m);
         };
         let root = self.world.sim.fork_root_pose();
         let fields = m
             .built
             .fields(&m.fields, &set, s.requested_mps, self.world.sim.steer_rad());
+        let latches = (&mut m.muted, &mut m.warning_muted);
+        let at_reach = (near_m, m.mute_near_target_m, m.fields.outline.front_m);
+        if mute_at_reach(self.stage, latches, at_reach, fields) && forward {
+            return clear(m);
+        }
+        let warning_muted = m.warning_muted.is_some() && forward;
         let view = WithMovers {
             sim: &self.world.sim,
             movers: &s.movers,
@@ -214,17 +236,8 @@ impl Trial<'_> {
         let reading = Reading {
             t_s: t,
             protective: intruder.is_some(),
-            warning: seen.warning,
-            mover_in_protective: intruder.is_some()
-                && s.movers.iter().any(|mv| {
-                    mv.seen().iter().any(|(p, l, w)| {
-                        let corners = forkbench_core::geometry::rect_corners(p, *l, *w);
-                        corners
-                            .iter()
-                            .chain([[p.x_m, p.y_m]].iter())
-                            .any(|c| fields.hit(local(&root, *c)).0)
-                    })
-                }),
+            warning: seen.warning && !warning_muted,
+            mover_in_protective: intruder.is_some() && mover_in_protective(s, &root, fields),
         };
         let new_break = intruder.is_some() && !m.broken && !m.function.stopped();
         m.broken = intruder.is_some();
@@ -282,4 +295,47 @@ impl Trial<'_> {
         }
         out.safety = Some(report);
     }
+}
+
+/// Without a muting distance (`near_m` the tips' distance to the target, `set_m` the
+/// scenario's muting distance, `front_m` the tips ahead of the fork root): latches the
+/// warning field muted once the target lies within its reach ahead of the tips, and every
+/// field once it lies within the protective field's; true when every field is muted.
+fn mute_at_reach(
+    stage: Stage,
+    (muted, warning_muted): (&mut Option<Stage>, &mut Option<Stage>),
+    (near_m, set_m, front_m): (Option<f64>, Option<f64>, f64),
+    fields: &Fields,
+) -> bool {
+    let (Some(near), None) = (near_m, set_m) else {
+        return muted.is_some();
+    };
+    let reach = |polys: &[Vec<[f64; 2]>]| {
+        polys
+            .iter()
+            .flatten()
+            .map(|p| p[0] - front_m)
+            .fold(0.0, f64::max)
+    };
+    if near <= reach(&fields.warning) {
+        *warning_muted = Some(stage);
+    }
+    if near <= reach(&fields.protective) {
+        *muted = Some(stage);
+    }
+    muted.is_some()
+}
+
+/// Whether a person or vehicle stands in the protective field of `fields` (the truck's
+/// fork root at `root`): a corner or the centre of what a scanner sees of one.
+fn mover_in_protective(s: &SafetyRun, root: &Pose2, fields: &Fields) -> bool {
+    s.movers.iter().any(|mv| {
+        mv.seen().iter().any(|(p, l, w)| {
+            let corners = forkbench_core::geometry::rect_corners(p, *l, *w);
+            corners
+                .iter()
+                .chain([[p.x_m, p.y_m]].iter())
+                .any(|c| fields.hit(local(root, *c)).0)
+        })
+    })
 }
