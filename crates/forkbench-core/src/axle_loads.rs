@@ -1,10 +1,10 @@
-//! Where a truck's unladen mass lies between its axles: from its declared axle loads (VDI 2198 line 2.2) or its chassis centre, and the refusal of a truck that would tip or leave an axle without grip.
+//! Where a truck's unladen mass lies between its axles: from its declared axle loads (VDI 2198 line 2.3) or its chassis centre, and the refusal of a truck that would tip or leave an axle without grip.
 
 use crate::vehicle::{ForkliftSpec, SpecError};
 
 /// The least share of the unladen weight either axle may carry: a choice. Below it that
 /// axle's tyres pass too little side force to hold the truck in a turn (in the tyre model,
-/// grip is μ times the axle's load), and real trucks' type sheets (VDI 2198 line 2.2) put
+/// grip is μ times the axle's load), and real trucks' type sheets (VDI 2198 line 2.3) put
 /// a quarter or more on each.
 pub const MIN_AXLE_SHARE: f64 = 0.05;
 
@@ -47,7 +47,7 @@ impl ForkliftSpec {
                         self.mass_kg,
                         &format!(
                             "{side} the axle loads it declares ({f} kg + {s} kg = {sum} kg): \
-                             VDI 2198's service weight (line 2.1) is their sum (line 2.2)"
+                             VDI 2198's service weight (line 2.1) is their sum (line 2.3)"
                         ),
                     ));
                 }
@@ -61,7 +61,7 @@ impl ForkliftSpec {
                 return Err(SpecError::field(
                     missing,
                     "must be given with the other axle's load: together they place the \
-                     centre of mass (VDI 2198 line 2.2)",
+                     centre of mass (VDI 2198 line 2.3)",
                 ));
             }
         };
@@ -93,7 +93,7 @@ impl ForkliftSpec {
                 &format!(
                     "without declared axle loads the bench puts the mass at the chassis \
                      centre, {:.3} m from the fixed axle: {carries}; declare \
-                     axle_load_fixed_kg and axle_load_steered_kg (VDI 2198 line 2.2)",
+                     axle_load_fixed_kg and axle_load_steered_kg (VDI 2198 line 2.3)",
                     -self.mass_centre_ahead_of_front_axle_m()
                 ),
             ),

@@ -42,13 +42,13 @@ pub struct ForkliftSpec {
     /// Fork blade thickness; when given, a pallet whose pockets are lower is refused.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fork_thickness_m: Option<f64>,
-    /// What the fixed (fork-side) axle carries unladen, VDI 2198 line 2.2 (a
+    /// What the fixed (fork-side) axle carries unladen, VDI 2198 line 2.3 (a
     /// counterbalance truck's front axle, a stacker's load wheels). Given with
     /// `axle_load_steered_kg`, the two place the truck's centre of mass; without them it
     /// sits at the chassis centre.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub axle_load_fixed_kg: Option<f64>,
-    /// What the steered wheel carries unladen, VDI 2198 line 2.2 (a counterbalance
+    /// What the steered wheel carries unladen, VDI 2198 line 2.3 (a counterbalance
     /// truck's rear axle, a stacker's drive side).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub axle_load_steered_kg: Option<f64>,

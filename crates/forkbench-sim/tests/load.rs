@@ -283,7 +283,7 @@ fn a_carried_pallet_touches_what_it_is_driven_into() {
     );
 }
 
-/// Declared axle loads (VDI 2198 line 2.2) put the unladen mass where they say: the static
+/// Declared axle loads (VDI 2198 line 2.3) put the unladen mass where they say: the static
 /// loads on the two axles are the declared ones, whatever the chassis's outline.
 #[test]
 fn declared_axle_loads_are_the_static_axle_loads() {

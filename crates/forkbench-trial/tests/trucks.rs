@@ -165,7 +165,7 @@ fn drawn() -> impl Strategy<Value = Drawn> {
                 ),
             };
             // A chassis whose centre leaves an axle less than a tenth of the weight has
-            // its mass placed by drawn axle loads instead (VDI 2198 line 2.2), as its
+            // its mass placed by drawn axle loads instead (VDI 2198 line 2.3), as its
             // type sheet would.
             let centre_share = -(root_ahead_m - l / 2.0) / y;
             let steered_share = (!(0.1..=0.9).contains(&centre_share)).then_some(share);
