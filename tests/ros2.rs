@@ -1,4 +1,4 @@
-//! ROS 2 bags (`--ros2`): the MCAP `ros2` profile, every message CDR with a ros2msg schema, and the scans equal to the ones the Foxglove MCAP of the same trial holds.
+//! ROS 2 bags (`--ros2`): a rosbag2 directory whose metadata.yaml counts its MCAP's messages, the MCAP `ros2` profile, every message CDR with a ros2msg schema, and the scans equal to the ones the Foxglove MCAP of the same trial holds.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -46,6 +46,41 @@ fn layout(bytes: &[u8]) -> Layout {
     (profile, schemas, channels)
 }
 
+/// The bytes of a bag directory's one MCAP, after checking the directory holds it and a
+/// `metadata.yaml` that names it and counts each topic's messages as the MCAP holds them.
+fn bag_bytes(dir: &Path) -> Vec<u8> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .expect("a bag directory")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort_by_key(|n| n != "metadata.yaml");
+    assert!(
+        names.len() == 2 && names[0] == "metadata.yaml" && names[1].ends_with("_0.mcap"),
+        "{names:?}"
+    );
+    let bytes = std::fs::read(dir.join(&names[1])).expect("the MCAP");
+    let yaml = std::fs::read_to_string(dir.join("metadata.yaml")).expect("metadata.yaml");
+    assert!(yaml.contains(&format!("- path: {}", names[1])), "{yaml}");
+    let mut total = 0;
+    for (topic, ms) in messages(&bytes) {
+        let entry = format!("name: {topic}\n");
+        let at = yaml
+            .find(&entry)
+            .unwrap_or_else(|| panic!("{topic} not listed: {yaml}"));
+        let count = yaml[at..]
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("message_count: "))
+            .expect("a count");
+        assert_eq!(count, ms.len().to_string(), "{topic}");
+        total += ms.len();
+    }
+    assert!(
+        yaml.contains(&format!("  message_count: {total}\n")),
+        "{yaml}"
+    );
+    bytes
+}
+
 /// Each topic's messages, in order.
 fn messages(bytes: &[u8]) -> BTreeMap<String, Vec<Vec<u8>>> {
     let mut out: BTreeMap<String, Vec<Vec<u8>>> = BTreeMap::new();
@@ -68,7 +103,7 @@ fn valid_ros2_name(topic: &str) -> bool {
 
 #[test]
 fn a_trial_writes_a_ros2_bag_whose_scans_equal_the_mcap_ones() {
-    let (bag, mcap) = (tmp("field.ros2.mcap"), tmp("field.mcap"));
+    let (bag, mcap) = (tmp("field.ros2"), tmp("field.mcap"));
     let out = Command::new(env!("CARGO_BIN_EXE_forkbench"))
         .args([
             "trial",
@@ -90,7 +125,7 @@ fn a_trial_writes_a_ros2_bag_whose_scans_equal_the_mcap_ones() {
         "{out:?}"
     );
     let outcome: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
-    let bytes = std::fs::read(&bag).expect("bag");
+    let bytes = bag_bytes(&bag);
     let (profile, schemas, channels) = layout(&bytes);
     assert_eq!(profile, "ros2");
     assert!(schemas.values().all(|(_, e)| e == "ros2msg"), "{schemas:?}");
@@ -151,7 +186,7 @@ fn a_trial_writes_a_ros2_bag_whose_scans_equal_the_mcap_ones() {
 
 #[test]
 fn a_mission_bag_has_its_map_and_routes_and_a_batch_refuses_bags_of_nothing() {
-    let bag = tmp("mission.ros2.mcap");
+    let bag = tmp("mission.ros2");
     let out = Command::new(env!("CARGO_BIN_EXE_forkbench"))
         .args([
             "mission",
@@ -167,7 +202,7 @@ fn a_mission_bag_has_its_map_and_routes_and_a_batch_refuses_bags_of_nothing() {
         out.status.code().is_some_and(|c| c == 0 || c == 3),
         "{out:?}"
     );
-    let ros = messages(&std::fs::read(&bag).expect("bag"));
+    let ros = messages(&bag_bytes(&bag));
     assert!(
         ros.keys().any(|t| t.starts_with("/grid/nav")),
         "{:?}",
@@ -189,6 +224,50 @@ fn a_mission_bag_has_its_map_and_routes_and_a_batch_refuses_bags_of_nothing() {
         .expect("runs");
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--record none records none"));
+}
+
+/// A bag's name ending .mcap is refused (the bag is a directory), and `--force` replaces
+/// only a bag directory forkbench wrote: one holding anything else is refused and kept.
+#[test]
+fn a_bag_directory_replaces_only_a_bag_forkbench_wrote() {
+    let run = |bag: &Path, force: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_forkbench"));
+        c.args(["trial", &repo("scenarios/field-test.toml"), "--no-noise"])
+            .args(["--ros2", bag.to_str().expect("utf-8")]);
+        if force {
+            c.arg("--force");
+        }
+        c.output().expect("runs")
+    };
+    let named = tmp("named.mcap");
+    let out = run(&named, true);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("rosbag2 directory"));
+    assert!(!named.exists());
+    let bag = tmp("again.ros2");
+    assert!(run(&bag, false).status.success());
+    let first = bag_bytes(&bag);
+    let out = run(&bag, false);
+    assert_eq!(out.status.code(), Some(1), "exists, no --force");
+    assert!(run(&bag, true).status.success());
+    let counts = |b: &[u8]| -> Vec<(String, usize)> {
+        messages(b).into_iter().map(|(t, m)| (t, m.len())).collect()
+    };
+    assert_eq!(
+        counts(&bag_bytes(&bag)),
+        counts(&first),
+        "replaced by the same trial"
+    );
+    std::fs::write(bag.join("notes.txt"), "mine").expect("write");
+    let out = run(&bag, true);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("notes.txt"));
+    assert_eq!(
+        std::fs::read_to_string(bag.join("notes.txt"))
+            .ok()
+            .as_deref(),
+        Some("mine")
+    );
 }
 
 fn detect(args: &[&str]) -> std::process::Output {
@@ -250,7 +329,7 @@ fn detect_reads_a_bag_rosbags_wrote_and_scores_it_against_labels() {
 /// by the bag's /tf), give the trial's own detections.
 #[test]
 fn a_trials_scans_through_its_bag_and_detect_give_its_estimates() {
-    let (bag, lines) = (tmp("replan.ros2.mcap"), tmp("replan.jsonl"));
+    let (bag, lines) = (tmp("replan.ros2"), tmp("replan.jsonl"));
     let out = Command::new(env!("CARGO_BIN_EXE_forkbench"))
         .args([
             "trial",
@@ -284,7 +363,7 @@ fn a_trials_scans_through_its_bag_and_detect_give_its_estimates() {
         .lines()
         .map(|l| serde_json::from_str(l).expect("JSON"))
         .collect();
-    let msgs = messages(&std::fs::read(&bag).expect("bag"));
+    let msgs = messages(&bag_bytes(&bag));
     let detections = &msgs["/pose/sensors/pallet_detection"];
     assert!(detections.len() >= 2, "{}", detections.len());
     for d in detections {

@@ -1,15 +1,17 @@
 #!/usr/bin/env python3
-"""Checks a forkbench ROS 2 bag (`trial --ros2 FILE`) with two independent readers: mcap-ros2-support decodes every message with the bag's own ros2msg schemas, and rosbags deserialises the CDR with its built-in ROS 2 Humble definitions (not the bag's), so a schema and an encoding that agree with each other but not with ROS 2 fail.
+"""Checks a forkbench ROS 2 bag (`trial --ros2 DIR`, a rosbag2 directory) with two independent readers: rosbags opens the directory by its metadata.yaml as `ros2 bag play` does (its counts must match the messages) and deserialises the CDR with its built-in ROS 2 Humble definitions (not the bag's), and mcap-ros2-support decodes every message with the bag's own ros2msg schemas, so a schema and an encoding that agree with each other but not with ROS 2 fail.
 
-usage: check_ros2.py BAG.mcap OUTCOME.json [--mission]
+usage: check_ros2.py BAG_DIR OUTCOME.json [--mission]
 """
 
 import json
 import math
 import sys
+from pathlib import Path
 
 from mcap.reader import make_reader
 from mcap_ros2.reader import read_ros2_messages
+from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 # ackermann_msgs is not among Humble's core definitions: its published .msg files, as
@@ -22,9 +24,22 @@ ACKERMANN = {
 
 
 def main() -> None:
-    bag, outcome_file = sys.argv[1], sys.argv[2]
+    bag_dir, outcome_file = Path(sys.argv[1]), sys.argv[2]
     mission = "--mission" in sys.argv[3:]
     outcome = json.load(open(outcome_file))
+    # The directory as rosbag2 opens it: metadata.yaml names the MCAP and counts each
+    # topic's messages, which must be the messages the MCAP holds.
+    with Reader(bag_dir) as r:
+        listed = {c.topic: c.msgcount for c in r.connections}
+        found = {}
+        for c, _, _ in r.messages():
+            found[c.topic] = found.get(c.topic, 0) + 1
+        assert {t: n for t, n in listed.items() if n} == found, (listed, found)
+        assert r.message_count == sum(found.values())
+    files = sorted(bag_dir.glob("*.mcap"))
+    assert len(files) == 1 and sorted(p.name for p in bag_dir.iterdir()) == sorted(
+        ["metadata.yaml", files[0].name]), list(bag_dir.iterdir())
+    bag = str(files[0])
     with open(bag, "rb") as f:
         reader = make_reader(f)
         header = reader.get_header()
@@ -81,7 +96,7 @@ def main() -> None:
     assert any(m.drive.steering_angle != 0 for m in got) and any(m.drive.speed > 0 for m in got)
     levels = {m.level for m in decoded["/rosout"]}
     assert levels <= {20, 30, 40}, levels
-    print(f"ros2 bag ok: {count} messages on {len(decoded)} topics, {len(scans)} scans, "
+    print(f"ros2 bag directory ok: {count} messages on {len(decoded)} topics, {len(scans)} scans, "
           f"{len(root)} fork-root transforms, outcome {'success' if last['success'] else last['failure']}")
 
 

@@ -32,12 +32,25 @@ fn recording_names(dir: &Path) -> std::collections::HashSet<String> {
     for r in &records {
         for replan in [false, true] {
             let stem = r.outcome.recording_stem(replan);
-            for ext in ["rrd", "mcap", "ros2.mcap"] {
+            // `ros2.mcap`: a bag as batches wrote it before bags became directories.
+            for ext in ["rrd", "mcap", "ros2", "ros2.mcap"] {
                 names.insert(format!("{stem}.{ext}"));
             }
         }
     }
     names
+}
+
+/// Whether `path` holds only what a batch's `--ros2` bag directory holds (its
+/// `metadata.yaml` and MCAP files): a folder with anything else in it is not deleted.
+fn is_bag_dir(path: &Path) -> bool {
+    std::fs::read_dir(path).is_ok_and(|entries| {
+        entries.flatten().all(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            e.file_type().is_ok_and(|t| t.is_file())
+                && (name == "metadata.yaml" || name.ends_with(".mcap"))
+        })
+    })
 }
 
 impl BatchSpec {
@@ -74,8 +87,14 @@ impl BatchSpec {
             for entry in std::fs::read_dir(&rec).map_err(io(&rec))?.flatten() {
                 let path = entry.path();
                 let name = entry.file_name().to_string_lossy().into_owned();
-                if ours_recorded.contains(&name) && entry.file_type().is_ok_and(|t| t.is_file()) {
+                if !ours_recorded.contains(&name) {
+                    continue;
+                }
+                let kind = entry.file_type();
+                if kind.as_ref().is_ok_and(std::fs::FileType::is_file) {
                     remove_if_present(&path)?;
+                } else if kind.is_ok_and(|t| t.is_dir()) && is_bag_dir(&path) {
+                    std::fs::remove_dir_all(&path).map_err(io(&path))?;
                 }
             }
             // Left in place when anything else is in it.

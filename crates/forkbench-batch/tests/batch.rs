@@ -241,10 +241,24 @@ fn force_new_deletes_only_the_recordings_of_its_trials() {
     std::fs::write(&batch_own, "the batch's").expect("write");
     let mine = rec.join("my-review.rrd");
     std::fs::write(&mine, "mine").expect("write");
+    // Its ROS 2 bags are directories: one holding only a bag's files is the batch's, one
+    // with a file of yours in it is kept whole.
+    let bag = rec.join(format!("{}.ros2", records[0].outcome.recording_stem(false)));
+    std::fs::create_dir_all(&bag).expect("dir");
+    std::fs::write(bag.join("metadata.yaml"), "x").expect("write");
+    std::fs::write(bag.join("b_0.mcap"), "x").expect("write");
+    let my_bag = rec.join(format!("{}.ros2", records[1].outcome.recording_stem(false)));
+    std::fs::create_dir_all(&my_bag).expect("dir");
+    std::fs::write(my_bag.join("notes.txt"), "mine").expect("write");
     base.force_new = true;
     batch::run_batch(&base, &d, 2, &|_| {}).expect("starts over");
     assert!(!batch_own.exists(), "the batch's recording is deleted");
+    assert!(!bag.exists(), "the batch's bag directory is deleted");
     assert_eq!(std::fs::read_to_string(&mine).expect("kept"), "mine");
+    assert_eq!(
+        std::fs::read_to_string(my_bag.join("notes.txt")).expect("kept"),
+        "mine"
+    );
 }
 
 /// Trials a directory holds from another build are not resumed: one verdict would mix

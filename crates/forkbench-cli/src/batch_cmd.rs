@@ -100,8 +100,9 @@ pub struct BatchArgs {
     /// Which trials to record as .rrd and .mcap under OUT/recordings/.
     #[arg(long, value_enum, default_value_t = RecordWhich::Failures)]
     pub record: RecordWhich,
-    /// Also write each recorded trial as a ROS 2 bag, `<stem>.ros2.mcap` (the MCAP `ros2`
-    /// profile: CDR messages with ros2msg schemas, for `ros2 bag play`, RViz, rosbags).
+    /// Also write each recorded trial as a ROS 2 bag, the rosbag2 directory `<stem>.ros2`
+    /// (metadata.yaml and an MCAP of the `ros2` profile: CDR messages with ros2msg
+    /// schemas, for `ros2 bag play`, RViz, rosbags).
     #[arg(long)]
     pub ros2: bool,
     /// At most this many recordings, spread over scenario × case × failure × mode (one

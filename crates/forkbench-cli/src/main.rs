@@ -63,8 +63,9 @@ pub(crate) struct RecordFlags {
     /// Write an MCAP log to FILE (.mcap).
     #[arg(long)]
     mcap: Option<PathBuf>,
-    /// Write a ROS 2 bag to FILE (.mcap, the ros2 profile: CDR messages, ros2msg schemas).
-    #[arg(long)]
+    /// Write a ROS 2 bag to DIR: a rosbag2 directory (metadata.yaml and DIR_0.mcap, the
+    /// ros2 profile: CDR messages, ros2msg schemas) that `ros2 bag play DIR` opens.
+    #[arg(long, value_name = "DIR")]
     ros2: Option<PathBuf>,
     /// Write the actuator log to FILE (.csv: t_s, steer_cmd_rad, steer_rad, speed_cmd_mps,
     /// speed_mps at every physics step), what `identify` reads.

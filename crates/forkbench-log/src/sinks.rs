@@ -16,7 +16,7 @@ use crate::{RerunRecorder, RerunTarget};
 pub struct RecordTargets {
     pub rrd: Option<PathBuf>,
     pub mcap: Option<PathBuf>,
-    /// A ROS 2 bag (MCAP, `ros2` profile).
+    /// A ROS 2 bag: a rosbag2 directory (`metadata.yaml` and an MCAP, `ros2` profile).
     pub ros2: Option<PathBuf>,
     /// The actuator log as CSV (what `forkbench identify` reads).
     pub actuator_csv: Option<PathBuf>,
@@ -83,7 +83,6 @@ impl Sinks {
                         .into(),
                 });
             }
-            check_writable(p, a.force)?;
             forkbench_core::files::check_not_input(p, &a.inputs).map_err(|e| LogError::Io {
                 path: p.display().to_string(),
                 message: match e {
@@ -93,6 +92,11 @@ impl Sinks {
                     other => other.to_string(),
                 },
             })?;
+            if a.ros2.as_ref() == Some(*p) {
+                crate::ros2::check_bag_dir(p, a.force)?;
+            } else {
+                check_writable(p, a.force)?;
+            }
         }
         let (rerun, viewer_error) = open_rerun(a)?;
         let ros2 = a
@@ -238,7 +242,7 @@ pub fn run_recorded(
 }
 
 /// Re-runs one trial of a scenario into `<dir>/<stem>.{rrd,mcap}` (the stem is
-/// [`TrialOutcome::recording_stem`]), and `<stem>.ros2.mcap` with `ros2`; returns the
+/// [`TrialOutcome::recording_stem`]), and the bag directory `<stem>.ros2` with `ros2`; returns the
 /// outcome and the .rrd's path.
 pub fn record_trial(
     scn: &Scenario,
@@ -257,7 +261,7 @@ pub fn record_trial(
     let targets = RecordTargets {
         rrd: Some(rrd.clone()),
         mcap: Some(dir.join(format!("{stem}.mcap"))),
-        ros2: ros2.then(|| dir.join(format!("{stem}.ros2.mcap"))),
+        ros2: ros2.then(|| dir.join(format!("{stem}.ros2"))),
         force: true,
         ..RecordTargets::default()
     };

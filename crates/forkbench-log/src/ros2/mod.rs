@@ -1,5 +1,6 @@
-//! A trial recorded as a ROS 2 bag: MCAP with the `ros2` profile, `ros2msg` schemas and CDR messages (`/tf`, poses, plans, laser scans, maps, markers, `/rosout`, the outcome), so `ros2 bag play`, RViz and rosbags-based analysis read it.
+//! A trial recorded as a ROS 2 bag: a rosbag2 directory (`metadata.yaml` and an MCAP with the `ros2` profile, `ros2msg` schemas and CDR messages: `/tf`, poses, plans, laser scans, maps, markers, `/rosout`, the outcome), so `ros2 bag play`, RViz and rosbags-based analysis read it.
 
+pub mod bag_dir;
 pub mod cdr;
 pub mod msgs;
 pub mod scan_bag;
@@ -42,9 +43,15 @@ const TOPICS: [(&str, &MsgType); 10] = [
     ("/forkbench/outcome", &msgs::STRING_MSG),
 ];
 
-/// Records a trial as a ROS 2 bag in one MCAP file, written as the trial runs.
+/// Records a trial as a ROS 2 bag directory, its MCAP written as the trial runs.
 pub struct Ros2Recorder {
     path: String,
+    /// The MCAP's name in the directory, as `metadata.yaml` lists it.
+    file_name: String,
+    /// Every topic's type and message count, for `metadata.yaml`.
+    counts: BTreeMap<String, (&'static str, u64)>,
+    /// The first and last messages' stamps (ns since the Unix epoch).
+    span_ns: Option<(u64, u64)>,
     writer: Option<mcap::Writer<BufWriter<File>>>,
     schemas: BTreeMap<&'static str, u16>,
     channels: BTreeMap<String, u16>,
@@ -52,8 +59,8 @@ pub struct Ros2Recorder {
     /// The last pallet estimate written, so a new one is written when it changes.
     pallet_estimate: Option<Pose2>,
     error: Option<String>,
-    /// The file being written beside the path, renamed onto it when all went well.
-    partial: Option<forkbench_core::files::Partial>,
+    /// The directory being built beside the path, renamed onto it when all went well.
+    out: Option<forkbench_core::out_dir::OutDir>,
 }
 
 impl std::fmt::Debug for Ros2Recorder {
@@ -63,15 +70,18 @@ impl std::fmt::Debug for Ros2Recorder {
 }
 
 impl Ros2Recorder {
-    /// Creates the bag for `path` (checked beforehand with [`crate::check_writable`]) with
-    /// the trial's metadata record; it appears at `path` when [`Self::finish`] succeeds.
+    /// Creates the bag directory for `path` (checked beforehand with
+    /// [`check_bag_dir`]) with the trial's metadata record; it appears at `path` when
+    /// [`Self::finish`] succeeds.
     pub fn create(path: &FsPath, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
         let p = path.display().to_string();
         let io = |e: &dyn std::error::Error| LogError::Io {
             path: p.clone(),
             message: with_causes(e),
         };
-        let (partial, file) = forkbench_core::files::Partial::create(path)?;
+        let out = forkbench_core::out_dir::OutDir::create(path)?;
+        let file_name = mcap_name(path);
+        let file = File::create_new(out.file(&file_name)).map_err(|e| io(&e))?;
         let mut writer = mcap::WriteOptions::new()
             .profile("ros2")
             .chunk_size(Some(256 * 1024))
@@ -87,13 +97,16 @@ impl Ros2Recorder {
             .map_err(|e| io(&e))?;
         let mut me = Self {
             path: p,
+            file_name,
+            counts: BTreeMap::new(),
+            span_ns: None,
             writer: Some(writer),
             schemas: BTreeMap::new(),
             channels: BTreeMap::new(),
             sequence: 0,
             pallet_estimate: None,
             error: None,
-            partial: Some(partial),
+            out: Some(out),
         };
         for (topic, ty) in TOPICS {
             me.channel(topic, ty);
@@ -112,11 +125,26 @@ impl Ros2Recorder {
                 self.error.get_or_insert(e.to_string());
             }
         }
-        let partial = self.partial.take();
+        let out = self.out.take();
         if self.error.is_none()
-            && let Some(Err(e)) = partial.map(forkbench_core::files::Partial::commit)
+            && let Some(out) = out
         {
-            self.error = Some(e.reason());
+            let topics: Vec<bag_dir::TopicCount> = self
+                .counts
+                .iter()
+                .map(|(name, (ty, count))| bag_dir::TopicCount {
+                    name: name.clone(),
+                    ty,
+                    count: *count,
+                })
+                .collect();
+            let yaml = bag_dir::metadata_yaml(&self.file_name, &topics, self.span_ns);
+            let written =
+                forkbench_core::files::write_atomic(&out.file("metadata.yaml"), yaml.as_bytes())
+                    .and_then(|()| out.commit());
+            if let Err(e) = written {
+                self.error = Some(e.reason());
+            }
         }
         match self.error.take() {
             Some(message) => Err(LogError::Io {
@@ -144,6 +172,7 @@ impl Ros2Recorder {
         match id {
             Ok(id) => {
                 self.channels.insert(topic.to_owned(), id);
+                self.counts.insert(topic.to_owned(), (ty.name, 0));
                 Some(id)
             }
             Err(e) => {
@@ -162,6 +191,13 @@ impl Ros2Recorder {
         };
         self.sequence += 1;
         let ns = msgs::unix_ns(t_s);
+        if let Some((_, n)) = self.counts.get_mut(topic) {
+            *n += 1;
+        }
+        self.span_ns = Some(
+            self.span_ns
+                .map_or((ns, ns), |(a, b)| (a.min(ns), b.max(ns))),
+        );
         let header = mcap::records::MessageHeader {
             channel_id,
             sequence: self.sequence,
@@ -172,6 +208,39 @@ impl Ros2Recorder {
             self.error.get_or_insert(with_causes(&e));
         }
     }
+}
+
+/// The MCAP's name inside the bag directory at `path`: rosbag2's `<bag>_0.mcap`, the
+/// bag named by the directory without a `.ros2` ending.
+fn mcap_name(path: &FsPath) -> String {
+    let name = path
+        .file_name()
+        .map_or_else(|| "bag".to_owned(), |n| n.to_string_lossy().into_owned());
+    let bag = name
+        .strip_suffix(".ros2")
+        .filter(|b| !b.is_empty())
+        .unwrap_or(&name);
+    format!("{bag}_0.mcap")
+}
+
+/// Checks before a run that a bag directory can be written at `path` without touching
+/// it: a name not ending `.mcap` (a directory so named reads as a file), absent unless
+/// `force`, and then a bag directory forkbench wrote.
+pub fn check_bag_dir(path: &FsPath, force: bool) -> Result<(), LogError> {
+    forkbench_core::out_dir::check_out_dir(path, force, bag_dir::is_bag_file)?;
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+    {
+        return Err(LogError::Io {
+            path: path.display().to_string(),
+            message: "--ros2 writes a rosbag2 directory (metadata.yaml and its MCAP, what \
+                      `ros2 bag play` opens), so its name does not end .mcap; give a \
+                      directory's name, e.g. trial.ros2 (--mcap writes one MCAP file)"
+                .into(),
+        });
+    }
+    Ok(())
 }
 
 /// The scene's markers: racks and walls as boxes in the map; the truck's and the pallet's

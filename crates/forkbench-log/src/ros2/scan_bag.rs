@@ -103,22 +103,12 @@ impl ScanBag {
     /// bag play` and rosbags' reader open), the bag being `file` in it: rosbag2's
     /// version 5 layout (ROS 2 Humble), MCAP storage, the scan topic with its count.
     pub fn rosbag2_metadata(&self, file: &str) -> String {
-        let (start, end) = self.span_ns.unwrap_or((0, 0));
-        let (n, duration) = (self.written, end - start);
-        format!(
-            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  \
-             duration:\n    nanoseconds: {duration}\n  starting_time:\n    \
-             nanoseconds_since_epoch: {start}\n  message_count: {n}\n  \
-             topics_with_message_count:\n    - topic_metadata:\n        name: {topic}\n        \
-             type: {ty}\n        serialization_format: cdr\n        \
-             offered_qos_profiles: \"\"\n      message_count: {n}\n  \
-             compression_format: \"\"\n  compression_mode: \"\"\n  relative_file_paths:\n    \
-             - {file}\n  files:\n    - path: {file}\n      starting_time:\n        \
-             nanoseconds_since_epoch: {start}\n      duration:\n        nanoseconds: {duration}\n      \
-             message_count: {n}\n",
-            topic = self.topic,
-            ty = msgs::LASER_SCAN_MSG.name,
-        )
+        let topic = super::bag_dir::TopicCount {
+            name: self.topic.clone(),
+            ty: msgs::LASER_SCAN_MSG.name,
+            count: u64::from(self.written),
+        };
+        super::bag_dir::metadata_yaml(file, &[topic], self.span_ns)
     }
 
     /// Finishes the file and moves it into place; on an error nothing appears at the path.
