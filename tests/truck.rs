@@ -200,6 +200,36 @@ fn a_trials_mcap_bag_and_actuator_log_are_identified() {
     );
 }
 
+/// A trial's text names the truck that ran it, after any `--truck`: its layout (which way
+/// the forks face), wheelbase, mass and forks.
+#[test]
+fn a_trials_text_names_the_truck_that_ran() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scn = root.join("scenarios/field-test.toml");
+    let efg = root.join("trucks/jungheinrich-efg-320.toml");
+    for (extra, says) in [
+        (
+            vec![],
+            "counterbalance: fixed front axle drives, rear wheels steer, forks leading; wheelbase 1.629 m, 4850 kg",
+        ),
+        (
+            vec!["--truck", s(&efg)],
+            "counterbalance: fixed front axle drives, rear wheels steer, forks leading; wheelbase 1.508 m, 3306 kg",
+        ),
+    ] {
+        let mut args = vec!["trial", s(&scn), "--no-noise"];
+        args.extend(extra);
+        let t = text(&forkbench(&args));
+        assert!(t.contains(&format!("truck                {says}")), "{t}");
+    }
+    let stacker = root.join("scenarios/field-test-stacker.toml");
+    let t = text(&forkbench(&["trial", s(&stacker), "--no-noise"]));
+    assert!(
+        t.contains("pallet stacker") && t.contains("enters the pallet in reverse"),
+        "{t}"
+    );
+}
+
 #[test]
 fn bad_truck_files_and_logs_are_refused_naming_where() {
     let bad = tmp("bad.toml");

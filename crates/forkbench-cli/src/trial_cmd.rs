@@ -60,7 +60,7 @@ pub fn run(
             .profile
             .as_ref()
             .map_or(String::new(), |p| p.lines("profile ").join("\n") + "\n");
-        crate::mission_report::legs_text(&out) + &text_report(&out) + &profile
+        crate::mission_report::legs_text(&out) + &text_report(&out, &run.truck) + &profile
     };
     crate::emit(&text)?;
     written.context("writing the recording")?;
@@ -82,8 +82,8 @@ fn json_report(out: &TrialOutcome) -> anyhow::Result<String> {
     Ok(format!("{v}\n"))
 }
 
-/// The pick's outcome as aligned text lines.
-fn text_report(out: &TrialOutcome) -> String {
+/// The pick's outcome as aligned text lines, after the truck that ran it.
+fn text_report(out: &TrialOutcome, truck: &forkbench_core::ForkliftSpec) -> String {
     // A trial that failed before driving has no final pose: "–", not "NaN m".
     let num = |v: f64, digits: usize, unit: &str| {
         if v.is_finite() {
@@ -97,6 +97,13 @@ fn text_report(out: &TrialOutcome) -> String {
     };
     let mut lines = verdict_lines(out);
     lines.extend([
+        format!(
+            "truck                {}; wheelbase {:.3} m, {:.0} kg, forks {:.3} m",
+            truck.layout.describe(),
+            truck.wheelbase_m,
+            truck.mass_kg,
+            truck.fork_length_m
+        ),
         format!(
             "lateral error entry  {}",
             opt(out.lateral_error_m, 1.0, "m")
