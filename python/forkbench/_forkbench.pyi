@@ -26,7 +26,9 @@ class RunOptions(TypedDict, total=False):
     pallet_sensing: str | None
     missing_reflectors: Sequence[str] | None
     truck_preset: str | None
-    truck: Mapping[str, float] | None
+    truck: Mapping[str, float | str] | None
+    """Truck settings by dotted path (`steering.dead_time_s`, `wheelbase_m`), numbers but
+    for `layout`, a name: `counterbalance`, `pallet_stacker`, `reach_truck`."""
 
 Outcome: TypeAlias = dict[str, Any]
 """A judged trial: the CLI's `trial --json` record (a batch's also has `trial`, `replan`)."""

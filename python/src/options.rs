@@ -26,12 +26,33 @@ pub fn overrides(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Overrides> {
         }
         let bad = |why: String| PyTypeError::new_err(format!("{key}: {why}"));
         let text = crate::convert::json_text(&v).map_err(|e| bad(e.to_string()))?;
-        let value: serde_json::Value =
+        let mut value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| bad(format!("{text}: {e}")))?;
+        if key == "truck" {
+            layout_as_code(&mut value).map_err(bad)?;
+        }
         let one = serde_json::Value::Object([(key.clone(), value.clone())].into_iter().collect());
         serde_json::from_value::<Overrides>(one).map_err(|e| bad(e.to_string()))?;
         map.insert(key, value);
     }
     serde_json::from_value(serde_json::Value::Object(map))
         .map_err(|e| PyTypeError::new_err(e.to_string()))
+}
+
+/// A truck's `layout` given by name (`"pallet_stacker"`, as a truck file says it) rides
+/// among the numeric settings as its code, as the truck file's reader puts it.
+fn layout_as_code(truck: &mut serde_json::Value) -> Result<(), String> {
+    let Some(slot) = truck.get_mut("layout") else {
+        return Ok(());
+    };
+    if let Some(name) = slot.as_str() {
+        let layout = forkbench_core::TruckLayout::from_key(name).ok_or_else(|| {
+            format!(
+                "layout: unknown layout {name:?} (known: {})",
+                forkbench_core::TruckLayout::keys()
+            )
+        })?;
+        *slot = serde_json::Value::from(layout.code());
+    }
+    Ok(())
 }

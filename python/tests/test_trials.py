@@ -175,6 +175,10 @@ def test_a_runs_truck_is_its_actuators_timing_and_geometry():
     assert run(truck={"wheelbase_m": 2.0})["lateral_error_m"] != default["lateral_error_m"]
     with pytest.raises(forkbench.ScenarioError, match="wheelbase_m"):
         run(truck={"wheelbase_m": -1.0})
+    # The layout by its name, as a truck file gives it.
+    assert run(truck={"layout": "counterbalance"}) == default
+    with pytest.raises(TypeError, match="unknown layout"):
+        run(truck={"layout": "sideways"})
 
 
 def test_a_tracker_from_a_components_file_runs_on_any_scenario(tmp_path):
