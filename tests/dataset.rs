@@ -140,6 +140,8 @@ fn bad_specs_and_outputs_are_refused_naming_why() {
         ("range_m = [5.0, 2.0]\n", "range_m"),
         ("colour = 1\n", "colour"),
         ("present_fraction = 1.5\n", "present_fraction"),
+        ("prior_error_m = -0.1\n", "prior_error_m"),
+        ("prior_error_deg = 90\n", "prior_error_deg"),
         ("scanner = \"velodyne\"\n", "velodyne"),
     ] {
         std::fs::write(&spec, body).expect("spec");
@@ -390,4 +392,74 @@ fn labels_the_scores_cannot_use_are_warned_of() {
         2
     );
     let _ = std::fs::remove_dir_all(dir.parent().expect("folder"));
+}
+
+/// Each scan's label carries the prior the set was drawn with (near the face, or where a
+/// pallet would stand), and `detect --labels` hands it to the detector: the RANSAC
+/// example, which fits best near its prior, finds many more faces with the labels' priors
+/// than without; `--prior` beside them is refused.
+#[test]
+fn a_sets_priors_reach_the_detector() {
+    let dir = tmp_in("dataset-prior", "set");
+    let o = forkbench(&["dataset", "--out", s(&dir), "--scans", "60", "--seed", "2"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let labels: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("labels.json")).expect("labels"))
+            .expect("json");
+    let mut bare = labels.clone();
+    for l in labels["scans"].as_array().expect("scans") {
+        let p = &l["prior"];
+        assert!(p["x_m"].is_f64() && p["heading_deg"].is_f64(), "{l}");
+        if l["present"] == true {
+            let off = (p["x_m"].as_f64().expect("x") - l["face"]["x_m"].as_f64().expect("x"))
+                .hypot(p["y_m"].as_f64().expect("y") - l["face"]["y_m"].as_f64().expect("y"));
+            assert!(off < 0.6, "a prior 6 σ off its face: {l}");
+        }
+    }
+    for l in bare["scans"].as_array_mut().expect("scans") {
+        l.as_object_mut().expect("object").remove("prior");
+    }
+    let bare_file = dir.join("bare.json");
+    std::fs::write(&bare_file, bare.to_string()).expect("write");
+    let components = dir.join("components.toml");
+    let ransac =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/detectors/ransac.py");
+    std::fs::write(
+        &components,
+        format!(
+            "[[detector]]\nname = \"ransac\"\nkind = \"external\"\ncommand = [\"python3\", {:?}]\ntimeout_s = 10.0\n",
+            ransac.display().to_string()
+        ),
+    )
+    .expect("components");
+    let recall = |labels: &std::path::Path| {
+        let o = forkbench(&[
+            "detect",
+            s(&dir.join("scans.mcap")),
+            "--labels",
+            s(labels),
+            "--components",
+            s(&components),
+            "--detector",
+            "ransac",
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        json(&o)["scores"]["recall"].as_f64().expect("recall")
+    };
+    let (with, without) = (recall(&dir.join("labels.json")), recall(&bare_file));
+    assert!(
+        with > 0.3 && without < 0.1,
+        "recall {with} with priors, {without} without"
+    );
+    let o = forkbench(&[
+        "detect",
+        s(&dir.join("scans.mcap")),
+        "--labels",
+        s(&dir.join("labels.json")),
+        "--prior",
+        "5,0,180",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("each scan its own"), "{}", text(&o));
 }

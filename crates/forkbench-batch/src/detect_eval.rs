@@ -18,6 +18,10 @@ pub struct Label {
     pub present: bool,
     #[serde(default)]
     pub face: Option<LabelFace>,
+    /// Where the detector is told to look for this scan, as `forkbench dataset` writes
+    /// it: `detect --labels` hands it to the detector.
+    #[serde(default)]
+    pub prior: Option<LabelFace>,
     /// The pallet's kind, as `forkbench dataset` writes it (`pallet_kind epal-1`): a
     /// label of another kind than the pallet the detector looks for is named
     /// ([`label_problems`]).
@@ -273,6 +277,7 @@ mod tests {
                 index,
                 present,
                 face,
+                prior: None,
                 kind: None,
                 clutter: Vec::new(),
             },

@@ -229,7 +229,9 @@ fn holds_a_set(labels: &Path) -> bool {
 
 /// One scan's label as JSON.
 fn label(kind: &str, s: &Sample) -> serde_json::Value {
-    let mut v = json!({"index": s.index, "present": s.face.is_some(), "clutter": s.clutter});
+    let p = &s.prior;
+    let prior = json!({"x_m": p.x_m, "y_m": p.y_m, "heading_deg": p.heading_rad.to_degrees()});
+    let mut v = json!({"index": s.index, "present": s.face.is_some(), "clutter": s.clutter, "prior": prior});
     if let Some(f) = s.face {
         v["face"] = json!({"x_m": f.x_m, "y_m": f.y_m, "heading_deg": f.heading_rad.to_degrees()});
         v["kind"] = json!(kind);

@@ -48,7 +48,8 @@ pub struct DetectArgs {
     #[arg(long)]
     frame: Option<String>,
     /// Where the pallet should be, `x,y,heading_deg` in that frame (heading into the
-    /// pallet); without it the detector searches the whole scan.
+    /// pallet), for every scan; without it each scan's prior from --labels (as `forkbench
+    /// dataset` writes them), else none: the detector searches the whole scan.
     #[arg(long, value_parser = crate::parse_pose, allow_hyphen_values = true)]
     prior: Option<Pose2>,
     /// Labels (JSON: {"scans": [{"index": 0, "present": true, "face": {"x_m": …, "y_m": …,
@@ -103,6 +104,18 @@ impl DetectArgs {
             }
             None => None,
         };
+        let per_scan = labels
+            .as_ref()
+            .is_some_and(|l| l.values().any(|l| l.prior.is_some()));
+        if self.prior.is_some() && per_scan {
+            bail!(
+                "--prior gives every scan one prior, and {} gives each scan its own: drop \
+                 one (the labels' priors are what the set was drawn with)",
+                self.labels
+                    .as_deref()
+                    .map_or(String::new(), |f| f.display().to_string())
+            );
+        }
         let gate = Gate {
             position_m: self.match_m,
             heading_rad: self.match_deg.to_radians(),
@@ -136,6 +149,21 @@ struct Tally {
     seconds: f64,
 }
 
+/// What the detector is run with: the flags, and each scan's prior from the labels.
+fn options(a: &DetectArgs, labels: Option<&BTreeMap<usize, Label>>) -> DetectOptions {
+    DetectOptions {
+        topics: a.topic.clone(),
+        frame: a.frame.clone(),
+        prior: a.prior,
+        priors: labels
+            .into_iter()
+            .flatten()
+            .filter_map(|(i, l)| Some((*i, l.prior.as_ref()?.pose())))
+            .collect(),
+        min_score: a.min_score,
+    }
+}
+
 /// Runs `forkbench detect`: reads, detects, writes the lines, scores, prints.
 pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
     let (gate, labels) = a.check()?;
@@ -144,12 +172,7 @@ pub fn run(a: &DetectArgs) -> anyhow::Result<()> {
         a.components.as_deref(),
     )?;
     let (name, mut detector) = build_detector(a, &scn)?;
-    let opts = DetectOptions {
-        topics: a.topic.clone(),
-        frame: a.frame.clone(),
-        prior: a.prior,
-        min_score: a.min_score,
-    };
+    let opts = options(a, labels.as_ref());
     if let Some(out) = &a.out {
         forkbench_core::files::check_not_input(out, std::slice::from_ref(&a.bag))?;
     }

@@ -19,8 +19,11 @@ pub struct DetectOptions {
     /// bag's transforms; `None`: each scan's `frame_id` (a ROS 2 scanner's own frame, or
     /// the frame a forkbench scan's pose is given in).
     pub frame: Option<String>,
-    /// Where the pallet should be, in that frame.
+    /// Where the pallet should be, in that frame, for every scan.
     pub prior: Option<Pose2>,
+    /// Where the pallet should be for the scan of each index (a labelled set's own
+    /// priors), before `prior`.
+    pub priors: std::collections::BTreeMap<usize, Pose2>,
     /// Least evidence score (`forkbench_sensors::evidence`) a located face needs to be
     /// reported found: below it the scan says there is no pallet there.
     pub min_score: f64,
@@ -179,7 +182,7 @@ fn one(
     let req = DetectRequest {
         scans: &views,
         pallet,
-        prior: opts.prior,
+        prior: opts.priors.get(&index).copied().or(opts.prior),
     };
     let v = verified(detector, &req, opts.min_score)?;
     match &v.chosen {

@@ -24,6 +24,9 @@ pub struct Sample {
     pub scan: Scan,
     /// The pallet's face centre, heading into the pallet; `None`: no pallet in the scene.
     pub face: Option<Pose2>,
+    /// Where the detector is told to look: the face (or, without a pallet, where one
+    /// would stand) off by the spec's prior error.
+    pub prior: Pose2,
     /// The clutter placed, in order.
     pub clutter: Vec<&'static str>,
 }
@@ -47,6 +50,7 @@ pub fn sample(
     let mut presence = stream(spec.seed, index, "presence");
     let present = presence.random_bool(spec.present_fraction);
     let face = present.then(|| scene::draw_face(spec, &mut stream(spec.seed, index, "pallet")));
+    let prior = prior_of(spec, face, index);
     let view = (scanner.range_max_m, scanner.fov_rad / 2.0);
     let scene = scene::build(
         spec,
@@ -72,8 +76,23 @@ pub fn sample(
         index,
         scan,
         face,
+        prior,
         clutter: scene.clutter,
     }
+}
+
+/// The prior of scan `index`: its face (or one drawn where a pallet would stand) off by
+/// a Gaussian error of the spec's σ, from streams of their own.
+fn prior_of(spec: &DatasetSpec, face: Option<Pose2>, index: usize) -> Pose2 {
+    let at =
+        face.unwrap_or_else(|| scene::draw_face(spec, &mut stream(spec.seed, index, "prior slot")));
+    let mut rng = stream(spec.seed, index, "prior");
+    let mut z = || -> f64 { rng.sample(rand_distr::StandardNormal) };
+    Pose2::new(
+        at.x_m + spec.prior_error_m * z(),
+        at.y_m + spec.prior_error_m * z(),
+        at.heading_rad + spec.prior_error_deg.to_radians() * z(),
+    )
 }
 
 #[cfg(test)]

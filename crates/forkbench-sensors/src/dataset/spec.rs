@@ -40,6 +40,12 @@ pub struct DatasetSpec {
     pub bearing_deg: [f64; 2],
     /// How far the face is turned from facing the scanner (degrees).
     pub heading_deg: [f64; 2],
+    /// Each scan's prior (where a warehouse system says the pallet stands, what a
+    /// detector is handed) is the true face off by a Gaussian error of this σ, each axis
+    /// (m) and heading (degrees); a scan without a pallet gets a prior where one would
+    /// stand.
+    pub prior_error_m: f64,
+    pub prior_error_deg: f64,
     pub clutter: ClutterSpec,
 }
 
@@ -80,6 +86,9 @@ impl Default for DatasetSpec {
             range_m: [1.5, 8.0],
             bearing_deg: [-45.0, 45.0],
             heading_deg: [-30.0, 30.0],
+            // A choice: a slot's placement tolerance of about a pallet's block width.
+            prior_error_m: 0.1,
+            prior_error_deg: 3.0,
             clutter: ClutterSpec::default(),
         }
     }
@@ -102,6 +111,8 @@ impl DatasetSpec {
             ("bearing_deg[1]", self.bearing_deg[1], -180.0, 180.0),
             ("heading_deg[0]", self.heading_deg[0], -80.0, 80.0),
             ("heading_deg[1]", self.heading_deg[1], -80.0, 80.0),
+            ("prior_error_m", self.prior_error_m, 0.0, 2.0),
+            ("prior_error_deg", self.prior_error_deg, 0.0, 45.0),
             (
                 "clutter.wall_behind_fraction",
                 self.clutter.wall_behind_fraction,
