@@ -44,13 +44,8 @@ fn recording_names(dir: &Path) -> std::collections::HashSet<String> {
 /// Whether `path` holds only what a batch's `--ros2` bag directory holds (its
 /// `metadata.yaml` and MCAP files): a folder with anything else in it is not deleted.
 fn is_bag_dir(path: &Path) -> bool {
-    std::fs::read_dir(path).is_ok_and(|entries| {
-        entries.flatten().all(|e| {
-            let name = e.file_name().to_string_lossy().into_owned();
-            e.file_type().is_ok_and(|t| t.is_file())
-                && (name == "metadata.yaml" || name.ends_with(".mcap"))
-        })
-    })
+    use forkbench_core::out_dir::{first_foreign, is_rosbag2_file};
+    matches!(first_foreign(path, is_rosbag2_file), Ok(None))
 }
 
 impl BatchSpec {

@@ -58,27 +58,41 @@ pub fn check_out_dir(path: &Path, force: bool, ours: fn(&str) -> bool) -> Result
     OutDir::create(path).map(drop)
 }
 
+/// The files a rosbag2 directory forkbench writes holds (its `metadata.yaml` and MCAP
+/// parts): what `--force` or a batch's restart may replace.
+pub fn is_rosbag2_file(name: &str) -> bool {
+    name == "metadata.yaml" || name.ends_with(".mcap")
+}
+
+/// The first entry of the directory at `path` that is not a regular file `ours` accepts
+/// by name: something this output did not write. `Ok(None)`: all of it is ours.
+pub fn first_foreign(path: &Path, ours: fn(&str) -> bool) -> std::io::Result<Option<String>> {
+    for e in std::fs::read_dir(path)?.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !e.file_type().is_ok_and(|t| t.is_file()) || !ours(&name) {
+            return Ok(Some(name));
+        }
+    }
+    Ok(None)
+}
+
 /// A directory that `--force` may replace holds only what this output writes; anything
 /// else in it is someone's, and is never deleted.
 fn check_only_ours(path: &Path, ours: fn(&str) -> bool) -> Result<(), FileError> {
-    let entries = std::fs::read_dir(path).map_err(|cause| FileError::Io {
+    let foreign = first_foreign(path, ours).map_err(|cause| FileError::Io {
         path: path.display().to_string(),
         cause,
     })?;
-    for e in entries.flatten() {
-        let name = e.file_name().to_string_lossy().into_owned();
-        let is_file = e.file_type().is_ok_and(|t| t.is_file());
-        if !is_file || !ours(&name) {
-            return Err(refuse(
-                path,
-                &format!(
-                    "holds {name}, which this output does not write; it replaces only a \
-                     directory it wrote (give another name)"
-                ),
-            ));
-        }
+    match foreign {
+        Some(name) => Err(refuse(
+            path,
+            &format!(
+                "holds {name}, which this output does not write; it replaces only a \
+                 directory it wrote (give another name)"
+            ),
+        )),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 fn parent_of(path: &Path) -> &Path {
@@ -172,10 +186,6 @@ impl Drop for OutDir {
 mod tests {
     use super::*;
 
-    fn bag_file(name: &str) -> bool {
-        name == "metadata.yaml" || name.ends_with(".mcap")
-    }
-
     /// A directory output appears whole, replaces only a directory of its own kind with
     /// `force`, and a drop without a commit leaves the path as it was.
     #[test]
@@ -184,7 +194,7 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("dir");
         let bag = dir.join("run.ros2");
-        check_out_dir(&bag, false, bag_file).expect("a new name");
+        check_out_dir(&bag, false, is_rosbag2_file).expect("a new name");
         let out = OutDir::create(&bag).expect("staging");
         std::fs::write(out.file("metadata.yaml"), "1").expect("write");
         assert!(!bag.exists(), "nothing at the path before the commit");
@@ -195,11 +205,11 @@ mod tests {
                 .as_deref(),
             Some("1")
         );
-        let e = check_out_dir(&bag, false, bag_file)
+        let e = check_out_dir(&bag, false, is_rosbag2_file)
             .expect_err("exists")
             .to_string();
         assert!(e.contains("--force"), "{e}");
-        check_out_dir(&bag, true, bag_file).expect("ours, with force");
+        check_out_dir(&bag, true, is_rosbag2_file).expect("ours, with force");
         let out = OutDir::create(&bag).expect("staging");
         std::fs::write(out.file("metadata.yaml"), "2").expect("write");
         drop(out);
@@ -219,13 +229,13 @@ mod tests {
             Some("3")
         );
         std::fs::write(bag.join("notes.txt"), "mine").expect("write");
-        let e = check_out_dir(&bag, true, bag_file)
+        let e = check_out_dir(&bag, true, is_rosbag2_file)
             .expect_err("not ours")
             .to_string();
         assert!(e.contains("notes.txt"), "{e}");
         let file = dir.join("plain.mcap");
         std::fs::write(&file, "x").expect("write");
-        let e = check_out_dir(&file, true, bag_file)
+        let e = check_out_dir(&file, true, is_rosbag2_file)
             .expect_err("a file")
             .to_string();
         assert!(e.contains("not a directory"), "{e}");

@@ -9,11 +9,6 @@ pub struct TopicCount {
     pub count: u64,
 }
 
-/// The files a rosbag2 directory forkbench writes holds: what `--force` may replace.
-pub fn is_bag_file(name: &str) -> bool {
-    name == "metadata.yaml" || name.ends_with(".mcap")
-}
-
 /// The `metadata.yaml` for a bag stored in `file` (MCAP, beside it), its messages
 /// stamped from `span_ns.0` to `span_ns.1` (ns since the Unix epoch).
 pub fn metadata_yaml(file: &str, topics: &[TopicCount], span_ns: Option<(u64, u64)>) -> String {

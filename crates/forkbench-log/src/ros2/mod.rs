@@ -227,7 +227,7 @@ fn mcap_name(path: &FsPath) -> String {
 /// it: a name not ending `.mcap` (a directory so named reads as a file), absent unless
 /// `force`, and then a bag directory forkbench wrote.
 pub fn check_bag_dir(path: &FsPath, force: bool) -> Result<(), LogError> {
-    forkbench_core::out_dir::check_out_dir(path, force, bag_dir::is_bag_file)?;
+    forkbench_core::out_dir::check_out_dir(path, force, forkbench_core::out_dir::is_rosbag2_file)?;
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
