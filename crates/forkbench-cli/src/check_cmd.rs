@@ -238,6 +238,30 @@ fn truck_line(t: &forkbench_core::ForkliftSpec) -> String {
         t.fork_root_ahead_of_front_axle_m,
         t.max_speed_mps
     ) + &mass_centre_line(t)
+        + &mounts_line(t)
+}
+
+/// Where the truck carries its sensors, when its file or table says.
+fn mounts_line(t: &forkbench_core::ForkliftSpec) -> String {
+    if t.mounts.is_empty() {
+        return "\n             sensors at their models' mounts or the scenario's [sensors] (the truck mounts none)".to_owned();
+    }
+    let each: Vec<String> = t
+        .mounts
+        .iter()
+        .map(|(n, m)| {
+            format!(
+                "{n} at ({:.3}, {:.3}) m facing {:.1}°",
+                m.x_m,
+                m.y_m,
+                m.heading_rad.to_degrees()
+            )
+        })
+        .collect();
+    format!(
+        "\n             mounts (fork-root frame) {}",
+        each.join(", ")
+    )
 }
 
 /// Where the unladen mass sits, and what placed it.
@@ -271,6 +295,10 @@ fn whole_truck(t: &forkbench_core::ForkliftSpec) -> serde_json::Value {
         m.insert(
             "control".into(),
             serde_json::to_value(&t.control).unwrap_or_default(),
+        );
+        m.insert(
+            "mounts".into(),
+            serde_json::to_value(&t.mounts).unwrap_or_default(),
         );
         m.insert("max_curvature_per_m".into(), t.max_curvature_per_m().into());
         m.insert(

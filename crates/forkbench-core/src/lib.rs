@@ -7,6 +7,7 @@ pub mod files;
 pub mod geometry;
 pub mod hash;
 pub mod layout;
+pub mod mounts;
 pub mod out_dir;
 pub mod pallet;
 pub mod path;

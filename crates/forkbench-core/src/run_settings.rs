@@ -52,9 +52,15 @@ pub fn truck_path(name: &str) -> Option<&'static str> {
         .or_else(|| TRUCK_GEOMETRY.iter().find(|g| **g == name).copied())
 }
 
-/// Whether `path` names the truck's geometry or mass (not its actuators or timing).
+/// Whether `path` names the truck's geometry, mass or a sensor's mount (not its
+/// actuators or timing).
 pub fn is_geometry(path: &str) -> bool {
-    TRUCK_GEOMETRY.contains(&path)
+    TRUCK_GEOMETRY.contains(&path) || mount_path(path).is_some()
+}
+
+/// A sensor mount's dotted path (`mount.<sensor>.<field>`) as its sensor and field.
+pub fn mount_path(path: &str) -> Option<(&str, &str)> {
+    path.strip_prefix("mount.")?.split_once('.')
 }
 
 /// Sets the truck's setting at `path` (one of [`TRUCK_KNOBS`]); false for another path.
@@ -77,7 +83,10 @@ pub fn set(t: &mut ForkliftSpec, path: &str, v: f64) -> bool {
         "drive.creep_speed_mps" => dr.creep_speed_mps = v,
         "control.period_s" => ct.period_s = Some(v),
         "control.transport_delay_s" => ct.transport_delay_s = v,
-        _ => return set_geometry(t, path, v),
+        _ => match mount_path(path) {
+            Some((sensor, field)) => return t.mounts.set(sensor, field, v),
+            None => return set_geometry(t, path, v),
+        },
     }
     true
 }

@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::actuators::{Actuators, ControlTiming, DriveActuator, SteeringActuator};
 use crate::layout::TruckLayout;
+use crate::mounts::SensorMounts;
 
 /// Geometry and limits of a rear-steered counterbalance forklift.
 ///
@@ -62,6 +63,10 @@ pub struct ForkliftSpec {
     /// The controller's period and transport delay (`[control]`).
     #[serde(skip_serializing_if = "ControlTiming::is_default")]
     pub control: ControlTiming,
+    /// Where the truck carries its sensors (`[mount.<sensor>]` in a truck file); left
+    /// out of serialised specs when it gives none.
+    #[serde(skip_serializing_if = "SensorMounts::is_empty")]
+    pub mounts: SensorMounts,
 }
 
 /// The A30's rating: 3 t.
@@ -97,6 +102,7 @@ impl Default for ForkliftSpec {
             steering: SteeringActuator::default(),
             drive: DriveActuator::default(),
             control: ControlTiming::default(),
+            mounts: SensorMounts::default(),
         }
     }
 }
@@ -257,6 +263,7 @@ impl ForkliftSpec {
             ));
         }
         self.validate_mass_centre()?;
+        self.mounts.validate()?;
         self.steering.validate()?;
         self.drive.validate()?;
         self.control.validate()

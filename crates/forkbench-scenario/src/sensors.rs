@@ -159,6 +159,7 @@ pub(super) fn resolve(
     truck: &ForkliftSpec,
     file: &str,
 ) -> Result<PalletSensing, ScenarioError> {
+    check_mount_names(truck, file)?;
     let Some(p) = f.and_then(|s| s.pallet.as_ref()) else {
         return Ok(PalletSensing::Gaussian);
     };
@@ -203,18 +204,7 @@ pub(super) fn resolve(
                 &format!("{name:?} is named twice"),
             ));
         }
-        let table = if p.scanners.contains_key(name) {
-            format!("sensors.pallet.scanners.{name}")
-        } else {
-            "sensors.pallet.scanner".to_owned()
-        };
-        let scanner = match p.scanners.get(name).or(p.scanner.as_ref()) {
-            Some(keys) => {
-                over_preset(&preset, keys).map_err(|e| invalid_setting(file, &table, &e))?
-            }
-            None => preset,
-        };
-        check_scanner(&scanner, truck, file, &table)?;
+        let scanner = scanner_on(preset, name, p, truck, file)?;
         sensors.push(NamedScanner {
             name: name.to_owned(),
             scanner,
@@ -230,6 +220,87 @@ pub(super) fn resolve(
         latency_s,
         min_score,
     })
+}
+
+/// Scanner model `name` as `p` sets it over its `preset`, on the truck's mount for it,
+/// checked (in range, outside the body).
+fn scanner_on(
+    preset: ScannerConfig,
+    name: &str,
+    p: &PalletSensorFile,
+    truck: &ForkliftSpec,
+    file: &str,
+) -> Result<ScannerConfig, ScenarioError> {
+    let table = if p.scanners.contains_key(name) {
+        format!("sensors.pallet.scanners.{name}")
+    } else {
+        "sensors.pallet.scanner".to_owned()
+    };
+    let keys = p.scanners.get(name).or(p.scanner.as_ref());
+    let preset = mounted_on(preset, name, truck, keys, (file, &table))?;
+    let scanner = match keys {
+        Some(keys) => over_preset(&preset, keys).map_err(|e| invalid_setting(file, &table, &e))?,
+        None => preset,
+    };
+    // A mount the truck gives is named as the truck's.
+    let mount_field = match truck.mounts.get(name) {
+        Some(_) => format!("truck.mount.{name}"),
+        None => format!("{table}.mount"),
+    };
+    check_scanner(&scanner, truck, file, (&table, &mount_field))?;
+    Ok(scanner)
+}
+
+/// Every sensor the truck mounts is one the bench knows: a scanner model, or the
+/// reflector localiser: the first that is not, and why, else `None`.
+pub(crate) fn unknown_mount(truck: &ForkliftSpec) -> Option<(String, String)> {
+    let localizer = forkbench_sensors::reflector_nav::MOUNT_NAME;
+    let (n, _) = truck
+        .mounts
+        .iter()
+        .find(|(n, _)| !SCANNER_PRESETS.contains(n) && *n != localizer)?;
+    Some((
+        n.to_owned(),
+        format!(
+            "{n:?} is no sensor the truck can carry (known: {}, {localizer})",
+            SCANNER_PRESETS.join(", ")
+        ),
+    ))
+}
+
+/// The truck's mounts refused at the scenario when one names no known sensor.
+fn check_mount_names(truck: &ForkliftSpec, file: &str) -> Result<(), ScenarioError> {
+    match unknown_mount(truck) {
+        Some((n, why)) => Err(invalid(file, &format!("truck.mount.{n}"), &why)),
+        None => Ok(()),
+    }
+}
+
+/// A scanner model's preset on the truck's mount for it, when the truck gives one; the
+/// scenario's own `mount` for it beside the truck's is refused (one place says where a
+/// sensor sits).
+fn mounted_on(
+    mut preset: ScannerConfig,
+    name: &str,
+    truck: &ForkliftSpec,
+    keys: Option<&toml::Table>,
+    (file, table): (&str, &str),
+) -> Result<ScannerConfig, ScenarioError> {
+    let Some(m) = truck.mounts.get(name) else {
+        return Ok(preset);
+    };
+    if keys.is_some_and(|k| k.contains_key("mount")) {
+        return Err(invalid(
+            file,
+            &format!("{table}.mount"),
+            &format!(
+                "the truck mounts {name} already ([mount.{name}] in its file or \
+                 [truck.mount.{name}]): say where it sits in one place"
+            ),
+        ));
+    }
+    preset.mount = *m;
+    Ok(preset)
 }
 
 /// `[sensors.pallet.detector]`: its kind (the pocket detector by default) and settings.
@@ -331,7 +402,7 @@ fn check_scanner(
     scanner: &ScannerConfig,
     truck: &ForkliftSpec,
     file: &str,
-    table: &str,
+    (table, mount_field): (&str, &str),
 ) -> Result<(), ScenarioError> {
     scanner
         .validate()
@@ -341,7 +412,7 @@ fn check_scanner(
     if m.x_m < 0.0 && m.x_m > -truck.body_length_m && m.y_m.abs() < truck.body_width_m / 2.0 {
         return Err(invalid(
             file,
-            &format!("{table}.mount"),
+            mount_field,
             &format!(
                 "({}, {}) m lies inside the truck's body (fork-root frame: the body \
                  spans x from -{} to 0 m, y within ±{} m); mount it at the fork root or ahead \

@@ -27,6 +27,7 @@ fn known_keys() -> String {
     let mut k: Vec<&str> = vec!["name", "source", "preset"];
     k.extend(TRUCK_GEOMETRY);
     k.extend(TRUCK_KNOBS.iter().map(|(_, p)| *p));
+    k.push("mount.<sensor>.{x_m, y_m, heading_rad}");
     k.join(", ")
 }
 
@@ -92,7 +93,7 @@ pub fn read_truck_text(text: &str, file: &str) -> Result<TruckSettings, Scenario
     })?;
     // Applying them refuses a key that is no truck setting and a value out of its range;
     // the error is placed at the key's line.
-    apply_truck(
+    let truck = apply_truck(
         &ForkliftSpec::default(),
         out.preset.as_deref(),
         &out.settings,
@@ -104,6 +105,14 @@ pub fn read_truck_text(text: &str, file: &str) -> Result<TruckSettings, Scenario
         }
         other => other,
     })?;
+    if let Some((name, why)) = crate::sensors::unknown_mount(&truck) {
+        let header = format!("[mount.{name}]");
+        let place = match text.lines().position(|l| l.trim() == header) {
+            Some(i) => format!("{file}:{}", i + 1),
+            None => file.to_owned(),
+        };
+        return Err(invalid(&place, &format!("mount.{name}"), &why));
+    }
     Ok(out)
 }
 
@@ -206,7 +215,8 @@ pub(crate) fn resolve_entry(
     Ok(truck)
 }
 
-/// Every number of `table` by dotted path, one level of tables deep.
+/// Every number of `table` by dotted path, one level of tables deep (two for a sensor's
+/// `[mount.<sensor>]`).
 fn flatten(
     table: &toml::Table,
     out: &mut BTreeMap<String, f64>,
@@ -236,7 +246,15 @@ fn flatten(
         match value {
             toml::Value::Table(inner) => {
                 for (k, v) in inner {
-                    put(format!("{key}.{k}"), v)?;
+                    match v {
+                        // `[mount.<sensor>]`: the one table two levels deep.
+                        toml::Value::Table(pose) if key == "mount" => {
+                            for (f, v) in pose {
+                                put(format!("{key}.{k}.{f}"), v)?;
+                            }
+                        }
+                        v => put(format!("{key}.{k}"), v)?,
+                    }
                 }
             }
             v => put(key.clone(), v)?,
@@ -280,6 +298,8 @@ impl<R: crate::Catalogue> crate::Scenario<R> {
         let checked = Self::parse_layout(src, &self.file, world, &no_file, Some(truck))?;
         Ok(Self {
             truck: checked.truck,
+            // Its scanners on the run's truck's mounts.
+            pallet_sensing: checked.pallet_sensing,
             ..self.clone()
         })
     }
@@ -313,6 +333,30 @@ mod tests {
             .to_string();
         assert!(
             e.contains("t.toml:2") && e.contains("steering.dead_time"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_truck_file_mounts_its_sensors_and_names_an_unknown_one_at_its_line() {
+        let s = read_truck_text(
+            "wheelbase_m = 1.4\n[mount.tim561]\nx_m = 0.05\ny_m = 0.1\n[mount.nav350]\nx_m = -0.4\n",
+            "t.toml",
+        )
+        .expect("valid");
+        assert_eq!(s.settings["mount.tim561.y_m"], 0.1);
+        let t = apply_truck(&ForkliftSpec::default(), None, &s.settings).expect("applies");
+        let m = t.mounts.get("nav350").expect("mounted");
+        assert_eq!((m.x_m, m.y_m, m.heading_rad), (-0.4, 0.0, 0.0));
+        let e = read_truck_text("name = \"x\"\n[mount.tim651]\nx_m = 0.1\n", "t.toml")
+            .expect_err("no such sensor")
+            .to_string();
+        assert!(e.contains("t.toml:2") && e.contains("tim651"), "{e}");
+        let e = read_truck_text("[mount.tim561]\nx_m = 30\n", "t.toml")
+            .expect_err("far off")
+            .to_string();
+        assert!(
+            e.contains("t.toml:2") && e.contains("mount.tim561.x_m"),
             "{e}"
         );
     }

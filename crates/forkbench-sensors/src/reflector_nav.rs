@@ -12,6 +12,9 @@ use crate::reflectors::{self, Observation, Reflector, ReflectorNavConfig};
 use crate::scan::Surface;
 use crate::sight::Sight;
 
+/// The name a truck's `[mount.<sensor>]` table gives the reflector localiser's scanner.
+pub const MOUNT_NAME: &str = "nav350";
+
 /// The `nav350` localiser's settings (`[sensors.localizer]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

@@ -94,6 +94,65 @@ fn a_truck_file_gives_the_outcome_of_the_scenario_naming_it() {
     }
 }
 
+/// A truck file's sensor mounts reach its scanners and its NAV350, by `--truck` and by
+/// the scenario naming the file alike, and move the outcome.
+#[test]
+fn a_truck_files_mounts_place_its_sensors() {
+    let dir = std::env::temp_dir().join(format!("fb-mounts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let file = dir.join("mounted.toml");
+    let base = std::fs::read_to_string(repo("trucks/jungheinrich-efg-316k.toml")).expect("reads");
+    std::fs::write(
+        &file,
+        format!("{base}\n[mount.tim561]\nx_m = 0.05\ny_m = 0.12\n[mount.nav350]\nx_m = -0.6\n"),
+    )
+    .expect("written");
+    let plain_truck = repo("trucks/jungheinrich-efg-316k.toml");
+    for scenario in ["scenarios/field-test.toml", "scenarios/rack-pick.toml"] {
+        let path = repo(scenario);
+        let text = std::fs::read_to_string(&path).expect("reads");
+        let named = format!("truck = {:?}\n{text}", file.display().to_string());
+        let inline = Scenario::parse(&named, "named.toml", |p| {
+            World::load(&repo("scenarios").join(p))
+        })
+        .expect("loads with its truck file");
+        let plain = Scenario::load(&path).expect("loads");
+        let opts = TrialOptions {
+            seed: Some(7),
+            ..TrialOptions::default()
+        };
+        let run = with_truck_file(&file, opts.clone())
+            .resolve(&plain)
+            .expect("resolves");
+        if let Some(tim) = run.pallet_sensing.scanner("tim561") {
+            assert_eq!((tim.mount.x_m, tim.mount.y_m), (0.05, 0.12), "{scenario}");
+        }
+        let a = run_trial(&inline, &inline.cases[0], &opts);
+        let b = run_trial(
+            &plain,
+            &plain.cases[0],
+            &with_truck_file(&file, opts.clone()),
+        );
+        let c = run_trial(
+            &plain,
+            &plain.cases[0],
+            &with_truck_file(&plain_truck, opts),
+        );
+        assert!(
+            a.failure != Some(forkbench_trial::Failure::Error),
+            "{scenario}: {:?}",
+            a.failure_detail
+        );
+        assert_eq!(without_clock(&a), without_clock(&b), "{scenario}");
+        assert_ne!(
+            without_clock(&a),
+            without_clock(&c),
+            "{scenario}: the mounts moved nothing"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The A30's file is the bench's default truck: every field written out.
 #[test]
 fn the_a30_file_is_the_default_truck() {

@@ -169,9 +169,16 @@ impl Registry {
             Ok(Box::new(Nav350::new(cfg, cx.noise)))
         })
         .with_scaled_localizer("nav350", |s, cx| {
-            let settings: ReflectorNavSettings = forkbench_core::settings::parse(s)?;
+            let mut settings: ReflectorNavSettings = forkbench_core::settings::parse(s)?;
+            let on_truck = truck_mount(s, cx.truck, &mut settings.mount)?;
             settings.validate(cx.reflectors)?;
-            check_mount(&settings.mount, cx.truck)?;
+            check_mount(&settings.mount, cx.truck).map_err(|e| match on_truck {
+                true => SettingsError::field(
+                    "mount",
+                    format!("the truck's [mount.nav350]: {}", e.reason),
+                ),
+                false => e,
+            })?;
             let timing = (cx.nav350.rate_hz, cx.nav350.latency_s);
             Ok(Box::new(ReflectorNav::new(
                 settings,
@@ -425,6 +432,30 @@ impl Registry {
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Empty {}
+
+/// The NAV350's mount from the truck into `mount`, when the truck gives one (true);
+/// refused beside the localiser's own `mount` (one place says where it sits).
+fn truck_mount(
+    s: &forkbench_core::Settings,
+    truck: &ForkliftSpec,
+    mount: &mut forkbench_core::Pose2,
+) -> Result<bool, SettingsError> {
+    let Some(m) = truck
+        .mounts
+        .get(forkbench_sensors::reflector_nav::MOUNT_NAME)
+    else {
+        return Ok(false);
+    };
+    if s.contains_key("mount") {
+        return Err(SettingsError::field(
+            "mount",
+            "the truck mounts nav350 already ([mount.nav350] in its file or \
+             [truck.mount.nav350]): say where it sits in one place",
+        ));
+    }
+    *mount = *m;
+    Ok(true)
+}
 
 /// A localiser's mount on the truck: over its body or at the fork root (fork-root frame:
 /// the body spans x from −length to 0, y within ± half its width).

@@ -122,10 +122,19 @@ pub fn scenario_for<'s>(
     scn: &'s Scenario,
     run: &Resolved,
 ) -> Result<std::borrow::Cow<'s, Scenario>, ScenarioError> {
-    if run.truck.same_geometry(&scn.truck) {
+    scenario_with(scn, &run.truck)
+}
+
+/// `scn` with `truck` for its own: itself when the geometry (mounts included) is the
+/// same, else checked anew ([`Scenario::with_truck`]).
+pub(crate) fn scenario_with<'s>(
+    scn: &'s Scenario,
+    truck: &forkbench_core::ForkliftSpec,
+) -> Result<std::borrow::Cow<'s, Scenario>, ScenarioError> {
+    if truck.same_geometry(&scn.truck) {
         return Ok(std::borrow::Cow::Borrowed(scn));
     }
-    scn.with_truck(&run.truck).map(std::borrow::Cow::Owned)
+    scn.with_truck(truck).map(std::borrow::Cow::Owned)
 }
 
 /// The outcome of a run whose options do not resolve.

@@ -238,7 +238,10 @@ impl TrialOptions {
         self.validate()?;
         let o = &self.overrides;
         let noise = scn.noise.enabled && !self.no_noise;
-        let sensing = scn.sensing_for(o.pallet_sensing.as_deref())?;
+        let truck = truck_for(scn, o)?;
+        // The sensors sit where the run's truck mounts them.
+        let sensing =
+            super::scenario_with(scn, &truck)?.sensing_for(o.pallet_sensing.as_deref())?;
         let localizer =
             scn.localizer_for(o.localizer.as_deref(), o.missing_reflectors.as_deref())?;
         if !noise && let Some(knob) = NOISE_KNOBS.iter().find(|k| o.scale(k).is_some()) {
@@ -282,7 +285,7 @@ impl TrialOptions {
             localization_noise_scale,
             odometry: scaled_odometry(scn, o.odometry_noise_scale)?,
             wall_budget_s: self.wall_budget_s.unwrap_or(DEFAULT_WALL_BUDGET_S),
-            truck: truck_for(scn, o)?,
+            truck,
             uncertain: BTreeMap::new(),
             shift: Default::default(),
         };
@@ -295,10 +298,11 @@ impl TrialOptions {
     /// trial.
     pub fn check_against(&self, scn: &Scenario) -> Result<Resolved, ScenarioError> {
         let run = self.resolve(scn)?;
-        // A run's own geometry is checked against the scenario once, here.
-        super::scenario_for(scn, &run)?;
+        // A run's own geometry is checked against the scenario once, here, and the
+        // localiser on its truck.
+        let own = super::scenario_for(scn, &run)?;
         scn.registry
-            .check_localizer(&run.localizer, scn)
+            .check_localizer(&run.localizer, &own)
             .map_err(|e| invalid_setting(&scn.file, "sensors.localizer", &e))?;
         Ok(run)
     }
