@@ -201,10 +201,17 @@ fn warehouse_people(scale: Option<f64>) -> Scenario {
 
 /// Seeds 1–200 of the people cycle, with the fields scaled by `scale` (`None`: as sized).
 fn cycles(scale: Option<f64>) -> Vec<forkbench_trial::TrialOutcome> {
+    cycles_over(scale, 1..=200)
+}
+
+fn cycles_over(
+    scale: Option<f64>,
+    seeds: std::ops::RangeInclusive<u64>,
+) -> Vec<forkbench_trial::TrialOutcome> {
     use rayon::prelude::*;
     let scn = warehouse_people(scale);
     assert_eq!(scn.movers.len(), 5);
-    (1..=200u64)
+    seeds
         .into_par_iter()
         .map(|seed| {
             let opts = TrialOptions {
@@ -237,8 +244,16 @@ fn in_200_cycles_the_sized_fields_touch_nobody_and_fields_30_percent_shorter_do(
     let done = sized.iter().filter(|o| o.success).count();
     assert!(done >= 190, "{done} of 200 cycles done");
     // The same cycles, seeds and people with protective fields 0.7 × S_L: the scanner's
-    // worst-case range errors eat the margin the supplements left.
-    let short = cycles(Some(0.7));
+    // worst-case range errors eat the margin the supplements left. One contact is what
+    // this asserts, so the seeds run in blocks of 8 up to the first block that has one
+    // (every contact found is checked).
+    let mut short = Vec::new();
+    for first in (1..=200u64).step_by(8) {
+        short.extend(cycles_over(Some(0.7), first..=(first + 7).min(200)));
+        if !touched(&short).is_empty() {
+            break;
+        }
+    }
     let hits = touched(&short);
     assert!(!hits.is_empty(), "no contact in 200 cycles at 0.7 × S_L");
     for o in short
