@@ -76,6 +76,14 @@ impl SensorMounts {
     }
 }
 
+/// Why a sensor's own `mount` beside the truck's mount for it is refused.
+pub fn mounted_twice(name: &str) -> String {
+    format!(
+        "the truck mounts {name} already ([mount.{name}] in its file or [truck.mount.{name}]): \
+         say where it sits in one place"
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -293,10 +293,7 @@ fn mounted_on(
         return Err(invalid(
             file,
             &format!("{table}.mount"),
-            &format!(
-                "the truck mounts {name} already ([mount.{name}] in its file or \
-                 [truck.mount.{name}]): say where it sits in one place"
-            ),
+            &forkbench_core::mounts::mounted_twice(name),
         ));
     }
     preset.mount = *m;

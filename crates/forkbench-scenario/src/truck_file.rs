@@ -88,8 +88,8 @@ pub fn read_truck_text(text: &str, file: &str) -> Result<TruckSettings, Scenario
             _ => out.source = Some(s),
         }
     }
-    flatten(&numbers, &mut out.settings, &|path| {
-        invalid(&at(file, text, path), path, "must be a number")
+    flatten(&numbers, &mut out.settings, &|path, why| {
+        invalid(&at(file, text, path), path, why)
     })?;
     // Applying them refuses a key that is no truck setting and a value out of its range;
     // the error is placed at the key's line.
@@ -199,8 +199,8 @@ pub(crate) fn resolve_entry(
     };
     if !table.is_empty() {
         let mut settings = BTreeMap::new();
-        flatten(&table, &mut settings, &|path| {
-            invalid(&here, &format!("truck.{path}"), "must be a number")
+        flatten(&table, &mut settings, &|path, why| {
+            invalid(&here, &format!("truck.{path}"), why)
         })?;
         // A refusal names the scenario and the line of the key it refuses (a check over
         // several keys names the one it reports), else the `truck` entry's line.
@@ -216,11 +216,11 @@ pub(crate) fn resolve_entry(
 }
 
 /// Every number of `table` by dotted path, one level of tables deep (two for a sensor's
-/// `[mount.<sensor>]`).
+/// `[mount.<sensor>]`); `refuse` makes the error for a path and its reason.
 fn flatten(
     table: &toml::Table,
     out: &mut BTreeMap<String, f64>,
-    not_a_number: &dyn Fn(&str) -> ScenarioError,
+    refuse: &dyn Fn(&str, &str) -> ScenarioError,
 ) -> Result<(), ScenarioError> {
     for (key, value) in table {
         let mut put = |path: String, v: &toml::Value| {
@@ -230,15 +230,12 @@ fn flatten(
                 // The one key that is a name: it rides among the numbers as its code.
                 toml::Value::String(name) if path == "layout" => TruckLayout::from_key(name)
                     .ok_or_else(|| {
-                        let mut e = not_a_number(&path);
-                        if let ScenarioError::Invalid { reason, .. } = &mut e {
-                            *reason =
-                                format!("unknown layout {name:?} (known: {})", TruckLayout::keys());
-                        }
-                        e
+                        let why =
+                            format!("unknown layout {name:?} (known: {})", TruckLayout::keys());
+                        refuse(&path, &why)
                     })?
                     .code(),
-                _ => return Err(not_a_number(&path)),
+                _ => return Err(refuse(&path, "must be a number")),
             };
             out.insert(path, n);
             Ok(())
@@ -357,6 +354,26 @@ mod tests {
             .to_string();
         assert!(
             e.contains("t.toml:2") && e.contains("mount.tim561.x_m"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_unknown_layout_is_named_at_its_line_with_the_known_ones() {
+        let e = read_truck_text("name = \"x\"\nlayout = \"sideways\"\n", "t.toml")
+            .expect_err("no such layout")
+            .to_string();
+        assert!(
+            e.contains("t.toml:2")
+                && e.contains("unknown layout \"sideways\"")
+                && e.contains("pallet_stacker"),
+            "{e}"
+        );
+        let e = read_truck_text("wheelbase_m = \"long\"\n", "t.toml")
+            .expect_err("not a number")
+            .to_string();
+        assert!(
+            e.contains("t.toml:1") && e.contains("must be a number"),
             "{e}"
         );
     }

@@ -153,6 +153,45 @@ fn a_truck_files_mounts_place_its_sensors() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A sensor mounted twice (by the truck and by the scenario's `[sensors]`) is refused at
+/// load, and so is a NAV350 the run's truck mounts outside its body, before any trial.
+#[test]
+fn a_mount_given_twice_or_off_the_truck_is_refused_at_load() {
+    let load =
+        |text: &str| Scenario::parse(text, "t.toml", |p| World::load(&repo("scenarios").join(p)));
+    let field = std::fs::read_to_string(repo("scenarios/field-test.toml")).expect("reads");
+    let twice = field.replace(
+        "kind = \"tim561+kinect2\"",
+        "kind = \"tim561+kinect2\"\n[sensors.pallet.scanners.tim561]\nmount = { x_m = 0.1, y_m = 0.0, heading_rad = 0.0 }",
+    ) + "\n[truck.mount.tim561]\nx_m = 0.05\n";
+    let e = load(&twice).expect_err("mounted twice").to_string();
+    assert!(
+        e.contains("sensors.pallet.scanners.tim561.mount") && e.contains("mounts tim561 already"),
+        "{e}"
+    );
+    let rack = std::fs::read_to_string(repo("scenarios/rack-pick.toml")).expect("reads");
+    // Refused as the scenario loads (its components are built once there).
+    let e = load(&format!("{rack}\n[truck.mount.nav350]\nx_m = 1.0\n"))
+        .expect_err("a NAV350 ahead of the forks")
+        .to_string();
+    assert!(
+        e.contains("mount.nav350") && e.contains("outside the truck"),
+        "{e}"
+    );
+    // The same truck given by the run, as `--truck` does.
+    let dir = std::env::temp_dir().join(format!("fb-mount-off-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let file = dir.join("off.toml");
+    std::fs::write(&file, "[mount.nav350]\nx_m = 1.0\n").expect("written");
+    let plain = Scenario::load(&repo("scenarios/rack-pick.toml")).expect("loads");
+    let e = with_truck_file(&file, TrialOptions::default())
+        .check_against(&plain)
+        .expect_err("refused before the first trial")
+        .to_string();
+    assert!(e.contains("mount.nav350"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The A30's file is the bench's default truck: every field written out.
 #[test]
 fn the_a30_file_is_the_default_truck() {

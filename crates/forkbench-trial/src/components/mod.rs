@@ -447,10 +447,10 @@ fn truck_mount(
         return Ok(false);
     };
     if s.contains_key("mount") {
+        let name = forkbench_sensors::reflector_nav::MOUNT_NAME;
         return Err(SettingsError::field(
             "mount",
-            "the truck mounts nav350 already ([mount.nav350] in its file or \
-             [truck.mount.nav350]): say where it sits in one place",
+            forkbench_core::mounts::mounted_twice(name),
         ));
     }
     *mount = *m;
