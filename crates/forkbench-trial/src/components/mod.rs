@@ -440,14 +440,11 @@ fn truck_mount(
     truck: &ForkliftSpec,
     mount: &mut forkbench_core::Pose2,
 ) -> Result<bool, SettingsError> {
-    let Some(m) = truck
-        .mounts
-        .get(forkbench_sensors::reflector_nav::MOUNT_NAME)
-    else {
+    let name = forkbench_sensors::reflector_nav::MOUNT_NAME;
+    let Some(m) = truck.mounts.get(name) else {
         return Ok(false);
     };
     if s.contains_key("mount") {
-        let name = forkbench_sensors::reflector_nav::MOUNT_NAME;
         return Err(SettingsError::field(
             "mount",
             forkbench_core::mounts::mounted_twice(name),

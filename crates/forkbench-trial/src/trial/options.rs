@@ -239,9 +239,14 @@ impl TrialOptions {
         let o = &self.overrides;
         let noise = scn.noise.enabled && !self.no_noise;
         let truck = truck_for(scn, o)?;
-        // The sensors sit where the run's truck mounts them.
-        let sensing =
-            super::scenario_with(scn, &truck)?.sensing_for(o.pallet_sensing.as_deref())?;
+        // The sensors sit where the run's truck mounts them. Of the truck, only its mounts
+        // move the sensing (its other geometry is checked by `scenario_for`), so the
+        // scenario is read again on the run's truck only when those differ.
+        let sensing = if truck.mounts == scn.truck.mounts {
+            scn.sensing_for(o.pallet_sensing.as_deref())?
+        } else {
+            super::scenario_with(scn, &truck)?.sensing_for(o.pallet_sensing.as_deref())?
+        };
         let localizer =
             scn.localizer_for(o.localizer.as_deref(), o.missing_reflectors.as_deref())?;
         if !noise && let Some(knob) = NOISE_KNOBS.iter().find(|k| o.scale(k).is_some()) {
