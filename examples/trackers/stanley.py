@@ -14,6 +14,9 @@ cross-track error e; the curvature command is the path's plus a gain on the head
 to turn, and the steering angle follows from the truck's wheelbase. The speed profile is
 pure pursuit's: cruise, slower over the last metres, and a stop at the end.
 No dependencies beyond the standard library. Forward paths only (a pick's).
+
+`--shift-m D` makes it believe the truck D metres left of where it is: a calibration
+error, for trying the regression gate (docs/gate.md) on a tracker that still enters.
 """
 import json
 import math
@@ -25,6 +28,7 @@ V_SOFT = 0.3          # softening speed (m/s): the law stays gentle when slow
 K_HEADING = 2.0       # curvature per radian of heading still to turn (1/m)
 CRUISE, APPROACH, APPROACH_M, DECEL = 0.8, 0.3, 2.0, 0.4
 WINDOW = 300          # samples searched ahead of the last progress
+SHIFT_M = 0.0         # believed offset to the left (m); set by --shift-m
 
 
 def wrap(a):
@@ -71,7 +75,8 @@ class Stanley:
     def tick(self, msg):
         pose, v = msg["pose"], msg["speed_mps"]
         h = pose["heading_rad"]
-        ax, ay = pose["x_m"] - self.d * math.cos(h), pose["y_m"] - self.d * math.sin(h)
+        x, y = pose["x_m"] - SHIFT_M * math.sin(h), pose["y_m"] + SHIFT_M * math.cos(h)
+        ax, ay = x - self.d * math.cos(h), y - self.d * math.sin(h)
         self.idx = self.closest(ax, ay)
         px, py, ph, pk = self.pts[self.idx]
         e = -math.sin(ph) * (ax - px) + math.cos(ph) * (ay - py)   # left of the path positive
@@ -95,6 +100,12 @@ class Stanley:
 
 
 def main():
+    global SHIFT_M
+    args = sys.argv[1:]
+    if args[:1] == ["--shift-m"] and len(args) == 2:
+        SHIFT_M = float(args[1])
+    elif args:
+        sys.exit("usage: stanley.py [--shift-m METRES]")
     tracker = Stanley()
     for line in sys.stdin:
         msg = json.loads(line)

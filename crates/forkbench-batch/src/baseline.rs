@@ -1,4 +1,4 @@
-//! Committed baselines: success counts per row and, for paired comparisons, every trial's key, seed and outcome.
+//! Committed baselines: success counts per row and, for paired comparisons, every trial's key, seed, outcome and measures.
 
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
@@ -23,6 +23,10 @@ pub struct Baseline {
     /// pair; baselines made before pairing have none and compare unpaired.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub trials: Vec<BaselineTrial>,
+    /// Whether its trials carry the gate's measures; baselines made before the gate
+    /// compared measures have none and are gated on counts, with a warning.
+    #[serde(default)]
+    pub measured: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -41,8 +45,8 @@ pub struct BaselineRow {
     pub successes: u64,
 }
 
-/// One trial of a baseline: its identity, seed and outcome.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+/// One trial of a baseline: its identity, seed, outcome and measures.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BaselineTrial {
     pub scenario: String,
@@ -55,6 +59,9 @@ pub struct BaselineTrial {
     pub success: bool,
     /// First failed criterion (none on success).
     pub failure: Option<String>,
+    /// What the gate compares pair by pair ([`crate::gate::trial_measures`]).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub measures: BTreeMap<String, f64>,
 }
 
 impl BaselineTrial {
@@ -70,6 +77,7 @@ impl BaselineTrial {
             seed: o.seed,
             success: o.success,
             failure: o.failure.as_ref().map(|f| f.name().to_owned()),
+            measures: super::gate::trial_measures(o),
         }
     }
 
@@ -106,6 +114,7 @@ impl Baseline {
                 })
                 .collect(),
             provenance: s.provenance.clone(),
+            measured: !trials.is_empty(),
             trials,
         }
     }
@@ -214,6 +223,11 @@ impl Baseline {
                 return Err(format!(
                     "trials[{i}]: success {} with failure {:?} is contradictory",
                     t.success, t.failure
+                ));
+            }
+            if let Some((k, v)) = t.measures.iter().find(|(_, v)| !v.is_finite()) {
+                return Err(format!(
+                    "trials[{i}].measures.{k} = {v}: not a finite number"
                 ));
             }
             let c = counts

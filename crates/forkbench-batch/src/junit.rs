@@ -118,6 +118,7 @@ pub fn regress_cases(
                 Verdict::BelowFloor => Some("success rate below the floor"),
                 Verdict::Missing => Some("row missing from the results"),
                 Verdict::Underpowered => Some("too few trials for --min-detectable-drop"),
+                Verdict::Worse => Some("a measure worse than the baseline beyond its margin"),
             };
             Case {
                 name,

@@ -28,6 +28,7 @@ mod order;
 mod outdir;
 pub mod prints;
 mod provenance;
+pub mod rank_tests;
 pub mod rare;
 mod rare_store;
 mod records_run;
@@ -47,9 +48,10 @@ pub use candidate::{Mapping, map_components};
 pub use case_grid::{CaseCells, ErrorGroup, case_grids, error_groups};
 pub use compare::{CompareOptions, CompareReport, CompareRow, Discordant, compare, compare_apart};
 pub use export::write_csv;
+pub use gate::num as gate_num;
 pub use gate::{
-    DEFAULT_ALPHA, GateOptions, GateReport, PairCounts, Pairing, RegressRow, Verdict,
-    paired_trials_needed, regress,
+    DEFAULT_ALPHA, GateOptions, GateReport, MeasureSetting, MeasureSettings, MeasureTest,
+    PairCounts, Pairing, RegressRow, Verdict, Worse, paired_trials_needed, regress, trial_measures,
 };
 pub use guard::guarded;
 pub use manifest::{DirLock, Manifest, build_commit};

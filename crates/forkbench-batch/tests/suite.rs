@@ -4,6 +4,7 @@ mod batch;
 mod custom_criterion;
 mod external;
 mod gate;
+mod gate_measures;
 mod hostile_external;
 mod modes;
 mod noise_knobs;

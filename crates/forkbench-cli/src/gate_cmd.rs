@@ -49,6 +49,11 @@ pub struct RegressArgs {
     /// many trials that needs, and rows with fewer fail as underpowered.
     #[arg(long)]
     pub min_detectable_drop: Option<f64>,
+    /// A gate file (TOML) setting measures' margins and directions: `[measure.NAME]`
+    /// with `margin` (in the measure's unit), `worse = "higher"|"lower"` and
+    /// `gate = false` (see the gate chapter).
+    #[arg(long, value_name = "FILE")]
+    pub gate: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
     /// Also write the verdicts as JUnit XML to FILE (a failing case per failed row).
@@ -143,6 +148,10 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
         floor: a.floor,
         fail_on_new: a.fail_on_new,
         min_detectable_drop: a.min_detectable_drop,
+        measures: match &a.gate {
+            Some(f) => batch::MeasureSettings::load(f)?,
+            None => batch::MeasureSettings::default(),
+        },
     };
     o.validate()?;
     if let Some(file) = &a.junit {
@@ -157,6 +166,9 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
             "warning: compared unpaired: {}",
             forkbench_trial::text::visible(reason)
         );
+    }
+    if let Some(note) = &report.measures_note {
+        eprintln!("warning: {}", forkbench_trial::text::visible(note));
     }
     for c in &report.setting_differences {
         eprintln!(

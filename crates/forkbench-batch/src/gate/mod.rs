@@ -1,6 +1,13 @@
-//! The regression gate: each result row against its baseline row, paired on common random numbers when the seeds match, with multiplicity control and stated power.
+//! The regression gate: each result row against its baseline row, on success and on each measure's margin, paired on common random numbers when the seeds match, with multiplicity control and stated power.
 
+mod measure_test;
+mod measures;
+mod row_measures;
 mod text;
+
+pub use measure_test::MeasureTest;
+pub use measures::{MeasureSetting, MeasureSettings, Worse, trial_measures};
+pub use text::num;
 
 use std::collections::HashMap;
 
@@ -31,6 +38,8 @@ pub struct GateOptions {
     pub fail_on_new: bool,
     /// The drop the gate must see with 80 % power: rows with too few trials fail.
     pub min_detectable_drop: Option<f64>,
+    /// Margins and directions of the measures, beside their defaults (a gate file).
+    pub measures: MeasureSettings,
 }
 
 impl GateOptions {
@@ -56,6 +65,7 @@ impl Default for GateOptions {
             floor: None,
             fail_on_new: false,
             min_detectable_drop: None,
+            measures: MeasureSettings::default(),
         }
     }
 }
@@ -74,6 +84,8 @@ pub enum Verdict {
     New,
     /// Fewer trials than `--min-detectable-drop` needs.
     Underpowered,
+    /// A measure worse than the baseline's by more than its margin, after the correction.
+    Worse,
 }
 
 impl Verdict {
@@ -85,6 +97,7 @@ impl Verdict {
             Verdict::Missing => "missing",
             Verdict::New => "new, unchecked",
             Verdict::Underpowered => "underpowered",
+            Verdict::Worse => "worse beyond margin",
         }
     }
 }
@@ -120,6 +133,9 @@ pub struct RegressRow {
     pub detectable_drop: Option<f64>,
     /// With `--min-detectable-drop`: trials (pairs, when paired) that drop needs.
     pub trials_needed: Option<u64>,
+    /// Each gated measure against its margin (none: the baseline carries no measures).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub measures: Vec<MeasureTest>,
     pub verdict: Verdict,
 }
 
@@ -143,6 +159,13 @@ pub struct GateReport {
     pub pairing: Pairing,
     pub setting_differences: Vec<String>,
     pub rows: Vec<RegressRow>,
+    /// Measures the records carry that the gate does not gate (unknown to it and not in
+    /// the gate file, or switched off there).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub ungated_measures: Vec<String>,
+    /// Why no measure was compared, when none was (an old baseline: counts only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measures_note: Option<String>,
 }
 
 /// Trials a row needs for the paired gate to see `drop` with 80 % power at level
@@ -244,6 +267,7 @@ fn blank_row(s: (&str, &str, &str, Option<bool>), verdict: Verdict) -> RegressRo
         p_adjusted: None,
         detectable_drop: None,
         trials_needed: None,
+        measures: Vec::new(),
         verdict,
     }
 }
@@ -327,14 +351,30 @@ fn judge(rows: &mut [RegressRow], o: &GateOptions) -> f64 {
     let tested: Vec<usize> = (0..rows.len())
         .filter(|&i| rows[i].p_value.is_some())
         .collect();
-    let p: Vec<f64> = tested.iter().filter_map(|&i| rows[i].p_value).collect();
-    for (&i, adj) in tested.iter().zip(o.correction.adjust(&p)) {
-        rows[i].p_adjusted = Some(adj);
+    // One family: every row's success test and every measure's, in row order.
+    let mut p: Vec<f64> = Vec::new();
+    for r in rows.iter() {
+        p.extend(r.p_value);
+        p.extend(r.measures.iter().filter_map(|m| m.p_value));
+    }
+    let mut adjusted = o.correction.adjust(&p).into_iter();
+    for r in rows.iter_mut() {
+        if r.p_value.is_some() {
+            r.p_adjusted = adjusted.next();
+        }
+        for m in r.measures.iter_mut().filter(|m| m.p_value.is_some()) {
+            m.p_adjusted = adjusted.next();
+        }
     }
     let power_level = match o.correction {
         Correction::None => o.alpha,
-        _ => o.alpha / tested.len().max(1) as f64,
+        _ => o.alpha / p.len().max(1) as f64,
     };
+    for r in rows.iter_mut() {
+        for m in &mut r.measures {
+            m.judge(power_level, o.alpha);
+        }
+    }
     for &i in &tested {
         let (mdd, need) = power_of(&rows[i], power_level, o.min_detectable_drop);
         let r = &mut rows[i];
@@ -343,6 +383,8 @@ fn judge(rows: &mut [RegressRow], o: &GateOptions) -> f64 {
         let have = r.paired.map_or(r.now_trials, |c| c.pairs);
         r.verdict = if r.p_adjusted.is_some_and(|p| p < o.alpha) {
             Verdict::Drop
+        } else if r.measures.iter().any(|m| m.worse_beyond_margin) {
+            Verdict::Worse
         } else if o.floor.is_some_and(|f| r.now_rate.is_some_and(|v| v < f)) {
             Verdict::BelowFloor
         } else if o.min_detectable_drop.is_some()
@@ -381,6 +423,20 @@ pub fn regress(
         .map(|r| (r.key(), (r.outcome.seed, r.outcome.success)))
         .collect();
     let reason = unpaired_reason(base, manifest).or_else(|| seed_mismatch(base, &index));
+    let measured: row_measures::Measured = records
+        .iter()
+        .map(|r| (r.key(), (r.outcome.seed, trial_measures(&r.outcome))))
+        .collect();
+    let ctx = row_measures::RowContext {
+        base,
+        records,
+        measured: &measured,
+        paired: reason.is_none(),
+        settings: &o.measures,
+        manifest,
+        alpha: o.alpha,
+    };
+    let mut ungated = std::collections::BTreeSet::new();
     let mut rows: Vec<RegressRow> = base
         .rows
         .iter()
@@ -389,7 +445,14 @@ pub fn regress(
                 .is_none()
                 .then(|| pair_row(base, b, &index))
                 .flatten();
-            compare_row(b, b.find(&now.rows), pairs)
+            let found = b.find(&now.rows);
+            let mut row = compare_row(b, found, pairs);
+            if found.is_some() && base.measured {
+                let (tests, skipped) = row_measures::row_tests(b, &ctx);
+                row.measures = tests;
+                ungated.extend(skipped);
+            }
+            row
         })
         .collect();
     rows.extend(new_rows(base, now));
@@ -412,6 +475,8 @@ pub fn regress(
         pairing,
         setting_differences: differences,
         rows,
+        ungated_measures: ungated.into_iter().collect(),
+        measures_note: (!base.measured).then(row_measures::unmeasured_note),
     }
 }
 

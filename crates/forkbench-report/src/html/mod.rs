@@ -1,5 +1,6 @@
 //! `forkbench report`: one self-contained HTML page per batch directory (tables, SVG plots, recordings, provenance).
 
+mod gate_measures;
 mod profile;
 mod safety;
 mod sections;
@@ -67,6 +68,7 @@ fn batch_body(dir: &Path, baseline: Option<&Path>) -> Result<String> {
             svg::esc(&gate.verdict_text())
         ));
         h.push_str(&sections::baseline_comparison(&gate));
+        h.push_str(&gate_measures::measures_section(&gate));
     }
     h.push_str("<h2>Success per scenario × planner × tracker</h2>");
     h.push_str(&sections::success_table(&summary));

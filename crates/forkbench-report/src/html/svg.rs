@@ -1,4 +1,4 @@
-//! Hand-written inline SVG charts for the HTML report: stacked bars, heatmaps, histograms, lines.
+//! Hand-written inline SVG charts for the HTML report: stacked bars, heatmaps, histograms, lines, paired scatters.
 
 use std::fmt::Write as _;
 
@@ -372,6 +372,77 @@ pub fn lines(id: &str, title: &str, series: &[(String, Vec<Point>)], x_label: &s
             );
         }
         legend_entry(&mut s, (left + w, top), k, &colour, label);
+    }
+    s + "</svg>"
+}
+
+/// Each pair (baseline, now) as a point, with the line of no change and the margin's line
+/// (`margin` signed: above the diagonal when higher is worse); points beyond the margin
+/// are drawn red.
+pub fn paired_scatter(
+    id: &str,
+    title: &str,
+    pairs: &[(f64, f64)],
+    margin: f64,
+    unit: &str,
+) -> String {
+    let (left, top, w, h) = (70.0, 30.0, 260.0, 260.0);
+    let (lo, hi) = pairs
+        .iter()
+        .flat_map(|(a, b)| [*a, *b])
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), v| {
+            (l.min(v), u.max(v))
+        });
+    let (lo, hi) = if lo.is_finite() {
+        (lo.min(0.0), hi.max(lo + 1e-9))
+    } else {
+        (0.0, 1.0)
+    };
+    let hi = hi + 0.05 * (hi - lo);
+    let mut s = open(id, left + w + 30.0, top + h + 50.0);
+    let base = format!("baseline ({unit})");
+    let now = format!("now ({unit})");
+    axes(
+        &mut s,
+        title,
+        (left, top, w, h),
+        (lo, hi),
+        (lo, hi),
+        &base,
+        &now,
+    );
+    let px = |x: f64| left + w * (x - lo) / (hi - lo);
+    let py = |y: f64| top + h * (1.0 - (y - lo) / (hi - lo));
+    let _ = write!(
+        s,
+        "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#888\"/>",
+        px(lo),
+        py(lo),
+        px(hi),
+        py(hi)
+    );
+    let _ = write!(
+        s,
+        "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"{}\" stroke-dasharray=\"4 3\"/>",
+        px(lo),
+        py((lo + margin).clamp(lo, hi)),
+        px(hi),
+        py((hi + margin).clamp(lo, hi)),
+        palette(1)
+    );
+    for (a, b) in pairs {
+        let beyond = if margin >= 0.0 {
+            b - a > margin
+        } else {
+            b - a < margin
+        };
+        let colour = if beyond { palette(1) } else { palette(0) };
+        let _ = write!(
+            s,
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"2.5\" fill=\"{colour}\" fill-opacity=\"0.7\"/>",
+            px(*a),
+            py(*b)
+        );
     }
     s + "</svg>"
 }

@@ -1,0 +1,248 @@
+//! What the gate compares besides success: each trial's measures (entry errors, contact force, displacement, robustness, time, the step criteria's), which way each gets worse, and its non-inferiority margin.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use forkbench_trial::TrialOutcome;
+
+/// Which way a measure gets worse.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Worse {
+    Higher,
+    Lower,
+}
+
+impl Worse {
+    /// +1 when higher is worse: a difference times this is positive when worse.
+    pub fn sign(self) -> f64 {
+        match self {
+            Worse::Higher => 1.0,
+            Worse::Lower => -1.0,
+        }
+    }
+}
+
+/// How a measure's default margin is found.
+#[derive(Debug, Clone, Copy)]
+enum Rule {
+    /// A tenth of the scenario's tolerance (its key under `tolerances`), times a unit
+    /// factor.
+    TenthOf(&'static str, f64),
+    /// A fixed amount, with its reason.
+    Fixed(f64, &'static str),
+    /// A share of the baseline row's median.
+    MedianShare(f64),
+}
+
+/// A measure the gate knows: its name in the records, which way is worse, its margin.
+struct Known {
+    name: &'static str,
+    worse: Worse,
+    rule: Rule,
+}
+
+/// The measures every pick reports, and the built-in step criteria's.
+const KNOWN: [Known; 7] = [
+    Known {
+        name: "entry_lateral_error_m",
+        worse: Worse::Higher,
+        rule: Rule::TenthOf("lateral_m", 1.0),
+    },
+    Known {
+        name: "entry_heading_error_rad",
+        worse: Worse::Higher,
+        rule: Rule::TenthOf("heading_deg", std::f64::consts::PI / 180.0),
+    },
+    Known {
+        name: "max_contact_force_n",
+        worse: Worse::Higher,
+        rule: Rule::TenthOf("contact_force_n", 1.0),
+    },
+    Known {
+        name: "pallet_displacement_m",
+        worse: Worse::Higher,
+        rule: Rule::TenthOf("pallet_displacement_m", 1.0),
+    },
+    Known {
+        name: "robustness",
+        worse: Worse::Lower,
+        rule: Rule::Fixed(
+            0.1,
+            "a tenth of a limit (robustness is the least margin as a share of its limit)",
+        ),
+    },
+    Known {
+        name: "time_s",
+        worse: Worse::Higher,
+        rule: Rule::MedianShare(0.05),
+    },
+    // A lateral offset narrows one fork's gap one for one: the lateral error's margin.
+    Known {
+        name: "fork_tip_clearance_mm",
+        worse: Worse::Lower,
+        rule: Rule::TenthOf("lateral_m", 1000.0),
+    },
+];
+
+/// The tolerances the margins take a tenth of when a scenario's are unknown (the format's
+/// defaults).
+fn default_tolerance(key: &str) -> f64 {
+    let t = forkbench_trial::Tolerances::default();
+    match key {
+        "lateral_m" => t.lateral_m,
+        "heading_deg" => t.heading_deg,
+        "contact_force_n" => t.contact_force_n,
+        _ => t.pallet_displacement_m,
+    }
+}
+
+/// A trial's measures, by name with its unit: the entry's absolute lateral and heading
+/// errors, the contact force and the pallet's displacement (once the tips reached the
+/// face: before it the forks cannot have touched it), the robustness margin, the time
+/// (the cycle's, else the pick's; on success only: a failed trial's time is when it
+/// stopped), and every step criterion's measure.
+pub fn trial_measures(o: &TrialOutcome) -> BTreeMap<String, f64> {
+    let mut m = BTreeMap::new();
+    let mut put = |k: &str, v: Option<f64>| {
+        if let Some(v) = v.filter(|v| v.is_finite()) {
+            m.insert(k.to_owned(), v);
+        }
+    };
+    let at_face = o.lateral_error_m.is_some();
+    put("entry_lateral_error_m", o.lateral_error_m.map(f64::abs));
+    put("entry_heading_error_rad", o.heading_error_rad.map(f64::abs));
+    put(
+        "max_contact_force_n",
+        at_face.then_some(o.max_contact_force_n),
+    );
+    put(
+        "pallet_displacement_m",
+        at_face.then_some(o.pallet_displacement_m),
+    );
+    put("robustness", o.robustness);
+    let time = o.cycle.map_or(o.sim_time_s, |c| c.time_s);
+    put("time_s", o.success.then_some(time));
+    for (k, v) in &o.measures {
+        put(k, Some(*v));
+    }
+    m
+}
+
+/// A gate file's setting for one measure (`[measure.NAME]`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeasureSetting {
+    /// The worsening allowed before the gate fails, in the measure's unit.
+    pub margin: Option<f64>,
+    /// Which way it gets worse (needed for a measure the gate does not know).
+    pub worse: Option<Worse>,
+    /// `false`: not gated (listed as such).
+    pub gate: Option<bool>,
+}
+
+/// What a gate file sets: margins and directions by measure.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeasureSettings {
+    #[serde(default)]
+    pub measure: BTreeMap<String, MeasureSetting>,
+}
+
+/// The largest margin a gate file may set (a bound on every unit the bench uses).
+const MAX_MARGIN: f64 = 1e9;
+
+impl MeasureSettings {
+    /// Reads a gate file (TOML), checking every setting; errors name the file and field.
+    pub fn load(path: &std::path::Path) -> Result<Self, crate::BatchError> {
+        let text = crate::read_regular(path, 1 << 20)?;
+        let s: MeasureSettings = toml::from_str(&text).map_err(|e| {
+            crate::BatchError::Content(format!("{}: {}", path.display(), e.message()))
+        })?;
+        s.check()
+            .map_err(|why| crate::BatchError::Content(format!("{}: {why}", path.display())))?;
+        Ok(s)
+    }
+
+    /// Every margin finite in [0, 1e9]; a measure the gate does not know says `worse`.
+    pub fn check(&self) -> Result<(), String> {
+        for (name, s) in &self.measure {
+            if let Some(m) = s.margin
+                && !(0.0..=MAX_MARGIN).contains(&m)
+            {
+                return Err(format!(
+                    "measure.{name}.margin = {m}: must be a worsening in [0, {MAX_MARGIN}] in \
+                     the measure's unit"
+                ));
+            }
+            if known(name).is_none() && s.worse.is_none() && s.gate != Some(false) {
+                return Err(format!(
+                    "measure.{name}: the gate does not know this measure; say which way it gets \
+                     worse (worse = \"higher\" or \"lower\") and its margin"
+                ));
+            }
+            if known(name).is_none() && s.gate != Some(false) && s.margin.is_none() {
+                return Err(format!(
+                    "measure.{name}.margin: missing; a measure the gate does not know needs its \
+                     margin"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn known(name: &str) -> Option<&'static Known> {
+    KNOWN.iter().find(|k| k.name == name)
+}
+
+/// How one measure is gated in one row: its direction, margin and the margin's reason.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Gated {
+    pub worse: Worse,
+    pub margin: f64,
+    pub source: String,
+}
+
+/// How `name` is gated for a scenario with `tolerances` (its resolved settings' JSON,
+/// if known) and a baseline `median`; `None`: not gated (unknown, or switched off).
+pub(super) fn gated(
+    name: &str,
+    settings: &MeasureSettings,
+    tolerances: Option<&serde_json::Value>,
+    median: Option<f64>,
+) -> Option<Gated> {
+    let set = settings.measure.get(name);
+    if set.and_then(|s| s.gate) == Some(false) {
+        return None;
+    }
+    let k = known(name);
+    let worse = set.and_then(|s| s.worse).or(k.map(|k| k.worse))?;
+    if let Some(m) = set.and_then(|s| s.margin) {
+        return Some(Gated {
+            worse,
+            margin: m,
+            source: "the gate file".into(),
+        });
+    }
+    let (margin, source) = match k?.rule {
+        Rule::TenthOf(key, unit) => {
+            let tol = tolerances
+                .and_then(|t| t.get(key))
+                .and_then(serde_json::Value::as_f64)
+                .unwrap_or_else(|| default_tolerance(key));
+            (tol * unit / 10.0, format!("a tenth of tolerances.{key}"))
+        }
+        Rule::Fixed(m, why) => (m, why.to_owned()),
+        Rule::MedianShare(share) => (
+            share * median?.abs(),
+            format!("{:.0} % of the baseline's median", 100.0 * share),
+        ),
+    };
+    Some(Gated {
+        worse,
+        margin,
+        source,
+    })
+}
