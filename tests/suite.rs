@@ -20,4 +20,5 @@ mod run_options;
 mod scenario_fuzz;
 mod shards;
 mod success_run;
+mod trials_auto;
 mod truck;

@@ -35,6 +35,7 @@ mod records_run;
 mod replay;
 mod safety_summary;
 mod seed;
+pub mod sequential;
 mod shard;
 pub mod stats;
 mod store;

@@ -265,3 +265,56 @@ fn a_gate_file_sets_margins_and_refuses_what_it_cannot_gate() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn trials_auto_stops_at_the_look_that_decides_and_keeps_alpha_over_the_looks() {
+    use forkbench_batch::sequential::{self, Decision, SequentialPlan};
+    let (s, r, _) = run(&spec(scenarios(0.0), 40, 21), "seq-base");
+    let base = Baseline::from_results(&s, &r, "built-in".into());
+    assert_eq!(sequential::baseline_cap(&base), 40);
+    let looks = sequential::plan_looks(sequential::FIRST_LOOK, 40);
+    assert_eq!(looks, vec![10, 20, 40]);
+    let run_auto = |shift_m: f64, name: &str| {
+        let dir = tmp(name);
+        let gate = |o: &GateOptions| {
+            let (s, r, m) = batch::load_batch(&dir)?;
+            Ok(batch::regress(&base, &s, &r, Some(&m), o))
+        };
+        let plan = SequentialPlan {
+            looks: looks.clone(),
+            options: GateOptions::default(),
+            want_drop: sequential::DEFAULT_DECIDE_DROP,
+            gate: &gate,
+        };
+        let mut first = spec(scenarios(shift_m), 40, 21);
+        first.trials = looks[0];
+        let out = sequential::run_sequential(&first, &dir, 2, &plan, &|_| {}).expect("runs");
+        let kept = batch::load_batch(&dir).expect("loads").1.len();
+        let _ = std::fs::remove_dir_all(&dir);
+        (out, kept)
+    };
+    // 3 cm off: a look fails it, and no more trials are run than that look's.
+    let (bad, kept) = run_auto(0.03, "seq-bad");
+    let last = bad.looks.last().expect("a look");
+    assert_eq!(last.decision, Decision::Regression, "{:?}", bad.looks);
+    assert_eq!(kept as u64, 2 * last.trials);
+    assert!(!bad.report.passed);
+    // Every look ran at α over the three planned looks.
+    assert!(
+        bad.looks
+            .iter()
+            .all(|l| (l.alpha - 0.05 / 3.0).abs() < 1e-12)
+    );
+    assert_eq!(bad.report.alpha, bad.looks[0].alpha);
+    // Unchanged: no look fails; at the cap it is undecided or passed, never a regression.
+    let (same, kept) = run_auto(0.0, "seq-same");
+    assert!(
+        same.looks
+            .iter()
+            .all(|l| l.decision != Decision::Regression),
+        "{:?}",
+        same.looks
+    );
+    assert!(same.report.passed);
+    assert_eq!(kept as u64, 2 * same.looks.last().expect("a look").trials);
+}

@@ -50,9 +50,14 @@ impl From<Modes> for batch::ReplanModes {
 pub struct BatchArgs {
     /// Scenario files (default: the embedded field-test, rack-pick, Table 2, warehouse mission and handling-cycle sets).
     pub scenarios: Vec<PathBuf>,
-    /// Trials per scenario × case × planner × tracker.
-    #[arg(long, default_value_t = 20)]
-    pub trials: u64,
+    /// Trials per scenario × case × planner × tracker, or `auto`: looks of 10, 20, 40, …
+    /// trials, each gated against --baseline at α over the planned looks, until the gate
+    /// decides (a failure, or a pass powered for --min-detectable-drop, default 0.1, and
+    /// twice each measure's margin) or --max-trials is reached.
+    #[arg(long, default_value = "20")]
+    pub trials: crate::sequential_cmd::TrialsArg,
+    #[command(flatten)]
+    pub auto: crate::sequential_cmd::AutoArgs,
     #[command(flatten)]
     pub options: crate::run_options::RunOptionArgs,
     /// Batch seed; each trial's seed derives from it and the trial's identity.
@@ -217,7 +222,12 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
         scenarios,
         planners: a.planners.clone(),
         trackers: a.trackers.clone(),
-        trials: a.trials,
+        trials: crate::sequential_cmd::first_look(
+            a.trials,
+            &a.auto,
+            a.sweep.is_some(),
+            a.shard.is_some(),
+        )?,
         seed: a.seed,
         shard,
         overrides: a.options.overrides()?,
@@ -233,14 +243,32 @@ fn prepare(a: BatchArgs) -> anyhow::Result<(BatchSpec, BatchArgs)> {
     Ok((spec, a))
 }
 
+/// The trials: the batch, or with `--trials auto` its looks (the spec then holds the
+/// last look's trial count, which the recordings and the report read).
+fn run_trials(
+    spec: &mut BatchSpec,
+    a: &BatchArgs,
+    auto: bool,
+) -> anyhow::Result<(Summary, Option<batch::sequential::Sequential>)> {
+    if !auto {
+        return Ok((run_one(spec, &a.out, a.jobs)?, None));
+    }
+    let o = batch::GateOptions::default();
+    let s =
+        crate::sequential_cmd::run_auto(spec, &a.out, a.jobs, &a.auto, o, a.min_detectable_drop)?;
+    spec.trials = s.looks.last().map_or(spec.trials, |l| l.trials);
+    Ok((s.summary.clone(), Some(s)))
+}
+
 /// Runs the batch; `Ok(false)` when a row fell below `--floor` (the run worked, the
 /// result is a failure: exit 3).
 pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     let began = std::time::Instant::now();
-    let (spec, a) = prepare(a)?;
+    let (mut spec, a) = prepare(a)?;
     // Before anything is sized by the trial count (the progress bar lists the jobs).
     spec.check(a.jobs)?;
-    if let Some(d) = a.min_detectable_drop {
+    let auto = a.trials == crate::sequential_cmd::TrialsArg::Auto;
+    if let Some(d) = a.min_detectable_drop.filter(|_| !auto) {
         spec.check_power(d)?;
     }
     if let Some(sweep) = &a.sweep {
@@ -248,7 +276,7 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     }
     let mut clock = Clock::new(began);
     clock.lap("setup");
-    let summary = run_one(&spec, &a.out, a.jobs)?;
+    let (summary, looks) = run_trials(&mut spec, &a, auto)?;
     clock.lap("trials");
     // Every output is attempted, whatever failed before it (a full disk while recording
     // must not cost the table, JUnit, CSV or report); the failures are reported together.
@@ -261,7 +289,9 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
     clock.lap("recordings");
     let extras = write_extras(&summary, &a, &mut failed);
     clock.lap("report, CSV and JUnit");
-    let shown = if a.json {
+    let shown = if let Some(s) = &looks {
+        crate::sequential_cmd::show(s, &summary, &a.out, a.json)
+    } else if a.json {
         crate::emit(&format!("{}\n", serde_json::to_string(&summary)?))
     } else {
         let profile = summary.profile.as_ref().map_or(String::new(), |p| {
@@ -303,7 +333,7 @@ pub fn run(a: BatchArgs) -> anyhow::Result<bool> {
             forkbench_trial::text::visible(&below.join(", "))
         );
     }
-    Ok(below.is_empty())
+    Ok(below.is_empty() && looks.is_none_or(|s| s.report.passed))
 }
 
 /// The batch's wall clock from its start, by part (what the closing line prints).

@@ -114,7 +114,7 @@ pub fn baseline(dir: &Path, out: &Path, description: Option<String>) -> anyhow::
 }
 
 /// The gate over a results directory, and the results' provenance.
-fn gate(
+pub(crate) fn gate(
     base: &Baseline,
     dir: &Path,
     mappings: &[batch::Mapping],

@@ -20,6 +20,7 @@ mod route_cmd;
 mod run_options;
 mod safety_cmd;
 mod scan_cmd;
+mod sequential_cmd;
 mod trial_cmd;
 mod truck_cmd;
 

@@ -238,7 +238,7 @@ impl GateReport {
              the discordance seen now, at least the drop itself). A row fails on adjusted p < α, \
              a rate below the floor, a missing row, too few trials for \
              --min-detectable-drop, or a measure worse beyond its margin.\n\n",
-            self.alpha,
+            (self.alpha * 1e6).round() / 1e6,
             self.tests(),
             self.correction.name(),
             self.power_level,
