@@ -62,6 +62,24 @@ fn trials_auto_gates_each_look_and_writes_them() {
         "--out",
         s(&out),
     ]);
+    let capped = forkbench(&[
+        "batch",
+        s(&scn),
+        "--trials",
+        "auto",
+        "--baseline",
+        s(&file),
+        "--max-trials",
+        "0",
+        "--out",
+        s(&tmp("capped")),
+    ]);
+    assert_eq!(capped.status.code(), Some(1), "{}", text(&capped));
+    assert!(
+        text(&capped).contains("--max-trials 0: must be 1 to"),
+        "{}",
+        text(&capped)
+    );
     // The same code: no look fails, so the gate passes (undecided at the 20-trial cap).
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert!(

@@ -91,6 +91,7 @@ fn a_tracker_3_cm_off_fails_on_how_it_enters_and_a_millimetre_passes() {
 
     let (s3, r3, m3) = run(&spec(scenarios(0.03), 40, 21), "shift3");
     let g = batch::regress(&base, &s3, &r3, Some(&m3), &GateOptions::default());
+    eprintln!("{}", g.markdown());
     assert!(!g.passed, "{}", g.markdown());
     // The rack pick enters 8 mm off the centre line: a fork's gap to the block beside it
     // shrinks by most of the shift, and the entry error grows by more than its margin.

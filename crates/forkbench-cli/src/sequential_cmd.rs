@@ -109,6 +109,11 @@ pub fn run_auto(
         ..options
     };
     options.validate()?;
+    if let Some(m) = auto.max_trials
+        && !(1..=1_000_000).contains(&m)
+    {
+        bail!("--max-trials {m}: must be 1 to 1000000 trials per case");
+    }
     let cap = auto
         .max_trials
         .unwrap_or_else(|| sequential::baseline_cap(&base));
@@ -117,9 +122,6 @@ pub fn run_auto(
             "{}: holds no per-trial results, so no look can pair with it; re-make it with `forkbench baseline`",
             file.display()
         );
-    }
-    if !(1..=1_000_000).contains(&cap) {
-        bail!("--max-trials {cap}: must be 1 to 1000000");
     }
     let gate = |o: &GateOptions| -> Result<batch::GateReport, batch::BatchError> {
         crate::gate_cmd::gate(&base, out, &auto.mappings, o)

@@ -88,7 +88,8 @@ pub(super) fn test(measure: &str, g: &Gated, sample: &Sample, alpha: f64) -> Mea
     let (base, now) = (sample.baseline_values(), sample.now_values());
     let (p, shift, se, paired) = match sample {
         Sample::Paired(pairs) => {
-            let d: Vec<f64> = pairs.iter().map(|(b, n)| s * (n - b)).collect();
+            // `+ 0.0` turns an equal pair's −0 into 0.
+            let d: Vec<f64> = pairs.iter().map(|(b, n)| s * (n - b) + 0.0).collect();
             let se = std_dev(&d) / (d.len().max(1) as f64).sqrt();
             let p = (!d.is_empty()).then(|| signed_rank_p_above(&d, g.margin));
             (p, paired_shift(&d, alpha), se, true)

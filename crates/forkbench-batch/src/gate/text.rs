@@ -10,6 +10,8 @@ fn pct(v: f64) -> String {
 
 /// A measure's value in its own unit, to four decimals or three significant digits.
 pub fn num(v: f64) -> String {
+    // −0 (a "lower is worse" measure's equal pair) reads as 0.
+    let v = if v == 0.0 { 0.0 } else { v };
     if v == 0.0 || v.abs() >= 0.01 {
         format!("{v:.4}")
     } else {

@@ -17,6 +17,15 @@ fn plotted(r: &RegressRow) -> Vec<&MeasureTest> {
         .collect()
 }
 
+/// A p-value to four decimals, or in exponent form below 0.001.
+fn p_text(p: f64) -> String {
+    if p >= 1e-3 {
+        format!("{p:.4}")
+    } else {
+        format!("{p:.2e}")
+    }
+}
+
 fn num(v: Option<f64>) -> String {
     v.map_or("–".into(), forkbench_batch::gate_num)
 }
@@ -57,7 +66,7 @@ pub fn measures_section(g: &GateReport) -> String {
                 esc(&m.shift_text()),
                 m.n,
                 if m.paired { "pairs" } else { "values" },
-                m.p_adjusted.map_or("–".into(), |p| format!("{p:.2e}")),
+                m.p_adjusted.map_or("–".into(), p_text),
                 num(m.detectable),
                 esc(m.verdict_text())
             );
