@@ -44,7 +44,7 @@ struct Known {
 }
 
 /// The measures every pick reports, and the built-in step criteria's.
-const KNOWN: [Known; 7] = [
+const KNOWN: &[Known] = &[
     Known {
         name: "entry_lateral_error_m",
         worse: Worse::Higher,
@@ -84,7 +84,48 @@ const KNOWN: [Known; 7] = [
         worse: Worse::Lower,
         rule: Rule::TenthOf("lateral_m", 1000.0),
     },
+    // The handling cycle's phases after the pick, by phase and measure.
+    Known {
+        name: "place.position_error_m",
+        worse: Worse::Higher,
+        rule: Rule::Fixed(0.005, PLACE_POSITION),
+    },
+    Known {
+        name: "place.heading_error_rad",
+        worse: Worse::Higher,
+        rule: Rule::Fixed(0.2 * std::f64::consts::PI / 180.0, PLACE_HEADING),
+    },
+    Known {
+        name: "place.clearance_m",
+        worse: Worse::Lower,
+        rule: Rule::Fixed(0.01, AS_ENTRY),
+    },
+    Known {
+        name: "carry.cross_track_max_m",
+        worse: Worse::Higher,
+        rule: Rule::Fixed(0.01, AS_ENTRY),
+    },
+    Known {
+        name: "return.cross_track_max_m",
+        worse: Worse::Higher,
+        rule: Rule::Fixed(0.01, AS_ENTRY),
+    },
+    Known {
+        name: "carry.final_position_error_m",
+        worse: Worse::Higher,
+        rule: Rule::Fixed(0.005, PLACE_POSITION),
+    },
+    Known {
+        name: "return.final_position_error_m",
+        worse: Worse::Higher,
+        rule: Rule::Fixed(0.005, PLACE_POSITION),
+    },
 ];
+
+/// The reasons of the phases' fixed margins.
+const PLACE_POSITION: &str = "a tenth of the place phase's default position tolerance (0.05 m)";
+const PLACE_HEADING: &str = "a tenth of the place phase's default heading tolerance (2°)";
+const AS_ENTRY: &str = "the entry error's default margin (a choice)";
 
 /// The tolerances the margins take a tenth of when a scenario's are unknown (the format's
 /// defaults).
@@ -102,7 +143,7 @@ fn default_tolerance(key: &str) -> f64 {
 /// errors, the contact force and the pallet's displacement (once the tips reached the
 /// face: before it the forks cannot have touched it), the robustness margin, the time
 /// (the cycle's, else the pick's; on success only: a failed trial's time is when it
-/// stopped), and every step criterion's measure.
+/// stopped), every step criterion's measure, and each later phase's (`place.clearance_m`).
 pub fn trial_measures(o: &TrialOutcome) -> BTreeMap<String, f64> {
     let mut m = BTreeMap::new();
     let mut put = |k: &str, v: Option<f64>| {
@@ -126,6 +167,17 @@ pub fn trial_measures(o: &TrialOutcome) -> BTreeMap<String, f64> {
     put("time_s", o.success.then_some(time));
     for (k, v) in &o.measures {
         put(k, Some(*v));
+    }
+    // The phases after the pick, as `phase.measure`; a heading error counts either way.
+    for p in &o.phases {
+        for (k, v) in &p.measures {
+            let v = if k.ends_with("heading_error_rad") {
+                v.abs()
+            } else {
+                *v
+            };
+            put(&format!("{}.{k}", p.name), Some(v));
+        }
     }
     m
 }
@@ -245,4 +297,47 @@ pub(super) fn gated(
         margin,
         source,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A handling cycle's record, cut to what the measures read.
+    const CYCLE: &str = r#"{"scenario": "warehouse-cycle", "case": "default", "planner": "bspline",
+        "tracker": "pure_pursuit", "seed": 1, "noise": true, "success": true, "failure": null,
+        "failure_detail": null, "lateral_error_m": -0.0488, "heading_error_rad": 0.00097,
+        "final_lateral_error_m": 0.012, "final_heading_error_rad": -0.024,
+        "insertion_depth_m": 1.16, "max_steer_rad": 1.0, "max_contact_force_n": 0.0,
+        "pallet_displacement_m": 0.0, "pallet_rotation_rad": 0.0, "replans": 0,
+        "replans_failed": 0, "path_length_m": 4.2, "sim_time_s": 197.45, "wall_time_ms": 151.2,
+        "measures": {"fork_tip_clearance_mm": 77.1}, "robustness": 0.51,
+        "cycle": {"time_s": 180.5, "distance_loaded_m": 20.0, "distance_unloaded_m": 21.0},
+        "phases": [{"name": "carry", "success": true, "failure": null, "failure_detail": null,
+        "time_s": 36.5, "distance_m": 16.6, "loaded": true, "measures": {"cross_track_max_m":
+        0.022, "planned_length_m": 12.7}}, {"name": "place", "success": true, "failure": null,
+        "failure_detail": null, "time_s": 20.4, "distance_m": 7.2, "loaded": true, "measures":
+        {"clearance_m": 0.295, "heading_error_rad": -0.001, "position_error_m": 0.0044}}]}"#;
+
+    #[test]
+    fn a_cycle_gives_the_picks_measures_and_its_phases_by_name() {
+        let o: TrialOutcome = serde_json::from_str(CYCLE).expect("a record");
+        let m = trial_measures(&o);
+        assert_eq!(m["entry_lateral_error_m"], 0.0488);
+        assert_eq!(m["time_s"], 180.5, "the cycle's time, not the pick's");
+        assert_eq!(m["fork_tip_clearance_mm"], 77.1);
+        assert_eq!(m["place.heading_error_rad"], 0.001, "either way");
+        assert_eq!(m["carry.cross_track_max_m"], 0.022);
+        // Known phase measures are gated with their margins; a plan's length is not known.
+        let s = MeasureSettings::default();
+        let g = gated("place.clearance_m", &s, None, None).expect("gated");
+        assert_eq!((g.worse, g.margin), (Worse::Lower, 0.01));
+        assert!(gated("carry.planned_length_m", &s, None, None).is_none());
+        // A failed trial keeps no time; one that never reached the face no entry measures.
+        let mut failed = o.clone();
+        failed.success = false;
+        failed.lateral_error_m = None;
+        let m = trial_measures(&failed);
+        assert!(!m.contains_key("time_s") && !m.contains_key("max_contact_force_n"));
+    }
 }
