@@ -20,12 +20,28 @@ pub type ExternalTrackerConfig = forkbench_ipc::CommandConfig;
 /// Consecutive timeouts per command, across worker threads.
 static BREAKER: LazyLock<Breaker> = LazyLock::new(Breaker::default);
 
-/// The truck's limits as sent: its spec plus the derived curvature limit.
-#[derive(Debug, Clone, Serialize)]
-struct TruckMsg<'a> {
-    #[serde(flatten)]
-    spec: &'a ForkliftSpec,
-    max_curvature_per_m: f64,
+/// The truck as sent: its spec with its steering, drive and control always written (a
+/// spec leaves them out at their defaults, which a tracker cannot know, and a stop or a
+/// dead-time compensation needs them), plus the derived curvature limit.
+fn truck_msg(truck: &ForkliftSpec) -> serde_json::Value {
+    let mut v = serde_json::to_value(truck).unwrap_or(serde_json::Value::Null);
+    if let Some(m) = v.as_object_mut() {
+        let parts = [
+            ("steering", serde_json::to_value(&truck.steering)),
+            ("drive", serde_json::to_value(&truck.drive)),
+            ("control", serde_json::to_value(&truck.control)),
+            (
+                "max_curvature_per_m",
+                Ok(truck.max_curvature_per_m().into()),
+            ),
+        ];
+        for (k, part) in parts {
+            if let Ok(part) = part {
+                m.insert(k.to_owned(), part);
+            }
+        }
+    }
+    v
 }
 
 /// The path as sent: samples as `[s_m, x_m, y_m, heading_rad, curvature_per_m]`, the
@@ -40,11 +56,11 @@ struct PathMsg {
 /// What forkbench sends: a new path to follow, or one control tick.
 #[derive(Debug, Clone, Serialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
-enum RequestMsg<'a> {
+enum RequestMsg {
     Reset {
         id: u64,
         path: PathMsg,
-        truck: TruckMsg<'a>,
+        truck: serde_json::Value,
     },
     Tick {
         id: u64,
@@ -118,7 +134,7 @@ impl ExternalTracker {
     }
 
     /// One request on this thread's pooled tracker (a new one when none waits).
-    fn request<'a>(&self, msg: impl FnOnce(u64) -> RequestMsg<'a>) -> Result<ResponseMsg, String> {
+    fn request(&self, msg: impl FnOnce(u64) -> RequestMsg) -> Result<ResponseMsg, String> {
         let callee = Callee {
             dir: &self.dir,
             protocol: PROTOCOL,
@@ -198,10 +214,7 @@ impl Tracker for ExternalTracker {
                 reverse: path.reverse,
                 samples: path.samples.iter().map(sample_row).collect(),
             },
-            truck: TruckMsg {
-                spec: truck,
-                max_curvature_per_m: truck.max_curvature_per_m(),
-            },
+            truck: truck_msg(truck),
         };
         self.fault = match self.request(msg) {
             Ok(ResponseMsg::Ok { .. }) => None,
@@ -239,5 +252,25 @@ impl Tracker for ExternalTracker {
 
     fn fault(&self) -> Option<String> {
         self.fault.clone()
+    }
+}
+
+#[cfg(test)]
+mod wire_tests {
+    use super::*;
+
+    #[test]
+    fn the_reset_carries_the_actuators_even_at_their_defaults() {
+        let truck = ForkliftSpec::default();
+        let v = truck_msg(&truck);
+        assert_eq!(v["drive"]["dead_time_s"], truck.drive.dead_time_s);
+        assert_eq!(v["drive"]["creep_speed_mps"], truck.drive.creep_speed_mps);
+        assert_eq!(
+            v["control"]["transport_delay_s"],
+            truck.control.transport_delay_s
+        );
+        assert_eq!(v["steering"]["dead_time_s"], truck.steering.dead_time_s);
+        assert_eq!(v["wheelbase_m"], truck.wheelbase_m);
+        assert_eq!(v["max_curvature_per_m"], truck.max_curvature_per_m());
     }
 }
