@@ -227,20 +227,7 @@ fn pair_row(
         broke: 0,
         fixed: 0,
     };
-    let mode = row.replan.unwrap_or(false);
-    for t in base.trials.iter().filter(|t| {
-        (
-            t.scenario.as_str(),
-            t.planner.as_str(),
-            t.tracker.as_str(),
-            t.replan,
-        ) == (
-            row.scenario.as_str(),
-            row.planner.as_str(),
-            row.tracker.as_str(),
-            mode,
-        )
-    }) {
+    for t in base.trials.iter().filter(|t| row_measures::in_row(row, t)) {
         if let Some(&(seed, ok)) = now.get(&t.key())
             && seed == t.seed
         {

@@ -20,7 +20,8 @@ pub(super) struct RowContext<'a> {
     pub alpha: f64,
 }
 
-fn in_row(row: &BaselineRow, t: &BaselineTrial) -> bool {
+/// Whether a baseline trial belongs to `row` (its mode, or plan-once for a row without).
+pub(super) fn in_row(row: &BaselineRow, t: &BaselineTrial) -> bool {
     (
         t.scenario.as_str(),
         t.planner.as_str(),
