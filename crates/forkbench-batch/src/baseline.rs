@@ -267,13 +267,19 @@ impl BaselineRow {
     /// Whether a result row is this row: same scenario × planner × tracker, and the same
     /// mode when the baseline row has one.
     pub(super) fn matches(&self, r: &super::SummaryRow) -> bool {
-        (r.scenario.as_str(), r.planner.as_str(), r.tracker.as_str())
+        self.holds(&r.scenario, &r.planner, &r.tracker, r.replan)
+    }
+
+    /// Whether results of this scenario × planner × tracker in mode `replan` belong to
+    /// this row (any mode when the row has none).
+    pub(super) fn holds(&self, scenario: &str, planner: &str, tracker: &str, replan: bool) -> bool {
+        (scenario, planner, tracker)
             == (
                 self.scenario.as_str(),
                 self.planner.as_str(),
                 self.tracker.as_str(),
             )
-            && self.replan.is_none_or(|m| r.replan == m)
+            && self.replan.is_none_or(|m| replan == m)
     }
 
     /// The result row this baseline row compares with; without a mode, the only row of

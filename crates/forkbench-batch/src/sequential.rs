@@ -57,12 +57,7 @@ pub struct Look {
 /// Whether `report` (one look's gate) decides, and why.
 pub fn decide(report: &GateReport, want_drop: f64) -> (Decision, String) {
     if !report.passed {
-        let text = report.verdict_text();
-        let why = text
-            .strip_prefix("REGRESSION: ")
-            .unwrap_or(&text)
-            .to_owned();
-        return (Decision::Regression, why);
+        return (Decision::Regression, report.verdict_reason());
     }
     let mut short = Vec::new();
     for r in report.rows.iter().filter(|r| r.verdict == Verdict::Ok) {

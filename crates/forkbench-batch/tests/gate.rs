@@ -10,9 +10,10 @@ use forkbench_batch::{
     self as batch, Baseline, BatchSpec, CompareOptions, GateOptions, GateReport, Pairing, Summary,
     Verdict, junit,
 };
-use forkbench_core::{ForkliftSpec, Path as TrackPath};
-use forkbench_track::{Command, PurePursuit, Tracker, TrackerInput};
+use forkbench_track::PurePursuit;
 use forkbench_trial::{Registry, Scenario};
+
+use crate::gate_measures::Shifted;
 
 fn scenario_file(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios")).join(name)
@@ -68,29 +69,11 @@ fn baseline_of(dir: &Path) -> Baseline {
     Baseline::from_results(&s, &records, "test".into())
 }
 
-/// Pure pursuit that believes the truck 2 cm further left than it is: a subtle
-/// calibration error, as a degraded build would have.
-struct Offset(PurePursuit);
-
-impl Tracker for Offset {
-    fn name(&self) -> &str {
-        Tracker::name(&self.0)
-    }
-    fn reset(&mut self, path: &TrackPath, truck: &ForkliftSpec) {
-        Tracker::reset(&mut self.0, path, truck);
-    }
-    fn command(&mut self, input: &TrackerInput) -> Command {
-        let mut i = *input;
-        let h = i.pose.heading_rad;
-        i.pose.x_m -= 0.02 * h.sin();
-        i.pose.y_m += 0.02 * h.cos();
-        Tracker::command(&mut self.0, &i)
-    }
-}
-
 fn offset_scenario(name: &str) -> Scenario {
     let registry = Registry::builtin().with_tracker("pure_pursuit", |s, _| {
-        Ok(Box::new(Offset(PurePursuit::from_settings(s)?)))
+        // Pure pursuit that believes the truck 2 cm further left than it is: a subtle
+        // calibration error, as a degraded build would have.
+        Ok(Box::new(Shifted(PurePursuit::from_settings(s)?, 0.02)))
     });
     Scenario::load_with(&scenario_file(name), Arc::new(registry))
         .and_then(|s| s.with_pallet_sensing("gaussian"))

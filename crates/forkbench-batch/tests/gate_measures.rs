@@ -21,8 +21,9 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-/// Pure pursuit that believes the truck `0` metres further left than it is.
-struct Shifted(PurePursuit, f64);
+/// Pure pursuit that believes the truck `.1` metres further left than it is (also the
+/// gate tests' degraded build).
+pub(crate) struct Shifted(pub(crate) PurePursuit, pub(crate) f64);
 
 impl Tracker for Shifted {
     fn name(&self) -> &str {

@@ -253,9 +253,7 @@ fn run_trials(
     if !auto {
         return Ok((run_one(spec, &a.out, a.jobs)?, None));
     }
-    let o = batch::GateOptions::default();
-    let s =
-        crate::sequential_cmd::run_auto(spec, &a.out, a.jobs, &a.auto, o, a.min_detectable_drop)?;
+    let s = crate::sequential_cmd::run_auto(spec, &a.out, a.jobs, &a.auto, a.min_detectable_drop)?;
     spec.trials = s.looks.last().map_or(spec.trials, |l| l.trials);
     Ok((s.summary.clone(), Some(s)))
 }

@@ -148,10 +148,7 @@ pub fn regress(a: &RegressArgs) -> anyhow::Result<bool> {
         floor: a.floor,
         fail_on_new: a.fail_on_new,
         min_detectable_drop: a.min_detectable_drop,
-        measures: match &a.gate {
-            Some(f) => batch::MeasureSettings::load(f)?,
-            None => batch::MeasureSettings::default(),
-        },
+        measures: batch::MeasureSettings::load_or_default(a.gate.as_deref())?,
     };
     o.validate()?;
     if let Some(file) = &a.junit {

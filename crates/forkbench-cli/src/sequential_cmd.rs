@@ -94,7 +94,6 @@ pub fn run_auto(
     out: &std::path::Path,
     jobs: usize,
     auto: &AutoArgs,
-    options: GateOptions,
     want_drop: Option<f64>,
 ) -> anyhow::Result<sequential::Sequential> {
     let Some(file) = &auto.baseline else {
@@ -102,11 +101,8 @@ pub fn run_auto(
     };
     let base = Baseline::load(file)?;
     let options = GateOptions {
-        measures: match &auto.gate_file {
-            Some(f) => batch::MeasureSettings::load(f)?,
-            None => batch::MeasureSettings::default(),
-        },
-        ..options
+        measures: batch::MeasureSettings::load_or_default(auto.gate_file.as_deref())?,
+        ..GateOptions::default()
     };
     options.validate()?;
     if let Some(m) = auto.max_trials

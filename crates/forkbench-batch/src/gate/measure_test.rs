@@ -82,10 +82,17 @@ pub(super) fn median(v: &[f64]) -> Option<f64> {
 }
 
 /// Tests `sample` of `measure` against its margin at one-sided level `alpha` (the
-/// bounds' level; the verdict waits for the correction).
-pub(super) fn test(measure: &str, g: &Gated, sample: &Sample, alpha: f64) -> MeasureTest {
+/// bounds' level; the verdict waits for the correction); `base` is the sample's
+/// baseline values with their median, which the margin was found from.
+pub(super) fn test(
+    measure: &str,
+    g: &Gated,
+    sample: &Sample,
+    (base, baseline_median): (&[f64], Option<f64>),
+    alpha: f64,
+) -> MeasureTest {
     let s = g.worse.sign();
-    let (base, now) = (sample.baseline_values(), sample.now_values());
+    let now = sample.now_values();
     let (p, shift, se, paired) = match sample {
         Sample::Paired(pairs) => {
             // `+ 0.0` turns an equal pair's −0 into 0.
@@ -114,7 +121,7 @@ pub(super) fn test(measure: &str, g: &Gated, sample: &Sample, alpha: f64) -> Mea
         paired,
         n: now.len() as u64,
         baseline_n: base.len() as u64,
-        baseline_median: median(&base),
+        baseline_median,
         now_median: median(&now),
         shift,
         p_value: p,

@@ -127,16 +127,13 @@ const PLACE_POSITION: &str = "a tenth of the place phase's default position tole
 const PLACE_HEADING: &str = "a tenth of the place phase's default heading tolerance (2°)";
 const AS_ENTRY: &str = "the entry error's default margin (a choice)";
 
-/// The tolerances the margins take a tenth of when a scenario's are unknown (the format's
-/// defaults).
-fn default_tolerance(key: &str) -> f64 {
-    let t = forkbench_trial::Tolerances::default();
-    match key {
-        "lateral_m" => t.lateral_m,
-        "heading_deg" => t.heading_deg,
-        "contact_force_n" => t.contact_force_n,
-        _ => t.pallet_displacement_m,
-    }
+/// The tolerance `key` when a scenario's are unknown: the format's default, read the way
+/// the manifest's resolved tolerances are.
+fn default_tolerance(key: &str) -> Option<f64> {
+    serde_json::to_value(forkbench_trial::Tolerances::default())
+        .ok()?
+        .get(key)?
+        .as_f64()
 }
 
 /// A trial's measures, by name with its unit: the entry's absolute lateral and heading
@@ -217,6 +214,11 @@ impl MeasureSettings {
         Ok(s)
     }
 
+    /// The gate file's settings, or the defaults without one.
+    pub fn load_or_default(path: Option<&std::path::Path>) -> Result<Self, crate::BatchError> {
+        path.map_or_else(|| Ok(Self::default()), Self::load)
+    }
+
     /// Every margin finite in [0, 1e9]; a measure the gate does not know says `worse`.
     pub fn check(&self) -> Result<(), String> {
         for (name, s) in &self.measure {
@@ -283,7 +285,7 @@ pub(super) fn gated(
             let tol = tolerances
                 .and_then(|t| t.get(key))
                 .and_then(serde_json::Value::as_f64)
-                .unwrap_or_else(|| default_tolerance(key));
+                .or_else(|| default_tolerance(key))?;
             (tol * unit / 10.0, format!("a tenth of tolerances.{key}"))
         }
         Rule::Fixed(m, why) => (m, why.to_owned()),
@@ -333,6 +335,14 @@ mod tests {
         let g = gated("place.clearance_m", &s, None, None).expect("gated");
         assert_eq!((g.worse, g.margin), (Worse::Lower, 0.01));
         assert!(gated("carry.planned_length_m", &s, None, None).is_none());
+        // Without a manifest the margins take a tenth of the format's default tolerances.
+        let lat = gated("entry_lateral_error_m", &s, None, None).expect("gated");
+        assert!((lat.margin - 0.01).abs() < 1e-12, "{lat:?}");
+        let heading = gated("entry_heading_error_rad", &s, None, None).expect("gated");
+        assert!(
+            (heading.margin - 0.3f64.to_radians()).abs() < 1e-12,
+            "{heading:?}"
+        );
         // A failed trial keeps no time; one that never reached the face no entry measures.
         let mut failed = o.clone();
         failed.success = false;

@@ -410,8 +410,10 @@ pub fn regress(
         .map(|r| (r.key(), (r.outcome.seed, r.outcome.success)))
         .collect();
     let reason = unpaired_reason(base, manifest).or_else(|| seed_mismatch(base, &index));
+    // A baseline without measures compares none: the records' are not taken.
     let measured: row_measures::Measured = records
         .iter()
+        .filter(|_| base.measured)
         .map(|r| (r.key(), (r.outcome.seed, trial_measures(&r.outcome))))
         .collect();
     let ctx = row_measures::RowContext {

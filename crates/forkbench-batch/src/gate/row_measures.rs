@@ -37,13 +37,12 @@ pub(super) fn in_row(row: &BaselineRow, t: &BaselineTrial) -> bool {
 
 fn record_in_row(row: &BaselineRow, r: &TrialRecord) -> bool {
     let o = &r.outcome;
-    (o.scenario.as_str(), o.planner.as_str(), o.tracker.as_str())
-        == (
-            row.scenario.as_str(),
-            row.planner.as_str(),
-            row.tracker.as_str(),
-        )
-        && row.replan.is_none_or(|m| r.replan.unwrap_or(false) == m)
+    row.holds(
+        &o.scenario,
+        &o.planner,
+        &o.tracker,
+        r.replan.unwrap_or(false),
+    )
 }
 
 /// Every measure's sample in this row.
@@ -92,14 +91,15 @@ pub(super) fn row_tests(
     let mut tests = Vec::new();
     let mut ungated = BTreeSet::new();
     for (name, sample) in samples(row, c) {
-        let m = median(&sample.baseline_values());
+        let base = sample.baseline_values();
+        let m = median(&base);
         match gated(
             &name,
             c.settings,
             tolerances_of(c.manifest, &row.scenario),
             m,
         ) {
-            Some(g) => tests.push(test(&name, &g, &sample, c.alpha)),
+            Some(g) => tests.push(test(&name, &g, &sample, (&base, m), c.alpha)),
             None => {
                 ungated.insert(name);
             }

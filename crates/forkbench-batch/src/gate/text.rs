@@ -148,6 +148,12 @@ impl GateReport {
 
     /// The verdict in one line.
     pub fn verdict_text(&self) -> String {
+        let word = if self.passed { "PASSED" } else { "REGRESSION" };
+        format!("{word}: {}", self.verdict_reason())
+    }
+
+    /// Why the gate passed or failed: the verdict without its first word.
+    pub fn verdict_reason(&self) -> String {
         let failed: Vec<&RegressRow> = self
             .rows
             .iter()
@@ -169,9 +175,9 @@ impl GateReport {
             } else {
                 ""
             };
-            format!("PASSED: no significant drop{measured}{new_text}")
+            format!("no significant drop{measured}{new_text}")
         } else if failed.is_empty() {
-            format!("REGRESSION: new rows with --fail-on-new{new_text}")
+            format!("new rows with --fail-on-new{new_text}")
         } else {
             let names: Vec<String> = failed
                 .iter()
@@ -184,7 +190,7 @@ impl GateReport {
                 })
                 .collect();
             format!(
-                "REGRESSION: {} rows failed: {}{new_text}",
+                "{} rows failed: {}{new_text}",
                 failed.len(),
                 names.join(", ")
             )

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use forkbench_batch::{GateReport, MeasureTest, RegressRow, Worse};
+use forkbench_batch::{GateReport, MeasureTest, RegressRow};
 
 use super::svg::{self, esc};
 
@@ -73,10 +73,7 @@ pub fn measures_section(g: &GateReport) -> String {
         }
         h.push_str("</table>");
         for m in plotted(r) {
-            let margin = match m.worse {
-                Worse::Higher => m.margin,
-                Worse::Lower => -m.margin,
-            };
+            let margin = m.worse.sign() * m.margin;
             let id = format!(
                 "paired-{}-{}-{}-{}",
                 r.scenario, r.planner, r.tracker, m.measure
