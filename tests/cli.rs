@@ -550,12 +550,28 @@ fn trial_records_rrd_and_mcap_and_refuses_to_overwrite() {
     let _ = (std::fs::remove_file(&rrd), std::fs::remove_file(&mcap));
     let (r, m) = (rrd.to_str().expect("utf8"), mcap.to_str().expect("utf8"));
     let out = forkbench(&["trial", scn, "--no-noise", "--rrd", r, "--mcap", m]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(std::fs::metadata(&rrd).expect("rrd").len() > 10_000);
+    if cfg!(feature = "rerun") {
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(std::fs::metadata(&rrd).expect("rrd").len() > 10_000);
+    } else {
+        // The default build has no rerun: refused before anything is opened or run.
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("--rrd needs rerun") && err.contains("--features rerun"),
+            "{err}"
+        );
+        assert!(out.stdout.is_empty() && !rrd.exists() && !mcap.exists());
+        assert!(
+            forkbench(&["trial", scn, "--no-noise", "--mcap", m])
+                .status
+                .success()
+        );
+    }
     assert_eq!(&std::fs::read(&mcap).expect("mcap")[..8], b"\x89MCAP0\r\n");
     let again = forkbench(&["trial", scn, "--no-noise", "--mcap", m]);
     assert_eq!(again.status.code(), Some(1));
@@ -578,10 +594,17 @@ fn an_unreachable_viewer_is_reported_and_the_trial_still_runs() {
         "127.0.0.1:9",
     ]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(
-        String::from_utf8_lossy(&out.stderr).contains("no rerun viewer reachable at 127.0.0.1:9")
-    );
-    assert!(String::from_utf8_lossy(&out.stdout).contains("outcome              SUCCESS"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    if cfg!(feature = "rerun") {
+        assert!(
+            err.contains("no rerun viewer reachable at 127.0.0.1:9"),
+            "{err}"
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("outcome              SUCCESS"));
+    } else {
+        assert!(err.contains("--connect needs rerun"), "{err}");
+        assert!(out.stdout.is_empty(), "refused before the trial runs");
+    }
 }
 
 #[test]
@@ -609,11 +632,10 @@ fn batch_records_failures_and_replay_reproduces_a_trial() {
         String::from_utf8_lossy(&out.stderr)
     );
     let files = crate::common::names_in(&dir.join("recordings"));
-    assert_eq!(
-        files.iter().filter(|f| f.ends_with(".rrd")).count(),
-        2,
-        "{files:?}"
-    );
+    // Both formats with rerun built in, the MCAP alone without.
+    let count = |ext: &str| files.iter().filter(|f| f.ends_with(ext)).count();
+    let rrds = if cfg!(feature = "rerun") { 2 } else { 0 };
+    assert_eq!((count(".rrd"), count(".mcap")), (rrds, 2), "{files:?}");
     assert!(
         files
             .iter()
@@ -621,7 +643,10 @@ fn batch_records_failures_and_replay_reproduces_a_trial() {
         "{files:?}"
     );
     let jsonl = dir.join("trials.jsonl");
-    let rrd = tmp("replayed.rrd");
+    let (flag, rrd) = match cfg!(feature = "rerun") {
+        true => ("--rrd", tmp("replayed.rrd")),
+        false => ("--mcap", tmp("replayed.mcap")),
+    };
     let _ = std::fs::remove_file(&rrd);
     let out = forkbench(&[
         "replay",
@@ -630,7 +655,7 @@ fn batch_records_failures_and_replay_reproduces_a_trial() {
         "3",
         "--scenario",
         scn.to_str().expect("utf8"),
-        "--rrd",
+        flag,
         rrd.to_str().expect("utf8"),
     ]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -767,7 +792,9 @@ fn names_cannot_steer_recording_paths() {
         .expect("recordings inside OUT")
         .map(|e| e.expect("entry").file_name().into_string().expect("utf8"))
         .collect();
-    assert_eq!(files.len(), 4, "{files:?}");
+    // Two trials, each an MCAP and, with rerun built in, an .rrd.
+    let per_trial = if cfg!(feature = "rerun") { 2 } else { 1 };
+    assert_eq!(files.len(), 2 * per_trial, "{files:?}");
     assert!(
         files.iter().all(|f| f.starts_with("______escaped_x-")),
         "{files:?}"
@@ -786,9 +813,9 @@ fn one_path_for_two_formats_and_unbounded_inputs_are_refused() {
         "trial",
         scn,
         "--no-noise",
-        "--rrd",
-        s,
         "--mcap",
+        s,
+        "--actuator-log",
         s,
         "--force",
     ]);
@@ -802,7 +829,7 @@ fn one_path_for_two_formats_and_unbounded_inputs_are_refused() {
         "trial",
         scn,
         "--no-noise",
-        "--rrd",
+        "--mcap",
         dir.to_str().expect("utf8"),
     ]);
     assert_eq!(out.status.code(), Some(1));
@@ -863,6 +890,10 @@ fn sim_and_replan_settings_are_checked_at_load() {
 /// Issue 21, defect 9: a port that accepts TCP but is no rerun viewer no longer hangs
 /// the run; the outcome is printed and the exit is non-zero.
 #[test]
+#[cfg_attr(
+    not(feature = "rerun"),
+    ignore = "a viewer needs rerun: --features rerun"
+)]
 fn a_silent_viewer_port_times_out() {
     let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
     let addr = listener.local_addr().expect("addr").to_string();

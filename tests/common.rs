@@ -61,3 +61,13 @@ pub fn names_in(dir: &Path) -> Vec<String> {
     names.sort();
     names
 }
+
+/// What a run that asks for an .rrd says: `with` in a build with rerun (`--features
+/// rerun`), and the refusal naming the feature in the default build, which leaves rerun out.
+pub fn rrd_says(with: &str) -> &str {
+    if cfg!(feature = "rerun") {
+        with
+    } else {
+        "needs rerun, which this build of forkbench leaves out"
+    }
+}

@@ -400,7 +400,10 @@ fn special_files_anywhere_are_refused_at_once() {
             "a device",
         ),
         (vec!["trial", &field, "--mcap", f], "not a regular file"),
-        (vec!["trial", &field, "--rrd", f], "not a regular file"),
+        (
+            vec!["trial", &field, "--rrd", f],
+            crate::common::rrd_says("not a regular file"),
+        ),
     ];
     for (args, want) in cases {
         let t0 = Instant::now();

@@ -136,7 +136,10 @@ fn recordings_are_checked_before_anything_is_touched() {
             vec!["--mcap", s(&old), "--ros2", s(&scn)],
             "which this run reads",
         ),
-        (vec!["--rrd", s(&scn)], "which this run reads"),
+        (
+            vec!["--rrd", s(&scn)],
+            crate::common::rrd_says("which this run reads"),
+        ),
         (vec!["--actuator-log", s(&scn)], "which this run reads"),
         (
             vec!["--truck", s(&truck), "--mcap", s(&truck)],
@@ -160,8 +163,12 @@ fn recordings_are_checked_before_anything_is_touched() {
     std::os::unix::fs::symlink(&old, &link).expect("symlink");
     for flag in ["--mcap", "--ros2", "--rrd", "--actuator-log"] {
         let out = trial(&[flag, s(&link)]);
+        let says = match flag {
+            "--rrd" => crate::common::rrd_says("symbolic link"),
+            _ => "symbolic link",
+        };
         assert_eq!(out.status.code(), Some(1), "{flag}: {}", err(&out));
-        assert!(err(&out).contains("symbolic link"), "{flag}: {}", err(&out));
+        assert!(err(&out).contains(says), "{flag}: {}", err(&out));
         assert!(
             std::fs::symlink_metadata(&link)
                 .expect("link")

@@ -12,9 +12,20 @@ fn tails() -> String {
 #[test]
 fn falsify_records_the_failure_it_found_and_its_line_replays() {
     let out = tmp_in("forkbench-rare", "falsify");
-    let rrd = tmp_in("forkbench-rare", "found.rrd");
+    // An .rrd where rerun is built in (`--features rerun`), else the MCAP.
+    let (flag, rrd) = match cfg!(feature = "rerun") {
+        true => ("--rrd", tmp_in("forkbench-rare", "found.rrd")),
+        false => ("--mcap", tmp_in("forkbench-rare", "found.mcap")),
+    };
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_file(&rrd);
+    if !cfg!(feature = "rerun") {
+        // Asked for an .rrd it cannot write, the campaign is refused before any trial.
+        let o = forkbench(&["falsify", &tails(), "--out", s(&out), "--rrd", "x.rrd"]);
+        assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+        assert!(text(&o).contains("--rrd needs rerun"), "{}", text(&o));
+        assert!(!out.join("trials.jsonl").exists(), "no trial ran");
+    }
     let o = forkbench(&[
         "falsify",
         &tails(),
@@ -24,7 +35,7 @@ fn falsify_records_the_failure_it_found_and_its_line_replays() {
         "1",
         "--out",
         s(&out),
-        "--rrd",
+        flag,
         s(&rrd),
     ]);
     let t = text(&o);

@@ -25,7 +25,8 @@ case "${1:-}" in
     cargo build --release --locked -p forkbench-cli
     ;;
   batch)
-    # Failed trials are recorded (rerun .rrd and MCAP) under $FORKBENCH_OUT/batch/recordings/.
+    # Failed trials are recorded (MCAP; rerun .rrd too with --features rerun) under
+    # $FORKBENCH_OUT/batch/recordings/.
     # shellcheck disable=SC2086 # the scenario list and the arguments are word lists
     "$forkbench" batch $FORKBENCH_SCENARIOS --trials "$FORKBENCH_TRIALS" $FORKBENCH_ARGS \
       --out "$FORKBENCH_OUT/batch" --report --junit "$FORKBENCH_OUT/batch.xml"

@@ -84,8 +84,9 @@ pub(crate) struct RecordFlags {
 }
 
 impl RecordFlags {
-    pub(crate) fn args(self) -> forkbench_log::RecordTargets {
-        forkbench_log::RecordTargets {
+    /// The targets, refused at once when they need rerun and this build has none.
+    pub(crate) fn args(self) -> Result<forkbench_log::RecordTargets, forkbench_log::LogError> {
+        let t = forkbench_log::RecordTargets {
             rrd: self.rrd,
             mcap: self.mcap,
             ros2: self.ros2,
@@ -94,7 +95,9 @@ impl RecordFlags {
             connect: self.connect,
             force: self.force,
             inputs: Vec::new(),
-        }
+        };
+        t.check_built()?;
+        Ok(t)
     }
 }
 
@@ -140,7 +143,7 @@ struct TrialCli {
 impl TrialCli {
     fn run(self, mission: bool) -> anyhow::Result<Done> {
         let overrides = self.options.overrides()?;
-        let mut record = self.record.args();
+        let mut record = self.record.args()?;
         record.inputs.extend(self.options.truck_file());
         record.inputs.extend(self.components.clone());
         let opts = trial_cmd::options(

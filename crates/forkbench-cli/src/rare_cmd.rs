@@ -210,6 +210,8 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
 /// command that replays it; records it when asked. Exit 3 when a failure was found.
 pub fn falsify(a: FalsifyArgs) -> anyhow::Result<bool> {
     let c = &a.common;
+    // The recording is checked first: a campaign must not run to fail at its replay.
+    let rec = a.record.args()?;
     c.out_dir()?;
     let setup = c.setup()?;
     let what = serde_json::json!({ "falsify": !a.monte_carlo, "budget": c.budget });
@@ -226,7 +228,6 @@ pub fn falsify(a: FalsifyArgs) -> anyhow::Result<bool> {
         return Ok(false);
     };
     let line = line_of(&tried, &found.z);
-    let rec = a.record.args();
     let asked = rec.rrd.is_some()
         || rec.mcap.is_some()
         || rec.ros2.is_some()
@@ -288,10 +289,15 @@ fn falsify_text(
             describe(&mut s, "most likely failure found", &m.z);
             let _ = writeln!(
                 s,
-                "replay: forkbench replay {} --line {} --scenario {} --rrd failure.rrd",
+                "replay: forkbench replay {} --line {} --scenario {} {}",
                 c.out.join(TRIALS_FILE).display(),
                 line_of(tried, &m.z),
-                c.scenario.display()
+                c.scenario.display(),
+                if forkbench_log::HAS_RERUN {
+                    "--rrd failure.rrd"
+                } else {
+                    "--mcap failure.mcap"
+                }
             );
         }
         None => s += "no trial had the event\n",

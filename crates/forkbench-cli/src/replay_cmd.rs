@@ -25,7 +25,7 @@ pub struct ReplayArgs {
 /// `forkbench replay` as the command line gives it.
 pub fn replay_args(a: ReplayArgs) -> anyhow::Result<bool> {
     let from = (a.scenario.as_deref(), a.components.as_deref());
-    replay(&a.file, a.line, from, &a.record.args())
+    replay(&a.file, a.line, from, &a.record.args()?)
 }
 
 /// `forkbench replay`: re-runs one trial from its JSON line, records it, and checks that

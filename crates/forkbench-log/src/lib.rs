@@ -25,6 +25,10 @@ pub use sinks::{RecordError, RecordTargets, Recorded, Sinks, record_trial, run_r
 /// checks this against Cargo.lock), for the recordings' metadata.
 pub const RERUN_VERSION: &str = "0.36.3";
 
+/// Whether this build writes rerun recordings (.rrd files and viewers): the `rerun`
+/// feature, off by default, for rerun's SDK is most of a cold build.
+pub const HAS_RERUN: bool = cfg!(feature = "rerun");
+
 /// The metadata record of a trial's MCAP file: what ran, the versions, and what log time
 /// means.
 pub fn mcap_metadata(

@@ -64,6 +64,7 @@ impl std::fmt::Debug for Sinks {
 impl Sinks {
     /// Checks file targets before anything runs, then opens every sink.
     pub fn open(a: &RecordTargets, metadata: BTreeMap<String, String>) -> Result<Self, LogError> {
+        a.check_built()?;
         let files: Vec<&PathBuf> = a
             .rrd
             .iter()
@@ -191,17 +192,33 @@ fn open_rerun(a: &RecordTargets) -> Result<(Vec<RerunRecorder>, Option<LogError>
     Ok((rerun, viewer_error))
 }
 
-/// Without rerun (the Python wheel) an .rrd or a viewer is refused, never dropped.
+/// Without rerun an .rrd or a viewer is refused (by `Sinks::open`, first), never dropped.
 #[cfg(not(feature = "rerun"))]
 fn open_rerun(a: &RecordTargets) -> Result<((), Option<LogError>), LogError> {
-    if a.rrd.is_some() || a.rerun || a.connect.is_some() {
-        return Err(LogError::Rerun(
-            "this build records MCAP and ROS 2 bags only (built without rerun); .rrd \
-             recordings and viewers come from the forkbench CLI"
-                .into(),
-        ));
-    }
+    a.check_built()?;
     Ok(((), None))
+}
+
+impl RecordTargets {
+    /// Whether this build can write what the targets ask for: an .rrd or a viewer needs
+    /// rerun, which the default build leaves out (its SDK is most of a cold build). Checked
+    /// before a run starts, so no campaign runs to then fail at its recording.
+    pub fn check_built(&self) -> Result<(), LogError> {
+        let wants = [
+            self.rrd.as_ref().map(|_| "--rrd"),
+            self.rerun.then_some("--rerun"),
+            self.connect.as_ref().map(|_| "--connect"),
+        ];
+        match wants.into_iter().flatten().next() {
+            Some(flag) if !crate::HAS_RERUN => Err(LogError::Rerun(format!(
+                "{flag} needs rerun, which this build of forkbench leaves out (rerun's SDK is \
+                 most of a cold build); build the command line with `--features rerun`: cargo \
+                 run --release -p forkbench-cli --features rerun -- … (MCAP and ROS 2 bags are \
+                 written either way)"
+            ))),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Metadata record of a trial's MCAP file.
@@ -241,9 +258,9 @@ pub fn run_recorded(
     })
 }
 
-/// Re-runs one trial of a scenario into `<dir>/<stem>.{rrd,mcap}` (the stem is
-/// [`TrialOutcome::recording_stem`]), and the bag directory `<stem>.ros2` with `ros2`; returns the
-/// outcome and the .rrd's path.
+/// Re-runs one trial of a scenario into `<dir>/<stem>.mcap`, and `<stem>.rrd` in a build with
+/// rerun (the stem is [`TrialOutcome::recording_stem`]), and the bag directory `<stem>.ros2`
+/// with `ros2`; returns the outcome and the .rrd's path (the MCAP's without rerun).
 pub fn record_trial(
     scn: &Scenario,
     case: &Case,
@@ -257,15 +274,17 @@ pub fn record_trial(
     let names = (run.planner.name.as_str(), run.tracker.name.as_str());
     let stem = TrialOutcome::blank(&scn.name, &case.name, names, run.seed, run.noise)
         .recording_stem(run.replan);
-    let rrd = dir.join(format!("{stem}.rrd"));
+    // The .rrd when this build has rerun, and the MCAP always.
+    let rrd = crate::HAS_RERUN.then(|| dir.join(format!("{stem}.rrd")));
+    let mcap = dir.join(format!("{stem}.mcap"));
     let targets = RecordTargets {
-        rrd: Some(rrd.clone()),
-        mcap: Some(dir.join(format!("{stem}.mcap"))),
+        rrd: rrd.clone(),
+        mcap: Some(mcap.clone()),
         ros2: ros2.then(|| dir.join(format!("{stem}.ros2"))),
         force: true,
         ..RecordTargets::default()
     };
     let r = run_recorded((scn, case), (opts, &run), &targets)?;
     r.written?;
-    Ok((r.outcome, rrd))
+    Ok((r.outcome, rrd.unwrap_or(mcap)))
 }

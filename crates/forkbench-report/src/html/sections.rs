@@ -209,9 +209,15 @@ pub fn failed_trials(dir: &Path, records: &[(usize, TrialRecord)]) -> String {
             .filter(|ext| rec_dir.join(format!("{stem}.{ext}")).is_file())
             .map(|ext| format!("<a href=\"recordings/{}.{ext}\">.{ext}</a>", esc(&stem)))
             .collect();
+        // The replay writes what this batch's build wrote: an .rrd needs rerun built in.
+        let again = if rec_dir.join(format!("{stem}.rrd")).is_file() {
+            "--rrd t.rrd"
+        } else {
+            "--mcap t.mcap"
+        };
         let _ = write!(
             h,
-            "<tr class=\"f\"><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td><b>{}</b>: {}</td><td>{}</td><td><code>forkbench replay {} --line {line} --rrd t.rrd</code></td></tr>",
+            "<tr class=\"f\"><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td><b>{}</b>: {}</td><td>{}</td><td><code>forkbench replay {} --line {line} {}</code></td></tr>",
             esc(&o.scenario),
             esc(&o.case),
             esc(&o.planner),
@@ -226,7 +232,8 @@ pub fn failed_trials(dir: &Path, records: &[(usize, TrialRecord)]) -> String {
             } else {
                 links.join(" ")
             },
-            esc(&trials_file)
+            esc(&trials_file),
+            again
         );
     }
     let _ = write!(
