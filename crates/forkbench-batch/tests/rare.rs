@@ -24,6 +24,7 @@ fn setup(seed: u64) -> RareSetup {
 }
 
 #[test]
+#[ignore = "a long statistical check (6,000 trials): CI runs it, `-- --ignored`"]
 fn importance_sampling_covers_the_brute_force_value_with_a_tenth_of_its_trials() {
     let (e, tried) = estimate(&setup(3), forkbench_rare::Method::Ce, 6000, None).expect("runs");
     assert_eq!(tried.len(), 6000);
