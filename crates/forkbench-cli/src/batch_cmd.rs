@@ -102,7 +102,8 @@ pub struct BatchArgs {
     /// odometry_noise, e.g. pallet_noise=0,1,3 (table and plot per planner).
     #[arg(long)]
     pub sweep: Option<String>,
-    /// Which trials to record as .rrd and .mcap under OUT/recordings/.
+    /// Which trials to record under OUT/recordings/: as .mcap, and as .rrd too in a CLI
+    /// built with `--features rerun`.
     #[arg(long, value_enum, default_value_t = RecordWhich::Failures)]
     pub record: RecordWhich,
     /// Also write each recorded trial as a ROS 2 bag, the rosbag2 directory `<stem>.ros2`
@@ -457,8 +458,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path, json: bool) -> anyhow::Result<()> {
     ))
 }
 
-/// Records the trials the library picks (failures, or all) as .rrd and .mcap (and ROS 2
-/// bags with `--ros2`).
+/// Records the trials the library picks (failures, or all) as .mcap, .rrd with rerun built
+/// in, and ROS 2 bags with `--ros2`.
 fn record_batch(spec: &BatchSpec, a: &BatchArgs) -> anyhow::Result<usize> {
     let choice = RecordChoice::from(a.record);
     if choice == RecordChoice::None {

@@ -58,7 +58,7 @@ enum ReproduceArg {
 /// Recording targets of one trial.
 #[derive(Debug, clap::Args)]
 pub(crate) struct RecordFlags {
-    /// Write a rerun recording to FILE (.rrd).
+    /// Write a rerun recording to FILE (.rrd); needs the CLI built with `--features rerun`.
     #[arg(long)]
     rrd: Option<PathBuf>,
     /// Write an MCAP log to FILE (.mcap).
@@ -72,10 +72,11 @@ pub(crate) struct RecordFlags {
     /// speed_mps at every physics step), what `identify` reads.
     #[arg(long, value_name = "FILE")]
     actuator_log: Option<PathBuf>,
-    /// Spawn a rerun viewer and stream to it.
+    /// Spawn a rerun viewer and stream to it; needs the CLI built with `--features rerun`.
     #[arg(long)]
     rerun: bool,
-    /// Stream to a running rerun viewer at HOST:PORT (e.g. 127.0.0.1:9876).
+    /// Stream to a running rerun viewer at HOST:PORT (e.g. 127.0.0.1:9876); needs the CLI
+    /// built with `--features rerun`.
     #[arg(long)]
     connect: Option<String>,
     /// Overwrite existing recording files.
