@@ -51,8 +51,9 @@ pub use compare::{CompareOptions, CompareReport, CompareRow, Discordant, compare
 pub use export::write_csv;
 pub use gate::num as gate_num;
 pub use gate::{
-    DEFAULT_ALPHA, GateOptions, GateReport, MeasureSetting, MeasureSettings, MeasureTest,
-    PairCounts, Pairing, RegressRow, Verdict, Worse, paired_trials_needed, regress, trial_measures,
+    DEFAULT_ALPHA, GateOptions, GateReport, MeasureSetting, MeasureSettingError, MeasureSettings,
+    MeasureTest, PairCounts, Pairing, RegressRow, Verdict, Worse, paired_trials_needed, regress,
+    trial_measures,
 };
 pub use guard::guarded;
 pub use manifest::{DirLock, Manifest, build_commit};

@@ -86,7 +86,7 @@ fn prim(name: &str) -> Option<Kind> {
 }
 
 /// One definition line as a field; `None` for blanks, comments and constants.
-fn field(line: &str, package: &str) -> Result<Option<Field>, String> {
+fn field(line: &str, package: &str) -> Result<Option<Field>, DefinitionError> {
     let line = line.split('#').next().unwrap_or("").trim();
     let mut words = line.split_whitespace();
     let (Some(ty), Some(name)) = (words.next(), words.next()) else {
@@ -102,17 +102,17 @@ fn field(line: &str, package: &str) -> Result<Option<Field>, String> {
             let count = if inner.is_empty() || inner.starts_with("<=") {
                 Count::Sequence
             } else {
-                Count::Fixed(
-                    inner
-                        .parse()
-                        .map_err(|_| format!("array size in {line:?}"))?,
-                )
+                Count::Fixed(inner.parse().map_err(|_| DefinitionError::ArraySize {
+                    line: line.to_owned(),
+                })?)
             };
             (base, count)
         }
     };
     if base == "wstring" || base.starts_with("wstring<=") {
-        return Err(format!("{line:?}: wide strings are not read"));
+        return Err(DefinitionError::WideString {
+            line: line.to_owned(),
+        });
     }
     let kind = prim(base).unwrap_or_else(|| Kind::Msg(full_name(base, package)));
     Ok(Some(Field {
@@ -126,21 +126,55 @@ fn field(line: &str, package: &str) -> Result<Option<Field>, String> {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum CdrError {
     /// The definition text (`ros2msg`) is not one this reader understands.
-    #[error("{0}")]
-    Definition(String),
+    #[error(transparent)]
+    Definition(#[from] DefinitionError),
     /// A message's bytes do not match its definition (short, nested too deeply, not
     /// little-endian).
-    #[error("{0}")]
-    Message(String),
+    #[error(transparent)]
+    Message(#[from] MessageError),
+}
+
+/// Why a `ros2msg` definition text could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DefinitionError {
+    #[error("array size in {line:?}")]
+    ArraySize { line: String },
+    #[error("{line:?}: wide strings are not read")]
+    WideString { line: String },
+    #[error("field {field} is of type {ty}, not defined")]
+    Undefined { field: String, ty: String },
+}
+
+/// Why a message's CDR bytes do not match its definition.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum MessageError {
+    #[error("shorter than the CDR header")]
+    NoHeader,
+    #[error("not little-endian CDR")]
+    NotLittleEndian,
+    #[error("nested too deeply")]
+    TooDeep,
+    #[error("type {0} not defined")]
+    Undefined(String),
+    #[error("{field}: {count} elements in {left} bytes")]
+    Sequence {
+        field: String,
+        count: usize,
+        left: usize,
+    },
+    #[error("its schema asks for more values than its {0} bytes hold")]
+    TooManyValues(usize),
+    #[error("ends {wanted} bytes early at {at}")]
+    Short { wanted: usize, at: usize },
 }
 
 impl Schema {
     /// The schema of a channel whose messages are `name` (`pkg/msg/Type`).
     pub fn parse(name: &str, text: &str) -> Result<Self, CdrError> {
-        Self::parse_text(name, text).map_err(CdrError::Definition)
+        Ok(Self::parse_text(name, text)?)
     }
 
-    fn parse_text(name: &str, text: &str) -> Result<Self, String> {
+    fn parse_text(name: &str, text: &str) -> Result<Self, DefinitionError> {
         let root = full_name(name, "");
         let mut types = HashMap::new();
         let mut current = root.clone();
@@ -166,13 +200,16 @@ impl Schema {
     }
 
     /// Every message type a field names is defined.
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), DefinitionError> {
         for fields in self.types.values() {
             for f in fields {
                 if let Kind::Msg(t) = &f.kind
                     && !self.types.contains_key(t)
                 {
-                    return Err(format!("field {} is of type {t}, not defined", f.name));
+                    return Err(DefinitionError::Undefined {
+                        field: f.name.clone(),
+                        ty: t.clone(),
+                    });
                 }
             }
         }
@@ -181,13 +218,13 @@ impl Schema {
 
     /// A message's CDR bytes (with their encapsulation header) as JSON.
     pub fn decode(&self, bytes: &[u8]) -> Result<Value, CdrError> {
-        self.decode_bytes(bytes).map_err(CdrError::Message)
+        Ok(self.decode_bytes(bytes)?)
     }
 
-    fn decode_bytes(&self, bytes: &[u8]) -> Result<Value, String> {
-        let body = bytes.get(4..).ok_or("shorter than the CDR header")?;
+    fn decode_bytes(&self, bytes: &[u8]) -> Result<Value, MessageError> {
+        let body = bytes.get(4..).ok_or(MessageError::NoHeader)?;
         if bytes[1] != 0x01 {
-            return Err("not little-endian CDR".into());
+            return Err(MessageError::NotLittleEndian);
         }
         // Every value costs at least one byte save empty messages: a schema declaring a
         // billion of them must not build a billion values from no bytes.
@@ -199,14 +236,14 @@ impl Schema {
         self.message(&self.root, &mut r, 0)
     }
 
-    fn message(&self, ty: &str, r: &mut Reader<'_>, depth: usize) -> Result<Value, String> {
+    fn message(&self, ty: &str, r: &mut Reader<'_>, depth: usize) -> Result<Value, MessageError> {
         if depth > MAX_DEPTH {
-            return Err("nested too deeply".into());
+            return Err(MessageError::TooDeep);
         }
         let fields = self
             .types
             .get(ty)
-            .ok_or_else(|| format!("type {ty} not defined"))?;
+            .ok_or_else(|| MessageError::Undefined(ty.to_owned()))?;
         let mut out = Map::new();
         for f in fields {
             let v = match f.count {
@@ -215,7 +252,11 @@ impl Schema {
                 Count::Sequence => {
                     let n = r.u32()? as usize;
                     if n > MAX_SEQUENCE || n > r.left() {
-                        return Err(format!("{}: {n} elements in {} bytes", f.name, r.left()));
+                        return Err(MessageError::Sequence {
+                            field: f.name.clone(),
+                            count: n,
+                            left: r.left(),
+                        });
                     }
                     self.values(&f.kind, n, r, depth)?
                 }
@@ -225,18 +266,22 @@ impl Schema {
         Ok(Value::Object(out))
     }
 
-    fn values(&self, k: &Kind, n: usize, r: &mut Reader<'_>, d: usize) -> Result<Value, String> {
-        let items: Result<Vec<Value>, String> = (0..n).map(|_| self.value(k, r, d)).collect();
+    fn values(
+        &self,
+        k: &Kind,
+        n: usize,
+        r: &mut Reader<'_>,
+        d: usize,
+    ) -> Result<Value, MessageError> {
+        let items: Result<Vec<Value>, MessageError> = (0..n).map(|_| self.value(k, r, d)).collect();
         Ok(Value::Array(items?))
     }
 
-    fn value(&self, kind: &Kind, r: &mut Reader<'_>, depth: usize) -> Result<Value, String> {
-        r.values_left = r.values_left.checked_sub(1).ok_or_else(|| {
-            format!(
-                "its schema asks for more values than its {} bytes hold",
-                r.body.len()
-            )
-        })?;
+    fn value(&self, kind: &Kind, r: &mut Reader<'_>, depth: usize) -> Result<Value, MessageError> {
+        r.values_left = r
+            .values_left
+            .checked_sub(1)
+            .ok_or(MessageError::TooManyValues(r.body.len()))?;
         match kind {
             Kind::Prim(p) => r.prim(*p),
             Kind::String => r.string(),
@@ -258,25 +303,28 @@ impl Reader<'_> {
         self.body.len().saturating_sub(self.at)
     }
 
-    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+    fn take(&mut self, n: usize) -> Result<&[u8], MessageError> {
         let end = self.at.checked_add(n).filter(|e| *e <= self.body.len());
-        let end = end.ok_or_else(|| format!("ends {n} bytes early at {}", self.at))?;
+        let end = end.ok_or(MessageError::Short {
+            wanted: n,
+            at: self.at,
+        })?;
         let s = &self.body[self.at..end];
         self.at = end;
         Ok(s)
     }
 
-    fn aligned(&mut self, n: usize) -> Result<&[u8], String> {
+    fn aligned(&mut self, n: usize) -> Result<&[u8], MessageError> {
         self.at = self.at.div_ceil(n) * n;
         self.take(n)
     }
 
-    fn u32(&mut self) -> Result<u32, String> {
+    fn u32(&mut self) -> Result<u32, MessageError> {
         let b = self.aligned(4)?;
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
 
-    fn prim(&mut self, p: Prim) -> Result<Value, String> {
+    fn prim(&mut self, p: Prim) -> Result<Value, MessageError> {
         let n = match p {
             Prim::Bool => 1,
             Prim::I(n) | Prim::U(n) | Prim::F(n) => n,
@@ -297,7 +345,7 @@ impl Reader<'_> {
         Ok(serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number))
     }
 
-    fn string(&mut self) -> Result<Value, String> {
+    fn string(&mut self) -> Result<Value, MessageError> {
         let n = self.u32()? as usize;
         let b = self.take(n)?;
         let text = b.strip_suffix(&[0]).unwrap_or(b);

@@ -33,6 +33,11 @@ pub struct ActuatorLog {
 pub enum LogError {
     #[error("{file}: {reason}")]
     File { file: String, reason: String },
+    #[error("{file}: {reason}")]
+    Mcap {
+        file: String,
+        reason: crate::mcap_log::McapError,
+    },
     #[error("{file}:{line}: column {column}: {reason}")]
     Cell {
         file: String,

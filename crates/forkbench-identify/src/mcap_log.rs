@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use crate::cdr::Schema;
+use crate::cdr::{CdrError, Schema};
 use crate::log::{ActuatorLog, COLUMNS, LogError, parse_csv};
 
 /// Where forkbench's recordings keep each control step.
@@ -37,6 +37,55 @@ pub fn ros2_fields() -> [String; 5] {
         "drive.speed".to_owned(),
         format!("{m}:drive.speed"),
     ]
+}
+
+/// Why an MCAP file or rosbag2 directory gives no actuator log.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum McapError {
+    #[error("not an MCAP file: {0}")]
+    NotMcap(String),
+    #[error("reading a record: {0}")]
+    Record(String),
+    #[error("reading a message: {0}")]
+    Message(String),
+    #[error(
+        "its chunks decompress to more than {MAX_DECODED_BYTES} bytes, the most identify reads"
+    )]
+    Decompressed,
+    #[error(
+        "more than {MAX_MESSAGES} messages on its topics, the most identify reads (cut the log \
+         to the runs to fit)"
+    )]
+    TooManyMessages,
+    #[error("a directory without .mcap files (identify reads rosbag2's MCAP storage)")]
+    NoParts,
+    #[error(
+        "its {parts} .mcap files hold {bytes} bytes, more than the {} a log may",
+        crate::log::MAX_LOG_BYTES
+    )]
+    PartsTooLarge { parts: usize, bytes: u64 },
+    #[error("the time field (the first of --fields) is required")]
+    NoTimeField,
+    #[error("no messages on topic {0}")]
+    NoTopic(String),
+    #[error("a message on {topic} is not JSON: {reason}")]
+    NotJson { topic: String, reason: String },
+    #[error("a message on {topic}: {error}")]
+    Cdr { topic: String, error: CdrError },
+    #[error("topic {topic} is {encoding:?}-encoded; identify reads JSON and CDR")]
+    Encoding { topic: String, encoding: String },
+    #[error("topic {topic} has no number at {path:?}")]
+    NoNumber { topic: String, path: String },
+    #[error("topic {0} is CDR without a ros2msg schema")]
+    NoSchema(String),
+    #[error("topic {0}: schema not UTF-8")]
+    SchemaNotUtf8(String),
+    #[error("topic {topic}: schema {name}: {error}")]
+    Schema {
+        topic: String,
+        name: String,
+        error: CdrError,
+    },
 }
 
 /// One column's source: a topic and a dotted path into its messages.
@@ -90,27 +139,28 @@ pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<Actua
     if !path.is_dir() {
         return read_one(path, topic, fields);
     }
-    let bad = |reason: String| LogError::File {
-        file: path.display().to_string(),
+    let file = path.display().to_string();
+    let bad = |reason: McapError| LogError::Mcap {
+        file: file.clone(),
         reason,
     };
-    let parts = forkbench_core::files::files_with_extension(path, "mcap")
-        .map_err(|e| bad(e.to_string()))?;
+    let parts =
+        forkbench_core::files::files_with_extension(path, "mcap").map_err(|e| LogError::File {
+            file: file.clone(),
+            reason: e.to_string(),
+        })?;
     if parts.is_empty() {
-        return Err(bad(
-            "a directory without .mcap files (identify reads rosbag2's MCAP storage)".into(),
-        ));
+        return Err(bad(McapError::NoParts));
     }
     let total: u64 = parts
         .iter()
         .map(|p| std::fs::metadata(p).map_or(0, |m| m.len()))
         .sum();
     if total > crate::log::MAX_LOG_BYTES {
-        return Err(bad(format!(
-            "its {} .mcap files hold {total} bytes, more than the {} a log may",
-            parts.len(),
-            crate::log::MAX_LOG_BYTES
-        )));
+        return Err(bad(McapError::PartsTooLarge {
+            parts: parts.len(),
+            bytes: total,
+        }));
     }
     let mut log = ActuatorLog { runs: Vec::new() };
     for p in &parts {
@@ -121,12 +171,17 @@ pub fn read_mcap(path: &Path, topic: &str, fields: &[String; 5]) -> Result<Actua
 
 fn read_one(path: &Path, topic: &str, fields: &[String; 5]) -> Result<ActuatorLog, LogError> {
     let file = path.display().to_string();
-    let bad = |reason: String| LogError::File {
+    let bad = |reason: McapError| LogError::Mcap {
         file: file.clone(),
         reason,
     };
-    let bytes = forkbench_core::files::read_bytes(path, crate::log::MAX_LOG_BYTES)
-        .map_err(|e| bad(e.to_string()))?;
+    let bytes =
+        forkbench_core::files::read_bytes(path, crate::log::MAX_LOG_BYTES).map_err(|e| {
+            LogError::File {
+                file: file.clone(),
+                reason: e.to_string(),
+            }
+        })?;
     check_decoded_size(&bytes).map_err(&bad)?;
     let topics = topics_in(&bytes).map_err(&bad)?;
     let defaults = COLUMNS.map(str::to_owned);
@@ -140,9 +195,7 @@ fn read_one(path: &Path, topic: &str, fields: &[String; 5]) -> Result<ActuatorLo
         (topic, fields.clone())
     };
     if fields[0].is_empty() {
-        return Err(bad(
-            "the time field (the first of --fields) is required".into()
-        ));
+        return Err(bad(McapError::NoTimeField));
     }
     let used: Vec<(usize, Source)> = fields
         .iter()
@@ -152,7 +205,7 @@ fn read_one(path: &Path, topic: &str, fields: &[String; 5]) -> Result<ActuatorLo
         .collect();
     for (_, s) in &used {
         if !topics.contains(&s.topic) {
-            return Err(bad(format!("no messages on topic {}", s.topic)));
+            return Err(bad(McapError::NoTopic(s.topic.clone())));
         }
     }
     let csv = rows(&bytes, &used).map_err(bad)?;
@@ -161,37 +214,36 @@ fn read_one(path: &Path, topic: &str, fields: &[String; 5]) -> Result<ActuatorLo
 
 /// The chunks' declared sizes (what decompressing them allocates) within
 /// [`MAX_DECODED_BYTES`], before any is decompressed.
-fn check_decoded_size(bytes: &[u8]) -> Result<(), String> {
+fn check_decoded_size(bytes: &[u8]) -> Result<(), McapError> {
     let mut total = 0u64;
-    for record in
-        mcap::read::LinearReader::new(bytes).map_err(|e| format!("not an MCAP file: {e}"))?
-    {
+    for record in mcap::read::LinearReader::new(bytes).map_err(not_mcap)? {
         if let mcap::records::Record::Chunk { header, .. } =
-            record.map_err(|e| format!("reading a record: {e}"))?
+            record.map_err(|e| McapError::Record(e.to_string()))?
         {
             total = total.saturating_add(header.uncompressed_size);
         }
         if total > MAX_DECODED_BYTES {
-            return Err(format!(
-                "its chunks decompress to more than {MAX_DECODED_BYTES} bytes, the most \
-                 identify reads"
-            ));
+            return Err(McapError::Decompressed);
         }
     }
     Ok(())
 }
 
+fn not_mcap(e: mcap::McapError) -> McapError {
+    McapError::NotMcap(e.to_string())
+}
+
 /// The topics that carry messages.
-fn topics_in(bytes: &[u8]) -> Result<BTreeSet<String>, String> {
-    let summary = mcap::Summary::read(bytes).map_err(|e| format!("not an MCAP file: {e}"))?;
+fn topics_in(bytes: &[u8]) -> Result<BTreeSet<String>, McapError> {
+    let summary = mcap::Summary::read(bytes).map_err(not_mcap)?;
     let mut topics = BTreeSet::new();
     if let Some(s) = summary {
         topics.extend(s.channels.values().map(|c| c.topic.clone()));
         return Ok(topics);
     }
-    for m in mcap::MessageStream::new(bytes).map_err(|e| format!("not an MCAP file: {e}"))? {
+    for m in mcap::MessageStream::new(bytes).map_err(not_mcap)? {
         topics.insert(
-            m.map_err(|e| format!("reading a message: {e}"))?
+            m.map_err(|e| McapError::Message(e.to_string()))?
                 .channel
                 .topic
                 .clone(),
@@ -205,7 +257,7 @@ type Sample = (u64, String, Vec<(usize, f64)>);
 
 /// The log as CSV text (so the one reader's checks apply): a row per message of the
 /// time's topic once every column has a value.
-fn rows(bytes: &[u8], used: &[(usize, Source)]) -> Result<String, String> {
+fn rows(bytes: &[u8], used: &[(usize, Source)]) -> Result<String, McapError> {
     let mut samples = samples(bytes, used)?;
     samples.sort_by_key(|s| s.0);
     let row_topic = &used[0].1.topic;
@@ -233,38 +285,39 @@ fn rows(bytes: &[u8], used: &[(usize, Source)]) -> Result<String, String> {
 }
 
 /// The needed messages decoded (JSON, or CDR by their channel's `ros2msg` schema).
-fn samples(bytes: &[u8], used: &[(usize, Source)]) -> Result<Vec<Sample>, String> {
+fn samples(bytes: &[u8], used: &[(usize, Source)]) -> Result<Vec<Sample>, McapError> {
     let mut schemas: HashMap<u16, Schema> = HashMap::new();
     let mut out = Vec::new();
-    let stream = mcap::MessageStream::new(bytes).map_err(|e| format!("not an MCAP file: {e}"))?;
+    let stream = mcap::MessageStream::new(bytes).map_err(not_mcap)?;
     for m in stream {
-        let m = m.map_err(|e| format!("reading a message: {e}"))?;
+        let m = m.map_err(|e| McapError::Message(e.to_string()))?;
         let topic = &m.channel.topic;
         if !used.iter().any(|(_, s)| &s.topic == topic) {
             continue;
         }
         if out.len() == MAX_MESSAGES {
-            return Err(format!(
-                "more than {MAX_MESSAGES} messages on its topics, the most identify reads \
-                 (cut the log to the runs to fit)"
-            ));
+            return Err(McapError::TooManyMessages);
         }
         let v = match m.channel.message_encoding.as_str() {
-            "json" => serde_json::from_slice(&m.data)
-                .map_err(|e| format!("a message on {topic} is not JSON: {e}"))?,
+            "json" => serde_json::from_slice(&m.data).map_err(|e| McapError::NotJson {
+                topic: topic.clone(),
+                reason: e.to_string(),
+            })?,
             "cdr" => {
                 let schema = match schemas.entry(m.channel.id) {
                     std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
                     std::collections::hash_map::Entry::Vacant(e) => e.insert(schema_of(&m)?),
                 };
-                schema
-                    .decode(&m.data)
-                    .map_err(|e| format!("a message on {topic}: {e}"))?
+                schema.decode(&m.data).map_err(|error| McapError::Cdr {
+                    topic: topic.clone(),
+                    error,
+                })?
             }
             other => {
-                return Err(format!(
-                    "topic {topic} is {other:?}-encoded; identify reads JSON and CDR"
-                ));
+                return Err(McapError::Encoding {
+                    topic: topic.clone(),
+                    encoding: other.to_owned(),
+                });
             }
         };
         let values = used
@@ -277,27 +330,32 @@ fn samples(bytes: &[u8], used: &[(usize, Source)]) -> Result<Vec<Sample>, String
                 } else {
                     number_at(&v, &s.path)
                 };
-                x.map(|x| (k, x))
-                    .ok_or_else(|| format!("topic {topic} has no number at {:?}", s.path))
+                x.map(|x| (k, x)).ok_or_else(|| McapError::NoNumber {
+                    topic: topic.clone(),
+                    path: s.path.clone(),
+                })
             })
-            .collect::<Result<Vec<_>, String>>()?;
+            .collect::<Result<Vec<_>, McapError>>()?;
         out.push((m.log_time, topic.clone(), values));
     }
     Ok(out)
 }
 
 /// The `ros2msg` schema of a CDR message's channel.
-fn schema_of(m: &mcap::Message<'_>) -> Result<Schema, String> {
+fn schema_of(m: &mcap::Message<'_>) -> Result<Schema, McapError> {
     let topic = &m.channel.topic;
     let s = m
         .channel
         .schema
         .as_ref()
         .filter(|s| s.encoding == "ros2msg")
-        .ok_or_else(|| format!("topic {topic} is CDR without a ros2msg schema"))?;
-    let text =
-        std::str::from_utf8(&s.data).map_err(|_| format!("topic {topic}: schema not UTF-8"))?;
-    Schema::parse(&s.name, text).map_err(|e| format!("topic {topic}: schema {}: {e}", s.name))
+        .ok_or_else(|| McapError::NoSchema(topic.clone()))?;
+    let text = std::str::from_utf8(&s.data).map_err(|_| McapError::SchemaNotUtf8(topic.clone()))?;
+    Schema::parse(&s.name, text).map_err(|error| McapError::Schema {
+        topic: topic.clone(),
+        name: s.name.clone(),
+        error,
+    })
 }
 
 #[cfg(test)]

@@ -45,7 +45,7 @@ pub enum BagEvent {
     /// A scan message that could not be used, and why (the reading goes on).
     Malformed {
         topic: String,
-        reason: String,
+        reason: ScanError,
     },
     /// A transform message that could not be decoded, and why (the reading goes on;
     /// scans that needed it find no transform).
@@ -53,6 +53,30 @@ pub enum BagEvent {
         topic: String,
         reason: String,
     },
+}
+
+/// Why a scan message could not be used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScanError {
+    #[error("not a LaserScan: {0}")]
+    NotLaserScan(CdrError),
+    #[error("not a foxglove.LaserScan: {0}")]
+    NotFoxglove(String),
+    #[error("range_min {min_m} m and range_max {max_m} m: not a range")]
+    Range { min_m: f64, max_m: f64 },
+    #[error("{0} ranges: a scan has 1 to {MAX_BEAMS}")]
+    Beams(usize),
+    #[error(
+        "angle_min {lo}, angle_max {hi}, angle_increment {inc} rad: not finite, or no increment"
+    )]
+    Angles { lo: f64, hi: f64, inc: f64 },
+    #[error(
+        "angle_max − angle_min is {steps:.1} increments, but the scan has {n} ranges ({} increments)",
+        n - 1
+    )]
+    Span { steps: f64, n: usize },
+    #[error("the scan's pose is not finite")]
+    Pose,
 }
 
 /// The kinds of topic read; others are passed over.
@@ -226,17 +250,15 @@ fn ranges(raw: impl Iterator<Item = Option<f64>>, min_m: f64, max_m: f64) -> Vec
     .collect()
 }
 
-fn ros2_scan(data: &[u8]) -> Result<BagScan, String> {
-    let m = decode_laser_scan(data).map_err(|e| format!("not a LaserScan: {e}"))?;
+fn ros2_scan(data: &[u8]) -> Result<BagScan, ScanError> {
+    let m = decode_laser_scan(data).map_err(ScanError::NotLaserScan)?;
     let inc = f64::from(m.angle_increment_rad);
     let (lo, hi) = (f64::from(m.angle_min_rad), f64::from(m.angle_max_rad));
     let n = m.ranges_m.len();
     check_angles(lo, hi, inc, n)?;
     let (min_m, max_m) = (f64::from(m.range_min_m), f64::from(m.range_max_m));
     if !(min_m.is_finite() && max_m.is_finite() && 0.0 <= min_m && min_m < max_m) {
-        return Err(format!(
-            "range_min {min_m} m and range_max {max_m} m: not a range"
-        ));
+        return Err(ScanError::Range { min_m, max_m });
     }
     Ok(BagScan {
         topic: String::new(),
@@ -267,22 +289,16 @@ fn forwards(mut scan: Scan) -> Scan {
 
 /// The angle fields must describe the ranges: a non-zero finite increment, and
 /// `angle_max − angle_min` within an increment and a half of (n − 1) increments.
-fn check_angles(lo: f64, hi: f64, inc: f64, n: usize) -> Result<(), String> {
+fn check_angles(lo: f64, hi: f64, inc: f64, n: usize) -> Result<(), ScanError> {
     if n == 0 || n > MAX_BEAMS {
-        return Err(format!("{n} ranges: a scan has 1 to {MAX_BEAMS}"));
+        return Err(ScanError::Beams(n));
     }
     if !(lo.is_finite() && hi.is_finite() && inc.is_finite() && inc != 0.0) {
-        return Err(format!(
-            "angle_min {lo}, angle_max {hi}, angle_increment {inc} rad: not finite, or no increment"
-        ));
+        return Err(ScanError::Angles { lo, hi, inc });
     }
     let steps = (hi - lo) / inc;
     if n > 1 && (steps - (n - 1) as f64).abs() > 1.5 {
-        return Err(format!(
-            "angle_max − angle_min is {steps:.1} increments, but the scan has {n} ranges \
-             ({} increments)",
-            n - 1
-        ));
+        return Err(ScanError::Span { steps, n });
     }
     Ok(())
 }
@@ -328,9 +344,9 @@ fn yaw(x: f64, y: f64, z: f64, w: f64) -> f64 {
     (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z))
 }
 
-fn foxglove_scan(data: &[u8]) -> Result<BagScan, String> {
+fn foxglove_scan(data: &[u8]) -> Result<BagScan, ScanError> {
     let m: FoxScan =
-        serde_json::from_slice(data).map_err(|e| format!("not a foxglove.LaserScan: {e}"))?;
+        serde_json::from_slice(data).map_err(|e| ScanError::NotFoxglove(e.to_string()))?;
     let n = m.ranges.len();
     let inc = if n > 1 {
         (m.end_angle - m.start_angle) / (n - 1) as f64
@@ -345,7 +361,7 @@ fn foxglove_scan(data: &[u8]) -> Result<BagScan, String> {
         yaw(q.x, q.y, q.z, q.w),
     );
     if !(sensor.x_m.is_finite() && sensor.y_m.is_finite() && sensor.heading_rad.is_finite()) {
-        return Err("the scan's pose is not finite".into());
+        return Err(ScanError::Pose);
     }
     Ok(BagScan {
         topic: String::new(),

@@ -101,7 +101,7 @@ pub fn detect_bag(
                 bad_tf.1.get_or_insert(format!("{topic}: {reason}"));
                 return;
             }
-            BagEvent::Malformed { topic, reason } => blank(index, topic, Some(reason)),
+            BagEvent::Malformed { topic, reason } => blank(index, topic, Some(reason.to_string())),
             BagEvent::Scan(s) => match one(&s, opts, &frames, detector, pallet, index) {
                 Ok(r) => r,
                 Err(e) => {

@@ -24,7 +24,7 @@ pub enum MapError {
         reason: String,
     },
     #[error("{path}: not a PGM image this reader knows: {reason}")]
-    Image { path: String, reason: String },
+    Image { path: String, reason: PgmError },
     #[error("{path}: {source}")]
     Grid { path: String, source: GridError },
     /// Not a regular file, too large, or an I/O error; names the file, never its contents.
@@ -239,6 +239,28 @@ fn check(m: &MapYaml, path: &str) -> Result<(), MapError> {
     Ok(())
 }
 
+/// Why an image is not a PGM this reader knows; never quotes the file's bytes (the path
+/// may be any file).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PgmError {
+    #[error("the header ends early")]
+    HeaderEnds,
+    #[error("it does not start with P5 (a binary greyscale PGM)")]
+    NotP5,
+    #[error("its {0} is not a whole number")]
+    NotNumber(&'static str),
+    #[error("{width} × {height} pixels, maxval {max}: expected a non-empty 8-bit image")]
+    Shape {
+        width: usize,
+        height: usize,
+        max: usize,
+    },
+    #[error("the image is too large")]
+    TooLarge,
+    #[error("{got} pixel bytes, expected {need}")]
+    Pixels { got: usize, need: usize },
+}
+
 /// A greyscale image.
 struct Pgm {
     width: usize,
@@ -248,9 +270,9 @@ struct Pgm {
 }
 
 /// Parses a binary (P5) 8-bit PGM, comments allowed in the header.
-fn parse_pgm(bytes: &[u8]) -> Result<Pgm, String> {
+fn parse_pgm(bytes: &[u8]) -> Result<Pgm, PgmError> {
     let mut pos = 0;
-    let mut token = || -> Result<String, String> {
+    let mut token = || -> Result<String, PgmError> {
         loop {
             while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
                 pos += 1;
@@ -266,34 +288,30 @@ fn parse_pgm(bytes: &[u8]) -> Result<Pgm, String> {
                 pos += 1;
             }
             if start == pos {
-                return Err("the header ends early".into());
+                return Err(PgmError::HeaderEnds);
             }
             return Ok(String::from_utf8_lossy(&bytes[start..pos]).into_owned());
         }
     };
-    // Messages name what is wrong, never the file's bytes: the path may be any file.
     if token()? != "P5" {
-        return Err("it does not start with P5 (a binary greyscale PGM)".into());
+        return Err(PgmError::NotP5);
     }
-    let mut number = |what: &str| -> Result<usize, String> {
+    let mut number = |what: &'static str| -> Result<usize, PgmError> {
         token()?
             .parse::<usize>()
-            .map_err(|_| format!("its {what} is not a whole number"))
+            .map_err(|_| PgmError::NotNumber(what))
     };
     let (width, height, max) = (number("width")?, number("height")?, number("maxval")?);
     if width == 0 || height == 0 || !(1..=255).contains(&max) {
-        return Err(format!(
-            "{width} × {height} pixels, maxval {max}: expected a non-empty 8-bit image"
-        ));
+        return Err(PgmError::Shape { width, height, max });
     }
     // One whitespace byte separates the header from the pixels.
     let start = pos + 1;
-    let need = width.checked_mul(height).ok_or("the image is too large")?;
-    let pixels = bytes.get(start..start + need).ok_or_else(|| {
-        format!(
-            "{} pixel bytes, expected {need}",
-            bytes.len().saturating_sub(start)
-        )
+    let need = width.checked_mul(height).ok_or(PgmError::TooLarge)?;
+    let end = start.checked_add(need).ok_or(PgmError::TooLarge)?;
+    let pixels = bytes.get(start..end).ok_or(PgmError::Pixels {
+        got: bytes.len().saturating_sub(start),
+        need,
     })?;
     Ok(Pgm {
         width,

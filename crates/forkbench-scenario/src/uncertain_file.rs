@@ -26,8 +26,59 @@ pub fn names_known() -> String {
     )
 }
 
+/// Why an entry's name or reach is refused (the field and file are the caller's).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(super) enum Refused {
+    #[error(
+        "{name:?} is not a setting a parameter can move (known: {})",
+        names_known()
+    )]
+    Unknown { name: String },
+    #[error(
+        "mover.{rest}: write mover.N.start_s or mover.N.speed_mps, N the [[mover]]'s index from 0"
+    )]
+    MoverIndex { rest: String },
+    #[error("mover.{index}: the scenario has {movers} [[mover]] entries")]
+    NoMover { index: usize, movers: usize },
+    #[error("mover.{index}.{what}: a mover's start_s or speed_mps")]
+    MoverSetting { index: usize, what: String },
+    #[error(
+        "reaches {lo:.4} to {hi:.4} {unit} (at ±{Z_LIMIT} σ); it must stay within {min} to {max} {unit}"
+    )]
+    Reach {
+        lo: f64,
+        hi: f64,
+        min: f64,
+        max: f64,
+        unit: &'static str,
+    },
+    #[error(
+        "the control period must be a whole number of physics steps ([sim] dt_s), which a \
+         draw from a distribution almost never is: give each period its own run \
+         ([truck.control] period_s, or a truck file per period) instead"
+    )]
+    ControlPeriod,
+    #[error(
+        "reaches {lo:.4} to {hi:.4} (at ±{Z_LIMIT} σ), and at {at} the truck's {path} {reason}"
+    )]
+    Truck {
+        lo: f64,
+        hi: f64,
+        at: f64,
+        path: &'static str,
+        reason: String,
+    },
+    #[error("reaches {lo:.4} to {hi:.4} (at ±{Z_LIMIT} σ), and at {at}: {reason}")]
+    Mover {
+        lo: f64,
+        hi: f64,
+        at: f64,
+        reason: String,
+    },
+}
+
 /// What `name` moves; the reason when it names nothing.
-pub(super) fn target_of(name: &str, movers: &[MoverSpec]) -> Result<Target, String> {
+pub(super) fn target_of(name: &str, movers: &[MoverSpec]) -> Result<Target, Refused> {
     let axis = |a: &str| match a {
         "x_m" => Some(Axis::X),
         "y_m" => Some(Axis::Y),
@@ -48,29 +99,29 @@ pub(super) fn target_of(name: &str, movers: &[MoverSpec]) -> Result<Target, Stri
                 .map(Target::Truck),
         },
     };
-    target.ok_or_else(|| {
-        format!(
-            "{name:?} is not a setting a parameter can move (known: {})",
-            names_known()
-        )
+    target.ok_or_else(|| Refused::Unknown {
+        name: name.to_owned(),
     })
 }
 
-fn mover_target(rest: &str, movers: &[MoverSpec]) -> Result<Target, String> {
+fn mover_target(rest: &str, movers: &[MoverSpec]) -> Result<Target, Refused> {
     let (i, what) = rest.split_once('.').unwrap_or((rest, ""));
-    let i: usize = i
-        .parse()
-        .map_err(|_| format!("mover.{rest}: write mover.N.start_s or mover.N.speed_mps, N the [[mover]]'s index from 0"))?;
+    let i: usize = i.parse().map_err(|_| Refused::MoverIndex {
+        rest: rest.to_owned(),
+    })?;
     if i >= movers.len() {
-        return Err(format!(
-            "mover.{i}: the scenario has {} [[mover]] entries",
-            movers.len()
-        ));
+        return Err(Refused::NoMover {
+            index: i,
+            movers: movers.len(),
+        });
     }
     match what {
         "start_s" => Ok(Target::MoverStart(i)),
         "speed_mps" => Ok(Target::MoverSpeed(i)),
-        _ => Err(format!("mover.{i}.{what}: a mover's start_s or speed_mps")),
+        _ => Err(Refused::MoverSetting {
+            index: i,
+            what: what.to_owned(),
+        }),
     }
 }
 
@@ -80,15 +131,19 @@ pub(super) fn check_reach(
     target: &Target,
     dist: &Dist,
     movers: &[MoverSpec],
-) -> Result<(), String> {
+) -> Result<(), Refused> {
     let (lo, hi) = (dist.at(-Z_LIMIT), dist.at(Z_LIMIT));
-    let within = |min: f64, max: f64, unit: &str| {
+    let within = |min: f64, max: f64, unit: &'static str| {
         if lo >= min && hi <= max {
             Ok(())
         } else {
-            Err(format!(
-                "reaches {lo:.4} to {hi:.4} {unit} (at ±{Z_LIMIT} σ); it must stay within {min} to {max} {unit}"
-            ))
+            Err(Refused::Reach {
+                lo,
+                hi,
+                min,
+                max,
+                unit,
+            })
         }
     };
     match target {
@@ -97,21 +152,17 @@ pub(super) fn check_reach(
         }
         Target::Pallet(_) | Target::Start(_) => within(-MAX_OFFSET_M, MAX_OFFSET_M, "m"),
         Target::DetectorLatency | Target::Nav350Latency => within(0.0, MAX_LATENCY_S, "s"),
-        Target::Truck("control.period_s") => Err(
-            "the control period must be a whole number of physics steps ([sim] dt_s), which a \
-             draw from a distribution almost never is: give each period its own run \
-             ([truck.control] period_s, or a truck file per period) instead"
-                .to_owned(),
-        ),
+        Target::Truck("control.period_s") => Err(Refused::ControlPeriod),
         Target::Truck(path) => {
             for v in [lo, hi] {
                 let mut truck = forkbench_core::ForkliftSpec::default();
                 set(&mut truck, path, v);
-                truck.validate().map_err(|e| {
-                    format!(
-                        "reaches {lo:.4} to {hi:.4} (at ±{Z_LIMIT} σ), and at {v} the truck's {path} {}",
-                        e.reason
-                    )
+                truck.validate().map_err(|e| Refused::Truck {
+                    lo,
+                    hi,
+                    at: v,
+                    path,
+                    reason: e.reason.to_string(),
                 })?;
             }
             Ok(())
@@ -124,8 +175,11 @@ pub(super) fn check_reach(
                 } else {
                     m.speed_mps = v;
                 }
-                m.validate().map_err(|e| {
-                    format!("reaches {lo:.4} to {hi:.4} (at ±{Z_LIMIT} σ), and at {v}: {e}")
+                m.validate().map_err(|e| Refused::Mover {
+                    lo,
+                    hi,
+                    at: v,
+                    reason: e.to_string(),
                 })?;
             }
             Ok(())
@@ -193,10 +247,10 @@ pub(super) fn resolve(
             ));
         }
         let target = target_of(&u.name, movers)
-            .map_err(|why| invalid(&at, &format!("{field}.name"), &why))?;
+            .map_err(|why| invalid(&at, &format!("{field}.name"), &why.to_string()))?;
         let dist = dist_of(u).map_err(|(k, why)| invalid(&at, &format!("{field}.{k}"), &why))?;
         check_reach(&target, &dist, movers)
-            .map_err(|why| invalid(&at, &format!("{field}.dist"), &why))?;
+            .map_err(|why| invalid(&at, &format!("{field}.dist"), &why.to_string()))?;
         out.push(Uncertain {
             name: u.name.clone(),
             target,

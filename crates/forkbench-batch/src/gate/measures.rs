@@ -220,31 +220,40 @@ impl MeasureSettings {
     }
 
     /// Every margin finite in [0, 1e9]; a measure the gate does not know says `worse`.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), MeasureSettingError> {
         for (name, s) in &self.measure {
-            if let Some(m) = s.margin
-                && !(0.0..=MAX_MARGIN).contains(&m)
+            let name = name.clone();
+            if let Some(margin) = s.margin
+                && !(0.0..=MAX_MARGIN).contains(&margin)
             {
-                return Err(format!(
-                    "measure.{name}.margin = {m}: must be a worsening in [0, {MAX_MARGIN}] in \
-                     the measure's unit"
-                ));
+                return Err(MeasureSettingError::Margin { name, margin });
             }
-            if known(name).is_none() && s.worse.is_none() && s.gate != Some(false) {
-                return Err(format!(
-                    "measure.{name}: the gate does not know this measure; say which way it gets \
-                     worse (worse = \"higher\" or \"lower\") and its margin"
-                ));
+            if known(&name).is_none() && s.worse.is_none() && s.gate != Some(false) {
+                return Err(MeasureSettingError::Unknown { name });
             }
-            if known(name).is_none() && s.gate != Some(false) && s.margin.is_none() {
-                return Err(format!(
-                    "measure.{name}.margin: missing; a measure the gate does not know needs its \
-                     margin"
-                ));
+            if known(&name).is_none() && s.gate != Some(false) && s.margin.is_none() {
+                return Err(MeasureSettingError::NoMargin { name });
             }
         }
         Ok(())
     }
+}
+
+/// Why a gate file's `[measure.*]` settings were refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeasureSettingError {
+    #[error(
+        "measure.{name}.margin = {margin}: must be a worsening in [0, {MAX_MARGIN}] in the \
+         measure's unit"
+    )]
+    Margin { name: String, margin: f64 },
+    #[error(
+        "measure.{name}: the gate does not know this measure; say which way it gets worse \
+         (worse = \"higher\" or \"lower\") and its margin"
+    )]
+    Unknown { name: String },
+    #[error("measure.{name}.margin: missing; a measure the gate does not know needs its margin")]
+    NoMargin { name: String },
 }
 
 fn known(name: &str) -> Option<&'static Known> {

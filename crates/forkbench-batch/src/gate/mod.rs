@@ -6,7 +6,7 @@ mod row_measures;
 mod text;
 
 pub use measure_test::MeasureTest;
-pub use measures::{MeasureSetting, MeasureSettings, Worse, trial_measures};
+pub use measures::{MeasureSetting, MeasureSettingError, MeasureSettings, Worse, trial_measures};
 pub use text::num;
 
 use std::collections::HashMap;

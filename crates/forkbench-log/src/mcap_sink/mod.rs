@@ -94,7 +94,7 @@ impl McapRecorder {
             1024,
             Box::new(move |file, rx| match Sink::open(file, metadata) {
                 Ok(sink) => sink.run(rx),
-                Err(e) => Some(e),
+                Err(e) => Some(crate::writer::with_causes(&e)),
             }),
         )?;
         Ok(Self {

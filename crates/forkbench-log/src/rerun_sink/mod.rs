@@ -92,12 +92,21 @@ impl std::fmt::Debug for RerunRecorder {
     }
 }
 
+/// Why the blueprint could not be built (kept with the cache, so each file reports it).
+#[derive(Debug, thiserror::Error)]
+enum BlueprintError {
+    #[error(transparent)]
+    Stream(#[from] rerun::RecordingStreamError),
+    #[error(transparent)]
+    Flush(#[from] rerun::sink::SinkFlushError),
+}
+
 /// The blueprint's messages for a focus, each built once per process: building them
 /// spins up a whole in-memory recording stream, which cost as much as a short trial when
 /// done per file.
 fn blueprint_msgs(focus: layout::Focus) -> Result<&'static [rerun::log::LogMsg], LogError> {
     use rerun::log::LogMsg;
-    type Built = std::sync::OnceLock<Result<Vec<LogMsg>, String>>;
+    type Built = std::sync::OnceLock<Result<Vec<LogMsg>, BlueprintError>>;
     static MSGS: [Built; 3] = [Built::new(), Built::new(), Built::new()];
     let k = layout::Focus::ALL
         .iter()
@@ -105,19 +114,15 @@ fn blueprint_msgs(focus: layout::Focus) -> Result<&'static [rerun::log::LogMsg],
         .unwrap_or(0);
     MSGS[k]
         .get_or_init(|| {
-            let (rec, storage) = rerun::RecordingStreamBuilder::new(APP)
-                .memory()
-                .map_err(|e| e.to_string())?;
-            layout::blueprint(focus)
-                .send(
-                    &rec,
-                    rerun::blueprint::BlueprintActivation {
-                        make_active: true,
-                        make_default: true,
-                    },
-                )
-                .map_err(|e| e.to_string())?;
-            rec.flush_blocking().map_err(|e| e.to_string())?;
+            let (rec, storage) = rerun::RecordingStreamBuilder::new(APP).memory()?;
+            layout::blueprint(focus).send(
+                &rec,
+                rerun::blueprint::BlueprintActivation {
+                    make_active: true,
+                    make_default: true,
+                },
+            )?;
+            rec.flush_blocking()?;
             // Keep only the blueprint store and its activation, not the carrier recording.
             Ok(storage
                 .take()

@@ -62,7 +62,10 @@ pub(super) struct Monitor {
 impl SafetyRun {
     /// The scenario's movers (their starts drawn from the trial's seed, a stream per
     /// mover) and its safety function; `None` when it has neither.
-    pub(super) fn new(scn: &Scenario, run: &super::Resolved) -> Result<Option<Self>, String> {
+    pub(super) fn new(
+        scn: &Scenario,
+        run: &super::Resolved,
+    ) -> Result<Option<Self>, forkbench_scenario::ScenarioError> {
         let (truck, seed) = (&run.truck, run.seed);
         let cfg = scn.safety.as_ref().filter(|c| c.monitor);
         if scn.movers.is_empty() && cfg.is_none() {
@@ -137,8 +140,8 @@ impl Monitor {
         scn: &Scenario,
         truck: &forkbench_core::ForkliftSpec,
         c: &SafetyConfig,
-    ) -> Result<Self, String> {
-        let sizing = scn.safety_fields_for(truck).map_err(|e| e.to_string())?;
+    ) -> Result<Self, forkbench_scenario::ScenarioError> {
+        let sizing = scn.safety_fields_for(truck)?;
         let outline = Outline {
             front_m: scn.truck.fork_length_m,
             rear_m: scn.truck.body_length_m,
