@@ -132,6 +132,33 @@ fn an_estimate_writes_its_result_and_refuses_what_it_cannot_weigh() {
     }
 }
 
+/// Subset simulation runs on the physics through the CLI: its levels are in the text and
+/// the JSON, within the budget.
+#[test]
+fn subset_simulation_reports_its_levels() {
+    let out = tmp_in("forkbench-rare", "subset");
+    let _ = std::fs::remove_dir_all(&out);
+    let args = [
+        "estimate",
+        &tails(),
+        "--method",
+        "subset",
+        "--budget",
+        "120",
+    ];
+    let o = forkbench(&[&args[..], &["--out", s(&out)]].concat());
+    assert!(o.status.success(), "{}", text(&o));
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("method subset simulation: "), "{said}");
+    assert!(said.contains(" levels (shares 0."), "{said}");
+    let e: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("estimate.json")).expect("read"))
+            .expect("json");
+    assert_eq!(e["method"], "subset");
+    assert!(e["trials"].as_u64().expect("trials") <= 120, "{e}");
+    assert_eq!(e["levels"][0]["points"], 30, "{e}");
+}
+
 /// A run stopped part-way resumes: the trials already in OUT are not run again (a line
 /// torn by the kill is dropped), and the result is the one an unbroken run gives; a run
 /// with other settings is refused, naming them, until --force-new.

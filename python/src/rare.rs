@@ -61,9 +61,10 @@ pub fn estimate<'py>(
     let method = match method {
         "ce" => forkbench_rare::Method::Ce,
         "mc" => forkbench_rare::Method::Mc,
+        "subset" => forkbench_rare::Method::Subset,
         m => {
             return Err(PyValueError::new_err(format!(
-                "method {m:?}: \"ce\" or \"mc\""
+                "method {m:?}: \"ce\", \"subset\" or \"mc\""
             )));
         }
     };

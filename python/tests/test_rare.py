@@ -39,6 +39,9 @@ def test_an_estimate_equals_the_clis_and_carries_its_trials(cli, tmp_path):
     }
     ce = forkbench.estimate(scn, budget=200, seed=3, jobs=1)
     assert ce["method"] == "ce" and ce["adapting"] <= 100 and ce["trials"] == 200
+    sub = forkbench.estimate(scn, method="subset", budget=200, seed=3, jobs=1)
+    assert sub["method"] == "subset" and 50 <= sub["trials"] <= 200
+    assert sub["levels"][0]["points"] == 50 and sub["stages"] == []
 
 
 def test_a_search_returns_its_points_and_refuses_bad_arguments():

@@ -57,7 +57,8 @@ pub struct RareArgs {
 pub struct EstimateArgs {
     #[command(flatten)]
     common: RareArgs,
-    /// `ce`: cross-entropy adaptive importance sampling; `mc`: plain Monte Carlo.
+    /// `ce`: cross-entropy adaptive importance sampling; `subset`: subset simulation
+    /// (failures in several regions); `mc`: plain Monte Carlo.
     #[arg(long, value_enum, default_value_t = MethodArg::Ce)]
     method: MethodArg,
 }
@@ -65,6 +66,7 @@ pub struct EstimateArgs {
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum MethodArg {
     Ce,
+    Subset,
     Mc,
 }
 
@@ -152,6 +154,7 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
     let setup = c.setup()?;
     let method = match a.method {
         MethodArg::Ce => forkbench_rare::Method::Ce,
+        MethodArg::Subset => forkbench_rare::Method::Subset,
         MethodArg::Mc => forkbench_rare::Method::Mc,
     };
     let what = serde_json::json!({ "estimate": method, "budget": c.budget });
@@ -178,19 +181,29 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
     let re = e
         .relative_error
         .map_or("—".into(), |r| format!("{:.1} %", r * 100.0));
+    let method = match method {
+        forkbench_rare::Method::Ce => format!(
+            "cross-entropy importance sampling: {} trials ({} adapting in {} stages)",
+            e.trials,
+            e.adapting,
+            e.stages.len()
+        ),
+        forkbench_rare::Method::Subset => format!(
+            "subset simulation: {} trials in {} levels (shares {})",
+            e.trials,
+            e.levels.len(),
+            e.levels
+                .iter()
+                .map(|l| format!("{:.3}", l.share))
+                .collect::<Vec<_>>()
+                .join(" × ")
+        ),
+        forkbench_rare::Method::Mc => format!("plain Monte Carlo: {} trials", e.trials),
+    };
     let _ = writeln!(
         s,
-        "method {}: {} trials ({} adapting in {} stages), {} with the event; relative error {re}, effective sample size {:.0}",
-        if method == forkbench_rare::Method::Ce {
-            "cross-entropy importance sampling"
-        } else {
-            "plain Monte Carlo"
-        },
-        e.trials,
-        e.adapting,
-        e.stages.len(),
-        e.events,
-        e.ess
+        "method {method}, {} with the event; relative error {re}, effective sample size {:.0}",
+        e.events, e.ess
     );
     if let Some(share) = e.not_rare() {
         let _ = writeln!(

@@ -4,6 +4,7 @@ use serde::Serialize;
 
 use crate::ce::{CeSettings, Stage, adapt};
 use crate::normal::upper_quantile;
+use crate::subset::{Halt, Level, SubsetSettings};
 use crate::{Outcome, RareError, run};
 
 /// The estimator.
@@ -14,6 +15,8 @@ pub enum Method {
     Mc,
     /// Cross-entropy adaptive importance sampling with likelihood-ratio weights.
     Ce,
+    /// Subset simulation: nested levels of the robustness, sampled by Markov chains.
+    Subset,
 }
 
 /// What to estimate with, and how much to spend.
@@ -30,6 +33,7 @@ pub struct EstimateSettings {
     /// Share of the budget kept for the final, unbiased stage (the rest adapts).
     pub final_share: f64,
     pub ce: CeSettings,
+    pub subset: SubsetSettings,
 }
 
 impl EstimateSettings {
@@ -42,6 +46,7 @@ impl EstimateSettings {
             confidence: 0.95,
             final_share: 0.5,
             ce: CeSettings::default(),
+            subset: SubsetSettings::default(),
         }
     }
 
@@ -64,7 +69,8 @@ impl EstimateSettings {
         if !(0.1..=0.9).contains(&self.final_share) {
             return bad("final_share", "from 0.1 to 0.9");
         }
-        self.ce.check()
+        self.ce.check()?;
+        self.subset.check(self.budget)
     }
 }
 
@@ -89,8 +95,12 @@ pub struct Estimate {
     pub adapting: usize,
     /// Points on which the event happened, over every stage.
     pub events: usize,
-    /// The adaptation's stages (none for Monte Carlo).
+    /// The adaptation's stages (cross-entropy only).
     pub stages: Vec<Stage>,
+    /// Subset simulation's levels, the nominal one first (subset simulation only).
+    pub levels: Vec<Level>,
+    /// Why subset simulation stopped before a level within the event, if it did.
+    pub halt: Option<Halt>,
 }
 
 /// Events the nominal first stage must draw before the event counts as not rare.
@@ -106,6 +116,9 @@ impl Estimate {
     /// [`MIN_ESS`] effective samples of the event (a starved adaptation, or too small a
     /// budget): the sentence a run warns with.
     pub fn thin(&self) -> Option<String> {
+        if self.method == Method::Subset {
+            return crate::subset::thin(self);
+        }
         if self.events == 0 || self.ess >= MIN_ESS {
             return None;
         }
@@ -140,6 +153,7 @@ pub fn estimate<E: std::error::Error + 'static>(
     match s.method {
         Method::Mc => monte_carlo(s, &mut eval),
         Method::Ce => importance(s, &mut eval),
+        Method::Subset => crate::subset::subset(s, &mut eval),
     }
 }
 
@@ -168,6 +182,8 @@ fn monte_carlo<E: std::error::Error + 'static>(
         adapting: 0,
         events: k,
         stages: Vec::new(),
+        levels: Vec::new(),
+        halt: None,
     })
 }
 
@@ -215,6 +231,8 @@ fn importance<E: std::error::Error + 'static>(
         adapting: seen.len(),
         events,
         stages,
+        levels: Vec::new(),
+        halt: None,
     })
 }
 

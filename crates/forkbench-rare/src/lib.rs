@@ -1,4 +1,4 @@
-//! Rare failures measured: the probability of an event over uncertain parameters (plain Monte Carlo, or cross-entropy adaptive importance sampling) and the most likely failure, all in standard-normal space.
+//! Rare failures measured: the probability of an event over uncertain parameters (plain Monte Carlo, cross-entropy adaptive importance sampling, or subset simulation) and the most likely failure, all in standard-normal space.
 //!
 //! Every uncertain parameter is a transform of one standard normal variable (its
 //! quantile at Φ(z)), so a trial is a point `z` of ℝᵈ with the nominal density N(0, I).
@@ -12,9 +12,11 @@ pub mod estimate;
 pub mod falsify;
 pub mod mixture;
 pub mod normal;
+pub mod subset;
 
 pub use estimate::{Estimate, EstimateSettings, MIN_ESS, Method, clopper_pearson, estimate};
 pub use falsify::{Falsified, FalsifySettings, falsify};
+pub use subset::{Halt, Level, SubsetSettings};
 
 /// What a trial at a point gave.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
