@@ -2,6 +2,7 @@
 
 pub mod actuator_csv;
 pub mod bag;
+pub mod dataset_set;
 pub mod detect;
 pub mod mcap_sink;
 #[cfg(feature = "rerun")]
