@@ -157,6 +157,41 @@ fn subset_simulation_reports_its_levels() {
     assert_eq!(e["method"], "subset");
     assert!(e["trials"].as_u64().expect("trials") <= 120, "{e}");
     assert_eq!(e["levels"][0]["points"], 30, "{e}");
+    // Its settings act: 40 trials a level, and the run's settings name them.
+    let out = tmp_in("forkbench-rare", "subset-set");
+    let _ = std::fs::remove_dir_all(&out);
+    let set = ["--per-level", "40", "--level-fraction", "0.2", "--json"];
+    let o = forkbench(&[&args[..], &set, &["--out", s(&out)]].concat());
+    assert!(o.status.success(), "{}", text(&o));
+    let e: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(e["levels"][0]["points"], 40, "{e}");
+    let run = std::fs::read_to_string(out.join("rare.json")).expect("rare.json");
+    assert!(
+        run.contains(r#""subset":{"level_fraction":0.2,"per_level":40}"#),
+        "{run}"
+    );
+    // Refused for another method, and out of range, naming the setting.
+    for (extra, why) in [
+        (
+            vec!["--method", "ce", "--per-level", "40"],
+            "--method subset",
+        ),
+        (
+            vec!["--method", "subset", "--level-fraction", "0.9"],
+            "subset.level_fraction",
+        ),
+        (
+            vec!["--method", "subset", "--per-level", "500"],
+            "subset.per_level",
+        ),
+    ] {
+        let dir = tmp_in("forkbench-rare", "subset-refused");
+        let _ = std::fs::remove_dir_all(&dir);
+        let a = ["estimate", &tails(), "--budget", "120"];
+        let o = forkbench(&[&a[..], &extra, &["--out", s(&dir)]].concat());
+        assert_eq!(o.status.code(), Some(1), "{extra:?}: {}", text(&o));
+        assert!(text(&o).contains(why), "{extra:?}: {}", text(&o));
+    }
 }
 
 /// A run stopped part-way resumes: the trials already in OUT are not run again (a line

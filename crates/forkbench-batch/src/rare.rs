@@ -255,10 +255,23 @@ pub fn estimate(
     budget: usize,
     store: Option<RareStore>,
 ) -> Result<(forkbench_rare::Estimate, Vec<Tried>), BatchError> {
+    estimate_with(setup, (method, Default::default()), budget, store)
+}
+
+/// [`estimate`] with subset simulation's settings (acting only for its method).
+pub fn estimate_with(
+    setup: &RareSetup,
+    (method, subset): (forkbench_rare::Method, forkbench_rare::SubsetSettings),
+    budget: usize,
+    store: Option<RareStore>,
+) -> Result<(forkbench_rare::Estimate, Vec<Tried>), BatchError> {
     let mut r = runner(setup, budget)?;
     r.store = store;
     let dims = setup.scenario.uncertain.0.len();
-    let s = EstimateSettings::new(method, dims, budget, setup.seed);
+    let s = EstimateSettings {
+        subset,
+        ..EstimateSettings::new(method, dims, budget, setup.seed)
+    };
     let e = forkbench_rare::estimate(&s, |p| r.eval(p));
     r.finish(e)
 }

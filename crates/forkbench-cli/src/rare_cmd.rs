@@ -61,6 +61,28 @@ pub struct EstimateArgs {
     /// (failures in several regions); `mc`: plain Monte Carlo.
     #[arg(long, value_enum, default_value_t = MethodArg::Ce)]
     method: MethodArg,
+    /// Subset simulation: the share of each level's trials kept below the next level's
+    /// threshold, p₀ (0.05 to 0.5; Au and Beck's 0.1).
+    #[arg(long)]
+    level_fraction: Option<f64>,
+    /// Subset simulation: trials per level (20 to the budget; default a quarter of it).
+    #[arg(long)]
+    per_level: Option<usize>,
+}
+
+impl EstimateArgs {
+    /// Subset simulation's settings; refused for another method, which has none.
+    fn subset(&self) -> anyhow::Result<forkbench_rare::SubsetSettings> {
+        let set = self.level_fraction.is_some() || self.per_level.is_some();
+        if set && !matches!(self.method, MethodArg::Subset) {
+            bail!("--level-fraction and --per-level are subset simulation's (--method subset)");
+        }
+        let d = forkbench_rare::SubsetSettings::default();
+        Ok(forkbench_rare::SubsetSettings {
+            level_fraction: self.level_fraction.unwrap_or(d.level_fraction),
+            per_level: self.per_level,
+        })
+    }
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -150,6 +172,7 @@ impl RareArgs {
 /// `forkbench estimate`: prints P(event) with its interval and what it cost.
 pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
     let c = &a.common;
+    let subset = a.subset()?;
     c.out_dir()?;
     let setup = c.setup()?;
     let method = match a.method {
@@ -157,9 +180,17 @@ pub fn estimate(a: &EstimateArgs) -> anyhow::Result<()> {
         MethodArg::Subset => forkbench_rare::Method::Subset,
         MethodArg::Mc => forkbench_rare::Method::Mc,
     };
-    let what = serde_json::json!({ "estimate": method, "budget": c.budget });
+    let mut what = serde_json::json!({ "estimate": method, "budget": c.budget });
+    if method == forkbench_rare::Method::Subset {
+        what["subset"] = serde_json::to_value(subset)?;
+    }
     let store = c.store(&setup, what)?;
-    let (e, _) = forkbench_batch::rare::estimate(&setup, method, c.budget as usize, Some(store))?;
+    let (e, _) = forkbench_batch::rare::estimate_with(
+        &setup,
+        (method, subset),
+        c.budget as usize,
+        Some(store),
+    )?;
     c.write("estimate.json", &e)?;
     if let Some(why) = e.thin() {
         eprintln!("warning: {why}");
