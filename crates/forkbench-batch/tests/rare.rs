@@ -3,10 +3,19 @@
 use forkbench_batch::rare::{Event, RareSetup, estimate, falsify};
 use forkbench_trial::Scenario;
 
-/// P(failure) of the example by plain Monte Carlo: 67 failures in 60,000 trials
-/// (`forkbench estimate examples/rare/field-test-tails.toml --method mc --budget 60000
-/// --seed 7`), its exact 95 % interval 8.7e-4 to 1.4e-3.
-const BRUTE_FORCE_P: f64 = 67.0 / 60_000.0;
+/// P(failure) of the example by plain Monte Carlo, from the reference committed beside it
+/// (its events over its trials, and how they were made).
+fn brute_force_p() -> f64 {
+    let (_, text) = example("field-test-tails.reference.toml");
+    let r: toml::Table = toml::from_str(&text).expect("the reference parses");
+    let count = |k: &str| r[k].as_integer().expect("a count") as f64;
+    let p = count("events") / count("trials");
+    assert!(
+        (p / r["p"].as_float().expect("p") - 1.0).abs() < 1e-3,
+        "{p}"
+    );
+    p
+}
 
 fn setup(seed: u64) -> RareSetup {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -28,8 +37,9 @@ fn setup(seed: u64) -> RareSetup {
 fn importance_sampling_covers_the_brute_force_value_with_a_tenth_of_its_trials() {
     let (e, tried) = estimate(&setup(3), forkbench_rare::Method::Ce, 6000, None).expect("runs");
     assert_eq!(tried.len(), 6000);
+    let p = brute_force_p();
     assert!(
-        e.ci.0 <= BRUTE_FORCE_P && BRUTE_FORCE_P <= e.ci.1,
+        e.ci.0 <= p && p <= e.ci.1,
         "{:.3e} ({:.3e} to {:.3e})",
         e.p,
         e.ci.0,
@@ -38,6 +48,26 @@ fn importance_sampling_covers_the_brute_force_value_with_a_tenth_of_its_trials()
     // Every trial's record carries the values its point stands for.
     let t = &tried[10];
     assert_eq!(t.record.outcome.uncertain.len(), 4);
+}
+
+#[test]
+#[ignore = "a long statistical check (5 × 4,000 trials): CI runs it, `-- --ignored`"]
+fn subset_simulation_covers_the_brute_force_value_in_four_of_five_seeds() {
+    let p = brute_force_p();
+    let subset = forkbench_rare::SubsetSettings {
+        level_fraction: 0.3,
+        per_level: None,
+    };
+    let method = (forkbench_rare::Method::Subset, subset);
+    let mut seen = Vec::new();
+    for seed in 1..=5 {
+        let (e, tried) =
+            forkbench_batch::rare::estimate_with(&setup(seed), method, 4000, None).expect("runs");
+        assert!(tried.len() <= 4000 && e.trials == tried.len());
+        seen.push((e.ci.0 <= p && p <= e.ci.1, e.p, e.ci));
+    }
+    let covered = seen.iter().filter(|s| s.0).count();
+    assert!(covered >= 4, "{covered} of 5 cover {p:.3e}: {seen:?}");
 }
 
 #[test]
