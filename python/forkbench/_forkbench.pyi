@@ -117,6 +117,8 @@ def estimate(
     jobs: int | None = None,
     planner: str | None = None,
     tracker: str | None = None,
+    level_fraction: float | None = None,
+    per_level: int | None = None,
     **options: Unpack[RunOptions],
 ) -> dict[str, Any]: ...
 def falsify(

@@ -38,12 +38,14 @@ fn setup(
 }
 
 /// P(`event`) over the scenario's uncertain parameters: `method` `"ce"` (cross-entropy
-/// importance sampling) or `"mc"` (plain Monte Carlo), `budget` trials in all. A dict:
-/// `p`, `ci`, `std_error`, `relative_error`, `ess`, `trials`, `adapting`, `events`,
-/// `stages`; and `records`, every trial's record with its standard-normal point `z`.
+/// importance sampling), `"subset"` (subset simulation, with its `level_fraction` p₀ and
+/// `per_level` N) or `"mc"` (plain Monte Carlo), `budget` trials in all. A dict: `p`,
+/// `ci`, `std_error`, `relative_error`, `ess`, `trials`, `adapting`, `events`, `stages`,
+/// `levels`, `halt`; and `records`, every trial's record with its standard-normal point `z`.
 #[pyfunction]
 #[pyo3(signature = (scenario, case=None, *, event="failure", method="ce", budget=2000,
-                    seed=1, jobs=None, planner=None, tracker=None, **options))]
+                    seed=1, jobs=None, planner=None, tracker=None, level_fraction=None,
+                    per_level=None, **options))]
 #[allow(clippy::too_many_arguments)]
 pub fn estimate<'py>(
     py: Python<'py>,
@@ -56,8 +58,20 @@ pub fn estimate<'py>(
     jobs: Option<usize>,
     planner: Option<String>,
     tracker: Option<String>,
+    level_fraction: Option<f64>,
+    per_level: Option<usize>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    if (level_fraction.is_some() || per_level.is_some()) && method != "subset" {
+        return Err(PyValueError::new_err(
+            "level_fraction and per_level are subset simulation's (method=\"subset\")",
+        ));
+    }
+    let subset = forkbench_rare::SubsetSettings {
+        level_fraction: level_fraction
+            .unwrap_or(forkbench_rare::SubsetSettings::default().level_fraction),
+        per_level,
+    };
     let method = match method {
         "ce" => forkbench_rare::Method::Ce,
         "mc" => forkbench_rare::Method::Mc,
@@ -77,7 +91,7 @@ pub fn estimate<'py>(
         options,
     )?;
     with_records(py, &s, |s| {
-        forkbench_batch::rare::estimate(s, method, budget, None)
+        forkbench_batch::rare::estimate_with(s, (method, subset), budget, None)
     })
 }
 

@@ -42,6 +42,14 @@ def test_an_estimate_equals_the_clis_and_carries_its_trials(cli, tmp_path):
     sub = forkbench.estimate(scn, method="subset", budget=200, seed=3, jobs=1)
     assert sub["method"] == "subset" and 50 <= sub["trials"] <= 200
     assert sub["levels"][0]["points"] == 50 and sub["stages"] == []
+    set_ = forkbench.estimate(
+        scn, method="subset", budget=200, seed=3, jobs=1, level_fraction=0.2, per_level=40
+    )
+    assert set_["levels"][0]["points"] == 40
+    with pytest.raises(ValueError, match="subset simulation"):
+        forkbench.estimate(scn, method="ce", budget=200, per_level=40)
+    with pytest.raises(forkbench.BatchError, match="subset.level_fraction"):
+        forkbench.estimate(scn, method="subset", budget=200, level_fraction=0.9)
 
 
 def test_a_search_returns_its_points_and_refuses_bad_arguments():
