@@ -308,8 +308,13 @@ fn finish(
 /// trusted: a choice, the count at which a binomial share's relative error is about 30 %.
 pub const MIN_LAST_EVENTS: usize = 10;
 
+/// Above this relative error a subset simulation's estimate is too imprecise to act on
+/// (its interval spans more than a factor of about seven at 95 %): a choice.
+pub const MAX_RELATIVE_ERROR: f64 = 0.5;
+
 /// Why a subset simulation's estimate is not to be trusted, if it is not: a plateau
-/// of the robustness, or too few points of the event in its last level.
+/// of the robustness, too few points of the event in its last level, or a relative
+/// error above [`MAX_RELATIVE_ERROR`].
 pub(crate) fn thin(e: &Estimate) -> Option<String> {
     let last = e.levels.last()?;
     let within = (last.share * last.points as f64).round() as usize;
@@ -321,10 +326,18 @@ pub(crate) fn thin(e: &Estimate) -> Option<String> {
             last.points
         ));
     }
-    (within < MIN_LAST_EVENTS).then(|| {
-        format!(
+    if within < MIN_LAST_EVENTS {
+        return Some(format!(
             "the estimate rests on {within} points of the event in subset simulation's last \
              level (under {MIN_LAST_EVENTS}): a larger --budget pays for more levels"
-        )
-    })
+        ));
+    }
+    let re = e.relative_error.filter(|r| *r > MAX_RELATIVE_ERROR)?;
+    Some(format!(
+        "the estimate's relative error is {:.0} % (over {:.0} %; its chains' correlation \
+         γ is up to {:.1}): a larger --budget, or a larger --per-level, narrows it",
+        100.0 * re,
+        100.0 * MAX_RELATIVE_ERROR,
+        e.levels.iter().map(|l| l.gamma).fold(0.0, f64::max)
+    ))
 }

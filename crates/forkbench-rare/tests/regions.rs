@@ -153,6 +153,19 @@ fn a_budget_short_of_the_event_bounds_it_and_warns() {
 }
 
 #[test]
+fn an_imprecise_subset_estimate_warns_of_its_relative_error() {
+    // 40 points a level over three regions: a relative error well over 50 %.
+    let f = Regions::new(&THREE);
+    let mut s = EstimateSettings::new(Method::Subset, 4, 4000, 2);
+    s.subset.per_level = Some(40);
+    let e = estimate(&s, f.eval()).expect("runs");
+    let re = e.relative_error.expect("events");
+    assert!(re > 0.5, "relative error {re}");
+    let why = e.thin().expect("warns");
+    assert!(why.contains("relative error"), "{why}");
+}
+
+#[test]
 fn subset_settings_out_of_range_are_named() {
     let f = Regions::new(&TWO);
     let mut s = EstimateSettings::new(Method::Subset, 2, 1000, 0);
