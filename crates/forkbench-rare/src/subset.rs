@@ -82,6 +82,8 @@ struct Sampled {
     chains: Vec<Vec<(Vec<f64>, f64)>>,
     accepted: usize,
     proposed: usize,
+    /// Of the points it evaluated, those within the event.
+    events: usize,
 }
 
 /// Estimates P(event) by subset simulation within `s.budget` trials.
@@ -94,7 +96,7 @@ pub(crate) fn subset<E: std::error::Error + 'static>(
     let points = crate::ce::Proposal::nominal(s.dims).draw(n, s.seed, NOMINAL);
     let out = run(eval, &points)?;
     let mut spent = n;
-    let mut events = out.iter().filter(|o| o.event).count();
+    let mut events = 0;
     let mut cur = Sampled {
         chains: points
             .into_iter()
@@ -103,10 +105,12 @@ pub(crate) fn subset<E: std::error::Error + 'static>(
             .collect(),
         accepted: n,
         proposed: n,
+        events: out.iter().filter(|o| o.event).count(),
     };
     let (mut levels, mut below, mut scale) = (Vec::new(), f64::INFINITY, 0.6);
     let mut evaluated = n;
     let halt = loop {
+        events += cur.events;
         let mut all: Vec<f64> = cur.chains.iter().flatten().map(|p| p.1).collect();
         all.sort_by(f64::total_cmp);
         let k = ((ss.level_fraction * all.len() as f64).ceil() as usize).clamp(1, all.len());
@@ -130,6 +134,9 @@ pub(crate) fn subset<E: std::error::Error + 'static>(
         if plateau {
             break Some(Halt::Plateau(next));
         }
+        if last {
+            break Some(Halt::Budget);
+        }
         let seeds: Vec<(Vec<f64>, f64)> = cur
             .chains
             .iter()
@@ -137,14 +144,10 @@ pub(crate) fn subset<E: std::error::Error + 'static>(
             .filter(|p| p.1 <= next)
             .cloned()
             .collect();
-        if last {
-            break Some(Halt::Budget);
-        }
         let lvl = levels.len() as u64;
         (cur, scale) = sample_level(seeds, (n, next, scale), (s.seed, lvl), eval)?;
         evaluated = n - cur.chains.len();
         spent += evaluated;
-        events += cur.chains.iter().flatten().filter(|p| p.1 <= 0.0).count();
         below = next;
     };
     Ok(finish(s, levels, halt, spent, events))
@@ -166,7 +169,7 @@ fn sample_level<E: std::error::Error + 'static>(
     let length = |j: usize| n / c + usize::from(j < n % c);
     let mut chains: Vec<Vec<(Vec<f64>, f64)>> = seeds.into_iter().map(|p| vec![p]).collect();
     let mut rng = stream(seed, NOMINAL + level);
-    let (mut accepted, mut proposed, mut sigma) = (0, 0, scale);
+    let (mut accepted, mut proposed, mut events, mut sigma) = (0, 0, 0, scale);
     for round in 1.. {
         let open: Vec<usize> = (0..c).filter(|&j| chains[j].len() < length(j)).collect();
         if open.is_empty() {
@@ -187,6 +190,7 @@ fn sample_level<E: std::error::Error + 'static>(
             .collect();
         let out = run(eval, &cand)?;
         let mut took = 0;
+        events += out.iter().filter(|o| o.event).count();
         for ((&j, z), o) in open.iter().zip(cand).zip(&out) {
             let step = if o.level() <= below {
                 took += 1;
@@ -210,6 +214,7 @@ fn sample_level<E: std::error::Error + 'static>(
             chains,
             accepted,
             proposed,
+            events,
         },
         sigma,
     ))
@@ -252,11 +257,11 @@ fn share_and_gamma(chains: &[Vec<(Vec<f64>, f64)>], threshold: f64) -> (f64, f64
 }
 
 /// The product of the levels' shares. Its relative error is Au and Beck's, the levels'
-/// squared coefficients of variation summed as if independent (it matched the spread
+/// squared coefficients of variation summed as if independent (it follows the spread
 /// over seeds on the known-answer functions); its interval is log-normal at their upper
 /// bound, the levels fully correlated ((Σδᵢ)²), a choice: the independent sum's interval
-/// covered in only 91 of 100 seeds there. With no point in the event, the bound is the
-/// levels reached times the exact bound on none in the last level's points.
+/// undercovered there. With no point in the event, the bound is the levels reached times
+/// the exact bound on none in the last level's points.
 fn finish(
     s: &EstimateSettings,
     levels: Vec<Level>,

@@ -116,6 +116,21 @@ fn a_seed_gives_the_same_levels_and_another_seed_other_ones() {
 }
 
 #[test]
+fn the_trials_and_events_reported_are_those_evaluated() {
+    let f = Regions::new(&THREE);
+    let (mut points, mut events) = (0, 0);
+    let mut inner = f.eval();
+    let counted = |pts: &[Vec<f64>]| {
+        let out = inner(pts)?;
+        points += out.len();
+        events += out.iter().filter(|o| o.event).count();
+        Ok::<_, Infallible>(out)
+    };
+    let e = estimate(&EstimateSettings::new(Method::Subset, 4, 4000, 7), counted).expect("runs");
+    assert_eq!((e.trials, e.events), (points, events));
+}
+
+#[test]
 fn a_plateau_of_the_robustness_halts_the_levels_and_says_so() {
     // The margin holds at 1.5 short of the event, as a protective stop holds the truck.
     let t = upper_quantile(1e-5);
